@@ -1,0 +1,167 @@
+// The steering queries of one tick, callable on their own (DESIGN.md §3-§5, §9).
+//
+// Each query has a naive access path (nested loops: the oracle) and, as the index issues land,
+// indexed access paths behind the same interface. Methods are chosen by name ("naive", "index",
+// "grid", ...) or left to the planner ("auto"). Results are identical across methods where
+// DESIGN.md says exact (first-to-collide, collision sets) and within its tolerance for fields.
+//
+// Thread-safety: the free functions are re-entrant; they use `threads` threads internally.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "crowddb/world.hpp"
+
+namespace crowddb {
+
+// Read-only view of moving discs (the agents) as columns. Indices read rows only through it
+// and keep orderings and aggregates of their own, never copies of the table.
+struct DiscView {
+  std::size_t n = 0;
+  const double* x = nullptr;
+  const double* y = nullptr;
+  const double* vx = nullptr;  // [length/tick]
+  const double* vy = nullptr;
+  const double* radius = nullptr;
+  const double* charge = nullptr;
+  const uint64_t* id = nullptr;  // public ids: tie-breaks and output order
+
+  std::size_t count() const { return n; }
+  static DiscView of(const AgentTable& t) {
+    return {t.size(), t.x.data(), t.y.data(), t.vx.data(), t.vy.data(), t.radius.data(), t.charge.data(), t.id.data()};
+  }
+};
+
+// How static obstacles contribute charged points to the potential field.
+enum class ObstacleCharges {
+  centres,   // one charged point per circle at its centre (the thesis's model; `crowddb query field`)
+  boundary,  // circles and polygons sampled along their boundary (the simulation's default)
+};
+
+// Static obstacles in the form the queries use, with derived data (bounding boxes, charged
+// points) computed once. Polygons are stored counter-clockwise.
+class StaticScene {
+ public:
+  StaticScene() = default;
+  // `spacing`: largest gap between charged points sampled along polygon edges (and circle
+  // boundaries with ObstacleCharges::boundary); DESIGN.md: no larger than the smallest agent radius.
+  StaticScene(std::vector<CircleObstacle> circles, std::vector<PolygonObstacle> polygons,
+              double spacing, ObstacleCharges charges = ObstacleCharges::boundary);
+
+  std::span<const CircleObstacle> circles() const { return circles_; }
+  std::span<const PolygonObstacle> polygons() const { return polygons_; }
+  struct Box {
+    double xmin, ymin, xmax, ymax;
+  };
+  std::span<const Box> polygon_boxes() const { return boxes_; }
+  // Charged points for the potential field: obstacle circles and polygon edge samples.
+  std::span<const double> point_x() const { return px_; }
+  std::span<const double> point_y() const { return py_; }
+  std::span<const double> point_charge() const { return pc_; }
+  std::size_t point_count() const { return px_.size(); }
+  bool empty() const { return circles_.empty() && polygons_.empty(); }
+
+ private:
+  std::vector<CircleObstacle> circles_;
+  std::vector<PolygonObstacle> polygons_;
+  std::vector<Box> boxes_;
+  std::vector<double> px_, py_, pc_;
+};
+
+// Per-query counters; the experiments plot them. Methods fill what applies to them.
+struct QueryStats {
+  uint64_t rows = 0;           // query rows (agents probed)
+  uint64_t pair_tests = 0;     // exact pair computations
+  uint64_t nodes_visited = 0;  // index nodes expanded
+  uint64_t queue_pushes = 0;
+  uint64_t queue_pops = 0;
+  double build_seconds = 0;    // index construction
+  double query_seconds = 0;    // probes
+  QueryStats& operator+=(const QueryStats& o);
+};
+
+// ---------------------------------------------------------------- first-to-collide (§5)
+
+// Who a disc meets first. Agents by row of the DiscView, obstacles by row of their table.
+struct Collider {
+  enum class Kind : uint8_t { none = 0, agent = 1, circle = 2, polygon = 3 };
+  Kind kind = Kind::none;
+  uint32_t row = 0;
+  friend bool operator==(Collider, Collider) = default;
+};
+
+struct FtcHit {
+  Collider with;             // kind none: no collision within the horizon
+  double time = INFINITY;    // [ticks], in [0, horizon]; 0 when already overlapping
+  friend bool operator==(const FtcHit&, const FtcHit&) = default;
+};
+
+// For each disc, the first agent or obstacle it collides with within `horizon` ticks, moving on
+// rays p + v t. Ties in time go to agents before obstacles, then the smaller id (agents) or row
+// (obstacles). Exact: every method returns the same hits.
+std::vector<FtcHit> first_to_collide(const DiscView& discs, const StaticScene& scene, double horizon,
+                                     std::string_view method = "auto", int threads = 1,
+                                     QueryStats* stats = nullptr);
+
+// ---------------------------------------------------------------- potential field (§4)
+
+enum class Kernel { exp, inv };
+enum class Metric { l1, l2, radial };
+
+struct PotentialSpec {
+  Kernel kernel = Kernel::exp;
+  Metric metric = Metric::l1;
+  double A = 0.929328;  // thesis values: A e^{-k x} fitted to 1/x
+  double k = 0.272194;
+  int radial_frames = 2;   // m rotated frames for the radial metric
+  double inv_floor = 0.1;  // inv kernel: distance floored here (> 0) so coincident points stay finite
+};
+
+// Potential and its gradient with respect to the probe's position, per disc.
+struct FieldColumns {
+  std::vector<double> potential, grad_x, grad_y;
+  void resize(std::size_t n) {
+    potential.assign(n, 0.0);
+    grad_x.assign(n, 0.0);
+    grad_y.assign(n, 0.0);
+  }
+};
+
+// P(p) = sum over q != p of A c_p c_q K(d(p, q)), over the other discs and the scene's charged
+// points, with its analytic gradient (sign(0) = 0 for L1 terms, 0 at coincident points for L2).
+FieldColumns potential_field(const DiscView& discs, const StaticScene& scene, const PotentialSpec& spec,
+                             std::string_view method = "auto", int threads = 1,
+                             QueryStats* stats = nullptr);
+
+// ---------------------------------------------------------------- collision sets (§3.2)
+
+// Overlapping pairs: discs overlap when the distance of centres is < the sum of radii; a disc
+// overlaps a circle obstacle likewise and a polygon when its centre is inside or its boundary
+// is closer than the radius.
+struct CollisionPairs {
+  std::vector<std::pair<uint32_t, uint32_t>> agents;  // (i, j) rows, i < j, sorted
+  std::vector<std::pair<uint32_t, Collider>> obstacles;  // (agent row, obstacle), sorted
+  void clear() {
+    agents.clear();
+    obstacles.clear();
+  }
+};
+
+// The rows of discs that overlap another disc or an obstacle, sorted.
+std::vector<uint32_t> collision_set(const DiscView& discs, const StaticScene& scene,
+                                    std::string_view method = "auto", int threads = 1,
+                                    QueryStats* stats = nullptr);
+
+// Names of the registered methods of each query, naive first.
+std::vector<std::string> ftc_methods();
+std::vector<std::string> field_methods();
+std::vector<std::string> collision_methods();
+
+}  // namespace crowddb

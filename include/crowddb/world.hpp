@@ -1,0 +1,177 @@
+// The crowd world as a small in-memory database (DESIGN.md §2): agents, static obstacles and
+// goals, stored as columns. Agents are addressed from outside by stable handles (index +
+// generation) and inside by dense rows; inserts, deletes and re-targeting are buffered and
+// applied as one batch at the start of the next tick.
+//
+// Thread-safety: a World is not synchronised; use it from one thread at a time. The tick's
+// parallel stages only read it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "crowddb/error.hpp"
+
+namespace crowddb {
+
+struct Vec2 {
+  double x = 0;
+  double y = 0;
+};
+
+// A stable agent handle. value() is the agent's public id (trajectories, CSV, hashes): it is
+// never reused within a run because a reused slot gets a new generation.
+struct AgentId {
+  static constexpr uint32_t kNoIndex = std::numeric_limits<uint32_t>::max();
+  uint32_t index = kNoIndex;
+  uint32_t generation = 0;
+
+  uint64_t value() const { return (static_cast<uint64_t>(generation) << 32) | index; }
+  static AgentId from_value(uint64_t v) {
+    return {static_cast<uint32_t>(v & 0xffffffffu), static_cast<uint32_t>(v >> 32)};
+  }
+  friend bool operator==(AgentId, AgentId) = default;
+};
+
+enum class AgentState : uint8_t {
+  active = 0,   // steering normally
+  frozen = 1,   // put back by the backoff loop in the last tick
+  arrived = 2,  // reached its goal and idles there (only when arrivals idle)
+};
+
+// One agent row as the user supplies it. Units: length, ticks; velocities in length/tick.
+struct AgentSpec {
+  double x = 0, y = 0;
+  double vx = 0, vy = 0;
+  double radius = 1;         // > 0
+  double max_speed = 1;      // > 0
+  double max_accel = std::numeric_limits<double>::infinity();  // > 0, may be infinite
+  double charge = 1;         // repulsive strength in the potential field, finite, >= 0
+  uint32_t goal = 0;         // row of the goals table
+};
+
+struct Goal {
+  std::string name;
+  double x = 0, y = 0;
+  double charge = 1;          // attraction strength (c_goal), >= 0
+  double arrival_radius = 1;  // an agent whose centre comes this close has arrived; > 0
+};
+
+struct CircleObstacle {
+  double x = 0, y = 0;
+  double radius = 1;  // > 0
+  double charge = 1;  // >= 0
+};
+
+// A simple polygon (no self-intersections), vertices in either order; stored counter-clockwise.
+struct PolygonObstacle {
+  std::vector<Vec2> vertices;  // >= 3, implicitly closed
+  double charge = 1;
+};
+
+struct Bounds {
+  double xmin = 0, ymin = 0, xmax = 0, ymax = 0;
+  double width() const { return xmax - xmin; }
+  double height() const { return ymax - ymin; }
+};
+
+// The agents table: structure-of-arrays columns, one entry per dense row. Columns are public
+// for reading; only World and the tick write them. Hot per-tick columns first.
+struct AgentTable {
+  // hot: read or written every tick
+  std::vector<double> x, y;           // position [length]
+  std::vector<double> vx, vy;         // velocity [length/tick]
+  std::vector<double> radius;         // [length]
+  std::vector<double> max_speed;      // [length/tick]
+  std::vector<double> max_accel;      // [length/tick^2], may be +inf
+  std::vector<double> charge;         // potential-field charge
+  std::vector<double> target_x, target_y;  // current waypoint (the goal when there is no route)
+  std::vector<uint32_t> goal;         // row of the goals table
+  std::vector<AgentState> state;
+  std::vector<uint32_t> frozen_ticks;  // consecutive ticks frozen by backoff (gridlock detection)
+  // cold: bookkeeping
+  std::vector<uint64_t> id;           // AgentId::value()
+  std::vector<std::vector<Vec2>> route;  // waypoints still ahead, the goal last (may be empty)
+
+  std::size_t size() const { return x.size(); }
+  bool empty() const { return x.empty(); }
+};
+
+class World {
+ public:
+  World() = default;
+  explicit World(Bounds bounds) : bounds_(bounds) {}
+
+  // ---- static tables; validated, applied immediately ----
+  uint32_t add_goal(const Goal& goal);
+  uint32_t add_obstacle(const CircleObstacle& obstacle);
+  uint32_t add_obstacle(PolygonObstacle obstacle);
+  void set_bounds(Bounds bounds);
+
+  // ---- agent changes: validated now, applied by apply_pending() (start of the next tick) ----
+  // Throws InvalidRow naming the field; nothing stored changes.
+  AgentId insert(const AgentSpec& spec);
+  // Throws Error(input) when the id is not alive or pending.
+  void erase(AgentId id);
+  void retarget(AgentId id, uint32_t goal);
+  std::size_t pending_changes() const { return pending_.size(); }
+  // Applies the buffered changes in call order. Returns the number applied.
+  std::size_t apply_pending();
+
+  // ---- reads ----
+  const AgentTable& agents() const { return agents_; }
+  std::span<const Goal> goals() const { return goals_; }
+  std::span<const CircleObstacle> circles() const { return circles_; }
+  std::span<const PolygonObstacle> polygons() const { return polygons_; }
+  const Bounds& bounds() const { return bounds_; }
+  // Dense row of a live agent, or nothing (unknown, erased, or insert still pending).
+  std::optional<std::size_t> row_of(AgentId id) const;
+  bool contains(AgentId id) const { return row_of(id).has_value(); }
+
+  // Checks every cross-table invariant (slot map <-> rows, columns the same length, goal rows
+  // valid). Throws std::logic_error on violation. For tests and debugging.
+  void validate() const;
+
+  // Mutable access for the tick's stages (and only them).
+  AgentTable& agents_for_tick() { return agents_; }
+  // Removes a row by swapping the last row into it; the handle of the removed agent dies.
+  void remove_row(std::size_t row);
+  // The current waypoint of a row: next route point, else its goal.
+  void refresh_target(std::size_t row);
+
+  static void validate_spec(const AgentSpec& spec, std::size_t goal_count);
+
+ private:
+  struct Slot {
+    uint32_t generation = 0;
+    uint32_t row = kNoRow;    // dense row, or kNoRow
+    bool pending = false;     // reserved by insert(), not applied yet
+    bool doomed = false;      // erase() buffered: no further changes accepted
+  };
+  static constexpr uint32_t kNoRow = std::numeric_limits<uint32_t>::max();
+  struct Change {
+    enum class Kind : uint8_t { insert, erase, retarget } kind;
+    AgentId id;
+    AgentSpec spec;  // insert only
+    uint32_t goal = 0;  // retarget only
+  };
+
+  const Slot* live_slot(AgentId id) const;
+  void push_row(AgentId id, const AgentSpec& spec);
+
+  Bounds bounds_{};
+  AgentTable agents_;
+  std::vector<Goal> goals_;
+  std::vector<CircleObstacle> circles_;
+  std::vector<PolygonObstacle> polygons_;
+  std::vector<Slot> slots_;
+  std::vector<uint32_t> free_slots_;  // LIFO, deterministic reuse order
+  std::vector<Change> pending_;
+};
+
+}  // namespace crowddb

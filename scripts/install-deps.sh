@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs every build, test and run-time dependency of crowddb from Debian 12 packages.
+# Run as root (or with sudo) on a fresh machine; safe to run again.
+set -euo pipefail
+packages=(
+  build-essential cmake ccache git python3 sqlite3
+  libgtest-dev libgmock-dev libbenchmark-dev   # tests and benchmarks
+  libcli11-dev nlohmann-json3-dev libfccp-dev  # CLI, scenario JSON, CSV tokenising
+  libsqlite3-dev                               # trajectory output
+  libtbb-dev                                   # threads (work stealing, caller participates)
+  libcgal-dev                                  # Delaunay collision heuristic
+  librecast-dev                                # navigation meshes
+  libpugixml-dev                               # SDF3 XML
+  gnuplot-nox graphviz                         # experiment plots, DOT rendering
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  sudo=""
+  [[ $(id -u) -eq 0 ]] || sudo="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# The whole test suite: a Release build with every test, then the same tests built with
+# AddressSanitizer + UndefinedBehaviorSanitizer. Tests labelled `slow` run only with
+# CROWDDB_SLOW_TESTS=1. Exits non-zero on the first failure.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+jobs=$(nproc)
+ctest_args=(--output-on-failure -j "$jobs" --timeout 900)
+[[ "${CROWDDB_SLOW_TESTS:-0}" == 1 ]] || ctest_args+=(-LE slow)
+
+echo "== Release build and tests"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DCROWDDB_WERROR=ON >/dev/null
+cmake --build build -j "$jobs"
+ctest --test-dir build "${ctest_args[@]}"
+
+echo "== ASan+UBSan build and tests"
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCROWDDB_SANITIZE=ON \
+  -DCROWDDB_WERROR=ON -DCROWDDB_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build build-asan -j "$jobs"
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  ctest --test-dir build-asan "${ctest_args[@]}" -LE "slow|nosan"
+echo "== all tests passed"

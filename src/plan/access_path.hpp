@@ -1,0 +1,95 @@
+// Access paths: the interchangeable operators behind each steering query. A stage of the tick
+// asks the plan for the access path of its query and calls run(); it never knows whether the
+// rows come from a nested loop or an index. New methods register in registry.cpp only.
+//
+// An access path object holds per-run state (index storage, scratch buffers) reused from tick
+// to tick; it is used by one tick at a time. run() may use the executor's threads but must give
+// the same output whatever the thread count.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "crowddb/query.hpp"
+#include "util/executor.hpp"
+
+namespace crowddb {
+
+class FtcPath {
+ public:
+  virtual ~FtcPath() = default;
+  // out[i] = the first collider of disc i within `horizon` (DESIGN.md §5), for every disc.
+  virtual void run(const DiscView& discs, const StaticScene& scene, double horizon,
+                   std::span<FtcHit> out, Executor& ex, QueryStats& stats) = 0;
+};
+
+class FieldPath {
+ public:
+  virtual ~FieldPath() = default;
+  // Potential and gradient at every disc over the other discs and the scene's charged points.
+  virtual void run(const DiscView& discs, const StaticScene& scene, const PotentialSpec& spec,
+                   FieldColumns& out, Executor& ex, QueryStats& stats) = 0;
+};
+
+class CollisionPath {
+ public:
+  virtual ~CollisionPath() = default;
+  // All overlapping pairs among the discs and between discs and obstacles (exact methods), or
+  // the pairs the method finds (heuristics, which may miss some but never invent one).
+  virtual void run(const DiscView& discs, const StaticScene& scene, CollisionPairs& out, Executor& ex,
+                   QueryStats& stats) = 0;
+};
+
+// What the planner knows about a registered method.
+struct MethodInfo {
+  std::string name;
+  std::string description;  // shown by EXPLAIN
+  bool exact = true;        // returns exactly the naive result (within tolerance for fields)
+  // The planner picks, among the exact methods whose `supports` accepts the query, the one with
+  // the highest rank whose auto_min_rows <= rows. Naive has rank 0 and min 0.
+  int auto_rank = 0;
+  std::size_t auto_min_rows = 0;
+  bool in_auto = true;  // false: only when forced by name
+};
+
+struct FtcMethod {
+  MethodInfo info;
+  std::function<std::unique_ptr<FtcPath>()> make;
+};
+
+struct FieldMethod {
+  MethodInfo info;
+  std::function<bool(const PotentialSpec&)> supports;
+  std::function<std::unique_ptr<FieldPath>()> make;
+};
+
+// Facts about the discs a collision method may depend on.
+struct CollisionQueryShape {
+  std::size_t rows = 0;
+  bool equal_radii = false;
+};
+
+struct CollisionMethod {
+  MethodInfo info;
+  std::function<bool(const CollisionQueryShape&)> supports;
+  std::function<std::unique_ptr<CollisionPath>()> make;
+};
+
+const std::vector<FtcMethod>& ftc_registry();
+const std::vector<FieldMethod>& field_registry();
+const std::vector<CollisionMethod>& collision_registry();
+
+// Lookup by name; throws Error(usage) naming the valid choices when unknown.
+const FtcMethod& find_ftc_method(std::string_view name);
+const FieldMethod& find_field_method(std::string_view name, const PotentialSpec& spec);
+const CollisionMethod& find_collision_method(std::string_view name, const CollisionQueryShape& shape);
+
+// The planner's choice for "auto".
+const FtcMethod& choose_ftc_method(std::size_t rows);
+const FieldMethod& choose_field_method(std::size_t rows, const PotentialSpec& spec);
+const CollisionMethod& choose_collision_method(const CollisionQueryShape& shape);
+
+}  // namespace crowddb

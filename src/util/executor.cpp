@@ -1,0 +1,40 @@
+#include "util/executor.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace crowddb {
+
+struct Executor::Arena {
+  explicit Arena(int threads) : arena(threads) {}
+  tbb::task_arena arena;
+};
+
+Executor::Executor(int threads) : threads_(threads) {
+  if (threads < 1) throw std::invalid_argument("Executor: threads must be >= 1");
+  if (threads > 1) arena_ = std::make_unique<Arena>(threads);
+}
+
+Executor::~Executor() = default;
+
+void Executor::for_each_chunk(std::size_t n, std::size_t grain,
+                              const std::function<void(std::size_t, std::size_t)>& body) {
+  if (n == 0) return;
+  grain = std::max<std::size_t>(grain, 1);
+  if (!arena_ || n <= grain) {
+    for (std::size_t b = 0; b < n; b += grain) body(b, std::min(n, b + grain));
+    return;
+  }
+  arena_->arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, grain),
+        [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); },
+        tbb::simple_partitioner());
+  });
+}
+
+}  // namespace crowddb

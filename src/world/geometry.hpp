@@ -1,0 +1,93 @@
+// Small exact-as-doubles geometry shared by every access path. Naive and indexed paths must call
+// the same primitive for the same pair, so that "exact" comparisons between them are meaningful.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <utility>
+
+#include "crowddb/world.hpp"
+
+namespace crowddb {
+
+// Twice the signed area (positive when counter-clockwise), halved.
+inline double signed_area(std::span<const Vec2> ring) {
+  double a = 0;
+  for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+    const Vec2& p = ring[i];
+    const Vec2& q = ring[(i + 1) % n];
+    a += p.x * q.y - q.x * p.y;
+  }
+  return a / 2;
+}
+
+inline double cross(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
+
+// Closest point of segment [a, b] to p, as the parameter in [0, 1].
+inline double segment_param(const Vec2& a, const Vec2& b, double px, double py) {
+  const double ex = b.x - a.x, ey = b.y - a.y;
+  const double len2 = ex * ex + ey * ey;
+  if (len2 == 0) return 0;
+  const double t = ((px - a.x) * ex + (py - a.y) * ey) / len2;
+  return t < 0 ? 0 : (t > 1 ? 1 : t);
+}
+
+inline Vec2 closest_on_segment(const Vec2& a, const Vec2& b, double px, double py) {
+  const double t = segment_param(a, b, px, py);
+  return {a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
+}
+
+inline double dist2_to_segment(const Vec2& a, const Vec2& b, double px, double py) {
+  const Vec2 c = closest_on_segment(a, b, px, py);
+  const double dx = px - c.x, dy = py - c.y;
+  return dx * dx + dy * dy;
+}
+
+// Even-odd rule; points exactly on the boundary may go either way (callers also test the
+// boundary distance, so the disc tests below are exact where it matters).
+inline bool point_in_polygon(std::span<const Vec2> ring, double px, double py) {
+  bool inside = false;
+  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
+    const Vec2& a = ring[i];
+    const Vec2& b = ring[j];
+    if ((a.y > py) != (b.y > py)) {
+      const double xcross = a.x + (py - a.y) * (b.x - a.x) / (b.y - a.y);
+      if (px < xcross) inside = !inside;
+    }
+  }
+  return inside;
+}
+
+// Squared distance from p to the polygon's boundary, and the closest boundary point.
+inline double dist2_to_boundary(std::span<const Vec2> ring, double px, double py, Vec2* closest = nullptr) {
+  double best = INFINITY;
+  for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+    const Vec2& a = ring[i];
+    const Vec2& b = ring[(i + 1) % n];
+    const Vec2 c = closest_on_segment(a, b, px, py);
+    const double dx = px - c.x, dy = py - c.y;
+    const double d2 = dx * dx + dy * dy;
+    if (d2 < best) {
+      best = d2;
+      if (closest) *closest = c;
+    }
+  }
+  return best;
+}
+
+// Does a disc of radius r centred at p overlap the polygon (interior or boundary closer than r)?
+inline bool disc_overlaps_polygon(std::span<const Vec2> ring, double px, double py, double r) {
+  return point_in_polygon(ring, px, py) || dist2_to_boundary(ring, px, py) < r * r;
+}
+
+// Discs overlap when the distance of centres is strictly less than the sum of radii.
+inline bool discs_overlap(double dx, double dy, double rsum) {
+  return dx * dx + dy * dy < rsum * rsum;
+}
+
+// The first pair of non-adjacent edges (i, j), i < j, that touch or cross, if any. O(v^2).
+std::optional<std::pair<std::size_t, std::size_t>> first_self_intersection(std::span<const Vec2> ring);
+
+}  // namespace crowddb
