@@ -39,6 +39,27 @@ struct DiscView {
   }
 };
 
+// Owned disc columns, for callers that do not keep a World (the CLI's CSV input, tests,
+// benchmarks, experiments). view() borrows them.
+struct DiscTable {
+  std::vector<double> x, y, vx, vy, radius, charge;
+  std::vector<uint64_t> id;
+
+  std::size_t size() const { return x.size(); }
+  void push_back(uint64_t row_id, double px, double py, double pvx, double pvy, double r, double c = 1) {
+    id.push_back(row_id);
+    x.push_back(px);
+    y.push_back(py);
+    vx.push_back(pvx);
+    vy.push_back(pvy);
+    radius.push_back(r);
+    charge.push_back(c);
+  }
+  DiscView view() const {
+    return {x.size(), x.data(), y.data(), vx.data(), vy.data(), radius.data(), charge.data(), id.data()};
+  }
+};
+
 // How static obstacles contribute charged points to the potential field.
 enum class ObstacleCharges {
   centres,   // one charged point per circle at its centre (the thesis's model; `crowddb query field`)

@@ -1,0 +1,169 @@
+#include "crowddb/world.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace crowddb {
+namespace {
+
+World world_with_goals(int goals = 2) {
+  World w(Bounds{0, 0, 100, 100});
+  for (int g = 0; g < goals; ++g) w.add_goal({"g" + std::to_string(g), 10.0 * g, 5, 1, 1});
+  return w;
+}
+
+AgentSpec spec_at(double x, double y, uint32_t goal = 0) {
+  AgentSpec s;
+  s.x = x;
+  s.y = y;
+  s.goal = goal;
+  return s;
+}
+
+TEST(World, InsertsAreBufferedUntilApplied) {
+  World w = world_with_goals();
+  const AgentId a = w.insert(spec_at(1, 2));
+  EXPECT_EQ(w.agents().size(), 0u);
+  EXPECT_FALSE(w.contains(a));
+  EXPECT_EQ(w.apply_pending(), 1u);
+  ASSERT_TRUE(w.contains(a));
+  EXPECT_EQ(w.agents().x[*w.row_of(a)], 1);
+  EXPECT_EQ(w.agents().target_x[*w.row_of(a)], 0);  // goal 0 at (0, 5)
+  w.validate();
+}
+
+TEST(World, EraseSwapsLastRowInAndKeepsHandlesValid) {
+  World w = world_with_goals();
+  const AgentId a = w.insert(spec_at(1, 0)), b = w.insert(spec_at(2, 0)), c = w.insert(spec_at(3, 0));
+  w.apply_pending();
+  w.erase(a);
+  EXPECT_TRUE(w.contains(a));  // still there until the batch is applied
+  w.apply_pending();
+  EXPECT_FALSE(w.contains(a));
+  ASSERT_TRUE(w.contains(b) && w.contains(c));
+  EXPECT_EQ(w.agents().x[*w.row_of(c)], 3);
+  EXPECT_EQ(w.agents().x[*w.row_of(b)], 2);
+  w.validate();
+}
+
+TEST(World, ReusedSlotsGetNewGenerationsSoIdsAreNeverReused) {
+  World w = world_with_goals();
+  const AgentId a = w.insert(spec_at(1, 0));
+  w.apply_pending();
+  w.erase(a);
+  w.apply_pending();
+  const AgentId b = w.insert(spec_at(2, 0));
+  w.apply_pending();
+  EXPECT_EQ(a.index, b.index);
+  EXPECT_NE(a.value(), b.value());
+  EXPECT_FALSE(w.contains(a));
+  EXPECT_THROW(w.erase(a), Error);
+  EXPECT_THROW(w.retarget(a, 1), Error);
+  w.validate();
+}
+
+TEST(World, InsertThenEraseInOneBatchLeavesNothing) {
+  World w = world_with_goals();
+  const AgentId a = w.insert(spec_at(1, 0));
+  w.erase(a);
+  w.apply_pending();
+  EXPECT_EQ(w.agents().size(), 0u);
+  EXPECT_FALSE(w.contains(a));
+  EXPECT_THROW(w.erase(a), Error);
+  w.validate();
+}
+
+TEST(World, DoubleEraseInOneBatchIsRejectedAtTheCall) {
+  World w = world_with_goals();
+  const AgentId a = w.insert(spec_at(1, 0));
+  w.apply_pending();
+  w.erase(a);
+  EXPECT_THROW(w.erase(a), Error);
+  w.apply_pending();
+  w.validate();
+}
+
+TEST(World, RetargetChangesGoalAndTargetAtNextBatch) {
+  World w = world_with_goals();
+  const AgentId a = w.insert(spec_at(1, 0));
+  w.apply_pending();
+  w.retarget(a, 1);
+  EXPECT_EQ(w.agents().goal[0], 0u);
+  w.apply_pending();
+  EXPECT_EQ(w.agents().goal[0], 1u);
+  EXPECT_EQ(w.agents().target_x[0], 10);
+  EXPECT_THROW(w.retarget(a, 7), InvalidRow);
+}
+
+struct BadField {
+  const char* field;
+  void (*mutate)(AgentSpec&);
+};
+
+class InvalidAgentRow : public ::testing::TestWithParam<BadField> {};
+
+TEST_P(InvalidAgentRow, IsRejectedNamingTheFieldAndNothingIsLost) {
+  World w = world_with_goals();
+  const AgentId keep = w.insert(spec_at(5, 5));
+  w.apply_pending();
+  AgentSpec s = spec_at(1, 1);
+  GetParam().mutate(s);
+  try {
+    w.insert(s);
+    FAIL() << "accepted an invalid " << GetParam().field;
+  } catch (const InvalidRow& e) {
+    EXPECT_EQ(e.field(), GetParam().field);
+    EXPECT_NE(std::string(e.what()).find(GetParam().field), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(w.pending_changes(), 0u);
+  w.apply_pending();
+  EXPECT_EQ(w.agents().size(), 1u);
+  EXPECT_TRUE(w.contains(keep));
+  w.validate();
+}
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+INSTANTIATE_TEST_SUITE_P(
+    World, InvalidAgentRow,
+    ::testing::Values(BadField{"x", [](AgentSpec& s) { s.x = kNaN; }},
+                      BadField{"y", [](AgentSpec& s) { s.y = kInf; }},
+                      BadField{"vx", [](AgentSpec& s) { s.vx = kNaN; }},
+                      BadField{"radius", [](AgentSpec& s) { s.radius = 0; }},
+                      BadField{"radius", [](AgentSpec& s) { s.radius = -1; }},
+                      BadField{"max_speed", [](AgentSpec& s) { s.max_speed = -2; }},
+                      BadField{"max_accel", [](AgentSpec& s) { s.max_accel = kNaN; }},
+                      BadField{"charge", [](AgentSpec& s) { s.charge = kInf; }},
+                      BadField{"goal", [](AgentSpec& s) { s.goal = 9; }}));
+
+TEST(World, InvalidStaticRowsAreRejected) {
+  World w = world_with_goals();
+  EXPECT_THROW(w.add_goal({"bad", kNaN, 0, 1, 1}), InvalidRow);
+  EXPECT_THROW(w.add_goal({"bad", 0, 0, 1, 0}), InvalidRow);
+  EXPECT_THROW(w.add_obstacle(CircleObstacle{0, 0, -1, 1}), InvalidRow);
+  EXPECT_THROW(w.add_obstacle(PolygonObstacle{{{0, 0}, {1, 1}}, 1}), InvalidRow);
+  // A bow tie is not a simple polygon.
+  EXPECT_THROW(w.add_obstacle(PolygonObstacle{{{0, 0}, {2, 2}, {2, 0}, {0, 2}}, 1}), InvalidRow);
+  EXPECT_THROW(w.add_obstacle(PolygonObstacle{{{0, 0}, {1, 0}, {2, 0}}, 1}), InvalidRow);  // zero area
+  EXPECT_EQ(w.goals().size(), 2u);
+  EXPECT_TRUE(w.circles().empty());
+  EXPECT_TRUE(w.polygons().empty());
+}
+
+TEST(World, PolygonsAreStoredCounterClockwiseAndClosingVertexDropped) {
+  World w = world_with_goals();
+  w.add_obstacle(PolygonObstacle{{{0, 0}, {0, 1}, {1, 1}, {1, 0}, {0, 0}}, 1});
+  ASSERT_EQ(w.polygons().size(), 1u);
+  const auto& v = w.polygons()[0].vertices;
+  ASSERT_EQ(v.size(), 4u);
+  double area2 = 0;
+  for (std::size_t i = 0; i < v.size(); ++i)
+    area2 += v[i].x * v[(i + 1) % v.size()].y - v[(i + 1) % v.size()].x * v[i].y;
+  EXPECT_GT(area2, 0);
+}
+
+}  // namespace
+}  // namespace crowddb

@@ -1,0 +1,26 @@
+// Subcommands of the `crowddb` CLI. Each registers its options on the app and returns the
+// action to run after parsing; actions throw crowddb::Error, which main turns into one line on
+// stderr and the exit status (2 usage, 1 other).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+
+namespace crowddb::cli {
+
+using Action = std::function<int()>;
+
+void add_query_commands(CLI::App& app, Action& action);
+void add_run_command(CLI::App& app, Action& action);
+void add_validate_command(CLI::App& app, Action& action);
+void add_experiment_command(CLI::App& app, Action& action);
+
+// Shortest decimal that reads back as the same double.
+std::string format_number(double v);
+
+// Writes `text` to `path` atomically: a temporary file beside it, renamed on success, so a
+// failed run never leaves a half-written file that looks complete. "-" writes to stdout.
+void write_output(const std::string& path, const std::string& text);
+
+}  // namespace crowddb::cli

@@ -1,0 +1,38 @@
+// `crowddb experiment NAME --out DIR [--quick]`: the thesis's experiments (DESIGN.md §7).
+#include <filesystem>
+#include <iostream>
+
+#include "commands.hpp"
+#include "crowddb/error.hpp"
+#include "experiment/experiment.hpp"
+
+namespace crowddb::cli {
+
+void add_experiment_command(CLI::App& app, Action& action) {
+  auto* sub = app.add_subcommand("experiment", "reproduce an experiment of the thesis (CSV + PNG plots)");
+  static std::string name, out;
+  static experiment::Options opts;
+  std::string names;
+  for (const auto& e : experiment::registry()) names += "\n  " + e.name + ": " + e.description;
+  sub->add_option("name", name, "experiment:" + (names.empty() ? std::string(" (none registered yet)") : names))
+      ->required();
+  sub->add_option("--out", out, "output folder (created if missing)")->required();
+  sub->add_flag("--quick", opts.quick, "small sizes, for tests and a first look");
+  sub->add_option("--threads", opts.threads, "threads")->check(CLI::Range(1, 256));
+  sub->add_option("--seed", opts.seed, "base seed");
+  sub->callback([&action] {
+    action = [] {
+      const auto& e = experiment::find(name);
+      std::error_code ec;
+      std::filesystem::create_directories(out, ec);
+      if (ec || !std::filesystem::is_directory(out))
+        throw Error(Error::Kind::io, out + ": cannot create output folder");
+      opts.out_dir = out;
+      opts.log = &std::cerr;
+      e.run(opts);
+      return 0;
+    };
+  });
+}
+
+}  // namespace crowddb::cli
