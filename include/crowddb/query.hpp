@@ -143,6 +143,10 @@ struct PotentialSpec {
   double k = 0.272194;
   int radial_frames = 2;   // m rotated frames for the radial metric
   double inv_floor = 0.1;  // inv kernel: distance floored here (> 0) so coincident points stay finite
+  // The thesis's finite-difference gradient (§1.2) instead of the analytic one:
+  // grad_x = (P(x + h, y) - P(x, y)) / h with h = fd_step, and likewise in y.
+  bool finite_difference = false;
+  double fd_step = 1e-3;
 };
 
 // Potential and its gradient with respect to the probe's position, per disc.
@@ -160,6 +164,33 @@ struct FieldColumns {
 FieldColumns potential_field(const DiscView& discs, const StaticScene& scene, const PotentialSpec& spec,
                              std::string_view method = "auto", int threads = 1,
                              QueryStats* stats = nullptr);
+
+// The field that `sources` and the scene's charged points create, evaluated at arbitrary points
+// (to draw it): potential[i] = sum over all sources q of A c_q K(d(points[i], q)) — a probe has
+// unit charge and excludes nothing, so a probe on top of a source gets that source's K(0) term —
+// with its gradient with respect to the probe's position (the same sign(0) = 0 conventions).
+// Methods as potential_field ("naive", "index", "auto"); spec.finite_difference is honoured.
+// Throws Error(input) when a point is not finite, Error(usage) for an unknown method or one that
+// does not support the spec.
+FieldColumns field_at(std::span<const Vec2> points, const DiscView& sources,
+                      const StaticScene& scene, const PotentialSpec& spec,
+                      std::string_view method = "auto", int threads = 1,
+                      QueryStats* stats = nullptr);
+
+// Least-squares fit of A e^{-k x} to alpha / x on [from, to] (DESIGN.md §4), so users can pick
+// their own kernel constants. samples = 0: the continuous L2 norm, the integral over [from, to]
+// of (A e^{-k x} - alpha / x)^2 dx by composite Gauss-Legendre quadrature; samples >= 2: the sum
+// over that many equally spaced points (both ends included). For fixed k the best A is linear
+// (closed form), so k alone is searched: a log-spaced bracketing scan, golden-section search,
+// then bisection on the sign of the derivative of the reduced objective.
+// Throws Error(usage) unless 0 < from < to, both finite, alpha > 0 finite, samples 0 or >= 2.
+struct KernelFit {
+  double A = 0, k = 0;
+  double max_abs_error = 0;  // max |A e^{-k x} - alpha/x| on a dense grid of [from, to]
+  double max_rel_error = 0;  // max of |A e^{-k x} - alpha/x| / (alpha/x) on that grid
+  double rms_error = 0;  // root mean square error in the fitted norm (per unit length or sample)
+};
+KernelFit fit_exp_kernel(double from, double to, double alpha = 1.0, int samples = 0);
 
 // ---------------------------------------------------------------- collision sets (§3.2)
 

@@ -32,6 +32,11 @@ class FieldPath {
   // Potential and gradient at every disc over the other discs and the scene's charged points.
   virtual void run(const DiscView& discs, const StaticScene& scene, const PotentialSpec& spec,
                    FieldColumns& out, Executor& ex, QueryStats& stats) = 0;
+  // The field of `sources` and the scene at arbitrary points (unit probe charge, no exclusion:
+  // see crowddb::field_at). Methods that cannot probe keep this default, which throws Error(usage).
+  virtual void probe(std::span<const Vec2> points, const DiscView& sources,
+                     const StaticScene& scene, const PotentialSpec& spec, FieldColumns& out,
+                     Executor& ex, QueryStats& stats);
 };
 
 class CollisionPath {

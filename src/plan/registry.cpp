@@ -2,6 +2,7 @@
 // one entry here; no stage of the tick changes.
 #include <algorithm>
 
+#include "index/field_index.hpp"
 #include "plan/access_path.hpp"
 #include "query/naive_paths.hpp"
 
@@ -46,6 +47,12 @@ const std::vector<FieldMethod>& field_registry() {
       {{"naive", "nested loop over all pairs, O(n^2)"},
        [](const PotentialSpec&) { return true; },
        [] { return std::make_unique<FieldNaive>(); }},
+      // auto_min_rows: below ~60 rows the naive loop is as fast (measured with
+      // bench/field_bench: BM_FieldCrossover, exp-l1, uniform on an n x n board).
+      {{"index", "exact separable aggregate index (exp-l1, exp-radial m <= 2), O(n log n)", true, 1,
+        64},
+       [](const PotentialSpec& s) { return field_index_supports(s); },
+       [] { return std::make_unique<FieldIndex>(); }},
   };
   return methods;
 }

@@ -18,7 +18,10 @@ struct PairKernel {
     for (int j = 0; j < m && j < kMaxFrames; ++j) {
       const double th = j * std::numbers::pi / (2.0 * m);
       cos_[j] = std::cos(th);
-      sin_[j] = std::sin(th);
+      // sin θ as cos(π/2 - θ) for j > 0, so that a frame at π/4 gets sin == cos bit for bit
+      // (std::sin(π/4) is one ulp below std::cos(π/4)): then a point exactly on a diagonal has
+      // u or w exactly 0 and gets sign(0) = 0, as on the axes.
+      sin_[j] = j == 0 ? 0.0 : std::cos((m - j) * std::numbers::pi / (2.0 * m));
     }
     radial_scale = std::numbers::pi / (4.0 * m);
   }

@@ -1,8 +1,12 @@
 // The public, stand-alone entry points of the steering queries: look the method up in the
 // registry, run it once on a private executor.
-#include <algorithm>
-
 #include "crowddb/query.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "crowddb/error.hpp"
 #include "plan/access_path.hpp"
 #include "util/stopwatch.hpp"
 
@@ -42,14 +46,52 @@ std::vector<FtcHit> first_to_collide(const DiscView& discs, const StaticScene& s
   return out;
 }
 
+namespace {
+
+// Rejects specs no method can evaluate (Error(usage) naming the field).
+void check_spec(const PotentialSpec& s) {
+  const auto bad = [](const std::string& field, const std::string& why) {
+    throw Error(Error::Kind::usage, "potential spec: " + field + " " + why);
+  };
+  if (!std::isfinite(s.A)) bad("A", "must be finite");
+  if (!std::isfinite(s.k)) bad("k", "must be finite");
+  if (s.radial_frames < 1 || s.radial_frames > 16) bad("radial_frames", "must be in [1, 16]");
+  if (s.kernel == Kernel::inv && !(s.inv_floor > 0 && std::isfinite(s.inv_floor)))
+    bad("inv_floor", "must be finite and > 0");
+  if (s.finite_difference && !(s.fd_step > 0 && std::isfinite(s.fd_step)))
+    bad("fd_step", "must be finite and > 0");
+}
+
+}  // namespace
+
 FieldColumns potential_field(const DiscView& discs, const StaticScene& scene, const PotentialSpec& spec,
                              std::string_view method, int threads, QueryStats* stats) {
+  check_spec(spec);
   const FieldMethod& m = method == "auto" ? choose_field_method(discs.n, spec) : find_field_method(method, spec);
   auto path = m.make();
   Executor ex(threads);
   QueryStats local;
   FieldColumns out;
   path->run(discs, scene, spec, out, ex, local);
+  if (stats) *stats += local;
+  return out;
+}
+
+FieldColumns field_at(std::span<const Vec2> points, const DiscView& sources,
+                      const StaticScene& scene, const PotentialSpec& spec, std::string_view method,
+                      int threads, QueryStats* stats) {
+  check_spec(spec);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (!std::isfinite(points[i].x) || !std::isfinite(points[i].y))
+      throw Error(Error::Kind::input, "field_at: point " + std::to_string(i) + " is not finite");
+  const std::size_t rows = points.size() + sources.n;
+  const FieldMethod& m =
+      method == "auto" ? choose_field_method(rows, spec) : find_field_method(method, spec);
+  auto path = m.make();
+  Executor ex(threads);
+  QueryStats local;
+  FieldColumns out;
+  path->probe(points, sources, scene, spec, out, ex, local);
   if (stats) *stats += local;
   return out;
 }

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   crowddb::cli::add_validate_command(app, action);
   crowddb::cli::add_query_commands(app, action);
   crowddb::cli::add_experiment_command(app, action);
+  crowddb::cli::add_fit_kernel_command(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

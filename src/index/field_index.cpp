@@ -1,0 +1,581 @@
+// The potential-field aggregate index: exact separable exponential sums for every probe at once.
+//
+// WHAT IS SUMMED. For each probe p: S(p) = sum over sources q other than p itself of
+// w_q e^{-k d(p, q)}, with its gradient with respect to p (DESIGN.md §4). With the L1 metric the
+// kernel separates by quadrant (thesis §2.2): for the sources q left of and below p,
+//     e^{-k(dx + dy)} = e^{-k x_p} e^{-k y_p} * e^{k x_q} e^{k y_q},     dx = x_p - x_q, dy = ...
+// so the quadrant sum is a 2-D dominance aggregate of the source weights w_q e^{k x_q + k y_q}.
+// The radial metric with m = 2 frames (θ = 0, π/4) is d = (π/8)(|dx| + |dy| + √2 max(|dx|,|dy|)):
+// the lines x = 0, y = 0, y = x and y = -x cut the plane around p into 8 wedges, inside each of
+// which every |.| has a fixed sign, so the kernel is e^{-(α Δa + β Δb)} for two linear keys a, b
+// (e.g. a = y, b = x - y in the wedge 0 < dy < dx, α = (2+√2)kπ/8, β = (1+√2)kπ/8) and the
+// wedge is the dominance region Δa > 0, Δb > 0 in those sheared coordinates. m = 1 is L1 scaled
+// by π/4. So every supported metric is a list of "combos" (keys a, b; rates α, β): each combo's
+// forward sweep gives the wedge Δa > 0, Δb > 0 and its backward sweep the opposite wedge
+// Δa < 0, Δb < 0 (L1: 2 combos, (x, y) and (x, -y); radial m = 2: 4 combos).
+//
+// TIES, EXACTLY AS THE NAIVE DEFINITION. Keys are exact: a single coordinate, or the exact sum
+// x ± y held unevaluated as hi + lo (TwoSum), so every comparison is the exact comparison of the
+// real coordinates. A source on a wedge's boundary ray (Δa = 0 < Δb or Δb = 0 < Δa) belongs to
+// the two wedges that share the ray; each counts it with weight 1/2. The potential is continuous
+// across the ray, and the gradient there is the mean of the two wedges' gradients, which is what
+// the naive rule sign(0) = 0 gives (only the |.| term of that line changes sign across it).
+// Coincident sources (Δa = Δb = 0 in every combo) are summed separately with weight e^0 and zero
+// gradient, excluding the probe's own entry by identity: coincident distinct points count.
+// (Radial keys x ± y are compared exactly; the naive path compares its rounded differences, so a
+// pair whose rounded differences tie on a diagonal while the exact coordinates do not — possible
+// only when coordinate differences round, never on lattices or small integers/dyadics — may get
+// an adjacent wedge's gradient. L1 classification is always exact: sign(x_p - x_q) is exact.)
+//
+// SWEEP. Per combo the tile's entries are sorted by (a, b) and b is ranked. The forward sweep
+// visits runs of equal a in increasing a; probes of a run query a Fenwick tree over b-ranks
+// (prefix: sources with smaller a and smaller b: the wedge interior), an array of per-rank sums
+// (smaller a, equal b: one ray) and a running sum inside the run (equal a, smaller b: the other
+// ray); then the run's sources are inserted. The backward sweep mirrors it with suffixes.
+//
+// NUMERICS: ANY COORDINATE RANGE. e^{k x} overflows a double near k x ≈ 709, so weights are
+// computed in tile-local coordinates. If the whole table's bounding box keeps every combo's
+// exponent α|a_local| + β|b_local| <= B = 600 (local origin at the box centre), it is one tile.
+// Otherwise probes are covered greedily by x-slabs and, inside a slab, by y-tiles of side T;
+// each tile sees the sources within a halo H of it and uses the origin (x0 + T/2, y0 + T/2), so
+// |local coordinate| <= R = T/2 + H with the exponent bound at R equal to B. H is chosen so that
+// a source outside the halo (L∞ distance > H, hence k d >= decay H) weighs at most
+// e^{-decay H} = e^{-36} / (n_sources + 1), i.e. all dropped terms together are below
+// 2.4e-16 · A c_max^2 — four orders below the absolute tolerance.
+// Weights are normalised by c_max, so stored sums stay below n e^{600} < 10^300 for n < 10^30,
+// and probe factors e^{-600} are normal numbers.
+//
+// ERROR BOUND (relative to S_abs, the sum of |contributions|, unit roundoff u = 1.1e-16):
+//  - each weight or probe factor e^{±α l}: the argument is rounded (|arg| <= 600, so
+//    <= 600u absolute), exp itself < 1 ulp: <= ~4 (600 + 2) u ≈ 2.7e-13 relative per term;
+//  - summation: Fenwick partial sums hold only terms of the probe's own wedge, at most
+//    2 log2(n) + 4 additions deep: <= 50u for n <= 10^6;
+//  - halo: <= 2.4e-16 A c_max^2 absolute; underflow of tiny weights: < 1e-250 A c_max^2.
+// So |S_idx - S_exact| <= 3e-13 S_abs + 3e-16 A c_max^2, far inside DESIGN.md's
+// 1e-9 S_abs + 1e-12 A c_max^2 (the naive sum itself is off by up to n u S_abs). Gradient
+// components are sums of the same terms times wedge coefficients of size <= k: the same bound
+// times k.
+//
+// COMPLEXITY. One global sort O(n log n); every source lies in at most 4 tiles (H < T/2);
+// per tile of m entries, per combo, two sorts and two sweeps: O(m log m). Total O(n log n)
+// time, O(n) memory. Exponentials: 4 per entry per combo per tile.
+//
+// DETERMINISM. Entries are ordered by (x, y, id); tiles are cut by a deterministic greedy rule;
+// each probe is computed in exactly one tile by one thread, and slabs are independent: the
+// output does not depend on the thread count.
+#include "index/field_index.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <numeric>
+
+#include "crowddb/error.hpp"
+#include "query/field_kernels.hpp"
+#include "util/stopwatch.hpp"
+
+namespace crowddb {
+namespace {
+
+constexpr double kExponentBudget = 600;  // max |exponent| of a stored weight (e^709 overflows)
+constexpr double kHaloMargin = 36;       // e^{-36} = 2.3e-16: per-table budget for dropped terms
+
+// A linear form cx x + cy y with cx, cy in {-1, 0, 1}.
+struct Form {
+  int cx, cy;
+};
+
+// The exact value of a form as an unevaluated sum hi + lo (Knuth's TwoSum): comparing keys
+// lexicographically compares the exact real values.
+struct Key {
+  double hi, lo;
+  friend bool operator==(const Key& a, const Key& b) { return a.hi == b.hi && a.lo == b.lo; }
+  friend bool operator<(const Key& a, const Key& b) {
+    return a.hi < b.hi || (a.hi == b.hi && a.lo < b.lo);
+  }
+};
+
+Key key_of(Form f, double x, double y) {
+  const double a = f.cx < 0 ? -x : x, b = f.cy < 0 ? -y : y;
+  if (f.cy == 0) return {a, 0.0};
+  if (f.cx == 0) return {b, 0.0};
+  const double s = a + b;
+  const double bb = s - a;
+  return {s, (a - (s - bb)) + (b - bb)};
+}
+
+double value_of(Form f, double lx, double ly) {
+  double v = 0;
+  if (f.cx) v = f.cx < 0 ? -lx : lx;
+  if (f.cy) v += f.cy < 0 ? -ly : ly;
+  return v;
+}
+
+// One pair of opposite wedges: forward (Δa > 0, Δb > 0) with gradient coefficients gpp and
+// backward (Δa < 0, Δb < 0) with gmm; the kernel in both is e^{-(α |Δa| + β |Δb|)}.
+struct Combo {
+  Form a, b;
+  double alpha, beta;
+  double gpp_x, gpp_y, gmm_x, gmm_y;
+};
+
+struct Separable {
+  int combos = 0;
+  Combo c[4];
+  double decay = 0;  // k d >= decay * max(|dx|, |dy|)
+
+  // Largest exponent of a stored weight when |local x| <= rx and |local y| <= ry.
+  double bound(double rx, double ry) const {
+    double m = 0;
+    for (int i = 0; i < combos; ++i) {
+      const Combo& q = c[i];
+      const double e = q.alpha * (std::abs(q.a.cx) * rx + std::abs(q.a.cy) * ry) +
+                       q.beta * (std::abs(q.b.cx) * rx + std::abs(q.b.cy) * ry);
+      m = std::max(m, e);
+    }
+    return m;
+  }
+};
+
+Separable separable_of(const PotentialSpec& s) {
+  Separable sep;
+  if (s.metric == Metric::l1 || (s.metric == Metric::radial && s.radial_frames == 1)) {
+    const double k = s.metric == Metric::l1 ? s.k : s.k * (std::numbers::pi / 4);
+    sep.combos = 2;
+    sep.c[0] = {{1, 0}, {0, 1}, k, k, -k, -k, k, k};   // q left-below / right-above
+    sep.c[1] = {{1, 0}, {0, -1}, k, k, -k, k, k, -k};  // q left-above / right-below
+    sep.decay = k;
+    return sep;
+  }
+  // Radial, m = 2: d = (π/8)((1+√2) max(|dx|,|dy|) + min(|dx|,|dy|)).
+  const double kp = s.k * (std::numbers::pi / 8);
+  const double al = (2 + std::numbers::sqrt2) * kp, be = (1 + std::numbers::sqrt2) * kp, g = be;
+  sep.combos = 4;
+  sep.c[0] = {{0, 1}, {1, -1}, al, be, -g, -kp, g, kp};   // 0 < dy < dx      | dx < dy < 0
+  sep.c[1] = {{1, 0}, {-1, 1}, al, be, -kp, -g, kp, g};   // 0 < dx < dy      | dy < dx < 0
+  sep.c[2] = {{-1, 0}, {1, 1}, al, be, kp, -g, -kp, g};   // 0 < -dx < dy     | 0 < dx < -dy
+  sep.c[3] = {{0, 1}, {-1, -1}, al, be, g, -kp, -g, kp};  // 0 < dy < -dx     | 0 < -dy < dx
+  sep.decay = g;
+  return sep;
+}
+
+// Sum over [0, i) of a Fenwick tree stored 1-based in t.
+inline double fen_prefix(const std::vector<double>& t, std::size_t i) {
+  double s = 0;
+  for (; i > 0; i &= i - 1) s += t[i];
+  return s;
+}
+inline void fen_add(std::vector<double>& t, std::size_t i, double v) {
+  for (++i; i < t.size(); i += i & (~i + 1)) t[i] += v;
+}
+
+// Per-thread working storage, reused across tiles.
+struct Scratch {
+  // Tile entries in (x, y, id) order.
+  std::vector<double> x, y, lx, ly, w, pot, gx, gy;
+  std::vector<uint32_t> slot;
+  // Per combo.
+  std::vector<Key> ka, kb;
+  std::vector<double> ea, iea, eb, ieb, fen, eq;
+  std::vector<uint32_t> order, rank;
+  std::vector<std::pair<Key, uint32_t>> bsort;
+  // Slab and tile cutting.
+  struct SlabItem {
+    double y;
+    uint32_t gpos;
+    uint32_t probe;
+  };
+  std::vector<SlabItem> slab;
+  std::vector<uint64_t> items;  // gpos << 1 | is-probe-of-this-tile
+};
+
+struct Outputs {
+  std::span<double> pot, gx, gy;
+};
+
+void run_combo(Scratch& s, const Combo& c) {
+  const std::size_t m = s.x.size();
+  s.ka.resize(m);
+  s.kb.resize(m);
+  s.ea.resize(m);
+  s.iea.resize(m);
+  s.eb.resize(m);
+  s.ieb.resize(m);
+  for (std::size_t i = 0; i < m; ++i) {
+    s.ka[i] = key_of(c.a, s.x[i], s.y[i]);
+    s.kb[i] = key_of(c.b, s.x[i], s.y[i]);
+    s.ea[i] = std::exp(c.alpha * value_of(c.a, s.lx[i], s.ly[i]));
+    s.eb[i] = std::exp(c.beta * value_of(c.b, s.lx[i], s.ly[i]));
+    s.iea[i] = 1 / s.ea[i];
+    s.ieb[i] = 1 / s.eb[i];
+  }
+  s.order.resize(m);
+  std::iota(s.order.begin(), s.order.end(), 0u);
+  std::sort(s.order.begin(), s.order.end(), [&](uint32_t i, uint32_t j) {
+    if (s.ka[i] < s.ka[j]) return true;
+    if (s.ka[j] < s.ka[i]) return false;
+    if (s.kb[i] < s.kb[j]) return true;
+    if (s.kb[j] < s.kb[i]) return false;
+    return i < j;
+  });
+  s.bsort.resize(m);
+  for (uint32_t i = 0; i < m; ++i) s.bsort[i] = {s.kb[i], i};
+  std::sort(s.bsort.begin(), s.bsort.end(),
+            [](const auto& p, const auto& q) { return p.first < q.first; });
+  s.rank.resize(m);
+  std::size_t r = 0;
+  for (std::size_t i = 0; i < m; ++i) {
+    if (i > 0 && !(s.bsort[i].first == s.bsort[i - 1].first)) ++r;
+    s.rank[s.bsort[i].second] = static_cast<uint32_t>(r);
+  }
+  r = m ? r + 1 : 0;
+
+  // Forward: wedge Δa > 0, Δb > 0 and its rays.
+  s.fen.assign(r + 1, 0.0);
+  s.eq.assign(r, 0.0);
+  for (std::size_t pos = 0; pos < m;) {
+    std::size_t run_end = pos + 1;
+    while (run_end < m && s.ka[s.order[run_end]] == s.ka[s.order[pos]]) ++run_end;
+    double pre = 0;  // same a, smaller b: sum of w e^{β b}
+    for (std::size_t g = pos; g < run_end;) {
+      std::size_t g_end = g + 1;
+      while (g_end < run_end && s.kb[s.order[g_end]] == s.kb[s.order[g]]) ++g_end;
+      for (std::size_t i = g; i < g_end; ++i) {
+        const uint32_t e = s.order[i];
+        if (s.slot[e] == FieldEntry::kNoSlot) continue;
+        const uint32_t rk = s.rank[e];
+        const double inter = fen_prefix(s.fen, rk) * s.iea[e] * s.ieb[e];
+        const double res = inter + 0.5 * (s.eq[rk] * s.iea[e] + pre * s.ieb[e]);
+        s.pot[e] += res;
+        s.gx[e] += c.gpp_x * res;
+        s.gy[e] += c.gpp_y * res;
+      }
+      for (std::size_t i = g; i < g_end; ++i) pre += s.w[s.order[i]] * s.eb[s.order[i]];
+      g = g_end;
+    }
+    for (std::size_t i = pos; i < run_end; ++i) {
+      const uint32_t e = s.order[i];
+      if (s.w[e] == 0) continue;
+      fen_add(s.fen, s.rank[e], s.w[e] * s.ea[e] * s.eb[e]);
+      s.eq[s.rank[e]] += s.w[e] * s.ea[e];
+    }
+    pos = run_end;
+  }
+
+  // Backward: wedge Δa < 0, Δb < 0; the tree is indexed by reversed rank (prefix = larger b).
+  s.fen.assign(r + 1, 0.0);
+  s.eq.assign(r, 0.0);
+  for (std::size_t end = m; end > 0;) {
+    std::size_t run_begin = end - 1;
+    while (run_begin > 0 && s.ka[s.order[run_begin - 1]] == s.ka[s.order[end - 1]]) --run_begin;
+    double suf = 0;  // same a, larger b: sum of w e^{-β b}
+    for (std::size_t g_end = end; g_end > run_begin;) {
+      std::size_t g = g_end - 1;
+      while (g > run_begin && s.kb[s.order[g - 1]] == s.kb[s.order[g_end - 1]]) --g;
+      for (std::size_t i = g; i < g_end; ++i) {
+        const uint32_t e = s.order[i];
+        if (s.slot[e] == FieldEntry::kNoSlot) continue;
+        const uint32_t rk = s.rank[e];
+        const double inter = fen_prefix(s.fen, r - 1 - rk) * s.ea[e] * s.eb[e];
+        const double res = inter + 0.5 * (s.eq[rk] * s.ea[e] + suf * s.eb[e]);
+        s.pot[e] += res;
+        s.gx[e] += c.gmm_x * res;
+        s.gy[e] += c.gmm_y * res;
+      }
+      for (std::size_t i = g; i < g_end; ++i) suf += s.w[s.order[i]] * s.ieb[s.order[i]];
+      g_end = g;
+    }
+    for (std::size_t i = run_begin; i < end; ++i) {
+      const uint32_t e = s.order[i];
+      if (s.w[e] == 0) continue;
+      fen_add(s.fen, r - 1 - s.rank[e], s.w[e] * s.iea[e] * s.ieb[e]);
+      s.eq[s.rank[e]] += s.w[e] * s.iea[e];
+    }
+    end = run_begin;
+  }
+}
+
+// Sums for the probes among `items` (global positions in (x, y, id) order, low bit = probe of
+// this tile) over the sources among them; local coordinates (x - ox) - half.
+void process_tile(const std::vector<FieldEntry>& E, std::span<const uint64_t> items, double ox,
+                  double oy, double half, const Separable& sep, Scratch& s, const Outputs& out) {
+  const std::size_t m = items.size();
+  for (auto* v : {&s.x, &s.y, &s.lx, &s.ly, &s.w}) v->resize(m);
+  s.slot.resize(m);
+  s.pot.assign(m, 0.0);
+  s.gx.assign(m, 0.0);
+  s.gy.assign(m, 0.0);
+  bool any_probe = false;
+  for (std::size_t i = 0; i < m; ++i) {
+    const FieldEntry& e = E[items[i] >> 1];
+    s.x[i] = e.x;
+    s.y[i] = e.y;
+    s.lx[i] = (e.x - ox) - half;
+    s.ly[i] = (e.y - oy) - half;
+    s.w[i] = e.w;
+    s.slot[i] = (items[i] & 1) ? e.slot : FieldEntry::kNoSlot;
+    any_probe |= (items[i] & 1) != 0;
+  }
+  if (!any_probe) return;
+
+  // Coincident sources (items are in (x, y, id) order): weight e^0, no gradient, never itself.
+  for (std::size_t g = 0; g < m;) {
+    std::size_t g_end = g + 1;
+    while (g_end < m && s.x[g_end] == s.x[g] && s.y[g_end] == s.y[g]) ++g_end;
+    if (g_end - g > 1) {
+      double pre = 0;
+      for (std::size_t i = g; i < g_end; ++i) {
+        s.pot[i] += pre;
+        pre += s.w[i];
+      }
+      double suf = 0;
+      for (std::size_t i = g_end; i > g; --i) {
+        s.pot[i - 1] += suf;
+        suf += s.w[i - 1];
+      }
+    }
+    g = g_end;
+  }
+  for (int c = 0; c < sep.combos; ++c) run_combo(s, sep.c[c]);
+  for (std::size_t i = 0; i < m; ++i) {
+    if (s.slot[i] == FieldEntry::kNoSlot) continue;
+    out.pot[s.slot[i]] = s.pot[i];
+    out.gx[s.slot[i]] = s.gx[i];
+    out.gy[s.slot[i]] = s.gy[i];
+  }
+}
+
+}  // namespace
+
+bool field_index_supports(const PotentialSpec& spec) {
+  if (spec.kernel != Kernel::exp) return false;
+  if (!std::isfinite(spec.A) || !std::isfinite(spec.k) || spec.k < 0) return false;
+  if (spec.finite_difference && !(spec.fd_step > 0 && std::isfinite(spec.fd_step))) return false;
+  return spec.metric == Metric::l1 ||
+         (spec.metric == Metric::radial && (spec.radial_frames == 1 || spec.radial_frames == 2));
+}
+
+void separable_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
+                          std::span<double> out_pot, std::span<double> out_gx,
+                          std::span<double> out_gy, Executor& ex, QueryStats& stats) {
+  if (!field_index_supports(spec))
+    throw Error(Error::Kind::usage, "field index: unsupported kernel or metric");
+  const Separable sep = separable_of(spec);
+  const Outputs out{out_pot, out_gx, out_gy};
+  const std::size_t n = E.size();
+  if (n == 0) return;
+  if (n >= (std::size_t{1} << 31)) throw Error(Error::Kind::input, "field index: too many points");
+  std::size_t sources = 0;
+  double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+  for (const FieldEntry& e : E) {
+    if (!std::isfinite(e.x) || !std::isfinite(e.y) || !std::isfinite(e.w))
+      throw Error(Error::Kind::input, "field index: a point or charge is not finite");
+    sources += e.w != 0;
+    xmin = std::min(xmin, e.x);
+    xmax = std::max(xmax, e.x);
+    ymin = std::min(ymin, e.y);
+    ymax = std::max(ymax, e.y);
+  }
+  Stopwatch clock;
+  std::sort(E.begin(), E.end(), [](const FieldEntry& a, const FieldEntry& b) {
+    if (a.x != b.x) return a.x < b.x;
+    if (a.y != b.y) return a.y < b.y;
+    return a.id < b.id;
+  });
+  stats.build_seconds += clock.seconds();
+  clock.restart();
+
+  const double hx = (xmax - xmin) / 2, hy = (ymax - ymin) / 2;
+  if (sep.bound(hx, hy) <= kExponentBudget) {
+    // One tile, origin at the centre of the bounding box, nothing dropped.
+    Scratch s;
+    s.items.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      s.items[i] = (uint64_t{i} << 1) | (E[i].slot != FieldEntry::kNoSlot);
+    process_tile(E, s.items, xmin + hx, ymin + hy, 0.0, sep, s, out);
+    stats.nodes_visited += 1;
+    stats.query_seconds += clock.seconds();
+    return;
+  }
+
+  const double halo = (std::log(static_cast<double>(sources) + 1) + kHaloMargin) / sep.decay;
+  const double reach = kExponentBudget / sep.bound(1, 1);  // R: largest |local coordinate|
+  const double side = 2 * (reach - halo);                  // T
+  if (!(side > 0) || !std::isfinite(side))
+    throw Error(Error::Kind::input, "field index: kernel rate out of range for tiling");
+  const double half = side / 2;
+  const auto is_probe = [&](std::size_t i) { return E[i].slot != FieldEntry::kNoSlot; };
+
+  // X-slabs: greedy from the first probe not yet covered.
+  struct Slab {
+    double s0;
+    std::size_t wl, wr;  // window of entries with x - s0 in [-halo, side + halo)
+  };
+  std::vector<Slab> slabs;
+  {
+    std::size_t i = 0, wl = 0, wr = 0;
+    while (i < n && !is_probe(i)) ++i;
+    while (i < n) {
+      const double s0 = E[i].x;
+      while (wl < n && E[wl].x - s0 < -halo) ++wl;
+      wr = std::max(wr, wl);
+      while (wr < n && E[wr].x - s0 < side + halo) ++wr;
+      slabs.push_back({s0, wl, wr});
+      while (i < n && (!is_probe(i) || E[i].x - s0 < side)) ++i;
+    }
+  }
+  stats.build_seconds += clock.seconds();
+  clock.restart();
+
+  std::vector<uint64_t> tiles_per_slab(slabs.size(), 0);
+  ex.for_each_chunk(slabs.size(), 4, [&](std::size_t begin, std::size_t end) {
+    Scratch s;
+    for (std::size_t si = begin; si < end; ++si) {
+      const Slab& sl = slabs[si];
+      s.slab.clear();
+      for (std::size_t j = sl.wl; j < sl.wr; ++j) {
+        const double rel = E[j].x - sl.s0;
+        const bool probe = is_probe(j) && rel >= 0 && rel < side;
+        if (probe || E[j].w != 0)
+          s.slab.push_back({E[j].y, static_cast<uint32_t>(j), probe ? 1u : 0u});
+      }
+      std::sort(s.slab.begin(), s.slab.end(),
+                [](const auto& a, const auto& b) { return a.y < b.y; });
+      const std::size_t m = s.slab.size();
+      std::size_t i = 0, wl = 0, wr = 0;
+      while (i < m && !s.slab[i].probe) ++i;
+      while (i < m) {
+        const double t0 = s.slab[i].y;
+        while (wl < m && s.slab[wl].y - t0 < -halo) ++wl;
+        wr = std::max(wr, wl);
+        while (wr < m && s.slab[wr].y - t0 < side + halo) ++wr;
+        s.items.clear();
+        for (std::size_t j = wl; j < wr; ++j) {
+          const auto& it = s.slab[j];
+          const double rel = it.y - t0;
+          const bool probe = it.probe && rel >= 0 && rel < side;
+          if (probe || E[it.gpos].w != 0)
+            s.items.push_back((uint64_t{it.gpos} << 1) | (probe ? 1u : 0u));
+        }
+        std::sort(s.items.begin(), s.items.end());
+        process_tile(E, s.items, sl.s0, t0, half, sep, s, out);
+        ++tiles_per_slab[si];
+        while (i < m && (!s.slab[i].probe || s.slab[i].y - t0 < side)) ++i;
+      }
+    }
+  });
+  for (uint64_t t : tiles_per_slab) stats.nodes_visited += t;
+  stats.query_seconds += clock.seconds();
+}
+
+namespace {
+
+// Fills `entries` with the sources: discs (weight c/c_max; probes of their own row when
+// `discs_probe`) and the scene's charged points. Returns c_max (0 when every charge is 0).
+double add_sources(std::vector<FieldEntry>& entries, const DiscView& d, const StaticScene& scene,
+                   bool discs_probe) {
+  double cmax = 0;
+  for (std::size_t i = 0; i < d.n; ++i) cmax = std::max(cmax, std::abs(d.charge[i]));
+  for (double c : scene.point_charge()) cmax = std::max(cmax, std::abs(c));
+  if (!std::isfinite(cmax)) throw Error(Error::Kind::input, "field index: a charge is not finite");
+  const double inv = cmax > 0 ? 1 / cmax : 0;
+  entries.clear();
+  entries.reserve(d.n + scene.point_count());
+  for (std::size_t i = 0; i < d.n; ++i) {
+    const double w = d.charge[i] * inv;
+    if (w == 0 && !discs_probe) continue;
+    entries.push_back({d.x[i], d.y[i], w,
+                       discs_probe ? static_cast<uint32_t>(i) : FieldEntry::kNoSlot,
+                       static_cast<uint32_t>(entries.size())});
+  }
+  const auto px = scene.point_x(), py = scene.point_y(), pc = scene.point_charge();
+  for (std::size_t j = 0; j < px.size(); ++j) {
+    if (pc[j] == 0) continue;
+    entries.push_back(
+        {px[j], py[j], pc[j] * inv, FieldEntry::kNoSlot, static_cast<uint32_t>(entries.size())});
+  }
+  return cmax;
+}
+
+void add_probe(std::vector<FieldEntry>& entries, double x, double y, std::size_t slot) {
+  entries.push_back(
+      {x, y, 0.0, static_cast<uint32_t>(slot), static_cast<uint32_t>(entries.size())});
+}
+
+}  // namespace
+
+void FieldIndex::run(const DiscView& d, const StaticScene& scene, const PotentialSpec& spec,
+                     FieldColumns& out, Executor& ex, QueryStats& stats) {
+  const std::size_t n = d.n;
+  out.resize(n);
+  stats.rows += n;
+  if (n == 0) return;
+  const double cmax = add_sources(entries_, d, scene, true);
+  const bool fd = spec.finite_difference;
+  if (fd)
+    for (std::size_t i = 0; i < n; ++i) {
+      add_probe(entries_, d.x[i] + spec.fd_step, d.y[i], n + i);
+      add_probe(entries_, d.x[i], d.y[i] + spec.fd_step, 2 * n + i);
+    }
+  const std::size_t slots = fd ? 3 * n : n;
+  std::vector<double> pot(slots, 0.0), gx(slots, 0.0), gy(slots, 0.0);
+  separable_field_sums(entries_, spec, pot, gx, gy, ex, stats);
+  if (!fd) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const double scale = spec.A * d.charge[i] * cmax;
+      out.potential[i] = scale * pot[i];
+      out.grad_x[i] = scale * gx[i];
+      out.grad_y[i] = scale * gy[i];
+    }
+    return;
+  }
+  // Forward differences; the shifted probes saw their own disc at distance h: remove that term.
+  const PairKernel kernel(spec);
+  double kx = 0, ky = 0, unused = 0;
+  kernel.add(spec.fd_step, 0, 1, kx, unused, unused);
+  kernel.add(0, spec.fd_step, 1, ky, unused, unused);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double ac = spec.A * d.charge[i];
+    const double p0 = ac * cmax * pot[i];
+    const double px = ac * (cmax * pot[n + i] - d.charge[i] * kx);
+    const double py = ac * (cmax * pot[2 * n + i] - d.charge[i] * ky);
+    out.potential[i] = p0;
+    out.grad_x[i] = (px - p0) / spec.fd_step;
+    out.grad_y[i] = (py - p0) / spec.fd_step;
+  }
+}
+
+void FieldIndex::probe(std::span<const Vec2> points, const DiscView& sources,
+                       const StaticScene& scene, const PotentialSpec& spec, FieldColumns& out,
+                       Executor& ex, QueryStats& stats) {
+  const std::size_t n = points.size();
+  out.resize(n);
+  stats.rows += n;
+  if (n == 0) return;
+  const double cmax = add_sources(entries_, sources, scene, false);
+  const bool fd = spec.finite_difference;
+  for (std::size_t i = 0; i < n; ++i) {
+    add_probe(entries_, points[i].x, points[i].y, i);
+    if (fd) {
+      add_probe(entries_, points[i].x + spec.fd_step, points[i].y, n + i);
+      add_probe(entries_, points[i].x, points[i].y + spec.fd_step, 2 * n + i);
+    }
+  }
+  const std::size_t slots = fd ? 3 * n : n;
+  std::vector<double> pot(slots, 0.0), gx(slots, 0.0), gy(slots, 0.0);
+  separable_field_sums(entries_, spec, pot, gx, gy, ex, stats);
+  const double scale = spec.A * cmax;
+  for (std::size_t i = 0; i < n; ++i) {
+    out.potential[i] = scale * pot[i];
+    if (!fd) {
+      out.grad_x[i] = scale * gx[i];
+      out.grad_y[i] = scale * gy[i];
+    } else {
+      out.grad_x[i] = (scale * pot[n + i] - out.potential[i]) / spec.fd_step;
+      out.grad_y[i] = (scale * pot[2 * n + i] - out.potential[i]) / spec.fd_step;
+    }
+  }
+}
+
+}  // namespace crowddb
