@@ -78,8 +78,10 @@
 namespace crowddb {
 namespace {
 
-constexpr double kExponentBudget = 600;  // max |exponent| of a stored weight (e^709 overflows)
+constexpr double kExponentBudget = 650;  // max |exponent| of a stored weight (e^709 overflows)
 constexpr double kHaloMargin = 36;       // e^{-36} = 2.3e-16: per-table budget for dropped terms
+// A tile with at most this many probe x source pairs per entry is summed pair by pair.
+constexpr std::size_t kDirectPairsPerEntry = 16;
 
 // A linear form cx x + cy y with cx, cy in {-1, 0, 1}.
 struct Form {
@@ -178,8 +180,10 @@ struct Scratch {
   // Per combo.
   std::vector<Key> ka, kb;
   std::vector<double> ea, iea, eb, ieb, fen, eq;
-  std::vector<uint32_t> order, rank;
+  std::vector<uint32_t> order, rank, yrank;
+  std::size_t yrank_count = 0;
   std::vector<std::pair<Key, uint32_t>> bsort;
+  std::vector<std::pair<double, uint32_t>> ysort;
   // Slab and tile cutting.
   struct SlabItem {
     double y;
@@ -211,25 +215,49 @@ void run_combo(Scratch& s, const Combo& c) {
     s.ieb[i] = 1 / s.eb[i];
   }
   s.order.resize(m);
-  std::iota(s.order.begin(), s.order.end(), 0u);
-  std::sort(s.order.begin(), s.order.end(), [&](uint32_t i, uint32_t j) {
-    if (s.ka[i] < s.ka[j]) return true;
-    if (s.ka[j] < s.ka[i]) return false;
-    if (s.kb[i] < s.kb[j]) return true;
-    if (s.kb[j] < s.kb[i]) return false;
-    return i < j;
-  });
-  s.bsort.resize(m);
-  for (uint32_t i = 0; i < m; ++i) s.bsort[i] = {s.kb[i], i};
-  std::sort(s.bsort.begin(), s.bsort.end(),
-            [](const auto& p, const auto& q) { return p.first < q.first; });
   s.rank.resize(m);
   std::size_t r = 0;
-  for (std::size_t i = 0; i < m; ++i) {
-    if (i > 0 && !(s.bsort[i].first == s.bsort[i - 1].first)) ++r;
-    s.rank[s.bsort[i].second] = static_cast<uint32_t>(r);
+  if (c.a.cx == 1 && c.a.cy == 0 && c.b.cx == 0) {
+    // L1 combos: entries are stored in (x, y, id) order with y ranked (process_tile).
+    r = s.yrank_count;
+    if (c.b.cy > 0) {
+      std::iota(s.order.begin(), s.order.end(), 0u);
+      std::copy(s.yrank.begin(), s.yrank.begin() + static_cast<std::ptrdiff_t>(m), s.rank.begin());
+    } else {
+      // (x, -y, id) order: inside each run of equal x, the groups of equal y reversed.
+      std::size_t out = 0;
+      for (std::size_t run = 0; run < m;) {
+        std::size_t run_end = run + 1;
+        while (run_end < m && s.x[run_end] == s.x[run]) ++run_end;
+        for (std::size_t g_end = run_end; g_end > run;) {
+          std::size_t g = g_end - 1;
+          while (g > run && s.y[g - 1] == s.y[g]) --g;
+          for (std::size_t i = g; i < g_end; ++i) s.order[out++] = static_cast<uint32_t>(i);
+          g_end = g;
+        }
+        run = run_end;
+      }
+      for (std::size_t i = 0; i < m; ++i) s.rank[i] = static_cast<uint32_t>(r - 1 - s.yrank[i]);
+    }
+  } else {
+    std::iota(s.order.begin(), s.order.end(), 0u);
+    std::sort(s.order.begin(), s.order.end(), [&](uint32_t i, uint32_t j) {
+      if (s.ka[i] < s.ka[j]) return true;
+      if (s.ka[j] < s.ka[i]) return false;
+      if (s.kb[i] < s.kb[j]) return true;
+      if (s.kb[j] < s.kb[i]) return false;
+      return i < j;
+    });
+    s.bsort.resize(m);
+    for (uint32_t i = 0; i < m; ++i) s.bsort[i] = {s.kb[i], i};
+    std::sort(s.bsort.begin(), s.bsort.end(),
+              [](const auto& p, const auto& q) { return p.first < q.first; });
+    for (std::size_t i = 0; i < m; ++i) {
+      if (i > 0 && !(s.bsort[i].first == s.bsort[i - 1].first)) ++r;
+      s.rank[s.bsort[i].second] = static_cast<uint32_t>(r);
+    }
+    r = m ? r + 1 : 0;
   }
-  r = m ? r + 1 : 0;
 
   // Forward: wedge Δa > 0, Δb > 0 and its rays.
   s.fen.assign(r + 1, 0.0);
@@ -296,17 +324,51 @@ void run_combo(Scratch& s, const Combo& c) {
   }
 }
 
-// Sums for the probes among `items` (global positions in (x, y, id) order, low bit = probe of
-// this tile) over the sources among them; local coordinates (x - ox) - half.
-void process_tile(const std::vector<FieldEntry>& E, std::span<const uint64_t> items, double ox,
-                  double oy, double half, const Separable& sep, Scratch& s, const Outputs& out) {
+// Sums for the probes among `items` (low bit = probe of this tile; the rest, gpos, indexes E)
+// over the sources among them; local coordinates (x - ox) - half. Sparse tiles (few probe x
+// source pairs) are summed pair by pair with the naive path's own kernel; the others by sweeps.
+void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, double ox,
+                  double oy, double half, double halo, const Separable& sep,
+                  const PairKernel& kernel, Scratch& s, const Outputs& out) {
   const std::size_t m = items.size();
+  std::size_t probes = 0, sources = 0;
+  for (uint64_t it : items) {
+    probes += it & 1;
+    sources += E[it >> 1].w != 0;
+  }
+  if (probes == 0) return;
+  if (probes * sources <= kDirectPairsPerEntry * m) {
+    for (std::size_t i = 0; i < m; ++i) {
+      if (!(items[i] & 1)) continue;
+      const FieldEntry& p = E[items[i] >> 1];
+      double pot = 0, gx = 0, gy = 0;
+      for (std::size_t j = 0; j < m; ++j) {
+        const FieldEntry& q = E[items[j] >> 1];
+        const double dx = p.x - q.x, dy = p.y - q.y;
+        // Beyond the halo in x or y a term is below the dropped-term bound (see above).
+        if (j == i || q.w == 0 || std::abs(dx) > halo || std::abs(dy) > halo) continue;
+        kernel.add(dx, dy, q.w, pot, gx, gy);
+      }
+      out.pot[p.slot] = pot;
+      out.gx[p.slot] = gx;
+      out.gy[p.slot] = gy;
+    }
+    return;
+  }
+
+  // Sweeps: entries in (x, y, id) order.
+  std::sort(items.begin(), items.end(), [&](uint64_t a, uint64_t b) {
+    const FieldEntry &p = E[a >> 1], &q = E[b >> 1];
+    if (p.x != q.x) return p.x < q.x;
+    if (p.y != q.y) return p.y < q.y;
+    return p.id < q.id;
+  });
   for (auto* v : {&s.x, &s.y, &s.lx, &s.ly, &s.w}) v->resize(m);
   s.slot.resize(m);
   s.pot.assign(m, 0.0);
   s.gx.assign(m, 0.0);
   s.gy.assign(m, 0.0);
-  bool any_probe = false;
+  s.ysort.resize(m);
   for (std::size_t i = 0; i < m; ++i) {
     const FieldEntry& e = E[items[i] >> 1];
     s.x[i] = e.x;
@@ -315,11 +377,19 @@ void process_tile(const std::vector<FieldEntry>& E, std::span<const uint64_t> it
     s.ly[i] = (e.y - oy) - half;
     s.w[i] = e.w;
     s.slot[i] = (items[i] & 1) ? e.slot : FieldEntry::kNoSlot;
-    any_probe |= (items[i] & 1) != 0;
+    s.ysort[i] = {e.y, static_cast<uint32_t>(i)};
   }
-  if (!any_probe) return;
+  std::sort(s.ysort.begin(), s.ysort.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  s.yrank.resize(m);
+  std::size_t r = 0;
+  for (std::size_t i = 0; i < m; ++i) {
+    if (i > 0 && s.ysort[i].first != s.ysort[i - 1].first) ++r;
+    s.yrank[s.ysort[i].second] = static_cast<uint32_t>(r);
+  }
+  s.yrank_count = r + 1;
 
-  // Coincident sources (items are in (x, y, id) order): weight e^0, no gradient, never itself.
+  // Coincident sources: weight e^0, no gradient, never the probe itself.
   for (std::size_t g = 0; g < m;) {
     std::size_t g_end = g + 1;
     while (g_end < m && s.x[g_end] == s.x[g] && s.y[g_end] == s.y[g]) ++g_end;
@@ -362,6 +432,7 @@ void separable_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
   if (!field_index_supports(spec))
     throw Error(Error::Kind::usage, "field index: unsupported kernel or metric");
   const Separable sep = separable_of(spec);
+  const PairKernel kernel(spec);
   const Outputs out{out_pot, out_gx, out_gy};
   const std::size_t n = E.size();
   if (n == 0) return;
@@ -378,11 +449,17 @@ void separable_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
     ymax = std::max(ymax, e.y);
   }
   Stopwatch clock;
-  std::sort(E.begin(), E.end(), [](const FieldEntry& a, const FieldEntry& b) {
-    if (a.x != b.x) return a.x < b.x;
-    if (a.y != b.y) return a.y < b.y;
-    return a.id < b.id;
-  });
+  {
+    // By x only (ties by id): slabs need x order; tiles that sweep sort their own entries.
+    std::vector<std::pair<double, uint32_t>> order(n);
+    for (std::size_t i = 0; i < n; ++i) order[i] = {E[i].x, static_cast<uint32_t>(i)};
+    std::sort(order.begin(), order.end(), [&](const auto& a, const auto& b) {
+      return a.first < b.first || (a.first == b.first && E[a.second].id < E[b.second].id);
+    });
+    std::vector<FieldEntry> sorted(n);
+    for (std::size_t i = 0; i < n; ++i) sorted[i] = E[order[i].second];
+    E.swap(sorted);
+  }
   stats.build_seconds += clock.seconds();
   clock.restart();
 
@@ -393,7 +470,7 @@ void separable_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
     s.items.resize(n);
     for (std::size_t i = 0; i < n; ++i)
       s.items[i] = (uint64_t{i} << 1) | (E[i].slot != FieldEntry::kNoSlot);
-    process_tile(E, s.items, xmin + hx, ymin + hy, 0.0, sep, s, out);
+    process_tile(E, s.items, xmin + hx, ymin + hy, 0.0, INFINITY, sep, kernel, s, out);
     stats.nodes_visited += 1;
     stats.query_seconds += clock.seconds();
     return;
@@ -459,7 +536,7 @@ void separable_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
             s.items.push_back((uint64_t{it.gpos} << 1) | (probe ? 1u : 0u));
         }
         std::sort(s.items.begin(), s.items.end());
-        process_tile(E, s.items, sl.s0, t0, half, sep, s, out);
+        process_tile(E, s.items, sl.s0, t0, half, halo, sep, kernel, s, out);
         ++tiles_per_slab[si];
         while (i < m && (!s.slab[i].probe || s.slab[i].y - t0 < side)) ++i;
       }

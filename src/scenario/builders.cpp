@@ -95,6 +95,26 @@ DiscTable duplicates(std::size_t n, std::size_t distinct, Box box, double vmax, 
   return t;
 }
 
+std::vector<CircleObstacle> circles(std::size_t count, Box box, double rmin, double rmax, double charge,
+                                    uint64_t seed) {
+  Rng rng(seed);
+  std::vector<CircleObstacle> out;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double x = rng.uniform(box.xmin, box.xmax), y = rng.uniform(box.ymin, box.ymax);
+    out.push_back({x, y, rng.uniform(rmin, rmax), charge});
+  }
+  return out;
+}
+
+FieldWorld e5_world(std::size_t n, uint64_t seed) {
+  const double side = static_cast<double>(n);
+  const Box box{0, 0, side, side};
+  FieldWorld w;
+  w.agents = uniform(n, box, 5, 1, 3, Rng::stream(seed, 1).next());
+  w.obstacles = circles((3 * n + 62) / 125, box, 5, 15, 1, Rng::stream(seed, 2).next());
+  return w;
+}
+
 void offset(DiscTable& t, double dx, double dy) {
   for (auto& x : t.x) x += dx;
   for (auto& y : t.y) y += dy;

@@ -34,6 +34,20 @@ DiscTable big_crunch(std::size_t n, Box box, double arrival, double rmin, double
 // Copies of `distinct` positions repeated until n rows: duplicate positions (and velocities).
 DiscTable duplicates(std::size_t n, std::size_t distinct, Box box, double vmax, double radius, uint64_t seed);
 
+// `count` circle obstacles, centres uniform in the box, radius uniform in [rmin, rmax], charge
+// `charge` (the "large static obstacles" of the potential-field experiments).
+std::vector<CircleObstacle> circles(std::size_t count, Box box, double rmin, double rmax, double charge,
+                                    uint64_t seed);
+
+// The E5 potential-field table (thesis §4.2, DESIGN.md §7): density x n = 1, i.e. n agents
+// uniform on an n x n board, radius in [1, 3], speed in [0, 5]; and round(3 n / 125) obstacles
+// of radius in [5, 15] (125 agents : 3 obstacles).
+struct FieldWorld {
+  DiscTable agents;
+  std::vector<CircleObstacle> obstacles;
+};
+FieldWorld e5_world(std::size_t n, uint64_t seed);
+
 // Shifts every position by (dx, dy): the far-offset variants (e.g. 1e6).
 void offset(DiscTable& t, double dx, double dy);
 

@@ -1,0 +1,74 @@
+// Potential field, E5 setup (DESIGN.md §7): n agents on an n x n board, 3 obstacles per 125
+// agents (charged points at their centres), A = 0.929328, k = 0.272194, potential + gradient
+// for every agent, single-threaded. Counters: `checksum` (sum of potentials: a fast wrong change
+// shows), `s_per_Magent` (= microseconds per agent).
+//
+//   build/bench/field_bench --benchmark_filter='Index'            # 10^3 .. 10^6
+//   build/bench/field_bench --benchmark_filter='Crossover'        # small n: index vs naive
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <memory>
+
+#include "crowddb/query.hpp"
+#include "scenario/builders.hpp"
+
+namespace crowddb {
+namespace {
+
+struct Fixture {
+  build::FieldWorld world;
+  StaticScene scene;
+};
+
+const Fixture& fixture(std::size_t n) {
+  static std::map<std::size_t, std::unique_ptr<Fixture>> cache;
+  auto& f = cache[n];
+  if (!f) {
+    f = std::make_unique<Fixture>();
+    f->world = build::e5_world(n, 2024);
+    f->scene = StaticScene(f->world.obstacles, {}, 1.0, ObstacleCharges::centres);
+  }
+  return *f;
+}
+
+PotentialSpec spec(Metric metric) {
+  PotentialSpec s;
+  s.metric = metric;
+  return s;
+}
+
+void run(benchmark::State& state, const char* method, Metric metric) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  const Fixture& f = fixture(n);
+  const PotentialSpec s = spec(metric);
+  double checksum = 0;
+  for (auto _ : state) {
+    const FieldColumns out = potential_field(f.world.agents.view(), f.scene, s, method, 1);
+    checksum = 0;
+    for (double p : out.potential) checksum += p;
+    benchmark::DoNotOptimize(checksum);
+  }
+  state.counters["checksum"] = checksum;
+  // Seconds per million agents (benchmark prints it with an "s" suffix) = microseconds per agent.
+  state.counters["s_per_Magent"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) * static_cast<double>(n) / 1e6,
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void BM_FieldIndexL1(benchmark::State& s) { run(s, "index", Metric::l1); }
+void BM_FieldIndexRadial(benchmark::State& s) { run(s, "index", Metric::radial); }
+void BM_FieldNaiveL1(benchmark::State& s) { run(s, "naive", Metric::l1); }
+void BM_FieldCrossoverIndex(benchmark::State& s) { run(s, "index", Metric::l1); }
+void BM_FieldCrossoverNaive(benchmark::State& s) { run(s, "naive", Metric::l1); }
+
+BENCHMARK(BM_FieldIndexL1)->RangeMultiplier(10)->Range(1000, 1000000)->Arg(20000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FieldIndexRadial)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FieldNaiveL1)->Arg(1000)->Arg(10000)->Arg(20000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FieldCrossoverIndex)->DenseRange(16, 128, 16)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FieldCrossoverNaive)->DenseRange(16, 128, 16)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace crowddb
+
+BENCHMARK_MAIN();
