@@ -38,8 +38,10 @@ class Node {
   bool has(const std::string& key) const { return j_.contains(key); }
 
   const json& raw(const std::string& key) {
+    const auto it = j_.find(key);
+    if (it == j_.end()) fail(key, "missing");
     used_.insert(key);
-    return j_.at(key);
+    return *it;
   }
 
   double number(const std::string& key, std::optional<double> fallback = std::nullopt) {
