@@ -51,19 +51,36 @@ void run(benchmark::State& state, const char* method, Metric metric) {
   }
   state.counters["checksum"] = checksum;
   // Seconds per million agents (benchmark prints it with an "s" suffix) = microseconds per agent.
-  state.counters["s_per_Magent"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) * static_cast<double>(n) / 1e6,
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["s_per_Magent"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * static_cast<double>(n) / 1e6,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-void BM_FieldIndexL1(benchmark::State& s) { run(s, "index", Metric::l1); }
-void BM_FieldIndexRadial(benchmark::State& s) { run(s, "index", Metric::radial); }
-void BM_FieldNaiveL1(benchmark::State& s) { run(s, "naive", Metric::l1); }
-void BM_FieldCrossoverIndex(benchmark::State& s) { run(s, "index", Metric::l1); }
-void BM_FieldCrossoverNaive(benchmark::State& s) { run(s, "naive", Metric::l1); }
+void BM_FieldIndexL1(benchmark::State& s) {
+  run(s, "index", Metric::l1);
+}
+void BM_FieldIndexRadial(benchmark::State& s) {
+  run(s, "index", Metric::radial);
+}
+void BM_FieldNaiveL1(benchmark::State& s) {
+  run(s, "naive", Metric::l1);
+}
+void BM_FieldCrossoverIndex(benchmark::State& s) {
+  run(s, "index", Metric::l1);
+}
+void BM_FieldCrossoverNaive(benchmark::State& s) {
+  run(s, "naive", Metric::l1);
+}
 
-BENCHMARK(BM_FieldIndexL1)->RangeMultiplier(10)->Range(1000, 1000000)->Arg(20000)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_FieldIndexRadial)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FieldIndexL1)
+    ->RangeMultiplier(10)
+    ->Range(1000, 1000000)
+    ->Arg(20000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FieldIndexRadial)
+    ->RangeMultiplier(10)
+    ->Range(1000, 1000000)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FieldNaiveL1)->Arg(1000)->Arg(10000)->Arg(20000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FieldCrossoverIndex)->DenseRange(16, 128, 16)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FieldCrossoverNaive)->DenseRange(16, 128, 16)->Unit(benchmark::kMicrosecond);
