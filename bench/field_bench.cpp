@@ -82,8 +82,26 @@ BENCHMARK(BM_FieldIndexRadial)
     ->Range(1000, 1000000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FieldNaiveL1)->Arg(1000)->Arg(10000)->Arg(20000)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_FieldCrossoverIndex)->DenseRange(16, 128, 16)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_FieldCrossoverNaive)->DenseRange(16, 128, 16)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FieldCrossoverIndex)
+    ->Arg(4)
+    ->Arg(8)
+    ->Arg(12)
+    ->Arg(16)
+    ->Arg(24)
+    ->Arg(32)
+    ->Arg(64)
+    ->Arg(128)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FieldCrossoverNaive)
+    ->Arg(4)
+    ->Arg(8)
+    ->Arg(12)
+    ->Arg(16)
+    ->Arg(24)
+    ->Arg(32)
+    ->Arg(64)
+    ->Arg(128)
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace crowddb

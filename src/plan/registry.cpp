@@ -47,10 +47,11 @@ const std::vector<FieldMethod>& field_registry() {
       {{"naive", "nested loop over all pairs, O(n^2)"},
        [](const PotentialSpec&) { return true; },
        [] { return std::make_unique<FieldNaive>(); }},
-      // auto_min_rows: below ~60 rows the naive loop is as fast (measured with
-      // bench/field_bench: BM_FieldCrossover, exp-l1, uniform on an n x n board).
+      // auto_min_rows 20: the index overtakes the naive loop between 16 and 24 rows (medians of
+      // 3 repetitions of bench/field_bench BM_FieldCrossover*, exp-l1, n agents on an n x n
+      // board: 16 rows 4.0 vs 3.4 us, 24 rows 5.3 vs 8.3 us, single-threaded, load ~8).
       {{"index", "exact separable aggregate index (exp-l1, exp-radial m <= 2), O(n log n)", true, 1,
-        64},
+        20},
        [](const PotentialSpec& s) { return field_index_supports(s); },
        [] { return std::make_unique<FieldIndex>(); }},
   };
