@@ -27,42 +27,50 @@
 // only when coordinate differences round, never on lattices or small integers/dyadics — may get
 // an adjacent wedge's gradient. L1 classification is always exact: sign(x_p - x_q) is exact.)
 //
-// SWEEP. Per combo the tile's entries are sorted by (a, b) and b is ranked. The forward sweep
-// visits runs of equal a in increasing a; probes of a run query a Fenwick tree over b-ranks
-// (prefix: sources with smaller a and smaller b: the wedge interior), an array of per-rank sums
-// (smaller a, equal b: one ray) and a running sum inside the run (equal a, smaller b: the other
-// ray); then the run's sources are inserted. The backward sweep mirrors it with suffixes.
+// SWEEP. Per combo the tile's entries are sorted by (a, b) and b is ranked (for the L1 combos
+// both come from the tile's (x, y, id) order and y ranks, without sorting again). The forward
+// sweep visits runs of equal a in increasing a; probes of a run query a Fenwick tree over
+// b-ranks (prefix: sources with smaller a and smaller b: the wedge interior), an array of
+// per-rank sums (smaller a, equal b: one ray) and a running sum inside the run (equal a,
+// smaller b: the other ray); then the run's sources are inserted. The backward sweep mirrors it.
 //
 // NUMERICS: ANY COORDINATE RANGE. e^{k x} overflows a double near k x ≈ 709, so weights are
 // computed in tile-local coordinates. If the whole table's bounding box keeps every combo's
-// exponent α|a_local| + β|b_local| <= B = 600 (local origin at the box centre), it is one tile.
+// exponent α|a_local| + β|b_local| <= B = 650 (local origin at the box centre), it is one tile.
 // Otherwise probes are covered greedily by x-slabs and, inside a slab, by y-tiles of side T;
 // each tile sees the sources within a halo H of it and uses the origin (x0 + T/2, y0 + T/2), so
-// |local coordinate| <= R = T/2 + H with the exponent bound at R equal to B. H is chosen so that
-// a source outside the halo (L∞ distance > H, hence k d >= decay H) weighs at most
-// e^{-decay H} = e^{-36} / (n_sources + 1), i.e. all dropped terms together are below
-// 2.4e-16 · A c_max^2 — four orders below the absolute tolerance.
-// Weights are normalised by c_max, so stored sums stay below n e^{600} < 10^300 for n < 10^30,
-// and probe factors e^{-600} are normal numbers.
+// |local coordinate| <= R = T/2 + H with the exponent bound at R equal to B (L1: k R = 325,
+// T ≈ 2 (325 - 50) / k, e.g. 2,000 units for the thesis's k). H is chosen so that a source
+// farther than H in x or y (hence k d >= decay H) weighs at most
+// e^{-decay H} = e^{-36} / (n_sources + 1): all dropped terms of a probe together are below
+// 2.4e-16 · A c_max^2, four orders below the absolute tolerance. The same cut is applied in
+// both tile paths. Weights are normalised by c_max, so stored sums stay below
+// n e^{650} < 10^300 for n < 2^31, and probe factors e^{-650} ≈ 10^-282 are normal numbers.
+//
+// SPARSE TILES. A tile with at most 16 probe x source pairs per entry (sparse worlds: the E5
+// board holds ~5 entries per tile) is summed pair by pair with the naive path's own PairKernel
+// (same halo cut): cheaper than sorting, and bit-for-bit the naive terms.
 //
 // ERROR BOUND (relative to S_abs, the sum of |contributions|, unit roundoff u = 1.1e-16):
-//  - each weight or probe factor e^{±α l}: the argument is rounded (|arg| <= 600, so
-//    <= 600u absolute), exp itself < 1 ulp: <= ~4 (600 + 2) u ≈ 2.7e-13 relative per term;
+//  - each weight or probe factor e^{±α l}: the argument is rounded (|arg| <= 650, so
+//    <= 650u absolute), exp itself < 1 ulp: <= ~4 (650 + 2) u ≈ 2.9e-13 relative per term;
 //  - summation: Fenwick partial sums hold only terms of the probe's own wedge, at most
 //    2 log2(n) + 4 additions deep: <= 50u for n <= 10^6;
 //  - halo: <= 2.4e-16 A c_max^2 absolute; underflow of tiny weights: < 1e-250 A c_max^2.
 // So |S_idx - S_exact| <= 3e-13 S_abs + 3e-16 A c_max^2, far inside DESIGN.md's
 // 1e-9 S_abs + 1e-12 A c_max^2 (the naive sum itself is off by up to n u S_abs). Gradient
 // components are sums of the same terms times wedge coefficients of size <= k: the same bound
-// times k.
+// times k. Measured (tests, E5): |S_idx - S_naive| <= ~1e-4 of the tolerance.
 //
-// COMPLEXITY. One global sort O(n log n); every source lies in at most 4 tiles (H < T/2);
-// per tile of m entries, per combo, two sorts and two sweeps: O(m log m). Total O(n log n)
-// time, O(n) memory. Exponentials: 4 per entry per combo per tile.
+// COMPLEXITY. One global sort by x, O(n log n); every source lies in at most 4 tiles
+// (2H < T); per swept tile of m entries: a sort by (x, y, id) and, per combo, at most two
+// sorts and two sweeps, O(m log m); a direct tile costs O(pairs) <= 16 m. Total O(n log n)
+// time, O(n) memory. Exponentials: 2 per entry per combo in swept tiles, 1 per pair in direct
+// tiles.
 //
-// DETERMINISM. Entries are ordered by (x, y, id); tiles are cut by a deterministic greedy rule;
-// each probe is computed in exactly one tile by one thread, and slabs are independent: the
-// output does not depend on the thread count.
+// DETERMINISM. Entries are ordered by (x, id) and inside swept tiles by (x, y, id); tiles are cut
+// by a deterministic greedy rule; each probe is computed in exactly one tile by one thread, and
+// slabs are independent: the output does not depend on the thread count.
 #include "index/field_index.hpp"
 
 #include <algorithm>
@@ -327,9 +335,9 @@ void run_combo(Scratch& s, const Combo& c) {
 // Sums for the probes among `items` (low bit = probe of this tile; the rest, gpos, indexes E)
 // over the sources among them; local coordinates (x - ox) - half. Sparse tiles (few probe x
 // source pairs) are summed pair by pair with the naive path's own kernel; the others by sweeps.
-void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, double ox,
-                  double oy, double half, double halo, const Separable& sep,
-                  const PairKernel& kernel, Scratch& s, const Outputs& out) {
+void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, double ox, double oy,
+                  double half, double halo, const Separable& sep, const PairKernel& kernel,
+                  Scratch& s, const Outputs& out) {
   const std::size_t m = items.size();
   std::size_t probes = 0, sources = 0;
   for (uint64_t it : items) {

@@ -60,6 +60,20 @@ TEST(KernelFit, ContinuousFitOnALongIntervalApproachesItsLimit) {
   EXPECT_NEAR(f.k, 0.2589469, 2e-6);
 }
 
+// The thesis's A = 0.929328, k = 0.272194: a least-squares fit over 400 equally spaced samples
+// of [1, 40.932] (spacing ~0.1) reproduces them to six digits. No interval does with the
+// continuous norm: its k/A depends only on to/from and decreases to 0.2929019 (at [1, 1000]),
+// above the thesis's 0.2928934.
+TEST(KernelFit, ReproducesTheThesisConstantsFromSamples) {
+  const KernelFit f = fit_exp_kernel(1, 40.93196, 1.0, 400);
+  EXPECT_NEAR(f.A, 0.929328, 2e-6);
+  EXPECT_NEAR(f.k, 0.272194, 2e-6);
+  for (double to : {20.0, 40.0, 100.0, 1000.0}) {
+    const KernelFit c = fit_exp_kernel(1, to);
+    EXPECT_GT(c.k / c.A, 0.2929015) << to;
+  }
+}
+
 TEST(KernelFit, RejectsBadIntervals) {
   EXPECT_THROW(fit_exp_kernel(0, 1), Error);
   EXPECT_THROW(fit_exp_kernel(2, 1), Error);
