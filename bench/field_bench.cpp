@@ -5,6 +5,7 @@
 //
 //   build/bench/field_bench --benchmark_filter='Index'            # 10^3 .. 10^6
 //   build/bench/field_bench --benchmark_filter='Crossover'        # small n: index vs naive
+//   build/bench/field_bench --benchmark_filter='L2'               # exp-l2: cutoff vs naive
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -72,6 +73,25 @@ void BM_FieldCrossoverNaive(benchmark::State& s) {
   run(s, "naive", Metric::l1);
 }
 
+void BM_FieldCutoffL2(benchmark::State& s) {
+  run(s, "cutoff", Metric::l2);
+}
+void BM_FieldNaiveL2(benchmark::State& s) {
+  run(s, "naive", Metric::l2);
+}
+void BM_FieldCutoffCrossoverCutoff(benchmark::State& s) {
+  run(s, "cutoff", Metric::l2);
+}
+void BM_FieldCutoffCrossoverNaive(benchmark::State& s) {
+  run(s, "naive", Metric::l2);
+}
+
+// Small to medium n for the cutoff's planner threshold: below a board of ~2 halos (n ~ 300 for
+// the thesis's k) the cutoff is one tile, i.e. the naive loop plus its overhead.
+void cutoff_sizes(benchmark::internal::Benchmark* b) {
+  for (int n : {16, 32, 64, 128, 256, 384, 512, 768, 1000, 2000}) b->Arg(n);
+}
+
 BENCHMARK(BM_FieldIndexL1)
     ->RangeMultiplier(10)
     ->Range(1000, 1000000)
@@ -102,6 +122,14 @@ BENCHMARK(BM_FieldCrossoverNaive)
     ->Arg(64)
     ->Arg(128)
     ->Unit(benchmark::kMicrosecond);
+
+BENCHMARK(BM_FieldCutoffL2)
+    ->RangeMultiplier(10)
+    ->Range(1000, 1000000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FieldNaiveL2)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FieldCutoffCrossoverCutoff)->Apply(cutoff_sizes)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FieldCutoffCrossoverNaive)->Apply(cutoff_sizes)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace crowddb

@@ -182,6 +182,7 @@ inline void fen_add(std::vector<double>& t, std::size_t i, double v) {
 
 // Per-thread working storage, reused across tiles.
 struct Scratch {
+  uint64_t pairs = 0;  // direct pair evaluations (QueryStats::pair_tests)
   // Tile entries in (x, y, id) order.
   std::vector<double> x, y, lx, ly, w, pot, gx, gy;
   std::vector<uint32_t> slot;
@@ -336,8 +337,8 @@ void run_combo(Scratch& s, const Combo& c) {
 // over the sources among them; local coordinates (x - ox) - half. Sparse tiles (few probe x
 // source pairs) are summed pair by pair with the naive path's own kernel; the others by sweeps.
 void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, double ox, double oy,
-                  double half, double halo, const Separable& sep, const PairKernel& kernel,
-                  Scratch& s, const Outputs& out) {
+                  double half, double halo, bool direct_only, const Separable& sep,
+                  const PairKernel& kernel, Scratch& s, const Outputs& out) {
   const std::size_t m = items.size();
   std::size_t probes = 0, sources = 0;
   for (uint64_t it : items) {
@@ -345,7 +346,7 @@ void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, d
     sources += E[it >> 1].w != 0;
   }
   if (probes == 0) return;
-  if (probes * sources <= kDirectPairsPerEntry * m) {
+  if (direct_only || probes * sources <= kDirectPairsPerEntry * m) {
     for (std::size_t i = 0; i < m; ++i) {
       if (!(items[i] & 1)) continue;
       const FieldEntry& p = E[items[i] >> 1];
@@ -356,6 +357,7 @@ void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, d
         // Beyond the halo in x or y a term is below the dropped-term bound (see above).
         if (j == i || q.w == 0 || std::abs(dx) > halo || std::abs(dy) > halo) continue;
         kernel.add(dx, dy, q.w, pot, gx, gy);
+        ++s.pairs;
       }
       out.pot[p.slot] = pot;
       out.gx[p.slot] = gx;
@@ -427,19 +429,31 @@ void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, d
 }  // namespace
 
 bool field_index_supports(const PotentialSpec& spec) {
-  if (spec.kernel != Kernel::exp) return false;
-  if (!std::isfinite(spec.A) || !std::isfinite(spec.k) || spec.k < 0) return false;
-  if (spec.finite_difference && !(spec.fd_step > 0 && std::isfinite(spec.fd_step))) return false;
-  return spec.metric == Metric::l1 ||
-         (spec.metric == Metric::radial && (spec.radial_frames == 1 || spec.radial_frames == 2));
+  return field_cutoff_supports(spec) &&
+         (spec.metric == Metric::l1 ||
+          (spec.metric == Metric::radial && (spec.radial_frames == 1 || spec.radial_frames == 2)));
 }
 
-void separable_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
-                          std::span<double> out_pot, std::span<double> out_gx,
-                          std::span<double> out_gy, Executor& ex, QueryStats& stats) {
-  if (!field_index_supports(spec))
-    throw Error(Error::Kind::usage, "field index: unsupported kernel or metric");
-  const Separable sep = separable_of(spec);
+bool field_cutoff_supports(const PotentialSpec& spec) {
+  if (spec.kernel != Kernel::exp) return false;
+  if (!std::isfinite(spec.A) || !std::isfinite(spec.k) || spec.k < 0) return false;
+  if (spec.radial_frames < 1 || spec.radial_frames > PairKernel::kMaxFrames) return false;
+  return !spec.finite_difference || (spec.fd_step > 0 && std::isfinite(spec.fd_step));
+}
+
+namespace {
+
+// Both modes: `cutoff` sums every tile pair by pair (any exp metric); otherwise swept tiles.
+void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, bool cutoff,
+                      std::span<double> out_pot, std::span<double> out_gx,
+                      std::span<double> out_gy, Executor& ex, QueryStats& stats) {
+  Separable sep;
+  if (cutoff) {
+    // k d >= decay max(|dx|, |dy|): l1 and l2 >= L∞; radial >= (π/4) L2 (each frame's L1 >= L2).
+    sep.decay = spec.metric == Metric::radial ? spec.k * (std::numbers::pi / 4) : spec.k;
+  } else {
+    sep = separable_of(spec);
+  }
   const PairKernel kernel(spec);
   const Outputs out{out_pot, out_gx, out_gy};
   const std::size_t n = E.size();
@@ -472,21 +486,26 @@ void separable_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
   clock.restart();
 
   const double hx = (xmax - xmin) / 2, hy = (ymax - ymin) / 2;
-  if (sep.bound(hx, hy) <= kExponentBudget) {
+  const double halo = (std::log(static_cast<double>(sources) + 1) + kHaloMargin) / sep.decay;
+  // Tile side T: swept tiles are as large as the exponent budget allows; direct tiles 2H, so a
+  // window of (T + 2H)^2 = 16 H^2 serves a tile of 4 H^2.
+  const double side = cutoff ? 2 * halo : 2 * (kExponentBudget / sep.bound(1, 1) - halo);
+  const bool one_tile =
+      cutoff ? !(2 * std::max(hx, hy) > side) : sep.bound(hx, hy) <= kExponentBudget;
+  if (one_tile) {
     // One tile, origin at the centre of the bounding box, nothing dropped.
     Scratch s;
     s.items.resize(n);
     for (std::size_t i = 0; i < n; ++i)
       s.items[i] = (uint64_t{i} << 1) | (E[i].slot != FieldEntry::kNoSlot);
-    process_tile(E, s.items, xmin + hx, ymin + hy, 0.0, INFINITY, sep, kernel, s, out);
+    process_tile(E, s.items, xmin + hx, ymin + hy, 0.0, INFINITY, cutoff, sep, kernel, s,
+                 out);
+    stats.pair_tests += s.pairs;
     stats.nodes_visited += 1;
     stats.query_seconds += clock.seconds();
     return;
   }
 
-  const double halo = (std::log(static_cast<double>(sources) + 1) + kHaloMargin) / sep.decay;
-  const double reach = kExponentBudget / sep.bound(1, 1);  // R: largest |local coordinate|
-  const double side = 2 * (reach - halo);                  // T
   if (!(side > 0) || !std::isfinite(side))
     throw Error(Error::Kind::input, "field index: kernel rate out of range for tiling");
   const double half = side / 2;
@@ -513,7 +532,7 @@ void separable_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
   stats.build_seconds += clock.seconds();
   clock.restart();
 
-  std::vector<uint64_t> tiles_per_slab(slabs.size(), 0);
+  std::vector<uint64_t> tiles_per_slab(slabs.size(), 0), pairs_per_slab(slabs.size(), 0);
   ex.for_each_chunk(slabs.size(), 4, [&](std::size_t begin, std::size_t end) {
     Scratch s;
     for (std::size_t si = begin; si < end; ++si) {
@@ -544,14 +563,35 @@ void separable_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
             s.items.push_back((uint64_t{it.gpos} << 1) | (probe ? 1u : 0u));
         }
         std::sort(s.items.begin(), s.items.end());
-        process_tile(E, s.items, sl.s0, t0, half, halo, sep, kernel, s, out);
+        process_tile(E, s.items, sl.s0, t0, half, halo, cutoff, sep, kernel, s, out);
         ++tiles_per_slab[si];
+        pairs_per_slab[si] += s.pairs;
+        s.pairs = 0;
         while (i < m && (!s.slab[i].probe || s.slab[i].y - t0 < side)) ++i;
       }
     }
   });
   for (uint64_t t : tiles_per_slab) stats.nodes_visited += t;
+  for (uint64_t p : pairs_per_slab) stats.pair_tests += p;
   stats.query_seconds += clock.seconds();
+}
+
+}  // namespace
+
+void separable_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
+                          std::span<double> out_pot, std::span<double> out_gx,
+                          std::span<double> out_gy, Executor& ex, QueryStats& stats) {
+  if (!field_index_supports(spec))
+    throw Error(Error::Kind::usage, "field index: unsupported kernel or metric");
+  tiled_field_sums(E, spec, false, out_pot, out_gx, out_gy, ex, stats);
+}
+
+void cutoff_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
+                       std::span<double> out_pot, std::span<double> out_gx,
+                       std::span<double> out_gy, Executor& ex, QueryStats& stats) {
+  if (!field_cutoff_supports(spec))
+    throw Error(Error::Kind::usage, "field cutoff: unsupported kernel");
+  tiled_field_sums(E, spec, true, out_pot, out_gx, out_gy, ex, stats);
 }
 
 namespace {
@@ -605,7 +645,7 @@ void FieldIndex::run(const DiscView& d, const StaticScene& scene, const Potentia
     }
   const std::size_t slots = fd ? 3 * n : n;
   std::vector<double> pot(slots, 0.0), gx(slots, 0.0), gy(slots, 0.0);
-  separable_field_sums(entries_, spec, pot, gx, gy, ex, stats);
+  sums(entries_, spec, pot, gx, gy, ex, stats);
   if (!fd) {
     for (std::size_t i = 0; i < n; ++i) {
       const double scale = spec.A * d.charge[i] * cmax;
@@ -649,7 +689,7 @@ void FieldIndex::probe(std::span<const Vec2> points, const DiscView& sources,
   }
   const std::size_t slots = fd ? 3 * n : n;
   std::vector<double> pot(slots, 0.0), gx(slots, 0.0), gy(slots, 0.0);
-  separable_field_sums(entries_, spec, pot, gx, gy, ex, stats);
+  sums(entries_, spec, pot, gx, gy, ex, stats);
   const double scale = spec.A * cmax;
   for (std::size_t i = 0; i < n; ++i) {
     out.potential[i] = scale * pot[i];

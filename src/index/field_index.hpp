@@ -37,9 +37,22 @@ void separable_field_sums(std::vector<FieldEntry>& entries, const PotentialSpec&
                           std::span<double> out_pot, std::span<double> out_gx,
                           std::span<double> out_gy, Executor& ex, QueryStats& stats);
 
-// FieldPath "index": set-at-a-time potential and gradient over separable kernels.
+// True for every exp kernel (any metric) with A finite, k finite and >= 0.
+bool field_cutoff_supports(const PotentialSpec& spec);
+
+// The same sums for any exp kernel by direct pair evaluation inside the tiles of the same
+// halo-cut tiling (terms farther than the halo are dropped: <= 2.4e-16 A c_max^2 per probe), so
+// exact within DESIGN.md's tolerance; O(n * sources within the halo), not O(n log n).
+void cutoff_field_sums(std::vector<FieldEntry>& entries, const PotentialSpec& spec,
+                       std::span<double> out_pot, std::span<double> out_gx,
+                       std::span<double> out_gy, Executor& ex, QueryStats& stats);
+
+// FieldPath "index" (separable sweeps) or "cutoff" (direct pairs within the halo):
+// set-at-a-time potential and gradient at every disc, and the field at arbitrary points.
 class FieldIndex final : public FieldPath {
  public:
+  enum class Mode { separable, cutoff };
+  explicit FieldIndex(Mode mode = Mode::separable) : mode_(mode) {}
   void run(const DiscView& discs, const StaticScene& scene, const PotentialSpec& spec,
            FieldColumns& out, Executor& ex, QueryStats& stats) override;
   void probe(std::span<const Vec2> points, const DiscView& sources, const StaticScene& scene,
@@ -47,6 +60,12 @@ class FieldIndex final : public FieldPath {
              QueryStats& stats) override;
 
  private:
+  void sums(std::vector<FieldEntry>& e, const PotentialSpec& spec, std::span<double> pot,
+            std::span<double> gx, std::span<double> gy, Executor& ex, QueryStats& stats) const {
+    (mode_ == Mode::cutoff ? cutoff_field_sums : separable_field_sums)(e, spec, pot, gx, gy, ex,
+                                                                       stats);
+  }
+  Mode mode_;
   std::vector<FieldEntry> entries_;  // reused from tick to tick
 };
 

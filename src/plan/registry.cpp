@@ -50,10 +50,19 @@ const std::vector<FieldMethod>& field_registry() {
       // auto_min_rows 20: the index overtakes the naive loop between 16 and 24 rows (medians of
       // 3 repetitions of bench/field_bench BM_FieldCrossover*, exp-l1, n agents on an n x n
       // board: 16 rows 4.0 vs 3.4 us, 24 rows 5.3 vs 8.3 us, single-threaded, load ~8).
-      {{"index", "exact separable aggregate index (exp-l1, exp-radial m <= 2), O(n log n)", true, 1,
+      {{"index", "exact separable aggregate index (exp-l1, exp-radial m <= 2), O(n log n)", true, 2,
         20},
        [](const PotentialSpec& s) { return field_index_supports(s); },
        [] { return std::make_unique<FieldIndex>(); }},
+      // cutoff: any exp kernel; direct pairs within the halo beyond which all terms together stay
+      // below 2.4e-16 A c_max^2 (exact within tolerance). While the world is smaller than two
+      // halos it is one tile: the naive loop plus overhead. auto_min_rows 400: bench/field_bench
+      // BM_FieldCutoffCrossover* (exp-l2, thesis k, n on n x n), medians of 3: 256 rows 1.00 vs
+      // 0.83 ms, 384 rows 1.6 vs 1.8 ms, 512 rows 1.8 vs 3.4 ms (single-threaded, load ~9).
+      {{"cutoff", "exp kernels: direct pairs within the negligible-tail halo, O(n * neighbours)",
+        true, 1, 400},
+       [](const PotentialSpec& s) { return field_cutoff_supports(s); },
+       [] { return std::make_unique<FieldIndex>(FieldIndex::Mode::cutoff); }},
   };
   return methods;
 }
