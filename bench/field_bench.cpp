@@ -6,6 +6,7 @@
 //   build/bench/field_bench --benchmark_filter='Index'            # 10^3 .. 10^6
 //   build/bench/field_bench --benchmark_filter='Crossover'        # small n: index vs naive
 //   build/bench/field_bench --benchmark_filter='L2'               # exp-l2: cutoff vs naive
+//   build/bench/field_bench --benchmark_filter='InvL2'            # inv-l2: Barnes-Hut vs naive
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -33,16 +34,18 @@ const Fixture& fixture(std::size_t n) {
   return *f;
 }
 
-PotentialSpec spec(Metric metric) {
+PotentialSpec spec(Metric metric, Kernel kernel) {
   PotentialSpec s;
   s.metric = metric;
+  s.kernel = kernel;
+  if (kernel == Kernel::inv) s.A = 1;
   return s;
 }
 
-void run(benchmark::State& state, const char* method, Metric metric) {
+void run(benchmark::State& state, const char* method, Metric metric, Kernel kernel = Kernel::exp) {
   const auto n = static_cast<std::size_t>(state.range(0));
   const Fixture& f = fixture(n);
-  const PotentialSpec s = spec(metric);
+  const PotentialSpec s = spec(metric, kernel);
   double checksum = 0;
   for (auto _ : state) {
     const FieldColumns out = potential_field(f.world.agents.view(), f.scene, s, method, 1);
@@ -92,6 +95,13 @@ void cutoff_sizes(benchmark::internal::Benchmark* b) {
   for (int n : {16, 32, 64, 128, 256, 384, 512, 768, 1000, 2000}) b->Arg(n);
 }
 
+void BM_FieldBhInvL2(benchmark::State& s) {
+  run(s, "bh", Metric::l2, Kernel::inv);
+}
+void BM_FieldNaiveInvL2(benchmark::State& s) {
+  run(s, "naive", Metric::l2, Kernel::inv);
+}
+
 BENCHMARK(BM_FieldIndexL1)
     ->RangeMultiplier(10)
     ->Range(1000, 1000000)
@@ -130,6 +140,9 @@ BENCHMARK(BM_FieldCutoffL2)
 BENCHMARK(BM_FieldNaiveL2)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FieldCutoffCrossoverCutoff)->Apply(cutoff_sizes)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FieldCutoffCrossoverNaive)->Apply(cutoff_sizes)->Unit(benchmark::kMicrosecond);
+
+BENCHMARK(BM_FieldBhInvL2)->RangeMultiplier(10)->Range(1000, 100000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FieldNaiveInvL2)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace crowddb

@@ -2,6 +2,7 @@
 // one entry here; no stage of the tick changes.
 #include <algorithm>
 
+#include "index/field_bh.hpp"
 #include "index/field_index.hpp"
 #include "plan/access_path.hpp"
 #include "query/naive_paths.hpp"
@@ -63,6 +64,11 @@ const std::vector<FieldMethod>& field_registry() {
         true, 1, 400},
        [](const PotentialSpec& s) { return field_cutoff_supports(s); },
        [] { return std::make_unique<FieldIndex>(FieldIndex::Mode::cutoff); }},
+      // bh: approximate (worst case 22% of S_abs on the potential, see field_bh.cpp): only by name.
+      {{"bh", "inv kernels: Barnes-Hut monopoles, theta 0.1, approximate with a stated bound", false, 0, 0,
+        false},
+       [](const PotentialSpec& s) { return field_bh_supports(s); },
+       [] { return std::make_unique<FieldBarnesHut>(); }},
   };
   return methods;
 }
