@@ -110,6 +110,26 @@ TEST(FieldCli, IndexRefusesKernelsItCannotSumExactly) {
   }
 }
 
+TEST(FieldCli, FiniteDifferenceGradientOption) {
+  TempDir dir;
+  const auto agents = dir.write("a.csv", "id,x,y,vx,vy,radius\n1,0,0,0,0,1\n2,3,4,0,0,1\n");
+  const std::string common =
+      "query field --agents " + agents.string() + " --A 1 --k 1 --fd-step 1e-4 --method ";
+  const auto naive = parse_field(run_cli(common + "naive", dir).out);
+  const auto index = parse_field(run_cli(common + "index", dir).out);
+  ASSERT_EQ(naive.size(), 2u);
+  ASSERT_EQ(index.size(), 2u);
+  // Forward difference of e^{-(|x - 3| + 4)} at x = 0: (e^{-(7 - h)} - e^{-7}) / h ~ e^{-7} (1 +
+  // h/2).
+  const double e = std::exp(-7.0), h = 1e-4, want = e * std::expm1(h) / h;
+  for (const auto* r : {&naive, &index}) {
+    EXPECT_NEAR(r->at(1).gx, want, 1e-10);  // the index removes the self term: ~u / h
+    EXPECT_NEAR(r->at(2).gx, e * std::expm1(-h) / h, 1e-10);
+    EXPECT_NEAR(r->at(1).pot, e, 1e-15);
+  }
+  EXPECT_EQ(run_cli(common + "naive --fd-step 0", dir).status, 2);
+}
+
 std::map<std::string, double> parse_fit(const std::string& out) {
   std::map<std::string, double> m;
   std::istringstream in(out);

@@ -101,6 +101,10 @@ void add_query_commands(CLI::App& app, Action& action) {
       ->capture_default_str();
   field->add_option("--floor", floor_value, "inv kernel: distance floor (default: a tenth of the smallest radius)")
       ->check(CLI::PositiveNumber);
+  static double fd_step = 0;
+  field->add_option("--fd-step", fd_step,
+                    "gradient by the thesis's forward finite differences with this step instead of analytically")
+      ->check(CLI::PositiveNumber);
   field->callback([&action] {
     action = [] {
       Inputs in = load(pc, ObstacleCharges::centres);
@@ -111,6 +115,8 @@ void add_query_commands(CLI::App& app, Action& action) {
       double rmin = std::numeric_limits<double>::infinity();
       for (double r : in.agents.radius) rmin = std::min(rmin, r);
       spec.inv_floor = floor_value > 0 ? floor_value : (std::isfinite(rmin) ? rmin / 10 : 0.1);
+      spec.finite_difference = fd_step > 0;
+      if (fd_step > 0) spec.fd_step = fd_step;
       const FieldColumns f = potential_field(in.agents.view(), in.scene, spec, pc.method, pc.threads);
       std::string text = "id,potential,grad_x,grad_y\n";
       for (std::size_t row : in.by_id)
