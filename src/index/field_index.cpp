@@ -445,8 +445,8 @@ namespace {
 
 // Both modes: `cutoff` sums every tile pair by pair (any exp metric); otherwise swept tiles.
 void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, bool cutoff,
-                      std::span<double> out_pot, std::span<double> out_gx,
-                      std::span<double> out_gy, Executor& ex, QueryStats& stats) {
+                      std::span<double> out_pot, std::span<double> out_gx, std::span<double> out_gy,
+                      Executor& ex, QueryStats& stats) {
   Separable sep;
   if (cutoff) {
     // k d >= decay max(|dx|, |dy|): l1 and l2 >= L∞; radial >= (π/4) L2 (each frame's L1 >= L2).
@@ -498,8 +498,7 @@ void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, boo
     s.items.resize(n);
     for (std::size_t i = 0; i < n; ++i)
       s.items[i] = (uint64_t{i} << 1) | (E[i].slot != FieldEntry::kNoSlot);
-    process_tile(E, s.items, xmin + hx, ymin + hy, 0.0, INFINITY, cutoff, sep, kernel, s,
-                 out);
+    process_tile(E, s.items, xmin + hx, ymin + hy, 0.0, INFINITY, cutoff, sep, kernel, s, out);
     stats.pair_tests += s.pairs;
     stats.nodes_visited += 1;
     stats.query_seconds += clock.seconds();

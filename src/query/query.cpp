@@ -34,8 +34,9 @@ CollisionQueryShape shape_of(const DiscView& d) {
 
 }  // namespace
 
-std::vector<FtcHit> first_to_collide(const DiscView& discs, const StaticScene& scene, double horizon,
-                                     std::string_view method, int threads, QueryStats* stats) {
+std::vector<FtcHit> first_to_collide(const DiscView& discs, const StaticScene& scene,
+                                     double horizon, std::string_view method, int threads,
+                                     QueryStats* stats) {
   const FtcMethod& m = method == "auto" ? choose_ftc_method(discs.n) : find_ftc_method(method);
   auto path = m.make();
   Executor ex(threads);
@@ -64,10 +65,12 @@ void check_spec(const PotentialSpec& s) {
 
 }  // namespace
 
-FieldColumns potential_field(const DiscView& discs, const StaticScene& scene, const PotentialSpec& spec,
-                             std::string_view method, int threads, QueryStats* stats) {
+FieldColumns potential_field(const DiscView& discs, const StaticScene& scene,
+                             const PotentialSpec& spec, std::string_view method, int threads,
+                             QueryStats* stats) {
   check_spec(spec);
-  const FieldMethod& m = method == "auto" ? choose_field_method(discs.n, spec) : find_field_method(method, spec);
+  const FieldMethod& m =
+      method == "auto" ? choose_field_method(discs.n, spec) : find_field_method(method, spec);
   auto path = m.make();
   Executor ex(threads);
   QueryStats local;
@@ -96,8 +99,8 @@ FieldColumns field_at(std::span<const Vec2> points, const DiscView& sources,
   return out;
 }
 
-std::vector<uint32_t> collision_set(const DiscView& discs, const StaticScene& scene, std::string_view method,
-                                    int threads, QueryStats* stats) {
+std::vector<uint32_t> collision_set(const DiscView& discs, const StaticScene& scene,
+                                    std::string_view method, int threads, QueryStats* stats) {
   const CollisionQueryShape shape = shape_of(discs);
   const CollisionMethod& m =
       method == "auto" ? choose_collision_method(shape) : find_collision_method(method, shape);

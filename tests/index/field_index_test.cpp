@@ -276,7 +276,8 @@ TEST(FieldIndex, WorldOfMillionByMillion) {
     for (std::size_t i = 0; i < c.size(); ++i)
       u.push_back(600 + i, c.x[i], c.y[i], 0, 0, c.radius[i], c.charge[i]);
     const StaticScene scene = obstacles(seed, {0, 0, 1e6, 1e6}, 12, 4);
-    check_all_metrics(u, scene, "1e6 world seed " + std::to_string(seed), seed == 1 ? 0.272194 : 0.02);
+    check_all_metrics(u, scene, "1e6 world seed " + std::to_string(seed),
+                      seed == 1 ? 0.272194 : 0.02);
   }
 }
 
@@ -402,15 +403,17 @@ TEST(FieldCutoff, MatchesNaiveForEveryExpMetric) {
   for (auto& [t, name] : tables) {
     random_charges(t, 7);
     const StaticScene scene = obstacles(5, {t.x[0], t.y[0], t.x[0] + 50, t.y[0] + 50}, 2, 1);
-    for (PotentialSpec s : {exp_spec(Metric::l2, 0.272194), exp_spec(Metric::l2, 2.0), exp_spec(Metric::l1, 2.0),
-                            exp_spec(Metric::radial, 2.0, 3), exp_spec(Metric::radial, 0.5, 2)}) {
+    for (PotentialSpec s :
+         {exp_spec(Metric::l2, 0.272194), exp_spec(Metric::l2, 2.0), exp_spec(Metric::l1, 2.0),
+          exp_spec(Metric::radial, 2.0, 3), exp_spec(Metric::radial, 0.5, 2)}) {
       const FieldColumns naive = potential_field(t.view(), scene, s, "naive");
       QueryStats st;
       const FieldColumns cut = potential_field(t.view(), scene, s, "cutoff", 1, &st);
       EXPECT_GT(st.nodes_visited, 0u);
-      EXPECT_EQ(compare(cut, naive, abs_sums(t.view(), scene, s), s.A, max_charge(t.view(), scene, false), s.k,
-                        "cutoff " + name + " k " + std::to_string(s.k)),
-                0);
+      EXPECT_EQ(
+          compare(cut, naive, abs_sums(t.view(), scene, s), s.A, max_charge(t.view(), scene, false),
+                  s.k, "cutoff " + name + " k " + std::to_string(s.k)),
+          0);
     }
   }
 }
@@ -424,7 +427,9 @@ TEST(FieldCutoff, ProbesMatchNaive) {
   for (PotentialSpec s : {exp_spec(Metric::l2, 1.0), exp_spec(Metric::radial, 1.0, 5)}) {
     const FieldColumns naive = field_at(probes, t.view(), StaticScene{}, s, "naive");
     const FieldColumns cut = field_at(probes, t.view(), StaticScene{}, s, "cutoff");
-    EXPECT_EQ(compare(cut, naive, abs_sums(t.view(), StaticScene{}, s, probes), s.A, 1.0, s.k, "cutoff probe"), 0);
+    EXPECT_EQ(compare(cut, naive, abs_sums(t.view(), StaticScene{}, s, probes), s.A, 1.0, s.k,
+                      "cutoff probe"),
+              0);
   }
 }
 
