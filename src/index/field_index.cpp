@@ -43,13 +43,17 @@
 // T ≈ 2 (325 - 50) / k, e.g. 2,000 units for the thesis's k). H is chosen so that a source
 // farther than H in x or y (hence k d >= decay H) weighs at most
 // e^{-decay H} = e^{-36} / (n_sources + 1): all dropped terms of a probe together are below
-// 2.4e-16 · A c_max^2, four orders below the absolute tolerance. The same cut is applied in
-// both tile paths. Weights are normalised by c_max, so stored sums stay below
+// 2.4e-16 · A c_max^2, four orders below the absolute tolerance (swept tiles drop only sources
+// outside their window, direct tiles every source beyond H in x or y: the bound holds for both).
+// Weights are normalised by c_max, so stored sums stay below
 // n e^{650} < 10^300 for n < 2^31, and probe factors e^{-650} ≈ 10^-282 are normal numbers.
 //
 // SPARSE TILES. A tile with at most 16 probe x source pairs per entry (sparse worlds: the E5
 // board holds ~5 entries per tile) is summed pair by pair with the naive path's own PairKernel
-// (same halo cut): cheaper than sorting, and bit-for-bit the naive terms.
+// (same halo cut): cheaper than sorting, and term for term the naive path's arithmetic.
+// The "cutoff" method (any exp metric: exp-l2, radial with m > 2) sums every tile this way,
+// with tiles of side 2H; its cost is O(n x sources within the halo), O(n^2) when the whole
+// table fits in one tile.
 //
 // ERROR BOUND (relative to S_abs, the sum of |contributions|, unit roundoff u = 1.1e-16):
 //  - each weight or probe factor e^{±α l}: the argument is rounded (|arg| <= 650, so
