@@ -27,9 +27,10 @@ void keep_smallest(Report& report, const std::string& claim, const Graph& g) {
   }
 }
 
-// Runs one policy and folds the result into the stats; returns the outcome.
-void measure_policy(Report& report, const std::string& prefix, PolicyStats& st, const Graph& g,
-                    const std::vector<uint64_t>& q, OnlineOptions sched) {
+// Runs one policy and folds the result into the stats; returns the summed buffers of the
+// window when the outcome is `returns` (0 otherwise).
+uint64_t measure_policy(Report& report, const std::string& prefix, PolicyStats& st, const Graph& g,
+                        const std::vector<uint64_t>& q, OnlineOptions sched) {
   OnlineRunOptions opt;
   opt.scheduler = sched;
   opt.max_decisions = 2'000'000;
@@ -42,10 +43,18 @@ void measure_policy(Report& report, const std::string& prefix, PolicyStats& st, 
       ++st.periodic;
       keep_smallest(report, prefix + "-periodic", g);
       break;
-    case Outcome::unbounded:
+    case Outcome::unbounded: {
       ++st.unbounded;
       keep_smallest(report, prefix + "-unbounded", g);
+      bool self_loop = false;
+      for (const Channel& c : g.channels()) self_loop = self_loop || c.src == c.dst;
+      if (!self_loop) keep_smallest(report, prefix + "-unbounded-without-self-loops", g);
+      OnlineRunOptions big = opt;
+      big.growth_periods *= 16;
+      big.max_listed_runs = 0;
+      if (run_online(g, q, big).outcome == Outcome::unbounded) ++st.unbounded_confirmed;
       break;
+    }
     case Outcome::deadlock:
       ++st.deadlock;
       keep_smallest(report, prefix + "-deadlock", g);
@@ -56,26 +65,31 @@ void measure_policy(Report& report, const std::string& prefix, PolicyStats& st, 
       break;
   }
   const uint64_t n = g.actor_count();
-  st.max_wait = std::max(st.max_wait, run.metrics.fairness.max);
-  if (run.metrics.fairness.max + 1 >= n && run.metrics.fairness.decisions > 0) {
+  const uint64_t wait = run.metrics.fairness.max;
+  st.max_wait = std::max(st.max_wait, wait);
+  if (wait + 1 >= n) {
     ++st.fairness_violations;
     keep_smallest(report, prefix + "-fairness", g);
+  }
+  if (wait + 1 > n) {
+    ++st.fairness_violations_weak;
+    keep_smallest(report, prefix + "-fairness-weak", g);
   }
   bool ok = run.runs_listed && run.metrics.followed_model;
   if (ok && (run.outcome == Outcome::returns || run.outcome == Outcome::periodic)) {
     const std::span<const Run> runs(run.runs);
-    const auto transient = runs.first(run.transient_decisions);
-    const CheckResult pre = check_admissible(g, transient);
+    const CheckResult pre = check_admissible(g, runs.first(run.transient_decisions));
     ok = pre.valid && check_period(g, q, runs.subspan(run.transient_decisions), pre.tokens).valid;
-    if (run.outcome == Outcome::returns) {
-      for (uint64_t b : run.metrics.buffers) st.buffer_total += b;
-    }
   }
   if (!ok) {
     ++st.checker_failures;
     keep_smallest(report, prefix + "-checker", g);
   }
   if (sched.bounded && run.outcome != Outcome::returns) keep_smallest(report, "bounded-invalid", g);
+  uint64_t total = 0;
+  if (run.outcome == Outcome::returns)
+    for (uint64_t b : run.metrics.buffers) total += b;
+  return total;
 }
 
 }  // namespace
@@ -110,11 +124,19 @@ Report run(const Options& options) {
             continue;
           }
           ++cs.graphs;
-          for (uint64_t b : measure(g, gg.q, Eligibility::owing, st.runs).buffers)
-            cs.static_buffer_total += b;
-          measure_policy(report, "online", cs.online, g, gg.q, {FiringRule::floor_key, false});
+          uint64_t stat = 0;
+          for (uint64_t b : measure(g, gg.q, Eligibility::owing, st.runs).buffers) stat += b;
+          const uint64_t on =
+              measure_policy(report, "online", cs.online, g, gg.q, {FiringRule::floor_key, false});
           measure_policy(report, "online-one", cs.online_one, g, gg.q, {FiringRule::one, false});
-          measure_policy(report, "bounded", cs.bounded, g, gg.q, {FiringRule::floor_key, true});
+          const uint64_t bo =
+              measure_policy(report, "bounded", cs.bounded, g, gg.q, {FiringRule::floor_key, true});
+          if (on > 0) {
+            ++cs.common;
+            cs.buffers_static += stat;
+            cs.buffers_online += on;
+            cs.buffers_bounded += bo;
+          }
         }
         report.classes.push_back(std::move(cs));
       }

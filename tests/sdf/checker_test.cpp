@@ -14,7 +14,8 @@ TEST(Checker, RejectsEachKindOfMistake) {
   const std::vector<uint64_t> q = {3, 2};
   EXPECT_TRUE(check_period(g, q, std::vector<sdf::Run>{{0, 3}, {1, 2}}).valid);
   EXPECT_TRUE(check_period(g, q, std::vector<sdf::Run>{{0, 2}, {1, 1}, {0, 1}, {1, 1}}).valid);
-  const CheckResult early = check_period(g, q, std::vector<sdf::Run>{{0, 1}, {1, 1}, {0, 2}, {1, 1}});
+  const CheckResult early =
+      check_period(g, q, std::vector<sdf::Run>{{0, 1}, {1, 1}, {0, 2}, {1, 1}});
   EXPECT_FALSE(early.valid);
   EXPECT_EQ(early.failed_firing, 2u);
   const CheckResult mid = check_period(g, q, std::vector<sdf::Run>{{0, 2}, {1, 2}});

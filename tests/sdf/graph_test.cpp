@@ -8,7 +8,8 @@ namespace sdf {
 namespace {
 
 TEST(Graph, DefaultChannelNamesCountParallelChannels) {
-  const Graph g = test::make({"A", "B"}, {{"A", "B", 1, 1, 0}, {"A", "B", 2, 2, 0}, {"B", "A", 1, 1, 1}});
+  const Graph g =
+      test::make({"A", "B"}, {{"A", "B", 1, 1, 0}, {"A", "B", 2, 2, 0}, {"B", "A", 1, 1, 1}});
   EXPECT_EQ(g.channel(0).name, "A->B#0");
   EXPECT_EQ(g.channel(1).name, "A->B#1");
   EXPECT_EQ(g.channel(2).name, "B->A#0");
@@ -28,8 +29,9 @@ TEST(Graph, RejectsDuplicatesAndZeroRates) {
 }
 
 TEST(Graph, AdjacencyListsChannelsInOrderAndSelfLoopsTwice) {
-  const Graph g = test::make({"A", "B", "C"},
-                             {{"A", "B", 1, 1, 0}, {"B", "B", 1, 1, 1}, {"A", "C", 1, 1, 0}, {"C", "B", 1, 1, 0}});
+  const Graph g = test::make(
+      {"A", "B", "C"},
+      {{"A", "B", 1, 1, 0}, {"B", "B", 1, 1, 1}, {"A", "C", 1, 1, 0}, {"C", "B", 1, 1, 0}});
   const Adjacency adj(g);
   EXPECT_EQ(std::vector<ChannelId>(adj.outputs(0).begin(), adj.outputs(0).end()),
             (std::vector<ChannelId>{0, 2}));

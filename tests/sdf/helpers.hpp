@@ -1,12 +1,13 @@
 // Shared by the sdf tests: compact graph construction and running the sdfsched binary.
 #pragma once
 
+#include <sys/wait.h>
+
 #include <array>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 #include <tuple>
 #include <vector>
 
@@ -29,7 +30,9 @@ inline Graph make(std::vector<const char*> actors, std::vector<Edge> edges) {
   return g;
 }
 
-inline std::string data(const std::string& name) { return std::string(SDF_DATA_DIR) + "/" + name; }
+inline std::string data(const std::string& name) {
+  return std::string(SDF_DATA_DIR) + "/" + name;
+}
 
 inline std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -46,8 +49,8 @@ struct Cli {
 // Runs `sdfsched ARGS` (ARGS already shell-quoted), capturing stdout, stderr and the exit status.
 inline Cli sdfsched(const std::string& args) {
   static int counter = 0;
-  const std::string err_file =
-      ::testing::TempDir() + "sdfsched_err_" + std::to_string(::getpid()) + "_" + std::to_string(counter++);
+  const std::string err_file = ::testing::TempDir() + "sdfsched_err_" + std::to_string(::getpid()) +
+                               "_" + std::to_string(counter++);
   const std::string cmd = std::string(SDFSCHED) + " " + args + " 2>" + err_file;
   Cli r;
   FILE* p = ::popen(cmd.c_str(), "r");

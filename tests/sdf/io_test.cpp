@@ -80,8 +80,9 @@ TEST(Sdf3Reader, ReadsCrlfFilesAndCountsTheirLines) {
 }
 
 TEST(Sdf3Reader, ElementOrderDoesNotMatter) {
-  const Graph g = read_sdf3(sdf3("<channel name='c' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n" +
-                                 std::string(kTwo)));
+  const Graph g =
+      read_sdf3(sdf3("<channel name='c' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n" +
+                     std::string(kTwo)));
   EXPECT_EQ(g.channel(0).name, "c");
 }
 
@@ -89,41 +90,52 @@ TEST(Sdf3Reader, NamesTheLineOfEachMistake) {
   const std::string ch = "<channel name='c' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n";
   // Line 5 is the first body line (after the xml declaration, sdf3, applicationGraph, sdf).
   EXPECT_EQ(sdf3_error(sdf3(std::string(kTwo) + ch)), "");
-  EXPECT_NE(sdf3_error(sdf3(kTwo)).find("f.xml:5: port 'o' of actor 'A' is not connected"), std::string::npos);
-  EXPECT_NE(sdf3_error(sdf3(std::string(kTwo) +
-                            "<channel name='c' srcActor='A' srcPort='o' dstActor='Z' dstPort='i'/>\n"))
-                .find("f.xml:7: channel refers to an unknown actor 'Z'"),
+  EXPECT_NE(sdf3_error(sdf3(kTwo)).find("f.xml:5: port 'o' of actor 'A' is not connected"),
             std::string::npos);
-  EXPECT_NE(sdf3_error(sdf3(std::string(kTwo) +
-                            "<channel name='c' srcActor='A' srcPort='x' dstActor='B' dstPort='i'/>\n"))
-                .find("f.xml:7: actor 'A' has no port 'x'"),
-            std::string::npos);
-  EXPECT_NE(sdf3_error(sdf3(std::string(kTwo) +
-                            "<channel name='c' srcActor='B' srcPort='i' dstActor='A' dstPort='o'/>\n"))
-                .find("is an input port"),
-            std::string::npos);
-  EXPECT_NE(sdf3_error(sdf3(std::string(kTwo) + ch +
-                            "<channel name='d' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n"))
-                .find("f.xml:8: port 'o' of actor 'A' is already connected to channel 'c'"),
-            std::string::npos);
-  EXPECT_NE(sdf3_error(sdf3("<actor name='A' type='a'><port name='o' type='out' rate='1,2'/></actor>\n"))
-                .find("f.xml:5: attribute rate='1,2' is not a positive 64-bit integer (CSDF"),
-            std::string::npos);
-  EXPECT_NE(sdf3_error(sdf3("<actor name='A' type='a'><port name='o' type='out' rate='0'/></actor>\n"))
-                .find("f.xml:5: attribute rate='0'"),
-            std::string::npos);
-  EXPECT_NE(sdf3_error(sdf3("<actor name='A' type='a'><port name='o' type='out' rate='99999999999999999999'/></actor>\n"))
+  EXPECT_NE(
+      sdf3_error(sdf3(std::string(kTwo) +
+                      "<channel name='c' srcActor='A' srcPort='o' dstActor='Z' dstPort='i'/>\n"))
+          .find("f.xml:7: channel refers to an unknown actor 'Z'"),
+      std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3(std::string(kTwo) +
+                      "<channel name='c' srcActor='A' srcPort='x' dstActor='B' dstPort='i'/>\n"))
+          .find("f.xml:7: actor 'A' has no port 'x'"),
+      std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3(std::string(kTwo) +
+                      "<channel name='c' srcActor='B' srcPort='i' dstActor='A' dstPort='o'/>\n"))
+          .find("is an input port"),
+      std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3(std::string(kTwo) + ch +
+                      "<channel name='d' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n"))
+          .find("f.xml:8: port 'o' of actor 'A' is already connected to channel 'c'"),
+      std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3("<actor name='A' type='a'><port name='o' type='out' rate='1,2'/></actor>\n"))
+          .find("f.xml:5: attribute rate='1,2' is not a positive 64-bit integer (CSDF"),
+      std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3("<actor name='A' type='a'><port name='o' type='out' rate='0'/></actor>\n"))
+          .find("f.xml:5: attribute rate='0'"),
+      std::string::npos);
+  EXPECT_NE(sdf3_error(sdf3("<actor name='A' type='a'><port name='o' type='out' "
+                            "rate='99999999999999999999'/></actor>\n"))
                 .find("not a positive 64-bit integer"),
             std::string::npos);
-  EXPECT_NE(sdf3_error(sdf3("<actor name='A'/>\n<actor name='A'/>\n")).find("f.xml:6: duplicate actor name 'A'"),
+  EXPECT_NE(sdf3_error(sdf3("<actor name='A'/>\n<actor name='A'/>\n"))
+                .find("f.xml:6: duplicate actor name 'A'"),
             std::string::npos);
-  EXPECT_NE(sdf3_error(sdf3("<actor type='a'/>\n")).find("f.xml:5: <actor> lacks the attribute 'name'"),
-            std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3("<actor type='a'/>\n")).find("f.xml:5: <actor> lacks the attribute 'name'"),
+      std::string::npos);
   EXPECT_NE(sdf3_error(std::string(kTwo) + ch).find("f.xml:"), std::string::npos);  // no root
   EXPECT_NE(sdf3_error("<sdf3 type='csdf'><applicationGraph/></sdf3>").find("not supported"),
             std::string::npos);
   EXPECT_NE(sdf3_error(sdf3(kTwo).substr(0, 120)).find("f.xml:"), std::string::npos);  // truncated
-  EXPECT_NE(sdf3_error("<sdf3 type=\"sdf\">\r\n<applicationGraph>\r\n<sdf>\r\n<actor name='A' x='1\"/>\r\n</sdf></applicationGraph></sdf3>")
+  EXPECT_NE(sdf3_error("<sdf3 type=\"sdf\">\r\n<applicationGraph>\r\n<sdf>\r\n<actor name='A' "
+                       "x='1\"/>\r\n</sdf></applicationGraph></sdf3>")
                 .find("f.xml:4: XML"),
             std::string::npos);
 }
@@ -133,35 +145,50 @@ TEST(JsonReader, ReadsTheDesignForm) {
   EXPECT_EQ(g.actor_count(), 6u);
   EXPECT_EQ(g.channel(4).name, "E->F#0");
   EXPECT_EQ(g.channel(4).prd, 5u);
-  const Graph d = read_json(R"({"channels":[{"src":"A","dst":"A","prd":1,"cns":1}],"actors":[{"name":"A"}]})");
+  const Graph d =
+      read_json(R"({"channels":[{"src":"A","dst":"A","prd":1,"cns":1}],"actors":[{"name":"A"}]})");
   EXPECT_EQ(d.channel(0).delay, 0u);  // delay defaults to 0; channels may precede actors
 }
 
 TEST(JsonReader, NamesTheFieldOfEachMistake) {
   EXPECT_EQ(json_error(R"({"actors":[{"name":"A"}],"channels":[]})"), "");
   EXPECT_EQ(json_error(R"({"channels":[]})"), "f.json: top level: missing field 'actors'");
-  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":0,"cns":1}]})"),
-            "f.json: channels[0].prd: must be positive");
-  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1,"cns":-1}]})"),
+  EXPECT_EQ(
+      json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":0,"cns":1}]})"),
+      "f.json: channels[0].prd: must be positive");
+  EXPECT_EQ(json_error(
+                R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1,"cns":-1}]})"),
             "f.json: channels[0].cns: must not be negative");
-  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1.5,"cns":1}]})"),
-            "f.json: channels[0].prd: '1.5' is not an integer below 2^64");
-  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1,"cns":1,"dely":1}]})"),
-            "f.json: channels[0]: unknown field 'dely'");
+  EXPECT_EQ(
+      json_error(
+          R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1.5,"cns":1}]})"),
+      "f.json: channels[0].prd: '1.5' is not an integer below 2^64");
+  EXPECT_EQ(
+      json_error(
+          R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1,"cns":1,"dely":1}]})"),
+      "f.json: channels[0]: unknown field 'dely'");
   EXPECT_EQ(json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","cns":1}]})"),
             "f.json: channels[0]: missing field 'prd'");
-  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"B","prd":1,"cns":1}]})"),
-            "f.json: channels[0].dst: unknown actor 'B'");
+  EXPECT_EQ(
+      json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"B","prd":1,"cns":1}]})"),
+      "f.json: channels[0].dst: unknown actor 'B'");
   EXPECT_EQ(json_error(R"({"actors":[{"name":"A"},{"name":"A"}]})"),
             "f.json: actors[1].name: duplicate actor name 'A'");
-  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"},{}]})"), "f.json: actors[1]: missing field 'name'");
-  EXPECT_EQ(json_error(R"({"actors":[{"name":["A"]}]})"), "f.json: actors[0].name: unexpected an array");
-  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":"1","cns":1}]})"),
-            "f.json: channels[0].prd: unexpected a string");
-  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1,"cns":99999999999999999999}]})"),
-            "f.json: channels[0].cns: '99999999999999999999' is not an integer below 2^64");
+  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"},{}]})"),
+            "f.json: actors[1]: missing field 'name'");
+  EXPECT_EQ(json_error(R"({"actors":[{"name":["A"]}]})"),
+            "f.json: actors[0].name: unexpected an array");
+  EXPECT_EQ(
+      json_error(
+          R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":"1","cns":1}]})"),
+      "f.json: channels[0].prd: unexpected a string");
+  EXPECT_EQ(
+      json_error(
+          R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1,"cns":99999999999999999999}]})"),
+      "f.json: channels[0].cns: '99999999999999999999' is not an integer below 2^64");
   EXPECT_EQ(json_error("[]"), "f.json: top level: unexpected an array");
-  EXPECT_NE(json_error("{\r\n\"actors\": [\r\n{\"name\": \"A\"},\r\n]}").find("f.json: parse error at line 4"),
+  EXPECT_NE(json_error("{\r\n\"actors\": [\r\n{\"name\": \"A\"},\r\n]}")
+                .find("f.json: parse error at line 4"),
             std::string::npos);
   EXPECT_NE(json_error("").find("f.json: parse error"), std::string::npos);
 }

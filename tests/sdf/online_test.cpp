@@ -43,9 +43,9 @@ TEST(Online, TwoActorChainsAndTheThesisAcyclicClaim) {
     uint64_t a, b;
     Outcome expect;
   };
-  for (const Case& c : {Case{3, 2, Outcome::returns}, Case{1, 1, Outcome::returns},
-                        Case{6, 4, Outcome::returns}, Case{2, 3, Outcome::periodic},
-                        Case{4, 6, Outcome::periodic}}) {
+  for (const Case& c :
+       {Case{3, 2, Outcome::returns}, Case{1, 1, Outcome::returns}, Case{6, 4, Outcome::returns},
+        Case{2, 3, Outcome::periodic}, Case{4, 6, Outcome::periodic}}) {
     const Graph g = test::make({"A", "B"}, {{"A", "B", c.a, c.b, 0}});
     const auto q = compute_repetitions(g).q;
     const OnlineRun r = run_online(g, q, options(FiringRule::floor_key, false));
@@ -53,14 +53,17 @@ TEST(Online, TwoActorChainsAndTheThesisAcyclicClaim) {
     expect_checked(g, q, r);
   }
   const Graph g = test::make({"A", "B"}, {{"A", "B", 2, 3, 0}});
-  const OnlineRun r = run_online(g, std::vector<uint64_t>{3, 2}, options(FiringRule::floor_key, false));
+  const OnlineRun r =
+      run_online(g, std::vector<uint64_t>{3, 2}, options(FiringRule::floor_key, false));
   // Transient: A (2 tokens); cycle: A (4) B (1) A (3) A (5, A wins the tie at key 1) B (2).
   EXPECT_EQ(r.transient_decisions, 1u);
   EXPECT_EQ(run_length_form(g, std::span<const sdf::Run>(r.runs).subspan(1)),
             "(1 A)(1 B)(1 A)(1 A)(1 B)");
   // Declared the other way round, B wins those ties and the run returns.
   const Graph h = test::make({"B", "A"}, {{"A", "B", 2, 3, 0}});
-  EXPECT_EQ(run_online(h, std::vector<uint64_t>{2, 3}, options(FiringRule::floor_key, false)).outcome, Outcome::returns);
+  EXPECT_EQ(
+      run_online(h, std::vector<uint64_t>{2, 3}, options(FiringRule::floor_key, false)).outcome,
+      Outcome::returns);
 }
 
 TEST(Online, FanOutOfTheThesisCounterExampleIsServed) {
@@ -131,9 +134,9 @@ TEST(Online, TiesGoToTheEarlierEligibleThenTheLowerId) {
 TEST(Online, KeysAreComparedExactly) {
   // B: 10^18 / 666666666666666667 = 1.4999999999999999992..., A: 3/2. In doubles both are 1.5
   // and B would win the tie by id; exactly, A's key is larger.
-  const Graph g = test::make({"S1", "S2", "B", "A"}, {{"S1", "A", 1, 2, 3},
-                                                     {"S2", "B", 1, 666666666666666667ull,
-                                                      1000000000000000000ull}});
+  const Graph g = test::make(
+      {"S1", "S2", "B", "A"},
+      {{"S1", "A", 1, 2, 3}, {"S2", "B", 1, 666666666666666667ull, 1000000000000000000ull}});
   OnlineScheduler s(g, {}, {FiringRule::one, false});
   EXPECT_EQ(s.step()->actor, 3u);
 }
@@ -212,7 +215,8 @@ TEST(OnlineBounded, CompletesAValidPeriodOnLiveRandomGraphs) {
     spec.self_loops = i % 2 == 0;
     spec.multirate = i % 7 != 0;
     const gen::Generated gg = gen::generate(spec, rng);
-    const OnlineRun r = run_online(gg.graph, gg.q, options(i % 3 ? FiringRule::floor_key : FiringRule::one, true));
+    const OnlineRun r =
+        run_online(gg.graph, gg.q, options(i % 3 ? FiringRule::floor_key : FiringRule::one, true));
     ASSERT_EQ(r.outcome, Outcome::returns) << i;
     ASSERT_EQ(r.transient_decisions, 0u);
     for (ActorId a = 0; a < gg.graph.actor_count(); ++a) EXPECT_EQ(r.cycle_fired[a], gg.q[a]) << i;

@@ -58,7 +58,8 @@ TEST(Repetitions, OverflowIsAnErrorNeverAWrappedNumber) {
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), Error::Kind::overflow);
   }
-  // The largest value that fits still works: 2^63 * ... and 2^64 - 1 = 3 * 5 * 17 * 257 * 641 * 65537 * 6700417.
+  // The largest value that fits still works: 2^63 * ... and 2^64 - 1 = 3 * 5 * 17 * 257 * 641 *
+  // 65537 * 6700417.
   const Graph fits = test::make({"A", "B"}, {{"A", "B", 18446744073709551615ull, 1, 0}});
   EXPECT_EQ(compute_repetitions(fits).q, (std::vector<uint64_t>{1, 18446744073709551615ull}));
   // An overflow in the lcm of denominators, with every single fraction small enough.

@@ -413,20 +413,21 @@ int cmd_convert(const std::string& path, const std::string& to, const std::strin
 }
 
 int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& save_dir) {
-  sdf::claims::Options o;
-  o.graphs_per_class = graphs;
-  o.seed = seed;
-  const sdf::claims::Report r = sdf::claims::run(o);
+  sdf::claims::Options opts;
+  opts.graphs_per_class = graphs;
+  opts.seed = seed;
+  const sdf::claims::Report r = sdf::claims::run(opts);
   auto stats = [](const sdf::claims::PolicyStats& s) {
     return Json{{"returns", s.returns},
                 {"periodic", s.periodic},
                 {"unbounded", s.unbounded},
+                {"unbounded_confirmed", s.unbounded_confirmed},
                 {"deadlock", s.deadlock},
                 {"limit", s.limit},
                 {"fairness_violations", s.fairness_violations},
+                {"fairness_violations_weak", s.fairness_violations_weak},
                 {"max_wait", s.max_wait},
-                {"checker_failures", s.checker_failures},
-                {"buffer_total", s.buffer_total}};
+                {"checker_failures", s.checker_failures}};
   };
   if (!save_dir.empty()) {
     std::filesystem::create_directories(save_dir);
@@ -443,30 +444,35 @@ int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& sav
                    {"online", stats(c.online)},
                    {"online_one", stats(c.online_one)},
                    {"bounded", stats(c.bounded)},
-                   {"static_buffer_total", c.static_buffer_total}});
+                   {"buffers_on_common_graphs",
+                    {{"graphs", c.common},
+                     {"static", c.buffers_static},
+                     {"online", c.buffers_online},
+                     {"bounded", c.buffers_bounded}}}});
     Json ce = Json::object();
     for (const auto& [claim, g] : r.counterexamples) ce[claim] = Json::parse(sdf::write_json(g));
     print_json({{"classes", j}, {"counterexamples", ce}});
     return 0;
   }
-  std::cout
-      << "| class | graphs | online returns / periodic / unbounded | fairness >= n-1 | max wait"
-         " | --firings one returns / periodic / unbounded | bounded valid | checker failures |"
-         " buffers static : online : bounded |\n|---|---|---|---|---|---|---|---|---|\n";
+  auto outcomes = [](const sdf::claims::PolicyStats& s) {
+    std::string t = std::to_string(s.returns) + " / " + std::to_string(s.periodic) + " / " +
+                    std::to_string(s.unbounded);
+    if (s.unbounded) t += " (" + std::to_string(s.unbounded_confirmed) + " confirmed)";
+    if (s.limit + s.deadlock) t += " +" + std::to_string(s.limit + s.deadlock) + " other";
+    return t;
+  };
+  std::cout << "| class | graphs | online: returns / periodic / unbounded | max wait >= n-1 | "
+               "max wait > n-1 | max wait | --firings one: returns / periodic / unbounded | "
+               "bounded valid | checker failures | buffers static : online : bounded (graphs) |\n"
+               "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : r.classes) {
-    const auto& o1 = c.online;
-    const auto& o2 = c.online_one;
-    const auto& b = c.bounded;
-    std::cout << "| " << c.name << " | " << c.graphs << " | " << o1.returns << " / " << o1.periodic
-              << " / " << o1.unbounded
-              << (o1.limit + o1.deadlock
-                      ? " (+" + std::to_string(o1.limit + o1.deadlock) + " other)"
-                      : "")
-              << " | " << o1.fairness_violations << " | " << o1.max_wait << " | " << o2.returns
-              << " / " << o2.periodic << " / " << o2.unbounded << " | " << b.returns << " of "
-              << c.graphs << " | " << o1.checker_failures + o2.checker_failures + b.checker_failures
-              << " | " << c.static_buffer_total << " : " << o1.buffer_total << " : "
-              << b.buffer_total << " |\n";
+    const auto& o = c.online;
+    std::cout << "| " << c.name << " | " << c.graphs << " | " << outcomes(o) << " | "
+              << o.fairness_violations << " | " << o.fairness_violations_weak << " | " << o.max_wait
+              << " | " << outcomes(c.online_one) << " | " << c.bounded.returns << " | "
+              << o.checker_failures + c.online_one.checker_failures + c.bounded.checker_failures
+              << " | " << c.buffers_static << " : " << c.buffers_online << " : "
+              << c.buffers_bounded << " (" << c.common << ") |\n";
   }
   std::cout << "\nsmallest counter-examples:";
   for (const auto& [claim, g] : r.counterexamples)
