@@ -73,11 +73,18 @@ class StaticScene {
   StaticScene() = default;
   // `spacing`: largest gap between charged points sampled along polygon edges (and circle
   // boundaries with ObstacleCharges::boundary); DESIGN.md: no larger than the smallest agent radius.
+  //
+  // `walls`: the world's bounds as solid walls, appended to the polygons as four rectangles
+  // outside the bounds (as thick as the world is wide, so nothing tunnels through them); their
+  // charged points lie on the bounds only.
   StaticScene(std::vector<CircleObstacle> circles, std::vector<PolygonObstacle> polygons,
-              double spacing, ObstacleCharges charges = ObstacleCharges::boundary);
+              double spacing, ObstacleCharges charges = ObstacleCharges::boundary,
+              const Bounds* walls = nullptr);
 
   std::span<const CircleObstacle> circles() const { return circles_; }
+  // The obstacle polygons followed by the wall polygons (rows >= wall_begin() are walls).
   std::span<const PolygonObstacle> polygons() const { return polygons_; }
+  std::size_t wall_begin() const { return wall_begin_; }
   struct Box {
     double xmin, ymin, xmax, ymax;
   };
@@ -94,6 +101,7 @@ class StaticScene {
   std::vector<PolygonObstacle> polygons_;
   std::vector<Box> boxes_;
   std::vector<double> px_, py_, pc_;
+  std::size_t wall_begin_ = 0;
 };
 
 // Per-query counters; the experiments plot them. Methods fill what applies to them.

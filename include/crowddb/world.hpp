@@ -96,7 +96,7 @@ struct AgentTable {
   std::vector<uint32_t> frozen_ticks;  // consecutive ticks frozen by backoff (gridlock detection)
   // cold: bookkeeping
   std::vector<uint64_t> id;           // AgentId::value()
-  std::vector<std::vector<Vec2>> route;  // waypoints still ahead, the goal last (may be empty)
+  std::vector<std::vector<Vec2>> route;  // intermediate waypoints still ahead of the goal
 
   std::size_t size() const { return x.size(); }
   bool empty() const { return x.empty(); }
