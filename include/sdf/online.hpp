@@ -14,9 +14,10 @@
 //
 // The scheduler state is the token vector, the eligible actors in tie-break order and, when
 // bounded, the per-iteration counts: two equal states have identical futures. Each decision
-// costs O(log n + the degrees of the winner and of its successors): the eligible actors sit in
-// an indexed binary heap, keys are recomputed only for the actors whose inputs changed, and a
-// hash of the state is maintained incrementally (Zobrist-style sum) for repeat detection.
+// costs O(log n + the degrees of the winner and of its successors): eligible actors with a key
+// above 1 sit in an indexed binary heap, those with key exactly 1 (sources, SDF3 self-loops) in
+// a FIFO list in tie-break order; keys are recomputed only for the actors whose inputs changed,
+// and a linear hash of the state is maintained incrementally for repeat detection.
 //
 // run_online() drives a scheduler until an honest outcome: the start token state returns after
 // every actor has fired (`returns`, a valid period), the full scheduler state repeats (`periodic`:
@@ -78,7 +79,8 @@ class OnlineScheduler {
   void reset_fired();
   std::span<const uint64_t> iteration_counts() const { return count_; }
   uint64_t iterations_completed() const { return iterations_; }
-  // Hash of the full state except the eligibility order (incremental, O(1)).
+  // Hash of the full state except the eligibility order (incremental, O(1)): a linear form
+  // sum(value · salt) with fixed odd pseudo-random salts; equality is then checked exactly.
   uint64_t state_hash() const { return token_hash_ ^ count_hash_; }
   // Eligible actors in tie-break order (earliest eligibility first, then id).
   std::vector<ActorId> eligibility_order() const;
@@ -88,14 +90,28 @@ class OnlineScheduler {
 
  private:
   struct Topology;  // immutable incidence lists, shared between copies
+  // A heap entry carries a copy of what the comparison needs, so sifting does not chase
+  // pointers: the key as a double, exact enough on its own when numerator and denominator are
+  // both below 2^21 (`small`: distinct such fractions differ by more than double rounding),
+  // else only a first guess that falls back to the exact fraction when the doubles are close.
+  struct Entry {
+    double key;
+    uint64_t stamp;
+    ActorId actor;
+    bool small;
+  };
   bool eligible(ActorId a) const;
   void recompute_key(ActorId a);
-  bool better(ActorId a, ActorId b) const;
+  Entry entry(ActorId a) const;
+  bool better(const Entry& x, const Entry& y) const;
   void heap_push(ActorId a);
+  void list_insert(ActorId a);
+  void list_remove(ActorId a);
+  void insert_eligible(ActorId a);
+  void remove_eligible(ActorId a);
   void heap_remove(ActorId a);
   void sift_up(uint32_t i);
   void sift_down(uint32_t i);
-  void heap_fix(ActorId a);
   void set_tokens(ChannelId c, uint64_t value);
   void set_count(ActorId a, uint64_t value);
   void start_iteration();
@@ -104,13 +120,20 @@ class OnlineScheduler {
   std::shared_ptr<const Topology> topo_;
   OnlineOptions opt_;
   size_t n_ = 0;
-  // Per channel (hot): rates, tokens, caps.
-  std::vector<uint64_t> prd_, cns_, tokens_, caps_;
+  // Per channel (hot): rates, tokens, caps, hash multipliers.
+  std::vector<uint64_t> prd_, cns_, tokens_, caps_, salt_;
   // Per actor (hot): key = key_num_/key_den_, eligibility stamp, heap position, counts.
   std::vector<uint64_t> key_num_, key_den_, stamp_, count_, q_;
-  std::vector<uint32_t> pos_;  // UINT32_MAX when not in the heap
+  std::vector<uint32_t> pos_;      // UINT32_MAX when not in the heap
+  std::vector<uint32_t> key_arg_;  // the input channel that sets the key (kNone: no inputs)
   std::vector<char> has_fired_;
-  std::vector<ActorId> heap_;
+  std::vector<Entry> heap_;  // eligible actors with key > 1
+  // Eligible actors with key exactly 1, in (stamp, id) order: a doubly linked list.
+  static constexpr uint32_t kNone = UINT32_MAX;
+  std::vector<uint32_t> prev_, next_;
+  std::vector<char> in_list_;
+  uint32_t head_ = kNone, tail_ = kNone;
+  size_t listed_ = 0;
   uint64_t decisions_ = 0, firings_ = 0, iterations_ = 0;
   size_t actors_fired_ = 0, owing_ = 0;
   uint64_t token_hash_ = 0, count_hash_ = 0;

@@ -15,14 +15,15 @@ struct OnlineScheduler::Topology {
 
 namespace {
 
-// Zobrist-style term of one (slot, value) pair; the state hash is the wrapping sum of the terms.
-inline uint64_t term(uint64_t slot, uint64_t value) {
-  uint64_t z = value + 0x9e3779b97f4a7c15ull * (slot + 1);
+// The salt of hash slot `slot` (channels, then per-actor counts): fixed, odd, well mixed.
+inline uint64_t salt_of(uint64_t slot) {
+  uint64_t z = 0x9e3779b97f4a7c15ull * (slot + 1);
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
+  return (z ^ (z >> 31)) | 1;
 }
 constexpr uint64_t kCountSalt = 0x632be59bd9b4e019ull;
+constexpr uint64_t kSmall = uint64_t{1} << 21;
 
 }  // namespace
 
@@ -60,17 +61,24 @@ OnlineScheduler::OnlineScheduler(const Graph& g, std::span<const uint64_t> q, On
     throw Error(Error::Kind::input, "online-bounded needs the repetitions vector");
   q_ = opt_.bounded ? std::vector<uint64_t>(q.begin(), q.end()) : std::vector<uint64_t>(n_, 1);
   count_.assign(n_, 0);
-  for (ChannelId c = 0; c < e; ++c) token_hash_ += term(c, tokens_[c]);
-  for (ActorId a = 0; a < n_; ++a) count_hash_ += term(a ^ kCountSalt, 0);
+  salt_.resize(e);
+  for (ChannelId c = 0; c < e; ++c) {
+    salt_[c] = salt_of(c);
+    token_hash_ += tokens_[c] * salt_[c];
+  }
   key_num_.assign(n_, 1);
+  key_arg_.assign(n_, kNone);
   key_den_.assign(n_, 1);
   stamp_.assign(n_, 0);
   pos_.assign(n_, UINT32_MAX);
+  prev_.assign(n_, kNone);
+  next_.assign(n_, kNone);
+  in_list_.assign(n_, 0);
   has_fired_.assign(n_, 0);
   owing_ = n_;
   for (ActorId a = 0; a < n_; ++a) {
     recompute_key(a);
-    if (eligible(a)) heap_push(a);
+    if (eligible(a)) insert_eligible(a);
   }
 }
 
@@ -94,108 +102,164 @@ void OnlineScheduler::recompute_key(ActorId a) {
   const uint32_t lo = t.in_off[a], hi = t.in_off[a + 1];
   if (lo == hi) {
     key_num_[a] = key_den_[a] = 1;
+    key_arg_[a] = kNone;
     return;
   }
-  uint64_t num = tokens_[t.in[lo]], den = cns_[t.in[lo]];
+  ChannelId arg = t.in[lo];
+  uint64_t num = tokens_[arg], den = cns_[arg];
   for (uint32_t i = lo + 1; i < hi; ++i) {
     const ChannelId c = t.in[i];
     if (static_cast<detail::u128>(tokens_[c]) * den < static_cast<detail::u128>(num) * cns_[c]) {
       num = tokens_[c];
       den = cns_[c];
+      arg = c;
     }
   }
   key_num_[a] = num;
   key_den_[a] = den;
+  key_arg_[a] = arg;
 }
 
 bool OnlineScheduler::eligible(ActorId a) const {
   return key_num_[a] >= key_den_[a] && count_[a] < q_[a];
 }
 
+OnlineScheduler::Entry OnlineScheduler::entry(ActorId a) const {
+  const uint64_t num = key_num_[a], den = key_den_[a];
+  return {static_cast<double>(num) / static_cast<double>(den), stamp_[a], a,
+          num < kSmall && den < kSmall};
+}
+
 // Larger key first; then earlier eligibility; then lower id.
-bool OnlineScheduler::better(ActorId a, ActorId b) const {
-  const detail::u128 l = static_cast<detail::u128>(key_num_[a]) * key_den_[b];
-  const detail::u128 r = static_cast<detail::u128>(key_num_[b]) * key_den_[a];
-  if (l != r) return l > r;
-  if (stamp_[a] != stamp_[b]) return stamp_[a] < stamp_[b];
-  return a < b;
+bool OnlineScheduler::better(const Entry& x, const Entry& y) const {
+  if (x.small && y.small) {
+    if (x.key != y.key) return x.key > y.key;
+  } else {
+    const double gap = (x.key > y.key ? x.key : y.key) * 1e-12;
+    if (x.key - y.key > gap) return true;
+    if (y.key - x.key > gap) return false;
+    const int c = detail::compare_fractions(key_num_[x.actor], key_den_[x.actor], key_num_[y.actor],
+                                            key_den_[y.actor]);
+    if (c != 0) return c > 0;
+  }
+  if (x.stamp != y.stamp) return x.stamp < y.stamp;
+  return x.actor < y.actor;
 }
 
 void OnlineScheduler::sift_up(uint32_t i) {
-  const ActorId a = heap_[i];
+  const Entry e = heap_[i];
   while (i > 0) {
     const uint32_t parent = (i - 1) / 2;
-    if (!better(a, heap_[parent])) break;
+    if (!better(e, heap_[parent])) break;
     heap_[i] = heap_[parent];
-    pos_[heap_[i]] = i;
+    pos_[heap_[i].actor] = i;
     i = parent;
   }
-  heap_[i] = a;
-  pos_[a] = i;
+  heap_[i] = e;
+  pos_[e.actor] = i;
 }
 
 void OnlineScheduler::sift_down(uint32_t i) {
-  const ActorId a = heap_[i];
+  const Entry e = heap_[i];
   const auto size = static_cast<uint32_t>(heap_.size());
   for (;;) {
     uint32_t child = 2 * i + 1;
     if (child >= size) break;
     if (child + 1 < size && better(heap_[child + 1], heap_[child])) ++child;
-    if (!better(heap_[child], a)) break;
+    if (!better(heap_[child], e)) break;
     heap_[i] = heap_[child];
-    pos_[heap_[i]] = i;
+    pos_[heap_[i].actor] = i;
     i = child;
   }
-  heap_[i] = a;
-  pos_[a] = i;
+  heap_[i] = e;
+  pos_[e.actor] = i;
 }
 
 void OnlineScheduler::heap_push(ActorId a) {
-  heap_.push_back(a);
+  heap_.push_back(entry(a));
   sift_up(static_cast<uint32_t>(heap_.size() - 1));
 }
 
+// Floyd's bottom-up deletion: the hole walks down to a leaf along the better children (one
+// comparison per level instead of two), the last entry fills it and sifts up, usually little.
 void OnlineScheduler::heap_remove(ActorId a) {
-  const uint32_t i = pos_[a];
+  uint32_t i = pos_[a];
   pos_[a] = UINT32_MAX;
-  const ActorId last = heap_.back();
+  const Entry last = heap_.back();
   heap_.pop_back();
-  if (last == a) return;
+  if (last.actor == a) return;
+  const auto size = static_cast<uint32_t>(heap_.size());
+  for (;;) {
+    uint32_t child = 2 * i + 1;
+    if (child >= size) break;
+    if (child + 1 < size && better(heap_[child + 1], heap_[child])) ++child;
+    heap_[i] = heap_[child];
+    pos_[heap_[i].actor] = i;
+    i = child;
+  }
   heap_[i] = last;
-  pos_[last] = i;
+  pos_[last.actor] = i;
   sift_up(i);
-  sift_down(pos_[last]);
-}
-
-void OnlineScheduler::heap_fix(ActorId a) {
-  sift_up(pos_[a]);
-  sift_down(pos_[a]);
 }
 
 void OnlineScheduler::set_tokens(ChannelId c, uint64_t value) {
-  token_hash_ += term(c, value) - term(c, tokens_[c]);
+  token_hash_ += (value - tokens_[c]) * salt_[c];  // wrapping arithmetic: exact mod 2^64
   tokens_[c] = value;
 }
 
 void OnlineScheduler::set_count(ActorId a, uint64_t value) {
-  count_hash_ += term(a ^ kCountSalt, value) - term(a ^ kCountSalt, count_[a]);
+  count_hash_ += (value - count_[a]) * (salt_of(a) ^ kCountSalt);
   count_[a] = value;
 }
 
-// Re-evaluates an actor whose inputs or count changed without it firing: it joins the heap
-// (stamped now) when it became eligible, leaves when it no longer is, and moves otherwise.
-void OnlineScheduler::refresh(ActorId a) {
-  recompute_key(a);
-  const bool in_heap = pos_[a] != UINT32_MAX;
-  if (eligible(a)) {
-    if (in_heap) {
-      heap_fix(a);
-    } else {
-      stamp_[a] = decisions_;
-      heap_push(a);
-    }
-  } else if (in_heap) {
+// Eligible actors with key exactly 1 wait in a list in (stamp, id) order; those with a larger
+// key in the heap, where any of them beats every list member. Insertion scans back from the
+// tail, which in a decision only passes actors stamped in the same decision.
+void OnlineScheduler::list_insert(ActorId a) {
+  uint32_t after = tail_;
+  while (after != kNone && (stamp_[after] > stamp_[a] || (stamp_[after] == stamp_[a] && after > a)))
+    after = prev_[after];
+  const uint32_t before = after == kNone ? head_ : next_[after];
+  prev_[a] = after;
+  next_[a] = before;
+  (after == kNone ? head_ : next_[after]) = a;
+  (before == kNone ? tail_ : prev_[before]) = a;
+  in_list_[a] = 1;
+  ++listed_;
+}
+
+void OnlineScheduler::list_remove(ActorId a) {
+  (prev_[a] == kNone ? head_ : next_[prev_[a]]) = next_[a];
+  (next_[a] == kNone ? tail_ : prev_[next_[a]]) = prev_[a];
+  in_list_[a] = 0;
+  --listed_;
+}
+
+void OnlineScheduler::insert_eligible(ActorId a) {
+  if (key_num_[a] == key_den_[a]) {
+    list_insert(a);
+  } else {
+    heap_push(a);
+  }
+}
+
+void OnlineScheduler::remove_eligible(ActorId a) {
+  if (in_list_[a]) {
+    list_remove(a);
+  } else if (pos_[a] != UINT32_MAX) {
     heap_remove(a);
+  }
+}
+
+// Re-evaluates an actor whose inputs or count changed without it firing: it joins (stamped
+// now) when it became eligible, leaves when it no longer is, and moves otherwise.
+void OnlineScheduler::refresh(ActorId a) {
+  const bool was = in_list_[a] || pos_[a] != UINT32_MAX;
+  remove_eligible(a);
+  recompute_key(a);
+  if (eligible(a)) {
+    if (!was) stamp_[a] = decisions_;
+    insert_eligible(a);
   }
 }
 
@@ -207,9 +271,10 @@ void OnlineScheduler::start_iteration() {
 }
 
 std::optional<Run> OnlineScheduler::step(uint64_t max_firings) {
-  if (heap_.empty() || max_firings == 0) return std::nullopt;
+  if ((heap_.empty() && head_ == kNone) || max_firings == 0) return std::nullopt;
   const Topology& t = *topo_;
-  const ActorId a = heap_[0];
+  const bool from_heap = !heap_.empty();
+  const ActorId a = from_heap ? heap_[0].actor : head_;
   uint64_t k = 1;
   if (opt_.firings == FiringRule::floor_key) k = key_num_[a] / key_den_[a];
   if (opt_.bounded) k = std::min(k, q_[a] - count_[a]);
@@ -246,20 +311,34 @@ std::optional<Run> OnlineScheduler::step(uint64_t max_firings) {
   recompute_key(a);
   if (eligible(a)) {
     stamp_[a] = decisions_;
-    sift_down(0);
+    if (from_heap && key_num_[a] != key_den_[a]) {
+      heap_[0] = entry(a);
+      sift_down(0);
+    } else {
+      remove_eligible(a);
+      insert_eligible(a);
+    }
   } else {
-    heap_remove(a);
+    remove_eligible(a);
   }
-  // Its consumers' keys can only have grown.
+  // Its consumers' keys can only have grown, and only if the channel that grew was the one
+  // setting the key (the first input with the least tokens/cns): otherwise nothing changes.
   for (uint32_t i = t.out_off[a]; i < t.out_off[a + 1]; ++i) {
-    const ActorId b = t.dst[t.out[i]];
-    if (b == a) continue;
+    const ChannelId c = t.out[i];
+    const ActorId b = t.dst[c];
+    if (b == a || key_arg_[b] != c) continue;
     recompute_key(b);
     if (pos_[b] != UINT32_MAX) {
+      heap_[pos_[b]] = entry(b);  // same stamp, larger key
       sift_up(pos_[b]);
+    } else if (in_list_[b]) {
+      if (key_num_[b] != key_den_[b]) {  // rose above 1: to the heap, same stamp
+        list_remove(b);
+        heap_push(b);
+      }
     } else if (eligible(b)) {
       stamp_[b] = decisions_;
-      heap_push(b);
+      insert_eligible(b);
     }
   }
   if (opt_.bounded && owing_ == 0) start_iteration();
@@ -284,7 +363,9 @@ void OnlineScheduler::change_rates(ActorId a, uint64_t prd, uint64_t cns,
 }
 
 std::vector<ActorId> OnlineScheduler::eligibility_order() const {
-  std::vector<ActorId> order(heap_.begin(), heap_.end());
+  std::vector<ActorId> order;
+  for (const Entry& e : heap_) order.push_back(e.actor);
+  for (uint32_t a = head_; a != kNone; a = next_[a]) order.push_back(a);
   std::sort(order.begin(), order.end(), [&](ActorId x, ActorId y) {
     return stamp_[x] != stamp_[y] ? stamp_[x] < stamp_[y] : x < y;
   });
@@ -293,7 +374,8 @@ std::vector<ActorId> OnlineScheduler::eligibility_order() const {
 
 bool OnlineScheduler::same_state(const OnlineScheduler& other) const {
   return state_hash() == other.state_hash() && tokens_ == other.tokens_ && count_ == other.count_ &&
-         heap_.size() == other.heap_.size() && eligibility_order() == other.eligibility_order();
+         heap_.size() == other.heap_.size() && listed_ == other.listed_ &&
+         eligibility_order() == other.eligibility_order();
 }
 
 const char* outcome_name(Outcome o) {
