@@ -10,13 +10,11 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
-#include <unordered_map>
 #include <vector>
 
 namespace sdf {
@@ -84,13 +82,22 @@ class Graph {
  private:
   std::vector<std::string> actor_names_;
   std::vector<Channel> channels_;
-  struct NameHash {
-    using is_transparent = void;
-    size_t operator()(std::string_view s) const { return std::hash<std::string_view>{}(s); }
+  // Flat open-addressing tables of ids (the names live in actor_names_ / channels_): no node
+  // per entry, so a 10^6-actor graph loads without millions of small allocations.
+  struct FlatIndex {
+    std::vector<uint32_t> slots;  // id + 1, 0 = empty
+    size_t size = 0;
   };
-  std::unordered_map<std::string, ActorId, NameHash, std::equal_to<>> actor_index_;
-  std::unordered_map<std::string, ChannelId, NameHash, std::equal_to<>> channel_index_;
-  std::unordered_map<uint64_t, uint32_t> parallel_count_;  // (src,dst) -> channels so far
+  template <class KeyOf>
+  static int64_t flat_find(const FlatIndex& t, std::string_view key, KeyOf&& key_of);
+  template <class KeyOf>
+  static void flat_insert(FlatIndex& t, uint32_t id, KeyOf&& key_of);
+  FlatIndex actor_index_, channel_index_;
+  // (src, dst) -> number of channels so far, for the default names `src->dst#k`.
+  std::vector<uint64_t> pair_keys_;
+  std::vector<uint32_t> pair_counts_;
+  size_t pair_size_ = 0;
+  uint32_t next_parallel_index(uint64_t pair);
 };
 
 // Compressed incidence lists: for actor a, inputs(a) / outputs(a) are channel ids in channel

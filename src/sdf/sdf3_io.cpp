@@ -43,6 +43,7 @@ class Sdf3Reader {
     if (!sdf) fail(app, "<applicationGraph> has no <sdf>");
     Graph g;
     g.name = sdf.attribute("name").value();
+    if (!valid_utf8(g.name)) fail(sdf, "attribute 'name' is not valid UTF-8");
     for (pugi::xml_node actor : sdf.children("actor")) read_actor(g, actor);
     std::sort(ports_.begin(), ports_.end(), [](const Port& a, const Port& b) {
       return a.actor != b.actor ? a.actor < b.actor : a.name < b.name;
@@ -76,6 +77,7 @@ class Sdf3Reader {
     if (!a) fail(node, "<" + std::string(node.name()) + "> lacks the attribute '" + attr + "'");
     const std::string_view v = trim(a.value());
     if (v.empty()) fail(node, "attribute '" + std::string(attr) + "' is empty");
+    if (!valid_utf8(v)) fail(node, "attribute '" + std::string(attr) + "' is not valid UTF-8");
     return v;
   }
 
@@ -125,6 +127,7 @@ class Sdf3Reader {
     const pugi::xml_attribute name_attr = ch.attribute("name");
     const std::string name(trim(name_attr.value()));
     if (name_attr && name.empty()) fail(ch, "attribute 'name' is empty");
+    if (!valid_utf8(name)) fail(ch, "attribute 'name' is not valid UTF-8");
     auto actor = [&](const char* attr) {
       const std::string_view v = required(ch, attr);
       const auto a = g.find_actor(v);

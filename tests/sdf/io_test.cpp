@@ -79,6 +79,17 @@ TEST(Sdf3Reader, ReadsCrlfFilesAndCountsTheirLines) {
   }
 }
 
+TEST(Sdf3Reader, RejectsNamesThatAreNotUtf8) {
+  // Found by fuzzing: such a name was read, and writing the graph as JSON then threw.
+  EXPECT_NE(sdf3_error(sdf3("<actor name='\xff\xfe'/>\n")).find("f.xml:5: attribute 'name' is not valid UTF-8"),
+            std::string::npos);
+  EXPECT_NE(sdf3_error(sdf3("<actor name='\xed\xa0\x80'/>\n")).find("not valid UTF-8"),
+            std::string::npos);  // a UTF-16 surrogate
+  EXPECT_NE(sdf3_error(sdf3("<actor name='\xc0\x80'/>\n")).find("not valid UTF-8"),
+            std::string::npos);  // overlong
+  EXPECT_EQ(sdf3_error(sdf3("<actor name='\xc3\xa9t\xc3\xa9'/>\n")), "");  // "été"
+}
+
 TEST(Sdf3Reader, ElementOrderDoesNotMatter) {
   const Graph g =
       read_sdf3(sdf3("<channel name='c' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n" +
