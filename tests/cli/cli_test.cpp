@@ -1,22 +1,25 @@
 // The crowddb CLI end to end: exit statuses, one-line errors, outputs.
+#include "support/cli.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "support/cli.hpp"
-
 namespace crowddb::test {
 namespace {
 
-int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+int lines(const std::string& s) {
+  return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
+}
 
 TEST(Cli, UsageErrorsExitWith2) {
   TempDir dir;
-  for (const char* args : {"", "frobnicate", "run", "query", "query ftc --agents x.csv", "run x.json --ticks -3",
-                           "run x.json --threads 0", "query collisions --no-such-option",
-                           "query field --agents x.csv --kernel gauss"}) {
+  for (const char* args :
+       {"", "frobnicate", "run", "query", "query ftc --agents x.csv", "run x.json --ticks -3",
+        "run x.json --threads 0", "query collisions --no-such-option",
+        "query field --agents x.csv --kernel gauss"}) {
     const CliResult r = run_cli(args, dir);
     EXPECT_EQ(r.status, 2) << args << ": " << r.err;
     EXPECT_EQ(lines(r.err), 1) << args << ": " << r.err;
@@ -27,7 +30,8 @@ TEST(Cli, UsageErrorsExitWith2) {
 TEST(Cli, UnknownMethodIsAUsageError) {
   TempDir dir;
   const auto agents = dir.write("a.csv", "id,x,y,vx,vy,radius\n1,0,0,0,0,1\n");
-  const CliResult r = run_cli("query ftc --horizon 3 --agents " + agents.string() + " --method psychic", dir);
+  const CliResult r =
+      run_cli("query ftc --horizon 3 --agents " + agents.string() + " --method psychic", dir);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("psychic"), std::string::npos);
 }
@@ -57,14 +61,17 @@ TEST(Cli, BadCsvFilesExitWith1NamingFileLineAndField) {
     EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.text << " -> " << r.err;
     EXPECT_TRUE(r.out.empty());
   }
-  const CliResult missing = run_cli("query collisions --agents " + (dir / "nope.csv").string(), dir);
+  const CliResult missing =
+      run_cli("query collisions --agents " + (dir / "nope.csv").string(), dir);
   EXPECT_EQ(missing.status, 1);
   EXPECT_NE(missing.err.find("cannot open"), std::string::npos) << missing.err;
 }
 
 TEST(Cli, CrlfAndSpacesAndOptionalChargeAreAccepted) {
   TempDir dir;
-  const auto agents = dir.write("a.csv", "id, x, y, vx, vy, radius, charge\r\n2, 1.5, 0, 0, 0, 1, 2\r\n1, 0, 0, 0, 0, 1, 1\r\n");
+  const auto agents = dir.write(
+      "a.csv",
+      "id, x, y, vx, vy, radius, charge\r\n2, 1.5, 0, 0, 0, 1, 2\r\n1, 0, 0, 0, 0, 1, 1\r\n");
   const CliResult r = run_cli("query collisions --agents " + agents.string(), dir);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.out, "1\n2\n");
@@ -74,11 +81,13 @@ TEST(Cli, QueryFieldWithObstaclesAndOutFile) {
   TempDir dir;
   const auto agents = dir.write("a.csv", "id,x,y,vx,vy,radius\n1,0,0,0,0,1\n");
   const auto obstacles = dir.write("o.csv", "x,y,radius,charge\n3,4,1,2\n");
-  const CliResult r = run_cli("query field --kernel exp --metric l2 --A 1 --k 1 --agents " + agents.string() +
-                                  " --obstacles " + obstacles.string() + " --out " + (dir / "f.csv").string(),
-                              dir);
+  const CliResult r =
+      run_cli("query field --kernel exp --metric l2 --A 1 --k 1 --agents " + agents.string() +
+                  " --obstacles " + obstacles.string() + " --out " + (dir / "f.csv").string(),
+              dir);
   EXPECT_EQ(r.status, 0) << r.err;
-  // one charged point of charge 2 at Euclidean distance 5: 2 e^-5; gradient -k sign... = 2 e^-5 * (3/5, 4/5)
+  // one charged point of charge 2 at Euclidean distance 5: 2 e^-5; gradient -k sign... = 2 e^-5 *
+  // (3/5, 4/5)
   const std::string text = slurp(dir / "f.csv");
   EXPECT_EQ(text.rfind("id,potential,grad_x,grad_y\n1,", 0), 0u) << text;
   double pot, gx, gy;
@@ -92,8 +101,9 @@ TEST(Cli, QueryFtcNamesObstaclesByRow) {
   TempDir dir;
   const auto agents = dir.write("a.csv", "id,x,y,vx,vy,radius\n4,0,0,1,0,1\n");
   const auto obstacles = dir.write("o.csv", "x,y,radius\n0,50,1\n10,0,1\n");
-  const CliResult r =
-      run_cli("query ftc --horizon 30 --agents " + agents.string() + " --obstacles " + obstacles.string(), dir);
+  const CliResult r = run_cli(
+      "query ftc --horizon 30 --agents " + agents.string() + " --obstacles " + obstacles.string(),
+      dir);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.out, "id,first_id,time\n4,o1,8\n");
 }
@@ -132,7 +142,8 @@ TEST(Cli, RunHashDoesNotDependOnThreads) {
 
 TEST(Cli, RunExplainPrintsThePlanWithoutRunning) {
   TempDir dir;
-  const CliResult r = run_cli("run " + tiny_scenario(dir) + " --explain --out " + (dir / "x.sqlite").string(), dir);
+  const CliResult r =
+      run_cli("run " + tiny_scenario(dir) + " --explain --out " + (dir / "x.sqlite").string(), dir);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("TICK PLAN"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir / "x.sqlite"));
@@ -140,7 +151,8 @@ TEST(Cli, RunExplainPrintsThePlanWithoutRunning) {
 
 TEST(Cli, RunToAnUnwritablePathFailsCleanly) {
   TempDir dir;
-  const CliResult r = run_cli("run " + tiny_scenario(dir) + " --out /nonexistent-dir/t.sqlite", dir);
+  const CliResult r =
+      run_cli("run " + tiny_scenario(dir) + " --out /nonexistent-dir/t.sqlite", dir);
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("/nonexistent-dir/t.sqlite"), std::string::npos) << r.err;
@@ -148,7 +160,8 @@ TEST(Cli, RunToAnUnwritablePathFailsCleanly) {
 
 TEST(Cli, BadScenarioIsOneLineAndNoOutputIsLeft) {
   TempDir dir;
-  const auto sc = dir.write("bad.json", R"({"bounds": [0, 0, 10, 10], "goals": [{"name": "g", "x": 1, "y": 1}],
+  const auto sc =
+      dir.write("bad.json", R"({"bounds": [0, 0, 10, 10], "goals": [{"name": "g", "x": 1, "y": 1}],
     "agents": [{"x": 1, "y": 1, "radius": 0, "goal": "g"}]})");
   const CliResult r = run_cli("run " + sc.string() + " --out " + (dir / "o.sqlite").string(), dir);
   EXPECT_EQ(r.status, 1);
@@ -174,7 +187,8 @@ TEST(Cli, OverlappingSpawnIsAWarningAndTheRunGoesOn) {
 TEST(Cli, ValidateShippedScenarios) {
   TempDir dir;
   for (const char* name : {"airport", "circle", "crossing", "bottleneck"}) {
-    const CliResult r = run_cli("validate " + source_path(std::string("scenarios/") + name + ".json"), dir);
+    const CliResult r =
+        run_cli("validate " + source_path(std::string("scenarios/") + name + ".json"), dir);
     EXPECT_EQ(r.status, 0) << name << ": " << r.err;
     EXPECT_NE(r.out.find(": ok: "), std::string::npos) << r.out;
   }

@@ -45,25 +45,33 @@ TEST(ScenarioJson, InvalidFieldsNameTheirPointer) {
   struct Case {
     std::string text, expect;
   };
-  const std::string head = R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "x": 1, "y": 1}], )";
+  const std::string head =
+      R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "x": 1, "y": 1}], )";
   const Case cases[] = {
       {head + R"("agents": [{"x": 1, "y": 1, "radius": 0, "goal": "g"}]})", "/agents/0/radius"},
       {head + R"("agents": [{"x": 1, "y": 1, "radius": -2, "goal": "g"}]})", "/agents/0/radius"},
       {head + R"("agents": [{"x": 1, "y": 1, "goal": "nowhere"}]})", "unknown goal 'nowhere'"},
-      {head + R"("agents": [{"x": "NaN", "y": 1, "goal": "g"}]})", "/agents/0/x: expected a number"},
+      {head + R"("agents": [{"x": "NaN", "y": 1, "goal": "g"}]})",
+       "/agents/0/x: expected a number"},
       {head + R"("agents": [{"x": 1e999, "y": 1, "goal": "g"}]})", "s.json"},
-      {head + R"("agents": [{"x": 1, "y": 1, "goal": "g", "colour": "red"}]})", "/agents/0/colour: unknown key"},
-      {head + R"("agents": [{"x": 1, "y": 1, "max_speed": -1, "goal": "g"}]})", "/agents/0/max_speed"},
+      {head + R"("agents": [{"x": 1, "y": 1, "goal": "g", "colour": "red"}]})",
+       "/agents/0/colour: unknown key"},
+      {head + R"("agents": [{"x": 1, "y": 1, "max_speed": -1, "goal": "g"}]})",
+       "/agents/0/max_speed"},
       {head + R"("ticks": -5})", "/ticks"},
       {head + R"("dt": 0})", "/dt"},
       {head + R"("steering": {"horizon": 0}})", "/steering/horizon"},
       {head + R"("steering": {"potential": {"kernel": "gauss"}}})", "/steering/potential/kernel"},
       {head + R"("arrival": "teleport"})", "/arrival"},
-      {head + R"("obstacles": [{"type": "polygon", "vertices": [[0,0],[2,2],[2,0],[0,2]]}]})", "/obstacles/0"},
-      {head + R"("obstacles": [{"type": "circle", "x": 1, "y": 1, "radius": 0}]})", "/obstacles/0/radius"},
-      {head + R"("groups": [{"count": 5, "placement": {"type": "grid", "region": [0,0,1,1], "spacing": 5}, "goal": "g"}]})",
+      {head + R"("obstacles": [{"type": "polygon", "vertices": [[0,0],[2,2],[2,0],[0,2]]}]})",
+       "/obstacles/0"},
+      {head + R"("obstacles": [{"type": "circle", "x": 1, "y": 1, "radius": 0}]})",
+       "/obstacles/0/radius"},
+      {head +
+           R"("groups": [{"count": 5, "placement": {"type": "grid", "region": [0,0,1,1], "spacing": 5}, "goal": "g"}]})",
        "the grid holds 1 agents"},
-      {head + R"("groups": [{"count": 500, "radius": 3, "placement": {"type": "uniform", "region": [0,0,10,10]}, "goal": "g"}]})",
+      {head +
+           R"("groups": [{"count": 500, "radius": 3, "placement": {"type": "uniform", "region": [0,0,10,10]}, "goal": "g"}]})",
        "too crowded"},
       {R"({"bounds": [0, 0, -1, 1]})", "/bounds"},
       {R"({"bounds": [0, 0, 1, 1], "bounds": [0, 0, 2, 2]})", "duplicate key"},
@@ -117,7 +125,8 @@ TEST(ScenarioJson, CircleWithAntipodalGoalsAndOverlapWarning) {
 
 TEST(ScenarioJson, ShippedScenariosLoadWithoutWarnings) {
   for (const char* name : {"airport", "circle", "crossing", "bottleneck"}) {
-    const Scenario sc = load_scenario(test::source_path(std::string("scenarios/") + name + ".json"));
+    const Scenario sc =
+        load_scenario(test::source_path(std::string("scenarios/") + name + ".json"));
     EXPECT_EQ(sc.name, name);
     EXPECT_GT(sc.world.agents().size(), 0u);
     EXPECT_TRUE(sc.warnings.empty()) << name << ": " << sc.warnings.front();

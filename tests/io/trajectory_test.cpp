@@ -1,8 +1,9 @@
 #include "io/trajectory.hpp"
 
 #include <gtest/gtest.h>
-#include <algorithm>
 #include <sqlite3.h>
+
+#include <algorithm>
 
 #include "support/cli.hpp"
 
@@ -50,20 +51,28 @@ TEST(TrajectorySqlite, JuPedSimSchemaVersion3WithOwnTables) {
   run_to(db, OutputSpec::Format::sqlite);
   EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.partial"));
   EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite-wal"));
-  EXPECT_EQ(query(db, "SELECT value FROM metadata WHERE key = 'version'"), std::vector<std::string>{"3"});
-  EXPECT_EQ(std::stod(query(db, "SELECT value FROM metadata WHERE key = 'fps'").at(0)), 2.0);  // dt = 0.5
-  EXPECT_EQ(query(db, "SELECT count(DISTINCT frame) FROM trajectory_data"), std::vector<std::string>{"11"});
-  EXPECT_EQ(query(db, "SELECT count(*) FROM frame_data"), std::vector<std::string>{"11"});
-  EXPECT_EQ(query(db, "SELECT count(*) FROM frame_data f JOIN geometry g ON f.geometry_hash = g.hash"),
+  EXPECT_EQ(query(db, "SELECT value FROM metadata WHERE key = 'version'"),
+            std::vector<std::string>{"3"});
+  EXPECT_EQ(std::stod(query(db, "SELECT value FROM metadata WHERE key = 'fps'").at(0)),
+            2.0);  // dt = 0.5
+  EXPECT_EQ(query(db, "SELECT count(DISTINCT frame) FROM trajectory_data"),
             std::vector<std::string>{"11"});
+  EXPECT_EQ(query(db, "SELECT count(*) FROM frame_data"), std::vector<std::string>{"11"});
+  EXPECT_EQ(
+      query(db, "SELECT count(*) FROM frame_data f JOIN geometry g ON f.geometry_hash = g.hash"),
+      std::vector<std::string>{"11"});
   const std::string wkt = query(db, "SELECT wkt FROM geometry").at(0);
   EXPECT_EQ(wkt.rfind("POLYGON((", 0), 0u) << wkt;
   EXPECT_NE(wkt.find("),("), std::string::npos) << "the obstacle should be a hole: " << wkt;
-  EXPECT_EQ(query(db, "SELECT count(*) FROM trajectory_data WHERE frame = 0"), std::vector<std::string>{"2"});
-  EXPECT_EQ(query(db, "SELECT pos_x FROM trajectory_data WHERE frame = 0 AND id = 0"), std::vector<std::string>{"10.0"});
+  EXPECT_EQ(query(db, "SELECT count(*) FROM trajectory_data WHERE frame = 0"),
+            std::vector<std::string>{"2"});
+  EXPECT_EQ(query(db, "SELECT pos_x FROM trajectory_data WHERE frame = 0 AND id = 0"),
+            std::vector<std::string>{"10.0"});
   EXPECT_EQ(query(db, "SELECT count(*) FROM crowddb_tick_metrics"), std::vector<std::string>{"10"});
-  EXPECT_EQ(query(db, "SELECT count(*) FROM crowddb_agent_state"), query(db, "SELECT count(*) FROM trajectory_data"));
-  EXPECT_EQ(query(db, "SELECT value FROM crowddb_run WHERE key = 'scenario_name'"), std::vector<std::string>{"two"});
+  EXPECT_EQ(query(db, "SELECT count(*) FROM crowddb_agent_state"),
+            query(db, "SELECT count(*) FROM trajectory_data"));
+  EXPECT_EQ(query(db, "SELECT value FROM crowddb_run WHERE key = 'scenario_name'"),
+            std::vector<std::string>{"two"});
   EXPECT_EQ(query(db, "PRAGMA journal_mode"), std::vector<std::string>{"delete"});
 }
 
@@ -71,7 +80,9 @@ TEST(TrajectorySqlite, EveryNthFrameAndFps) {
   test::TempDir dir;
   const auto db = dir / "run.sqlite";
   run_to(db, OutputSpec::Format::sqlite, 5);
-  EXPECT_EQ(query(db, "SELECT group_concat(frame) FROM (SELECT DISTINCT frame FROM trajectory_data ORDER BY frame)"),
+  EXPECT_EQ(query(db,
+                  "SELECT group_concat(frame) FROM (SELECT DISTINCT frame FROM trajectory_data "
+                  "ORDER BY frame)"),
             std::vector<std::string>{"0,1,2"});
   EXPECT_EQ(std::stod(query(db, "SELECT value FROM metadata WHERE key = 'fps'").at(0)), 0.4);
 }
@@ -98,7 +109,8 @@ TEST(TrajectoryCsv, RoundTripsExactly) {
   test::TempDir dir;
   run_to(dir / "run.csv", OutputSpec::Format::csv);
   const std::string text = test::slurp(dir / "run.csv");
-  EXPECT_EQ(text.rfind("frame,id,x,y,vx,vy,radius,state,goal\n0,0,10,25,0,0,1,active,0\n", 0), 0u) << text.substr(0, 120);
+  EXPECT_EQ(text.rfind("frame,id,x,y,vx,vy,radius,state,goal\n0,0,10,25,0,0,1,active,0\n", 0), 0u)
+      << text.substr(0, 120);
   const std::string metrics = test::slurp(dir / "run.metrics.csv");
   EXPECT_EQ(std::count(metrics.begin(), metrics.end(), '\n'), 11);
   EXPECT_FALSE(std::filesystem::exists(dir / "run.csv.partial"));

@@ -12,8 +12,8 @@
 namespace crowddb {
 namespace {
 
-DiscTable two(double x1, double y1, double vx1, double vy1, double r1, double x2, double y2, double vx2, double vy2,
-              double r2) {
+DiscTable two(double x1, double y1, double vx1, double vy1, double r1, double x2, double y2,
+              double vx2, double vy2, double r2) {
   DiscTable t;
   t.push_back(1, x1, y1, vx1, vy1, r1);
   t.push_back(2, x2, y2, vx2, vy2, r2);
@@ -70,8 +70,8 @@ TEST(FtcNaive, AgentsBeatObstaclesAtEqualTimes) {
 TEST(FtcNaive, EqualTimesPickTheSmallerId) {
   DiscTable t;
   t.push_back(50, 0, 0, 0, 0, 1);
-  t.push_back(40, 10, 0, -1, 0, 1);   // reaches agent 50 at t = 8
-  t.push_back(30, -10, 0, 1, 0, 1);   // reaches agent 50 at t = 8 too
+  t.push_back(40, 10, 0, -1, 0, 1);  // reaches agent 50 at t = 8
+  t.push_back(30, -10, 0, 1, 0, 1);  // reaches agent 50 at t = 8 too
   Executor ex(1);
   QueryStats st;
   std::vector<FtcHit> out(3);
@@ -87,8 +87,8 @@ TEST(FieldNaive, SixFunctionsOnTwoPoints) {
   struct Case {
     Kernel k;
     Metric m;
-    double d;           // distance
-    double ddx, ddy;    // gradient of d w.r.t. p at agent 1 (dx = -3, dy = -4)
+    double d;         // distance
+    double ddx, ddy;  // gradient of d w.r.t. p at agent 1 (dx = -3, dy = -4)
   };
   const double l2x = -3.0 / 5, l2y = -4.0 / 5;
   // radial, m = 2: frames 0 and pi/4. Frame 0: |dx| + |dy| = 7; frame 1: u = (dx+dy)/sqrt2,
@@ -98,9 +98,12 @@ TEST(FieldNaive, SixFunctionsOnTwoPoints) {
   // d/dx: frame 0: sign(dx) = -1; frame 1: sign(u) cos - sign(w) sin = (-1)(1/s2) - (-1)(1/s2) = 0
   // d/dy: frame 0: -1; frame 1: sign(u) sin + sign(w) cos = (-1)(1/s2) + (-1)(1/s2) = -s2
   const double rdx = std::numbers::pi / 8 * (-1 + 0), rdy = std::numbers::pi / 8 * (-1 - s2);
-  const Case cases[] = {{Kernel::exp, Metric::l1, 7, -1, -1}, {Kernel::exp, Metric::l2, 5, l2x, l2y},
-                        {Kernel::exp, Metric::radial, radial, rdx, rdy}, {Kernel::inv, Metric::l1, 7, -1, -1},
-                        {Kernel::inv, Metric::l2, 5, l2x, l2y}, {Kernel::inv, Metric::radial, radial, rdx, rdy}};
+  const Case cases[] = {{Kernel::exp, Metric::l1, 7, -1, -1},
+                        {Kernel::exp, Metric::l2, 5, l2x, l2y},
+                        {Kernel::exp, Metric::radial, radial, rdx, rdy},
+                        {Kernel::inv, Metric::l1, 7, -1, -1},
+                        {Kernel::inv, Metric::l2, 5, l2x, l2y},
+                        {Kernel::inv, Metric::radial, radial, rdx, rdy}};
   for (const Case& c : cases) {
     PotentialSpec spec;
     spec.kernel = c.k;
@@ -142,7 +145,8 @@ TEST(FieldNaive, CoincidentPointsContributeWithZeroGradientAndInvIsFloored) {
 TEST(FieldNaive, ChargedPointsOfObstaclesCount) {
   DiscTable t;
   t.push_back(1, 0, 0, 0, 0, 1, 2.0);  // charge 2
-  StaticScene scene({{3, 0, 0.5, 3.0}}, {}, 1.0, ObstacleCharges::centres);  // one point of charge 3
+  StaticScene scene({{3, 0, 0.5, 3.0}}, {}, 1.0,
+                    ObstacleCharges::centres);  // one point of charge 3
   PotentialSpec spec;
   spec.A = 1;
   spec.k = 1;
@@ -159,9 +163,9 @@ TEST(CollisionNaive, TouchingIsNotOverlappingAndObstaclesCount) {
   t.push_back(1, 0, 0, 0, 0, 1);
   t.push_back(2, 1.5, 0, 0, 0, 1);
   t.push_back(3, 10, 0, 0, 0, 1);
-  t.push_back(4, 12, 0, 0, 0, 1);        // touches 3 exactly
-  t.push_back(5, 30, 0, 0, 0, 1);        // overlaps the polygon
-  t.push_back(6, 50, 50, 0, 0, 1);       // overlaps the circle
+  t.push_back(4, 12, 0, 0, 0, 1);   // touches 3 exactly
+  t.push_back(5, 30, 0, 0, 0, 1);   // overlaps the polygon
+  t.push_back(6, 50, 50, 0, 0, 1);  // overlaps the circle
   const std::vector<PolygonObstacle> polys{{{{30.5, -1}, {35, -1}, {35, 1}, {30.5, 1}}, 1}};
   StaticScene scene({{52, 50, 1.5, 1}}, polys, 1);
   CollisionPairs pairs;

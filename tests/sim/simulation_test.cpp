@@ -13,8 +13,8 @@ namespace {
 
 // A small, dense airport: 250 travellers in a 160 x 160 hall with 6 pillars and 4 gates.
 std::string small_airport(uint64_t seed, int threads = 1, const char* arrival = "retarget") {
-  return std::string(R"({"bounds": [0, 0, 160, 160], "seed": )") + std::to_string(seed) + R"(, "threads": )" +
-         std::to_string(threads) + R"(, "arrival": ")" + arrival + R"(",
+  return std::string(R"({"bounds": [0, 0, 160, 160], "seed": )") + std::to_string(seed) +
+         R"(, "threads": )" + std::to_string(threads) + R"(, "arrival": ")" + arrival + R"(",
     "goals": [{"name": "S", "x": 80, "y": 4, "arrival_radius": 8}, {"name": "N", "x": 80, "y": 156, "arrival_radius": 8},
               {"name": "W", "x": 4, "y": 80, "arrival_radius": 8}, {"name": "E", "x": 156, "y": 80, "arrival_radius": 8}],
     "obstacles": [{"type": "circle", "x": 40, "y": 50, "radius": 8}, {"type": "circle", "x": 80, "y": 50, "radius": 10},
@@ -188,8 +188,8 @@ TEST(Simulation, ExplainNamesEveryOperatorAndAccessPath) {
   Scenario sc = parse_scenario(small_airport(1), "t.json");
   Simulation sim(std::move(sc.world), sc.config);
   const std::string plan = sim.explain();
-  for (const char* s : {"Q1 attraction", "Q2 inner avoidance", "Q3 outer avoidance", "backoff", "commit",
-                        "access path: naive", "exp-l1"})
+  for (const char* s : {"Q1 attraction", "Q2 inner avoidance", "Q3 outer avoidance", "backoff",
+                        "commit", "access path: naive", "exp-l1"})
     EXPECT_NE(plan.find(s), std::string::npos) << s << "\n" << plan;
   for (int t = 0; t < 3; ++t) sim.step();
   const std::string analyze = sim.explain_analyze();

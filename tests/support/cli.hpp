@@ -48,7 +48,8 @@ class TempDir {
 // `args` is appended to the binary path as-is (quote paths with spaces yourself).
 inline CliResult run_cli(const std::string& args, const TempDir& dir) {
   const auto out = dir / ".stdout", err = dir / ".stderr";
-  const std::string cmd = std::string(CROWDDB_CLI) + " " + args + " >" + out.string() + " 2>" + err.string() + " </dev/null";
+  const std::string cmd = std::string(CROWDDB_CLI) + " " + args + " >" + out.string() + " 2>" +
+                          err.string() + " </dev/null";
   const int raw = std::system(cmd.c_str());
   CliResult r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
@@ -57,6 +58,8 @@ inline CliResult run_cli(const std::string& args, const TempDir& dir) {
   return r;
 }
 
-inline std::string source_path(const std::string& rel) { return std::string(CROWDDB_SOURCE_DIR) + "/" + rel; }
+inline std::string source_path(const std::string& rel) {
+  return std::string(CROWDDB_SOURCE_DIR) + "/" + rel;
+}
 
 }  // namespace crowddb::test
