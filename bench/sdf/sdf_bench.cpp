@@ -97,7 +97,8 @@ void BM_LoadAndRepetitions(benchmark::State& state) {
   if (sum != checksum(graph(shape, n).q)) state.SkipWithError("wrong repetitions vector");
   state.counters["checksum"] = static_cast<double>(sum % 1000000);
   state.counters["MB"] = static_cast<double>(std::filesystem::file_size(path)) / 1e6;
-  state.SetLabel(std::string(kShapeNames[shape]) + " " + std::to_string(n) + (xml ? " SDF3" : " JSON"));
+  state.SetLabel(std::string(kShapeNames[shape]) + " " + std::to_string(n) +
+                 (xml ? " SDF3" : " JSON"));
   std::filesystem::remove(path);
 }
 
@@ -170,24 +171,21 @@ void sizes(benchmark::internal::Benchmark* b, std::initializer_list<int64_t> ns,
       for (int64_t e : extra) b->Args({shape, n, e});
 }
 
-BENCHMARK(BM_Repetitions)
-    ->Apply([](auto* b) { sizes(b, {1000, 10000, 100000, 1000000}); })
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Repetitions)->Apply([](auto* b) {
+                           sizes(b, {1000, 10000, 100000, 1000000});
+                         }) -> Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadAndRepetitions)
     ->Apply([](auto* b) {
       for (int64_t shape : {0, 2})
         for (int64_t xml : {0, 1}) b->Args({shape, 1000000, xml});
-    })
-    ->Unit(benchmark::kMillisecond)
-    ->Iterations(3);
-BENCHMARK(BM_Static)
-    ->Apply([](auto* b) { sizes(b, {1000, 10000, 100000, 1000000}); })
-    ->Unit(benchmark::kMillisecond);
+    }) -> Unit(benchmark::kMillisecond) -> Iterations(3);
+BENCHMARK(BM_Static)->Apply([](auto* b) {
+                      sizes(b, {1000, 10000, 100000, 1000000});
+                    }) -> Unit(benchmark::kMillisecond);
 BENCHMARK(BM_OnlineDecisions)->Apply([](auto* b) { sizes(b, {1000, 1000000}, {0, 1}); });
-BENCHMARK(BM_OnlineRun)
-    ->Apply([](auto* b) { sizes(b, {1000, 10000, 100000, 1000000}, {0, 1}); })
-    ->Unit(benchmark::kMillisecond)
-    ->Iterations(1);
+BENCHMARK(BM_OnlineRun)->Apply([](auto* b) {
+                         sizes(b, {1000, 10000, 100000, 1000000}, {0, 1});
+                       }) -> Unit(benchmark::kMillisecond) -> Iterations(1);
 
 }  // namespace
 

@@ -139,11 +139,12 @@ TEST(Cli, SimulateRateChange) {
 }
 
 TEST(Cli, ConvertRoundTrips) {
-  const std::string dir = ::testing::TempDir();
+  const std::string out = test::temp_path("g.xml");
   const test::Cli x =
-      test::sdfsched("convert " + graph("cd2dat.json") + " --to sdf3 -o '" + dir + "g.xml'");
+      test::sdfsched("convert " + graph("cd2dat.json") + " --to sdf3 -o '" + out + "'");
   ASSERT_EQ(x.status, 0) << x.err;
-  const test::Cli back = test::sdfsched("repetitions '" + dir + "g.xml' --json");
+  const test::Cli back = test::sdfsched("repetitions '" + out + "' --json");
+  std::remove(out.c_str());
   EXPECT_EQ(json::parse(back.out)["repetitions"]["F"], 160);
   const test::Cli j = test::sdfsched("convert " + graph("cd2dat.xml") + " --to json");
   EXPECT_EQ(json::parse(j.out)["channels"][0]["name"], "ab");

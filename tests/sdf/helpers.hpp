@@ -1,7 +1,9 @@
 // Shared by the sdf tests: compact graph construction and running the sdfsched binary.
 #pragma once
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>

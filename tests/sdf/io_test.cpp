@@ -81,12 +81,13 @@ TEST(Sdf3Reader, ReadsCrlfFilesAndCountsTheirLines) {
 
 TEST(Sdf3Reader, RejectsNamesThatAreNotUtf8) {
   // Found by fuzzing: such a name was read, and writing the graph as JSON then threw.
-  EXPECT_NE(sdf3_error(sdf3("<actor name='\xff\xfe'/>\n")).find("f.xml:5: attribute 'name' is not valid UTF-8"),
+  EXPECT_NE(sdf3_error(sdf3("<actor name='\xff\xfe'/>\n"))
+                .find("f.xml:5: attribute 'name' is not valid UTF-8"),
             std::string::npos);
   EXPECT_NE(sdf3_error(sdf3("<actor name='\xed\xa0\x80'/>\n")).find("not valid UTF-8"),
             std::string::npos);  // a UTF-16 surrogate
   EXPECT_NE(sdf3_error(sdf3("<actor name='\xc0\x80'/>\n")).find("not valid UTF-8"),
-            std::string::npos);  // overlong
+            std::string::npos);                                            // overlong
   EXPECT_EQ(sdf3_error(sdf3("<actor name='\xc3\xa9t\xc3\xa9'/>\n")), "");  // "été"
 }
 
@@ -238,11 +239,12 @@ TEST(GraphFile, ReportsMissingFilesAndUnknownContent) {
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), Error::Kind::io);
   }
-  const std::string path = ::testing::TempDir() + "graph.txt";
+  const std::string path = test::temp_path("graph.txt");
   std::ofstream(path) << "  {\"actors\":[{\"name\":\"A\"}]}";
   EXPECT_EQ(read_graph_file(path).actor_count(), 1u);  // sniffed as JSON
   std::ofstream(path) << "hello";
   EXPECT_THROW(read_graph_file(path), Error);
+  std::remove(path.c_str());
 }
 
 }  // namespace
