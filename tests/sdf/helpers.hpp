@@ -36,6 +36,11 @@ inline std::string data(const std::string& name) {
   return std::string(SDF_DATA_DIR) + "/" + name;
 }
 
+// A file name in the test temp directory, unique to this process (ctest runs tests in parallel).
+inline std::string temp_path(const std::string& name) {
+  return ::testing::TempDir() + "sdf_" + std::to_string(::getpid()) + "_" + name;
+}
+
 inline std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;
