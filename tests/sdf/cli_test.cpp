@@ -18,7 +18,7 @@ bool one_line(const std::string& s) {
   return !s.empty() && s.back() == '\n' && s.find('\n') == s.size() - 1;
 }
 
-TEST(Cli, RepetitionsJson) {
+TEST(SdfschedCli, RepetitionsJson) {
   const test::Cli r = test::sdfsched("repetitions " + graph("cd2dat.xml") + " --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
@@ -30,7 +30,7 @@ TEST(Cli, RepetitionsJson) {
   EXPECT_EQ(text.out, "A 147\nB 147\nC 98\nD 28\nE 32\nF 160\n");
 }
 
-TEST(Cli, InconsistentAndOverflow) {
+TEST(SdfschedCli, InconsistentAndOverflow) {
   const test::Cli r = test::sdfsched("repetitions " + graph("inconsistent.json") + " --json");
   EXPECT_EQ(r.status, 1);
   const json j = json::parse(r.out);
@@ -44,7 +44,7 @@ TEST(Cli, InconsistentAndOverflow) {
   EXPECT_TRUE(one_line(o.err));
 }
 
-TEST(Cli, ScheduleStaticJson) {
+TEST(SdfschedCli, ScheduleStaticJson) {
   const test::Cli r =
       test::sdfsched("schedule " + graph("cd2dat.json") + " --policy static --json");
   ASSERT_EQ(r.status, 0) << r.err;
@@ -59,7 +59,7 @@ TEST(Cli, ScheduleStaticJson) {
   EXPECT_TRUE(j["fairness"]["mean"].is_number());
 }
 
-TEST(Cli, ScheduleOnlineOutcomesAndExitStatus) {
+TEST(SdfschedCli, ScheduleOnlineOutcomesAndExitStatus) {
   const test::Cli p =
       test::sdfsched("schedule " + graph("cd2dat.json") + " --policy online --json");
   EXPECT_EQ(p.status, 3);
@@ -93,7 +93,7 @@ TEST(Cli, ScheduleOnlineOutcomesAndExitStatus) {
   EXPECT_NE(one.out.find("outcome: limit"), std::string::npos);
 }
 
-TEST(Cli, HugePeriodsAreNotListedButStillChecked) {
+TEST(SdfschedCli, HugePeriodsAreNotListedButStillChecked) {
   const test::Cli r = test::sdfsched("schedule " + graph("chain65537.json") + " --json");
   ASSERT_EQ(r.status, 0);
   const json j = json::parse(r.out);
@@ -103,7 +103,7 @@ TEST(Cli, HugePeriodsAreNotListedButStillChecked) {
   EXPECT_EQ(j["valid"], true);
 }
 
-TEST(Cli, Deadlock) {
+TEST(SdfschedCli, Deadlock) {
   for (const char* policy : {"static", "online", "online-bounded"}) {
     const test::Cli r =
         test::sdfsched("schedule " + graph("deadlock.json") + " --policy " + policy + " --json");
@@ -115,7 +115,7 @@ TEST(Cli, Deadlock) {
   }
 }
 
-TEST(Cli, SimulateRateChange) {
+TEST(SdfschedCli, SimulateRateChange) {
   const test::Cli r = test::sdfsched("simulate " + graph("cd2dat.json") +
                                      " --rate-change C:4/3@100 --policy online-bounded --json");
   ASSERT_EQ(r.status, 0) << r.err;
@@ -138,7 +138,7 @@ TEST(Cli, SimulateRateChange) {
   EXPECT_EQ(json::parse(inc.out)["consistent_after"], false);
 }
 
-TEST(Cli, ConvertRoundTrips) {
+TEST(SdfschedCli, ConvertRoundTrips) {
   const std::string out = test::temp_path("g.xml");
   const test::Cli x =
       test::sdfsched("convert " + graph("cd2dat.json") + " --to sdf3 -o '" + out + "'");
@@ -152,7 +152,7 @@ TEST(Cli, ConvertRoundTrips) {
   EXPECT_NE(d.out.find("\"A\" -> \"B\""), std::string::npos);
 }
 
-TEST(Cli, BadInputAndUsage) {
+TEST(SdfschedCli, BadInputAndUsage) {
   struct Case {
     std::string args;
     int status;
