@@ -29,10 +29,16 @@ void Executor::for_each_chunk(std::size_t n, std::size_t grain,
     for (std::size_t b = 0; b < n; b += grain) body(b, std::min(n, b + grain));
     return;
   }
+  // Split over chunk numbers, not rows: a row range split by oneTBB halves at arbitrary rows, so
+  // chunk boundaries (and any per-chunk buffer indexed by begin / grain) would depend on timing.
+  const std::size_t chunks = (n + grain - 1) / grain;
   arena_->arena.execute([&] {
     tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, n, grain),
-        [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); },
+        tbb::blocked_range<std::size_t>(0, chunks, 1),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t c = r.begin(); c < r.end(); ++c)
+            body(c * grain, std::min(n, (c + 1) * grain));
+        },
         tbb::simple_partitioner());
   });
 }

@@ -23,7 +23,9 @@ class Executor {
 
   int threads() const { return threads_; }
 
-  // Calls body(begin, end) for consecutive chunks of at most `grain` rows covering [0, n).
+  // Calls body(begin, end) for the chunks [k*grain, min(n, (k+1)*grain)) covering [0, n), in any
+  // order and on any thread; the boundaries are fixed, so per-chunk buffers may be indexed by
+  // begin / grain.
   // Not re-entrant: one call at a time per Executor. An exception thrown by a body is rethrown.
   void for_each_chunk(std::size_t n, std::size_t grain,
                       const std::function<void(std::size_t, std::size_t)>& body);

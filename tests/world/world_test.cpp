@@ -104,6 +104,10 @@ struct BadField {
   void (*mutate)(AgentSpec&);
 };
 
+void PrintTo(const BadField& b, std::ostream* os) {
+  *os << b.field;
+}
+
 class InvalidAgentRow : public ::testing::TestWithParam<BadField> {};
 
 TEST_P(InvalidAgentRow, IsRejectedNamingTheFieldAndNothingIsLost) {
@@ -139,7 +143,12 @@ INSTANTIATE_TEST_SUITE_P(
                       BadField{"max_speed", [](AgentSpec& s) { s.max_speed = -2; }},
                       BadField{"max_accel", [](AgentSpec& s) { s.max_accel = kNaN; }},
                       BadField{"charge", [](AgentSpec& s) { s.charge = kInf; }},
-                      BadField{"goal", [](AgentSpec& s) { s.goal = 9; }}));
+                      BadField{"goal", [](AgentSpec& s) { s.goal = 9; }}),
+    // Named by index and field: the default printer would name each case by pointer bytes,
+    // which change from run to run and so never match ctest's stored filter.
+    [](const ::testing::TestParamInfo<BadField>& param_info) {
+      return std::to_string(param_info.index) + "_" + param_info.param.field;
+    });
 
 TEST(World, InvalidStaticRowsAreRejected) {
   World w = world_with_goals();
