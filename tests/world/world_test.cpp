@@ -10,7 +10,7 @@ namespace {
 
 World world_with_goals(int goals = 2) {
   World w(Bounds{0, 0, 100, 100});
-  for (int g = 0; g < goals; ++g) w.add_goal({"g" + std::to_string(g), 10.0 * g, 5, 1, 1});
+  for (int g = 0; g < goals; ++g) w.add_goal({std::string("g").append(std::to_string(g)), 10.0 * g, 5, 1, 1});
   return w;
 }
 
