@@ -23,7 +23,7 @@ namespace {
 
 constexpr double kHorizon = 30;
 
-enum World { uniform_w = 0, crunch_w = 1, perturbed_w = 2 };
+enum World { uniform_w = 0, crunch_w = 1, perturbed_w = 2, plane_w = 3 };
 
 build::Box e1_box(std::size_t n) {
   const double s = std::sqrt(static_cast<double>(n) / 15000.0);
@@ -170,7 +170,8 @@ void BM_Naive(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
 }
 
-// Args: n, world (0 uniform, 1 Big Crunch, 2 perturbed), variant (0 default, 1 frustum bound,
+// Args: n, world (0 uniform, 1 Big Crunch, 2 perturbed: all at the E1 density; 3 uniform on the
+// fixed 640 x 480 plane), variant (0 default, 1 frustum bound,
 // 2 pure best-first order, 3/4 chord with 2/4 slices, 5 top-down nearer-first order,
 // 6..9 leaf size 4, 6, 12, 16).
 void sizes(benchmark::internal::Benchmark* b) {
@@ -184,6 +185,12 @@ void sizes(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_Build)->Apply(sizes);
 BENCHMARK(BM_Query)->Apply(sizes);
 BENCHMARK(BM_BuildQuery)->Apply(sizes);
+// Small n, index against naive: where the planner's threshold (auto_min_rows) comes from.
+BENCHMARK(BM_BuildQuery)
+    ->ArgsProduct({{16, 32, 64, 128, 256, 512}, {uniform_w, plane_w}, {0}})
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Naive)->ArgsProduct({{16, 32, 64, 128, 256, 512}, {uniform_w, plane_w}})->Unit(benchmark::kMicrosecond);
+
 // Leaf-size sweep (variant 100 + leaf size) at n = 15,000: how the default leaf size was chosen.
 BENCHMARK(BM_BuildQuery)
     ->ArgsProduct({{15000}, {uniform_w, crunch_w, perturbed_w}, {104, 108, 116, 124, 132, 148}})
