@@ -189,7 +189,9 @@ BENCHMARK(BM_BuildQuery)->Apply(sizes);
 BENCHMARK(BM_BuildQuery)
     ->ArgsProduct({{16, 32, 64, 128, 256, 512}, {uniform_w, plane_w}, {0}})
     ->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_Naive)->ArgsProduct({{16, 32, 64, 128, 256, 512}, {uniform_w, plane_w}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Naive)
+    ->ArgsProduct({{16, 32, 64, 128, 256, 512}, {uniform_w, plane_w}})
+    ->Unit(benchmark::kMicrosecond);
 
 // Leaf-size sweep (variant 100 + leaf size) at n = 15,000: how the default leaf size was chosen.
 BENCHMARK(BM_BuildQuery)

@@ -28,6 +28,29 @@ std::vector<FtcHit> naive(const DiscView& d, const StaticScene& s, double horizo
   return out;
 }
 
+// The oracle's answer for the last input seen: the option sweeps below ask for it many times.
+const std::vector<FtcHit>& naive_cached(const DiscView& d, const StaticScene& s, double horizon) {
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&](const void* p, std::size_t bytes) {
+    const auto* c = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < bytes; ++i) h = (h ^ c[i]) * 1099511628211ull;
+  };
+  for (const double* col : {d.x, d.y, d.vx, d.vy, d.radius}) mix(col, d.n * sizeof(double));
+  mix(d.id, d.n * sizeof(uint64_t));
+  mix(&horizon, sizeof horizon);
+  for (const auto& c : s.circles()) mix(&c, sizeof c);
+  for (const auto& p : s.polygons()) mix(p.vertices.data(), p.vertices.size() * sizeof(Vec2));
+  static uint64_t key = 0;
+  static std::size_t rows = 0;
+  static std::vector<FtcHit> answer;
+  if (key != h || rows != d.n || answer.size() != d.n) {
+    answer = naive(d, s, horizon);
+    key = h;
+    rows = d.n;
+  }
+  return answer;
+}
+
 std::string describe(const FtcHit& h) {
   return "kind " + std::to_string(static_cast<int>(h.with.kind)) + " row " +
          std::to_string(h.with.row) + " t " + std::to_string(h.time);
@@ -41,7 +64,7 @@ bool same_bits(double a, double b) {
 int compare(const DiscTable& t, const StaticScene& s, double horizon, Opt opt = {}, int threads = 1,
             QueryStats* stats_out = nullptr) {
   const DiscView d = t.view();
-  const auto want = naive(d, s, horizon);
+  const auto& want = naive_cached(d, s, horizon);
   FtcIndex index(opt);
   Executor ex(threads);
   QueryStats st;
@@ -163,20 +186,20 @@ TEST(FtcIndex, CoordinatesOffsetByAMillion) {
 TEST(FtcIndex, BigCrunchAndPerturbed) {
   for (double perturb : {0.0, 1.0}) {
     for (double arrival : {10.0, 30.0, 45.0}) {
-      DiscTable t = build::big_crunch(2000, {}, arrival, 1, 3, perturb, 21);
+      DiscTable t = build::big_crunch(1200, {}, arrival, 1, 3, perturb, 21);
       build::shuffle_ids(t, 3);
       EXPECT_EQ(compare(t, kNoScene, 30), 0) << perturb << " " << arrival;
       EXPECT_EQ(compare(t, kNoScene, 30, {.bound = Opt::Bound::frustum}), 0)
           << perturb << " " << arrival;
     }
     // Sparse: small discs far apart, so the collision times crowd just before the arrival.
-    const DiscTable sparse = build::big_crunch(1500, {0, 0, 4000, 3000}, 20, 0.1, 0.3, perturb, 4);
+    const DiscTable sparse = build::big_crunch(500, {0, 0, 3000, 2000}, 20, 0.1, 0.3, perturb, 4);
     for (const Opt& o : all_options()) EXPECT_EQ(compare(sparse, kNoScene, 30, o), 0) << perturb;
   }
 }
 
 TEST(FtcIndex, HorizonZeroAndInfinite) {
-  const DiscTable t = build::uniform(700, {0, 0, 800, 800}, 10, 1, 3, 12);
+  const DiscTable t = build::uniform(400, {0, 0, 800, 800}, 10, 1, 3, 12);
   for (double h : {0.0, 1e-9, 0.5, 1e6, double{INFINITY}}) {
     FtcIndex probe;
     probe.build(t.view(), kNoScene, h);
@@ -253,7 +276,7 @@ TEST(FtcIndex, GrazingPairs) {
 }
 
 TEST(FtcIndex, SameAnswerOnAnyThreadCount) {
-  const DiscTable t = build::uniform(5000, {}, 50, 1, 3, 31);
+  const DiscTable t = build::uniform(3000, {}, 50, 1, 3, 31);
   QueryStats s1, s3;
   EXPECT_EQ(compare(t, kNoScene, 30, {}, 1, &s1), 0);
   EXPECT_EQ(compare(t, kNoScene, 30, {}, 3, &s3), 0);
