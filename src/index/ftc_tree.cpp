@@ -163,7 +163,12 @@ struct AgentSource {
     __builtin_prefetch(d->radius + i);
     __builtin_prefetch(d->id + i);
   }
-  // Exactly the naive path's expression (ftc_naive.cpp), so times are bit-identical.
+  // Exactly the naive path's expressions (ftc_naive.cpp, ray_disc_time), so times are
+  // bit-identical: overlaps() is ray_disc_time's own test for time 0.
+  bool overlaps(const Probe& a, uint32_t b) const {
+    const double dx = d->x[b] - a.ax, dy = d->y[b] - a.ay, R = a.ar + d->radius[b];
+    return dx * dx + dy * dy - R * R < 0;
+  }
   double time(const Probe& a, uint32_t b, double horizon) const {
     return ray_disc_time(d->x[b] - a.ax, d->y[b] - a.ay, d->vx[b] - a.avx, d->vy[b] - a.avy,
                          a.ar + d->radius[b], horizon);
@@ -181,6 +186,10 @@ struct CircleSource {
   double r(uint32_t i) const { return c[i].radius; }
   uint64_t key(uint32_t i) const { return i; }
   void prefetch(uint32_t i) const { __builtin_prefetch(c.data() + i); }
+  bool overlaps(const Probe& a, uint32_t b) const {
+    const double dx = c[b].x - a.ax, dy = c[b].y - a.ay, R = a.ar + c[b].radius;
+    return dx * dx + dy * dy - R * R < 0;
+  }
   double time(const Probe& a, uint32_t b, double horizon) const {
     return ray_disc_time(c[b].x - a.ax, c[b].y - a.ay, -a.avx, -a.avy, a.ar + c[b].radius, horizon);
   }
@@ -195,6 +204,9 @@ class KineticTree {
   using Order = FtcIndexOptions::Order;
   // Adds this tree's members to `best`. self_pos: the query's position in tree order (it is
   // skipped as a member, and its leaf is scanned first), or kNone.
+  // OverlapOnly: only the members that overlap the query now (pair time 0) count; the bounds
+  // and the pair tests shrink to the t = 0 checks (see "Overlaps first" in ftc_tree.hpp).
+  template <bool OverlapOnly>
   void search(const Probe& q, double horizon, Best& best, Scratch& sc, Counters& c, Order order,
               uint32_t self_pos, bool seed) const;
   std::string validate(const Frame& f) const;
@@ -232,6 +244,7 @@ class KineticTree {
   void leaf_bounds(uint32_t node);
   void merge_bounds(uint32_t node, uint32_t l, uint32_t r);
   void finish_bounds(uint32_t node);
+  template <bool OverlapOnly>
   void scan(uint32_t node, const Probe& q, double horizon, Best& best, Counters& c) const;
 
   const Src* src_ = nullptr;
@@ -415,6 +428,7 @@ void KineticTree<Src>::finish_bounds(uint32_t node) {
 }
 
 template <class Src>
+template <bool OverlapOnly>
 void KineticTree<Src>::scan(uint32_t node, const Probe& q, double horizon, Best& best,
                             Counters& c) const {
   const Node& nd = nodes_[node];
@@ -425,19 +439,32 @@ void KineticTree<Src>::scan(uint32_t node, const Probe& q, double horizon, Best&
     if (best.beats(0, Src::kind, key)) break;
     if (row == q.self) continue;
     ++c.pair_tests;
-    best.offer(src_->time(q, row, horizon), Src::kind, key, row);
+    if constexpr (OverlapOnly) {
+      if (src_->overlaps(q, row)) best.offer(0.0, Src::kind, key, row);
+    } else {
+      best.offer(src_->time(q, row, horizon), Src::kind, key, row);
+    }
   }
 }
 
 template <class Src>
+template <bool OverlapOnly>
 void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratch& sc, Counters& c,
                               Order order, uint32_t self_pos, bool seed) const {
   if (nodes_.empty()) return;
   const Frame& f = *f_;
   constexpr Kind kind = Src::kind;
+  if constexpr (OverlapOnly) horizon = 0;
   auto bound_of = [&](uint32_t k) {
-    const double cap = best.kind == Kind::none ? horizon : std::min(horizon, best.t);
-    return node_bound(&slices_[k], stride_, f, q, q.ar + nodes_[k].rmax, cap);
+    const double R = q.ar + nodes_[k].rmax;
+    if constexpr (OverlapOnly) {  // within reach at t = 0, or out
+      const Slice& b = slices_[k];
+      return b.lo_x - q.fx <= R && q.fx - b.hi_x <= R && b.lo_y - q.fy <= R && q.fy - b.hi_y <= R ? 0.0
+                                                                                              : INFINITY;
+    } else {
+      const double cap = best.kind == Kind::none ? horizon : std::min(horizon, best.t);
+      return node_bound(&slices_[k], stride_, f, q, R, cap);
+    }
   };
   auto pruned = [&](double b, uint64_t min_key) {
     return b == INFINITY || best.beats(b, kind, min_key);
@@ -471,7 +498,7 @@ void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratc
       if (nd.leaf()) {
         if (node != skip_leaf) {
           ++c.visited;
-          scan(node, q, horizon, best, c);
+          scan<OverlapOnly>(node, q, horizon, best, c);
         }
         node = kNone;
         continue;
@@ -502,7 +529,7 @@ void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratc
   if (self_pos != kNone && (seed || order == Order::bottom_up || order == Order::leaf_queue)) {
     leaf = leaf_at_[self_pos];
     ++c.visited;
-    scan(leaf, q, horizon, best, c);
+    scan<OverlapOnly>(leaf, q, horizon, best, c);
   }
   if ((order == Order::bottom_up || order == Order::leaf_queue) && leaf != kNone) {
     // Then the siblings of the path to the root, nearest (deepest) first. Once every position
@@ -670,9 +697,15 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, Scratch& sc, Counters& 
           d.y[row] - frame.oy,
           row};
   Best best;
-  agent_tree.search(q, horizon, best, sc, c, opt.order, pos, opt.seed_own_leaf);
+  if (opt.overlaps_first) {
+    // An agent overlapping the query now wins outright (time 0, agents before obstacles); only
+    // the smallest such id is wanted, and only t = 0 checks are needed to find it.
+    agent_tree.search<true>(q, horizon, best, sc, c, opt.order, pos, opt.seed_own_leaf);
+    if (best.kind != Kind::none) return {{best.kind, best.row}, best.t};
+  }
+  agent_tree.search<false>(q, horizon, best, sc, c, opt.order, pos, opt.seed_own_leaf);
   q.self = kNone;
-  circle_tree.search(q, horizon, best, sc, c, opt.order, kNone, false);
+  circle_tree.search<false>(q, horizon, best, sc, c, opt.order, kNone, false);
   const auto polys = scene->polygons();
   const auto boxes = scene->polygon_boxes();
   for (std::size_t p = 0; p < polys.size(); ++p) {

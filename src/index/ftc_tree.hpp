@@ -34,6 +34,7 @@ struct FtcIndexOptions {
   };
   Order order = Order::leaf_queue;
   bool seed_own_leaf = true;  // top-down orders: scan the query's own leaf first
+  bool overlaps_first = true;  // first look only for agents overlapping the query now (t = 0)
 };
 
 class FtcIndex final : public FtcPath {

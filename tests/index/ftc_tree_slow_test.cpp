@@ -51,6 +51,8 @@ std::vector<Opt> options() {
           o.slices = slices;
           o.leaf_size = leaf;
           v.push_back(o);
+          o.overlaps_first = false;
+          v.push_back(o);
         }
   return v;
 }

@@ -102,6 +102,10 @@ std::vector<Opt> all_options() {
             o.leaf_size = leaf;
             o.seed_own_leaf = seed;
             v.push_back(o);
+            if (slices == 1) {  // and without the overlap-first phase
+              o.overlaps_first = false;
+              v.push_back(o);
+            }
           }
   return v;
 }
