@@ -102,12 +102,10 @@ struct Scratch {
   std::vector<Entry> heap;
 };
 
-// Earliest t in [0, tcap] at which the node's box comes within Chebyshev distance R of the
-// probe's centre, or +inf: a lower bound on every member's pair time with radius sum <= R.
-// Per slice the four edges are lines in t; an edge outside reach must close its gap within the
-// slice, an edge inside must not leave before the others arrive. Rejection needs no division.
-// The bound on one slice: the first t in [t0, t0 + span] at which the box is within reach, or
-// +inf. (qx, qy): the probe's centre at t0.
+// The bound on one slice: the first t in [t0, t0 + span] at which the box comes within
+// Chebyshev distance R of the probe's centre, or +inf. (qx, qy): the probe's centre at t0. The
+// four edges are lines in t in the probe's frame; an edge outside reach must close its gap within
+// the slice, an edge inside must not leave before the others arrive. Rejection needs no division.
 inline double slice_bound(const Slice& b, double qx, double qy, const Probe& q, double R, double t0,
                           double span) {
   const double p[4] = {b.lo_x - qx, qx - b.hi_x, b.lo_y - qy, qy - b.hi_y};
@@ -126,7 +124,8 @@ inline double slice_bound(const Slice& b, double qx, double qy, const Probe& q, 
   return ok && lo <= span ? t0 + lo : INFINITY;
 }
 
-// s[j * stride]: the node's slice j.
+// Earliest t in [0, tcap] at which the node's box comes within reach of the probe, or +inf: a
+// lower bound on every member's pair time with radius sum <= R. s[j * stride]: the slice j.
 inline double node_bound(const Slice* s, std::size_t stride, const Frame& f, const Probe& q,
                          double R, double tcap) {
   const int K = f.slices();
@@ -459,8 +458,9 @@ void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratc
     const double R = q.ar + nodes_[k].rmax;
     if constexpr (OverlapOnly) {  // within reach at t = 0, or out
       const Slice& b = slices_[k];
-      return b.lo_x - q.fx <= R && q.fx - b.hi_x <= R && b.lo_y - q.fy <= R && q.fy - b.hi_y <= R ? 0.0
-                                                                                              : INFINITY;
+      return b.lo_x - q.fx <= R && q.fx - b.hi_x <= R && b.lo_y - q.fy <= R && q.fy - b.hi_y <= R
+                 ? 0.0
+                 : INFINITY;
     } else {
       const double cap = best.kind == Kind::none ? horizon : std::min(horizon, best.t);
       return node_bound(&slices_[k], stride_, f, q, R, cap);
