@@ -8,7 +8,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libfccp-dev  # CLI, scenario JSON, CSV tokenising
   libsqlite3-dev                               # trajectory output
   libtbb-dev                                   # threads (work stealing, caller participates)
-  libcgal-dev                                  # Delaunay collision heuristic
+  libcgal-dev libboost-dev                     # Delaunay heuristic; Boost.Geometry for WKT
   librecast-dev                                # navigation meshes
   libpugixml-dev                               # SDF3 XML
   gnuplot-nox graphviz                         # experiment plots, DOT rendering

@@ -6,10 +6,27 @@
 
 namespace crowddb {
 
+namespace {
+
+void sample_segment(const Vec2& a, const Vec2& e, double spacing, double charge,
+                    std::vector<double>& px, std::vector<double>& py, std::vector<double>& pc) {
+  const double len = std::hypot(e.x - a.x, e.y - a.y);
+  const auto m = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(len / spacing)));
+  for (std::size_t k = 0; k < m; ++k) {
+    const double t = static_cast<double>(k) / static_cast<double>(m);
+    px.push_back(a.x + t * (e.x - a.x));
+    py.push_back(a.y + t * (e.y - a.y));
+    pc.push_back(charge);
+  }
+}
+
+}  // namespace
+
 StaticScene::StaticScene(std::vector<CircleObstacle> circles, std::vector<PolygonObstacle> polygons,
-                         double spacing, ObstacleCharges charges)
+                         double spacing, ObstacleCharges charges, const Bounds* walls)
     : circles_(std::move(circles)), polygons_(std::move(polygons)) {
   if (!(spacing > 0) || !std::isfinite(spacing)) spacing = 1;
+  wall_begin_ = polygons_.size();
   for (const CircleObstacle& c : circles_) {
     const double circumference = 2 * std::numbers::pi * c.radius;
     if (charges == ObstacleCharges::centres || c.radius <= spacing) {
@@ -27,21 +44,28 @@ StaticScene::StaticScene(std::vector<CircleObstacle> circles, std::vector<Polygo
     }
   }
   for (const PolygonObstacle& p : polygons_) {
-    Box b{INFINITY, INFINITY, -INFINITY, -INFINITY};
     const std::size_t n = p.vertices.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec2& a = p.vertices[i];
-      const Vec2& e = p.vertices[(i + 1) % n];
-      b = {std::min(b.xmin, a.x), std::min(b.ymin, a.y), std::max(b.xmax, a.x), std::max(b.ymax, a.y)};
-      const double len = std::hypot(e.x - a.x, e.y - a.y);
-      const auto m = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(len / spacing)));
-      for (std::size_t k = 0; k < m; ++k) {
-        const double t = static_cast<double>(k) / static_cast<double>(m);
-        px_.push_back(a.x + t * (e.x - a.x));
-        py_.push_back(a.y + t * (e.y - a.y));
-        pc_.push_back(p.charge);
-      }
-    }
+    for (std::size_t i = 0; i < n; ++i)
+      sample_segment(p.vertices[i], p.vertices[(i + 1) % n], spacing, p.charge, px_, py_, pc_);
+  }
+  if (walls) {
+    const Bounds& b = *walls;
+    const double t = std::max(b.width(), b.height());
+    auto rect = [&](double x0, double y0, double x1, double y1) {
+      polygons_.push_back({{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, 1.0});
+    };
+    rect(b.xmin - t, b.ymin - t, b.xmin, b.ymax + t);  // west, corners included
+    rect(b.xmax, b.ymin - t, b.xmax + t, b.ymax + t);  // east
+    rect(b.xmin, b.ymin - t, b.xmax, b.ymin);          // south
+    rect(b.xmin, b.ymax, b.xmax, b.ymax + t);          // north
+    const Vec2 c[4] = {{b.xmin, b.ymin}, {b.xmax, b.ymin}, {b.xmax, b.ymax}, {b.xmin, b.ymax}};
+    for (int i = 0; i < 4; ++i) sample_segment(c[i], c[(i + 1) % 4], spacing, 1.0, px_, py_, pc_);
+  }
+  for (const PolygonObstacle& p : polygons_) {
+    Box b{INFINITY, INFINITY, -INFINITY, -INFINITY};
+    for (const Vec2& a : p.vertices)
+      b = {std::min(b.xmin, a.x), std::min(b.ymin, a.y), std::max(b.xmax, a.x),
+           std::max(b.ymax, a.y)};
     boxes_.push_back(b);
   }
 }

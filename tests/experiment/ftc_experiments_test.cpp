@@ -3,13 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "support/cli.hpp"
 
 namespace crowddb {
 namespace {
@@ -55,23 +56,20 @@ bool is_png(const fs::path& p) {
   return f && std::string(magic + 1, 3) == "PNG" && fs::file_size(p) > 5000;
 }
 
-fs::path run_quick(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("crowddb_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  const std::string cmd =
-      std::string(CROWDDB_CLI) + " experiment " + name + " --quick --out " + dir.string() + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[512];
-  while (p && fgets(buf, sizeof buf, p)) out += buf;
-  const int status = p ? pclose(p) : -1;
-  EXPECT_EQ(status, 0) << out;
-  return dir;
-}
+// Runs `crowddb experiment NAME --quick` into a fresh folder.
+struct Quick {
+  explicit Quick(const std::string& name) {
+    const auto r =
+        test::run_cli("experiment " + name + " --quick --out " + (tmp / "out").string(), tmp);
+    EXPECT_EQ(r.status, 0) << r.err;
+  }
+  fs::path dir() const { return tmp / "out"; }
+  test::TempDir tmp;
+};
 
 TEST(FtcExperiments, E1Quick) {
-  const fs::path dir = run_quick("e1");
+  const Quick run("e1");
+  const fs::path dir = run.dir();
   std::vector<std::string> head;
   const auto rows = read_csv(dir / "e1.csv", head);
   EXPECT_EQ(head,
@@ -97,11 +95,11 @@ TEST(FtcExperiments, E1Quick) {
   for (const Row& r : dense) EXPECT_GT(num(r, "total_ms"), 0);
   EXPECT_TRUE(is_png(dir / "e1.png"));
   EXPECT_TRUE(is_png(dir / "e1_density.png"));
-  fs::remove_all(dir);
 }
 
 TEST(FtcExperiments, E2Quick) {
-  const fs::path dir = run_quick("e2");
+  const Quick run("e2");
+  const fs::path dir = run.dir();
   std::vector<std::string> head;
   const auto rows = read_csv(dir / "e2.csv", head);
   EXPECT_EQ(head,
@@ -122,11 +120,11 @@ TEST(FtcExperiments, E2Quick) {
   }
   EXPECT_EQ(naive_rows, 8);
   EXPECT_TRUE(is_png(dir / "e2.png"));
-  fs::remove_all(dir);
 }
 
 TEST(FtcExperiments, E3Quick) {
-  const fs::path dir = run_quick("e3");
+  const Quick run("e3");
+  const fs::path dir = run.dir();
   std::vector<std::string> head;
   const auto rows = read_csv(dir / "e3.csv", head);
   EXPECT_EQ(head, (std::vector<std::string>{
@@ -144,7 +142,6 @@ TEST(FtcExperiments, E3Quick) {
     }
   }
   EXPECT_TRUE(is_png(dir / "e3.png"));
-  fs::remove_all(dir);
 }
 
 }  // namespace

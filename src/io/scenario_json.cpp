@@ -1,0 +1,705 @@
+// Scenario files: JSON (nlohmann-json) -> World + SimConfig. The format is documented in
+// docs/scenario-format.md. Every error names the file and the JSON pointer of the field (or the
+// line and column of a syntax error); unknown keys and duplicate keys are errors, so a typo never
+// silently falls back to a default.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <unordered_map>
+
+#include "crowddb/scenario.hpp"
+#include "util/rng.hpp"
+#include "world/geometry.hpp"
+
+namespace crowddb {
+namespace {
+
+using nlohmann::json;
+
+// A JSON object being read: typed getters that know the object's pointer, and a check that
+// every key was used.
+class Node {
+ public:
+  Node(const json& j, std::string pointer, const std::string* file)
+      : j_(j), ptr_(std::move(pointer)), file_(file) {
+    if (!j_.is_object()) fail("", "expected an object");
+  }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    const std::string where = key.empty() ? (ptr_.empty() ? "/" : ptr_) : ptr_ + "/" + key;
+    throw Error(Error::Kind::input, *file_ + ": " + where + ": " + what);
+  }
+
+  bool has(const std::string& key) const { return j_.contains(key); }
+
+  const json& raw(const std::string& key) {
+    const auto it = j_.find(key);
+    if (it == j_.end()) fail(key, "missing");
+    used_.insert(key);
+    return *it;
+  }
+
+  double number(const std::string& key, std::optional<double> fallback = std::nullopt) {
+    if (!has(key)) {
+      if (!fallback) fail(key, "missing (a number is required)");
+      return *fallback;
+    }
+    return number_of(raw(key), key);
+  }
+
+  double number_of(const json& v, const std::string& key) const {
+    if (!v.is_number()) fail(key, "expected a number, got " + std::string(v.type_name()));
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) fail(key, "must be finite");
+    return d;
+  }
+
+  double positive(const std::string& key, std::optional<double> fallback = std::nullopt) {
+    const double v = number(key, fallback);
+    if (!(v > 0)) fail(key, "must be > 0 (got " + fmt(v) + ")");
+    return v;
+  }
+
+  double non_negative(const std::string& key, std::optional<double> fallback = std::nullopt) {
+    const double v = number(key, fallback);
+    if (!(v >= 0)) fail(key, "must be >= 0 (got " + fmt(v) + ")");
+    return v;
+  }
+
+  // A number, "inf", or absent (-> fallback).
+  double positive_or_inf(const std::string& key, double fallback) {
+    if (!has(key)) return fallback;
+    const json& v = raw(key);
+    if (v.is_string() && v.get<std::string>() == "inf")
+      return std::numeric_limits<double>::infinity();
+    const double d = number_of(v, key);
+    if (!(d > 0)) fail(key, "must be > 0 or \"inf\" (got " + fmt(d) + ")");
+    return d;
+  }
+
+  uint64_t integer(const std::string& key, std::optional<uint64_t> fallback = std::nullopt,
+                   uint64_t max = std::numeric_limits<uint64_t>::max()) {
+    if (!has(key)) {
+      if (!fallback) fail(key, "missing (a non-negative integer is required)");
+      return *fallback;
+    }
+    const json& v = raw(key);
+    if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<int64_t>() >= 0))
+      fail(key, "expected a non-negative integer");
+    const auto u = v.get<uint64_t>();
+    if (u > max) fail(key, "must be at most " + std::to_string(max));
+    return u;
+  }
+
+  bool boolean(const std::string& key, bool fallback) {
+    if (!has(key)) return fallback;
+    const json& v = raw(key);
+    if (!v.is_boolean()) fail(key, "expected true or false");
+    return v.get<bool>();
+  }
+
+  std::string string(const std::string& key, std::optional<std::string> fallback = std::nullopt) {
+    if (!has(key)) {
+      if (!fallback) fail(key, "missing (a string is required)");
+      return *fallback;
+    }
+    const json& v = raw(key);
+    if (!v.is_string()) fail(key, "expected a string");
+    return v.get<std::string>();
+  }
+
+  std::string choice(const std::string& key, std::initializer_list<const char*> options,
+                     const char* fallback) {
+    const std::string s = string(key, std::string(fallback));
+    for (const char* o : options)
+      if (s == o) return s;
+    std::string list;
+    for (const char* o : options) list += std::string(list.empty() ? "" : ", ") + o;
+    fail(key, "'" + s + "' is not one of: " + list);
+  }
+
+  // [a, b, ...] of exactly `n` finite numbers.
+  std::vector<double> numbers(const std::string& key, std::size_t n) {
+    const json& v = raw(key);
+    if (!v.is_array() || v.size() != n)
+      fail(key, "expected an array of " + std::to_string(n) + " numbers");
+    std::vector<double> out;
+    for (std::size_t i = 0; i < n; ++i)
+      out.push_back(number_of(v[i], key + "/" + std::to_string(i)));
+    return out;
+  }
+
+  // A number (fixed value) or [lo, hi] (uniform in the range).
+  std::pair<double, double> range(const std::string& key, std::pair<double, double> fallback) {
+    if (!has(key)) return fallback;
+    const json& v = raw(key);
+    if (v.is_number()) {
+      const double d = number_of(v, key);
+      return {d, d};
+    }
+    if (!v.is_array() || v.size() != 2) fail(key, "expected a number or a [low, high] pair");
+    const double lo = number_of(v[0], key + "/0"), hi = number_of(v[1], key + "/1");
+    if (!(lo <= hi)) fail(key, "low must not exceed high");
+    return {lo, hi};
+  }
+
+  std::vector<Vec2> points(const std::string& key) {
+    const json& v = raw(key);
+    if (!v.is_array()) fail(key, "expected an array of [x, y] points");
+    std::vector<Vec2> out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const std::string k = key + "/" + std::to_string(i);
+      if (!v[i].is_array() || v[i].size() != 2) fail(k, "expected an [x, y] point");
+      out.push_back({number_of(v[i][0], k + "/0"), number_of(v[i][1], k + "/1")});
+    }
+    return out;
+  }
+
+  const json& array(const std::string& key) {
+    const json& v = raw(key);
+    if (!v.is_array()) fail(key, "expected an array");
+    return v;
+  }
+
+  Node child(const std::string& key) { return Node(raw(key), ptr_ + "/" + key, file_); }
+  Node element(const json& arr, const std::string& key, std::size_t i) const {
+    return Node(arr[i], ptr_ + "/" + key + "/" + std::to_string(i), file_);
+  }
+
+  // Every key must have been read: unknown keys are typos.
+  void finish() const {
+    for (const auto& item : j_.items())
+      if (!used_.count(item.key())) fail(item.key(), "unknown key");
+  }
+
+  const std::string& pointer() const { return ptr_; }
+  const std::string& file() const { return *file_; }
+
+  static std::string fmt(double v) {
+    std::ostringstream os;
+    os.precision(17);
+    os << v;
+    return os.str();
+  }
+
+ private:
+  const json& j_;
+  std::string ptr_;
+  const std::string* file_;
+  std::set<std::string> used_;
+};
+
+// Line and column of a byte offset, for syntax errors.
+std::string line_col(std::string_view text, std::size_t byte) {
+  std::size_t line = 1, col = 1;
+  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return std::to_string(line) + ":" + std::to_string(col);
+}
+
+// Spatial hash of placed discs, for overlap-free placement and overlap warnings.
+class DiscGrid {
+ public:
+  explicit DiscGrid(double cell) : cell_(cell > 0 ? cell : 1) {}
+  void add(double x, double y, double r) {
+    const std::size_t i = xs_.size();
+    xs_.push_back(x);
+    ys_.push_back(y);
+    rs_.push_back(r);
+    rmax_ = std::max(rmax_, r);
+    cells_[key(cell_of(x), cell_of(y))].push_back(i);
+  }
+  // Index of a placed disc overlapping (x, y, r) with the extra gap, or npos.
+  std::size_t overlapping(double x, double y, double r, double gap = 0,
+                          std::size_t skip = SIZE_MAX) const {
+    const double reach = r + rmax_ + gap;
+    const int64_t x0 = cell_of(x - reach), x1 = cell_of(x + reach);
+    const int64_t y0 = cell_of(y - reach), y1 = cell_of(y + reach);
+    for (int64_t cx = x0; cx <= x1; ++cx)
+      for (int64_t cy = y0; cy <= y1; ++cy) {
+        auto it = cells_.find(key(cx, cy));
+        if (it == cells_.end()) continue;
+        for (std::size_t j : it->second)
+          if (j != skip && discs_overlap(xs_[j] - x, ys_[j] - y, rs_[j] + r + gap)) return j;
+      }
+    return SIZE_MAX;
+  }
+  // Overlapping pairs (i < j) among the placed discs.
+  std::vector<std::pair<std::size_t, std::size_t>> pairs() const {
+    std::vector<std::pair<std::size_t, std::size_t>> out;
+    for (std::size_t i = 0; i < xs_.size(); ++i) {
+      const double reach = rs_[i] + rmax_;
+      for (int64_t cx = cell_of(xs_[i] - reach); cx <= cell_of(xs_[i] + reach); ++cx)
+        for (int64_t cy = cell_of(ys_[i] - reach); cy <= cell_of(ys_[i] + reach); ++cy) {
+          auto it = cells_.find(key(cx, cy));
+          if (it == cells_.end()) continue;
+          for (std::size_t j : it->second)
+            if (j > i && discs_overlap(xs_[j] - xs_[i], ys_[j] - ys_[i], rs_[i] + rs_[j]))
+              out.push_back({i, j});
+        }
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+ private:
+  int64_t cell_of(double v) const { return static_cast<int64_t>(std::floor(v / cell_)); }
+  static uint64_t key(int64_t cx, int64_t cy) {
+    return (static_cast<uint64_t>(cx) * 0x9e3779b97f4a7c15ull) ^ static_cast<uint64_t>(cy);
+  }
+  double cell_;
+  double rmax_ = 0;
+  std::vector<double> xs_, ys_, rs_;
+  std::unordered_map<uint64_t, std::vector<std::size_t>> cells_;
+};
+
+struct Loader {
+  Scenario& sc;
+  std::map<std::string, uint32_t> goal_rows;
+  std::vector<AgentSpec> agents;          // in insertion order
+  std::vector<std::vector<Vec2>> routes;  // per agent (via points)
+  std::unique_ptr<DiscGrid> placed;       // every agent placed so far
+
+  bool blocked_by_obstacle(double x, double y, double r, double gap) const {
+    for (const CircleObstacle& c : sc.world.circles())
+      if (discs_overlap(c.x - x, c.y - y, c.radius + r + gap)) return true;
+    for (const PolygonObstacle& p : sc.world.polygons())
+      if (disc_overlaps_polygon(p.vertices, x, y, r + gap)) return true;
+    return false;
+  }
+
+  uint32_t goal_named(Node& n, const std::string& key, const std::string& name) {
+    auto it = goal_rows.find(name);
+    if (it == goal_rows.end()) n.fail(key, "unknown goal '" + name + "'");
+    return it->second;
+  }
+
+  void read_goals(Node& root) {
+    if (!root.has("goals")) return;
+    const json& arr = root.array("goals");
+    for (std::size_t i = 0; i < arr.size(); ++i) {
+      Node g = root.element(arr, "goals", i);
+      Goal goal;
+      goal.name = g.string("name");
+      goal.x = g.number("x");
+      goal.y = g.number("y");
+      goal.charge = g.number("charge", 1.0);
+      goal.arrival_radius = g.positive("arrival_radius", 1.0);
+      g.finish();
+      if (goal_rows.count(goal.name)) g.fail("name", "duplicate goal name '" + goal.name + "'");
+      goal_rows[goal.name] = sc.world.add_goal(goal);
+    }
+  }
+
+  void read_obstacles(Node& root) {
+    if (!root.has("obstacles")) return;
+    const json& arr = root.array("obstacles");
+    for (std::size_t i = 0; i < arr.size(); ++i) {
+      Node o = root.element(arr, "obstacles", i);
+      const std::string type = o.choice("type", {"circle", "polygon"}, "");
+      try {
+        if (type == "circle") {
+          CircleObstacle c;
+          c.x = o.number("x");
+          c.y = o.number("y");
+          c.radius = o.positive("radius");
+          c.charge = o.number("charge", 1.0);
+          o.finish();
+          sc.world.add_obstacle(c);
+        } else {
+          PolygonObstacle p;
+          p.vertices = o.points("vertices");
+          p.charge = o.number("charge", 1.0);
+          o.finish();
+          sc.world.add_obstacle(std::move(p));
+        }
+      } catch (const InvalidRow& e) {
+        o.fail(e.field(), e.what());
+      }
+    }
+  }
+
+  void add_agent(Node& n, AgentSpec spec, std::vector<Vec2> via) {
+    try {
+      World::validate_spec(spec, sc.world.goals().size());
+    } catch (const InvalidRow& e) {
+      n.fail(e.field(), e.what());
+    }
+    agents.push_back(spec);
+    routes.push_back(std::move(via));
+    placed->add(spec.x, spec.y, spec.radius);
+  }
+
+  void read_agents(Node& root) {
+    if (!root.has("agents")) return;
+    const json& arr = root.array("agents");
+    for (std::size_t i = 0; i < arr.size(); ++i) {
+      Node a = root.element(arr, "agents", i);
+      AgentSpec s;
+      s.x = a.number("x");
+      s.y = a.number("y");
+      s.vx = a.number("vx", 0.0);
+      s.vy = a.number("vy", 0.0);
+      s.radius = a.positive("radius", 1.0);
+      s.max_speed = a.positive("max_speed", 1.0);
+      s.max_accel = a.positive_or_inf("max_accel", std::numeric_limits<double>::infinity());
+      s.charge = a.number("charge", 1.0);
+      s.goal = goal_named(a, "goal", a.string("goal"));
+      std::vector<Vec2> via = a.has("via") ? a.points("via") : std::vector<Vec2>{};
+      a.finish();
+      add_agent(a, s, std::move(via));
+    }
+  }
+
+  void read_groups(Node& root) {
+    if (!root.has("groups")) return;
+    const json& arr = root.array("groups");
+    for (std::size_t gi = 0; gi < arr.size(); ++gi) {
+      Node g = root.element(arr, "groups", gi);
+      Rng rng = Rng::stream(sc.config.seed, gi);
+      g.string("name", std::string());
+      const uint64_t count = g.integer("count", std::nullopt, 10'000'000);
+      const auto radius = g.range("radius", {1, 1});
+      if (!(radius.first > 0)) g.fail("radius", "must be > 0");
+      const auto speed = g.range("speed", {0, 0});
+      if (!(speed.first >= 0)) g.fail("speed", "must be >= 0");
+      const std::string heading = g.choice("heading", {"random", "goal"}, "random");
+      AgentSpec base;
+      base.max_speed = g.positive("max_speed", 1.0);
+      base.max_accel = g.positive_or_inf("max_accel", std::numeric_limits<double>::infinity());
+      base.charge = g.number("charge", 1.0);
+      std::vector<Vec2> via = g.has("via") ? g.points("via") : std::vector<Vec2>{};
+
+      // Goal assignment: one named goal, or a rule over several.
+      std::string assign = "single";
+      std::vector<uint32_t> pool;
+      double antipodal_radius = 1, antipodal_charge = 1;
+      if (g.has("goal") == g.has("goals")) g.fail("goal", "give exactly one of 'goal' and 'goals'");
+      if (g.has("goal")) {
+        pool.push_back(goal_named(g, "goal", g.string("goal")));
+      } else {
+        Node rule = g.child("goals");
+        assign =
+            rule.choice("assign", {"round_robin", "random", "nearest", "antipodal"}, "round_robin");
+        if (assign == "antipodal") {
+          antipodal_radius = rule.positive("arrival_radius", 1.0);
+          antipodal_charge = rule.number("charge", 1.0);
+        } else if (rule.has("from")) {
+          const json& names = rule.array("from");
+          for (std::size_t k = 0; k < names.size(); ++k) {
+            if (!names[k].is_string())
+              rule.fail("from/" + std::to_string(k), "expected a goal name");
+            pool.push_back(
+                goal_named(rule, "from/" + std::to_string(k), names[k].get<std::string>()));
+          }
+        } else {
+          for (uint32_t k = 0; k < sc.world.goals().size(); ++k) pool.push_back(k);
+        }
+        if (assign != "antipodal" && pool.empty()) rule.fail("from", "no goals to assign");
+        rule.finish();
+      }
+
+      Node pl = g.child("placement");
+      const std::string type = pl.choice("type", {"uniform", "circle", "grid"}, "");
+      std::vector<double> region;
+      Vec2 centre{};
+      double ring = 0, gap = 0;
+      uint64_t attempts = 1000;
+      std::pair<double, double> spacing{0, 0};
+      if (type == "uniform" || type == "grid") {
+        region = pl.numbers("region", 4);
+        if (!(region[2] > region[0] && region[3] > region[1]))
+          pl.fail("region", "needs x1 > x0 and y1 > y0");
+      }
+      if (type == "uniform") {
+        gap = pl.non_negative("gap", 0.0);
+        attempts = pl.integer("attempts", 1000, 1'000'000);
+        if (attempts == 0) pl.fail("attempts", "must be >= 1");
+      } else if (type == "circle") {
+        const auto c = pl.numbers("center", 2);
+        centre = {c[0], c[1]};
+        ring = pl.positive("radius");
+      } else {
+        const json& sp = pl.raw("spacing");
+        if (sp.is_number()) {
+          spacing.first = spacing.second = pl.number_of(sp, "spacing");
+        } else {
+          const auto s2 = pl.numbers("spacing", 2);
+          spacing = {s2[0], s2[1]};
+        }
+        if (!(spacing.first > 0 && spacing.second > 0)) pl.fail("spacing", "must be > 0");
+      }
+      pl.finish();
+      if (assign == "antipodal" && type != "circle")
+        g.fail("goals", "antipodal goals need a circle placement");
+      g.finish();
+
+      // Grid capacity is known up front.
+      if (type == "grid") {
+        const auto cols =
+            static_cast<uint64_t>(std::floor((region[2] - region[0]) / spacing.first)) + 1;
+        const auto rows =
+            static_cast<uint64_t>(std::floor((region[3] - region[1]) / spacing.second)) + 1;
+        if (cols * rows < count)
+          pl.fail("spacing", "the grid holds " + std::to_string(cols * rows) +
+                                 " agents, fewer than count " + std::to_string(count));
+      }
+
+      for (uint64_t i = 0; i < count; ++i) {
+        AgentSpec s = base;
+        s.radius =
+            radius.first == radius.second ? radius.first : rng.uniform(radius.first, radius.second);
+        // Position.
+        if (type == "uniform") {
+          bool ok = false;
+          for (uint64_t a = 0; a < attempts && !ok; ++a) {
+            s.x = rng.uniform(region[0] + s.radius,
+                              std::max(region[0] + s.radius, region[2] - s.radius));
+            s.y = rng.uniform(region[1] + s.radius,
+                              std::max(region[1] + s.radius, region[3] - s.radius));
+            ok = placed->overlapping(s.x, s.y, s.radius, gap) == SIZE_MAX &&
+                 !blocked_by_obstacle(s.x, s.y, s.radius, gap);
+          }
+          if (!ok)
+            pl.fail("", "could not place agent " + std::to_string(i + 1) + " of " +
+                            std::to_string(count) + " without overlaps in " +
+                            std::to_string(attempts) +
+                            " attempts (region too crowded: enlarge it, lower count or radius)");
+        } else if (type == "circle") {
+          const double a =
+              2 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(count);
+          s.x = centre.x + ring * std::cos(a);
+          s.y = centre.y + ring * std::sin(a);
+        } else {
+          const auto cols =
+              static_cast<uint64_t>(std::floor((region[2] - region[0]) / spacing.first)) + 1;
+          s.x = region[0] + static_cast<double>(i % cols) * spacing.first;
+          s.y = region[1] + static_cast<double>(i / cols) * spacing.second;
+        }
+        // Goal.
+        if (assign == "antipodal") {
+          Goal goal;
+          goal.name = g.pointer() + "#" + std::to_string(i);
+          goal.x = 2 * centre.x - s.x;
+          goal.y = 2 * centre.y - s.y;
+          goal.arrival_radius = antipodal_radius;
+          goal.charge = antipodal_charge;
+          s.goal = sc.world.add_goal(goal);
+        } else if (assign == "single" || assign == "round_robin") {
+          s.goal = pool[i % pool.size()];
+        } else if (assign == "random") {
+          s.goal = pool[rng.below(pool.size())];
+        } else {  // nearest
+          double best = INFINITY;
+          for (uint32_t k : pool) {
+            const Goal& gl = sc.world.goals()[k];
+            const double d = std::hypot(gl.x - s.x, gl.y - s.y);
+            if (d < best) {
+              best = d;
+              s.goal = k;
+            }
+          }
+        }
+        // Initial velocity.
+        const double v =
+            speed.first == speed.second ? speed.first : rng.uniform(speed.first, speed.second);
+        double angle = rng.uniform(0, 2 * std::numbers::pi);
+        if (heading == "goal") {
+          const Goal& gl = sc.world.goals()[s.goal];
+          if (gl.x != s.x || gl.y != s.y) angle = std::atan2(gl.y - s.y, gl.x - s.x);
+        }
+        s.vx = v * std::cos(angle);
+        s.vy = v * std::sin(angle);
+        add_agent(g, s, via);
+      }
+    }
+  }
+
+  void warn_overlaps() {
+    double rmax = 0;
+    for (const AgentSpec& s : agents) rmax = std::max(rmax, s.radius);
+    DiscGrid all(2 * rmax);
+    for (const AgentSpec& s : agents) all.add(s.x, s.y, s.radius);
+    const auto pairs = all.pairs();
+    if (!pairs.empty())
+      sc.warnings.push_back(
+          "agents spawned overlapping: " + std::to_string(pairs.size()) + " pairs (first: agents " +
+          std::to_string(pairs[0].first) + " and " + std::to_string(pairs[0].second) +
+          " in spawn order); they are allowed to separate but not to overlap deeper");
+    std::size_t blocked = 0, outside = 0;
+    const Bounds& b = sc.world.bounds();
+    for (const AgentSpec& s : agents) {
+      blocked += blocked_by_obstacle(s.x, s.y, s.radius, 0);
+      outside += s.x - s.radius < b.xmin || s.x + s.radius > b.xmax || s.y - s.radius < b.ymin ||
+                 s.y + s.radius > b.ymax;
+    }
+    if (blocked)
+      sc.warnings.push_back(std::to_string(blocked) + " agents spawned overlapping an obstacle");
+    if (outside && sc.config.walls)
+      sc.warnings.push_back(std::to_string(outside) + " agents spawned outside the bounds");
+  }
+};
+
+void read_steering(Node& root, SimConfig& cfg) {
+  if (!root.has("steering")) return;
+  Node s = root.child("steering");
+  SteeringParams& p = cfg.steering;
+  p.tau = s.positive("tau", p.tau);
+  p.w_apf = s.non_negative("w_apf", p.w_apf);
+  p.w_ftc = s.non_negative("w_ftc", p.w_ftc);
+  p.horizon = s.positive("horizon", p.horizon);
+  p.obstacle_charges =
+      s.choice("obstacle_charges", {"boundary", "centres"}, "boundary") == "centres"
+          ? ObstacleCharges::centres
+          : ObstacleCharges::boundary;
+  if (s.has("potential")) {
+    Node pot = s.child("potential");
+    PotentialSpec& ps = p.potential;
+    ps.kernel = pot.choice("kernel", {"exp", "inv"}, "exp") == "inv" ? Kernel::inv : Kernel::exp;
+    const std::string m = pot.choice("metric", {"l1", "l2", "radial"}, "l1");
+    ps.metric = m == "l2" ? Metric::l2 : (m == "radial" ? Metric::radial : Metric::l1);
+    ps.A = pot.number("A", ps.A);
+    ps.k = pot.non_negative("k", ps.k);
+    ps.radial_frames = static_cast<int>(pot.integer("frames", 2, 16));
+    if (ps.radial_frames < 1) pot.fail("frames", "must be in 1..16");
+    ps.inv_floor = pot.positive("inv_floor", ps.inv_floor);
+    pot.finish();
+  }
+  s.finish();
+}
+
+}  // namespace
+
+Scenario parse_scenario(std::string_view text, const std::string& source) {
+  Scenario sc;
+  sc.source = source;
+  sc.text = std::string(text);
+  json doc;
+  try {
+    // Reject duplicate keys: nlohmann keeps the last one silently.
+    std::vector<std::set<std::string>> keys;
+    doc = json::parse(text, [&](int, json::parse_event_t event, json& parsed) {
+      if (event == json::parse_event_t::object_start) keys.emplace_back();
+      if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+      if (event == json::parse_event_t::key && !keys.empty() &&
+          !keys.back().insert(parsed.get<std::string>()).second)
+        throw Error(Error::Kind::input,
+                    source + ": duplicate key \"" + parsed.get<std::string>() + "\"");
+      return true;
+    });
+  } catch (const json::parse_error& e) {
+    std::string what = e.what();
+    const auto colon = what.rfind(": ");
+    throw Error(Error::Kind::input,
+                source + ":" + line_col(text, e.byte ? e.byte - 1 : 0) + ": malformed JSON: " +
+                    (colon == std::string::npos ? what : what.substr(colon + 2)));
+  } catch (const json::exception& e) {
+    throw Error(Error::Kind::input, source + ": malformed JSON: " + e.what());
+  }
+
+  Node root(doc, "", &source);
+  sc.name = root.string("name", std::string());
+  root.string("description", std::string());
+  try {
+    const auto b = root.numbers("bounds", 4);
+    sc.world.set_bounds({b[0], b[1], b[2], b[3]});
+  } catch (const InvalidRow& e) {
+    root.fail("bounds", e.what());
+  }
+  SimConfig& cfg = sc.config;
+  cfg.dt = root.positive("dt", 1.0);
+  cfg.seed = root.integer("seed", 1);
+  sc.ticks = root.integer("ticks", 100);
+  cfg.backoff = root.boolean("backoff", true);
+  cfg.walls = root.boolean("walls", true);
+  const std::string arrival = root.choice("arrival", {"remove", "idle", "retarget"}, "remove");
+  cfg.arrival = arrival == "idle"
+                    ? ArrivalPolicy::idle
+                    : (arrival == "retarget" ? ArrivalPolicy::retarget : ArrivalPolicy::remove);
+  cfg.threads = static_cast<int>(root.integer("threads", 1, 256));
+  if (cfg.threads < 1) root.fail("threads", "must be >= 1");
+  cfg.gridlock_ticks = static_cast<uint32_t>(root.integer("gridlock_ticks", 50, 1u << 30));
+  cfg.waypoint_radius = root.non_negative("waypoint_radius", 0.0);
+  cfg.nudge_after = static_cast<uint32_t>(root.integer("nudge_after", cfg.nudge_after, 1u << 30));
+  read_steering(root, cfg);
+  if (root.has("access")) {
+    Node a = root.child("access");
+    cfg.access.ftc = a.string("ftc", "auto");
+    cfg.access.field = a.string("field", "auto");
+    cfg.access.collisions = a.string("collisions", "auto");
+    a.finish();
+  }
+  if (root.has("output")) {
+    Node o = root.child("output");
+    sc.output.path = o.string("path", std::string());
+    sc.output.format = o.choice("format", {"sqlite", "csv"}, "sqlite") == "csv"
+                           ? OutputSpec::Format::csv
+                           : OutputSpec::Format::sqlite;
+    sc.output.every = static_cast<uint32_t>(o.integer("every", 1, 1u << 30));
+    if (sc.output.every == 0) o.fail("every", "must be >= 1");
+    o.finish();
+  }
+
+  Loader loader{sc, {}, {}, {}, nullptr};
+  loader.read_goals(root);
+  loader.read_obstacles(root);
+  double rmax = 1;
+  loader.placed = std::make_unique<DiscGrid>(2 * rmax);
+  // Cell size for the placement grid: twice the largest radius any agent may have.
+  if (root.has("groups") && root.raw("groups").is_array())
+    for (const json& g : root.raw("groups"))
+      if (g.is_object() && g.contains("radius")) {
+        const json& r = g["radius"];
+        if (r.is_number()) rmax = std::max(rmax, r.get<double>());
+        if (r.is_array() && r.size() == 2 && r[1].is_number())
+          rmax = std::max(rmax, r[1].get<double>());
+      }
+  if (std::isfinite(rmax)) loader.placed = std::make_unique<DiscGrid>(2 * rmax);
+  loader.read_agents(root);
+  loader.read_groups(root);
+  root.finish();
+  if (!loader.agents.empty() && sc.world.goals().empty())
+    root.fail("goals", "agents need at least one goal");
+  loader.warn_overlaps();
+
+  try {
+    cfg.validate();
+  } catch (const InvalidRow& e) {
+    root.fail(e.field(), e.what());
+  }
+  for (std::size_t i = 0; i < loader.agents.size(); ++i) {
+    const AgentId id = sc.world.insert(loader.agents[i]);
+    (void)id;
+  }
+  sc.world.apply_pending();
+  AgentTable& t = sc.world.agents_for_tick();
+  for (std::size_t i = 0; i < loader.routes.size(); ++i) {
+    t.route[i] = loader.routes[i];
+    sc.world.refresh_target(i);
+  }
+  return sc;
+}
+
+Scenario load_scenario(const std::filesystem::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw Error(Error::Kind::io, path.string() + ": cannot open file");
+  if (std::filesystem::is_directory(path))
+    throw Error(Error::Kind::io, path.string() + ": is a directory");
+  std::ostringstream os;
+  os << f.rdbuf();
+  return parse_scenario(os.str(), path.string());
+}
+
+}  // namespace crowddb

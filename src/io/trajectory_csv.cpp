@@ -1,0 +1,109 @@
+// CSV trajectories: PATH holds frame,id,x,y,vx,vy,radius,state,goal; PATH with its extension
+// replaced by .metrics.csv holds one row of tick metrics per tick. Numbers are written in
+// shortest round-trip form, so a CSV run reads back bit-identical.
+#include <charconv>
+#include <cstdio>
+#include <fstream>
+
+#include "io/trajectory.hpp"
+
+namespace crowddb::io {
+namespace {
+
+class CsvWriter final : public TrajectoryWriter {
+ public:
+  CsvWriter(std::filesystem::path path, uint32_t every)
+      : path_(std::move(path)), every_(every ? every : 1) {
+    metrics_path_ = path_;
+    metrics_path_.replace_extension(".metrics.csv");
+  }
+  ~CsvWriter() override { abort(); }
+
+  void begin(const Scenario&, const World&) override {
+    open(traj_, partial(path_), "frame,id,x,y,vx,vy,radius,state,goal\n");
+    open(metrics_, partial(metrics_path_),
+         "tick,agents,arrived,frozen,freeze_iterations,overlapping_pairs,obstacle_overlaps,"
+         "gridlocked,tick_seconds,"
+         "state_hash\n");
+  }
+
+  void frame(uint64_t tick, const World& world) override {
+    if (tick % every_ != 0) return;
+    const uint64_t frame = tick / every_;
+    const AgentTable& t = world.agents();
+    static const char* states[] = {"active", "frozen", "arrived"};
+    std::string line;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      line.clear();
+      line += std::to_string(frame) + "," + std::to_string(t.id[i]);
+      for (double v : {t.x[i], t.y[i], t.vx[i], t.vy[i], t.radius[i]}) line += "," + num(v);
+      line += ",";
+      line += states[static_cast<int>(t.state[i])];
+      line += "," + std::to_string(t.goal[i]) + "\n";
+      traj_ << line;
+    }
+    check(traj_, path_);
+  }
+
+  void metrics(const TickMetrics& m) override {
+    char hash[24];
+    std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(m.state_hash));
+    metrics_ << m.tick << "," << m.agents << "," << m.arrived << "," << m.frozen << ","
+             << m.freeze_iterations << "," << m.overlapping_pairs << "," << m.obstacle_overlaps
+             << "," << m.gridlocked << "," << num(m.seconds) << "," << hash << "\n";
+    check(metrics_, metrics_path_);
+  }
+
+  void finish(const RunInfo&) override {
+    traj_.close();
+    metrics_.close();
+    check(traj_, path_);
+    check(metrics_, metrics_path_);
+    for (const auto* p : {&path_, &metrics_path_}) {
+      std::error_code ec;
+      std::filesystem::rename(partial(*p), *p, ec);
+      if (ec)
+        throw Error(Error::Kind::io,
+                    p->string() + ": cannot move output into place: " + ec.message());
+    }
+  }
+
+  void abort() noexcept override {
+    if (traj_.is_open()) traj_.close();
+    if (metrics_.is_open()) metrics_.close();
+    std::error_code ec;
+    std::filesystem::remove(partial(path_), ec);
+    std::filesystem::remove(partial(metrics_path_), ec);
+  }
+
+ private:
+  static std::filesystem::path partial(const std::filesystem::path& p) {
+    return p.string() + ".partial";
+  }
+  static std::string num(double v) {
+    char buf[32];
+    auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+    return std::string(buf, end);
+  }
+  static void open(std::ofstream& f, const std::filesystem::path& p, const char* header) {
+    f.open(p, std::ios::binary | std::ios::trunc);
+    if (!f) throw Error(Error::Kind::io, p.string() + ": cannot create output");
+    f << header;
+  }
+  static void check(const std::ofstream& f, const std::filesystem::path& p) {
+    if (!f) throw Error(Error::Kind::io, p.string() + ": write failed");
+  }
+
+  std::filesystem::path path_, metrics_path_;
+  uint32_t every_;
+  std::ofstream traj_, metrics_;
+};
+
+}  // namespace
+
+std::unique_ptr<TrajectoryWriter> make_csv_writer(const std::filesystem::path& path,
+                                                  uint32_t every) {
+  return std::make_unique<CsvWriter>(path, every);
+}
+
+}  // namespace crowddb::io

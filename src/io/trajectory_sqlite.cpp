@@ -1,0 +1,276 @@
+// SQLite trajectories in JuPedSim's format, version 3 (its SqliteTrajectoryWriter defines it):
+//   trajectory_data(frame, id, pos_x, pos_y), metadata(key, value) with version and fps,
+//   geometry(hash, wkt), frame_data(frame, geometry_hash)
+// and crowddb's own tables beside them:
+//   crowddb_agent_state(frame, id, vel_x, vel_y, radius, state, goal)
+//   crowddb_tick_metrics(tick, agents, arrived, frozen, freeze_iterations, overlapping_pairs,
+//                        obstacle_overlaps, gridlocked, tick_seconds, state_hash)
+//   crowddb_run(key, value): scenario name and text, seed, threads, ticks, final state hash
+// WAL journal, frames batched into transactions; the file is renamed into place at the end.
+#include <sqlite3.h>
+
+#include <cstdio>
+#include <cstring>
+
+#include "io/trajectory.hpp"
+#include "io/walkable_wkt.hpp"
+
+namespace crowddb::io {
+namespace {
+
+constexpr uint64_t kFramesPerTransaction = 100;
+
+std::string hex(uint64_t v) {
+  char buf[24];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+// FNV-1a of the WKT, folded to a non-negative SQLite integer.
+int64_t text_hash(const std::string& s) {
+  uint64_t h = 0xcbf29ce484222325ull;
+  for (unsigned char c : s) h = (h ^ c) * 0x100000001b3ull;
+  return static_cast<int64_t>(h >> 1);
+}
+
+class Statement {
+ public:
+  Statement() = default;
+  Statement(sqlite3* db, const char* sql, const std::string& path) {
+    if (sqlite3_prepare_v2(db, sql, -1, &s_, nullptr) != SQLITE_OK)
+      throw Error(Error::Kind::io, path + ": " + sqlite3_errmsg(db));
+  }
+  ~Statement() { sqlite3_finalize(s_); }
+  Statement(Statement&& o) noexcept : s_(o.s_) { o.s_ = nullptr; }
+  Statement& operator=(Statement&& o) noexcept {
+    std::swap(s_, o.s_);
+    return *this;
+  }
+  sqlite3_stmt* get() const { return s_; }
+
+ private:
+  sqlite3_stmt* s_ = nullptr;
+};
+
+class SqliteWriter final : public TrajectoryWriter {
+ public:
+  SqliteWriter(std::filesystem::path path, uint32_t every)
+      : path_(std::move(path)), partial_(path_.string() + ".partial"), every_(every ? every : 1) {}
+  ~SqliteWriter() override { abort(); }
+
+  void begin(const Scenario& sc, const World& world) override {
+    remove_partial();
+    if (sqlite3_open_v2(partial_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
+                        nullptr) != SQLITE_OK) {
+      const std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
+      sqlite3_close(db_);
+      db_ = nullptr;
+      throw Error(Error::Kind::io, path_.string() + ": cannot create output (" + msg + ")");
+    }
+    exec("PRAGMA journal_mode=WAL");
+    exec("PRAGMA synchronous=NORMAL");
+    exec("BEGIN");
+    exec(
+        "CREATE TABLE trajectory_data (frame INTEGER NOT NULL, id INTEGER NOT NULL, pos_x REAL NOT "
+        "NULL, "
+        "pos_y REAL NOT NULL)");
+    exec("CREATE TABLE metadata (key TEXT NOT NULL UNIQUE PRIMARY KEY, value TEXT NOT NULL)");
+    exec("CREATE TABLE geometry (hash INTEGER NOT NULL, wkt TEXT NOT NULL)");
+    exec("CREATE UNIQUE INDEX geometry_hash ON geometry(hash)");
+    exec("CREATE TABLE frame_data (frame INTEGER NOT NULL, geometry_hash INTEGER NOT NULL)");
+    exec(
+        "CREATE TABLE crowddb_agent_state (frame INTEGER NOT NULL, id INTEGER NOT NULL, vel_x REAL "
+        "NOT NULL, "
+        "vel_y REAL NOT NULL, radius REAL NOT NULL, state TEXT NOT NULL, goal INTEGER NOT NULL)");
+    exec(
+        "CREATE TABLE crowddb_tick_metrics (tick INTEGER PRIMARY KEY, agents INTEGER NOT NULL, "
+        "arrived INTEGER NOT NULL, frozen INTEGER NOT NULL, freeze_iterations INTEGER NOT NULL, "
+        "overlapping_pairs INTEGER NOT NULL, obstacle_overlaps INTEGER NOT NULL, gridlocked "
+        "INTEGER NOT NULL, "
+        "tick_seconds REAL NOT NULL, state_hash TEXT NOT NULL)");
+    exec("CREATE TABLE crowddb_run (key TEXT NOT NULL UNIQUE PRIMARY KEY, value TEXT NOT NULL)");
+    exec(
+        "CREATE TABLE crowddb_goals (goal INTEGER PRIMARY KEY, name TEXT NOT NULL, x REAL NOT "
+        "NULL, "
+        "y REAL NOT NULL, arrival_radius REAL NOT NULL)");
+
+    const Bounds& b = world.bounds();
+    const double fps = 1.0 / (sc.config.dt * every_);
+    Statement meta(db_, "INSERT INTO metadata VALUES (?, ?)", path_.string());
+    for (const auto& [k, v] : {std::pair<std::string, std::string>{"version", "3"},
+                               {"fps", num(fps)},
+                               {"xmin", num(b.xmin)},
+                               {"xmax", num(b.xmax)},
+                               {"ymin", num(b.ymin)},
+                               {"ymax", num(b.ymax)}})
+      insert_text(meta, k, v);
+    Statement run(db_, "INSERT INTO crowddb_run VALUES (?, ?)", path_.string());
+    for (const auto& [k, v] : {std::pair<std::string, std::string>{"scenario_name", sc.name},
+                               {"scenario_source", sc.source},
+                               {"scenario_json", sc.text},
+                               {"seed", std::to_string(sc.config.seed)},
+                               {"dt", num(sc.config.dt)},
+                               {"frame_every", std::to_string(every_)}})
+      insert_text(run, k, v);
+    wkt_ = walkable_area_wkt(world);
+    geometry_hash_ = text_hash(wkt_);
+    Statement geo(db_, "INSERT INTO geometry VALUES (?, ?)", path_.string());
+    sqlite3_bind_int64(geo.get(), 1, geometry_hash_);
+    sqlite3_bind_text(geo.get(), 2, wkt_.c_str(), -1, SQLITE_TRANSIENT);
+    step(geo);
+    Statement goals(db_, "INSERT INTO crowddb_goals VALUES (?, ?, ?, ?, ?)", path_.string());
+    for (std::size_t i = 0; i < world.goals().size(); ++i) {
+      const Goal& g = world.goals()[i];
+      sqlite3_bind_int64(goals.get(), 1, static_cast<int64_t>(i));
+      sqlite3_bind_text(goals.get(), 2, g.name.c_str(), -1, SQLITE_TRANSIENT);
+      sqlite3_bind_double(goals.get(), 3, g.x);
+      sqlite3_bind_double(goals.get(), 4, g.y);
+      sqlite3_bind_double(goals.get(), 5, g.arrival_radius);
+      step(goals);
+    }
+    traj_ = Statement(db_, "INSERT INTO trajectory_data VALUES (?, ?, ?, ?)", path_.string());
+    state_ = Statement(db_, "INSERT INTO crowddb_agent_state VALUES (?, ?, ?, ?, ?, ?, ?)",
+                       path_.string());
+    frame_ = Statement(db_, "INSERT INTO frame_data VALUES (?, ?)", path_.string());
+    metric_ =
+        Statement(db_, "INSERT INTO crowddb_tick_metrics VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                  path_.string());
+  }
+
+  void frame(uint64_t tick, const World& world) override {
+    if (tick % every_ != 0) return;
+    const auto frame = static_cast<int64_t>(tick / every_);
+    const AgentTable& t = world.agents();
+    static const char* states[] = {"active", "frozen", "arrived"};
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      const auto id = static_cast<int64_t>(t.id[i]);
+      sqlite3_bind_int64(traj_.get(), 1, frame);
+      sqlite3_bind_int64(traj_.get(), 2, id);
+      sqlite3_bind_double(traj_.get(), 3, t.x[i]);
+      sqlite3_bind_double(traj_.get(), 4, t.y[i]);
+      step(traj_);
+      sqlite3_bind_int64(state_.get(), 1, frame);
+      sqlite3_bind_int64(state_.get(), 2, id);
+      sqlite3_bind_double(state_.get(), 3, t.vx[i]);
+      sqlite3_bind_double(state_.get(), 4, t.vy[i]);
+      sqlite3_bind_double(state_.get(), 5, t.radius[i]);
+      sqlite3_bind_text(state_.get(), 6, states[static_cast<int>(t.state[i])], -1, SQLITE_STATIC);
+      sqlite3_bind_int64(state_.get(), 7, t.goal[i]);
+      step(state_);
+    }
+    sqlite3_bind_int64(frame_.get(), 1, frame);
+    sqlite3_bind_int64(frame_.get(), 2, geometry_hash_);
+    step(frame_);
+    if (++frames_in_txn_ >= kFramesPerTransaction) {
+      exec("COMMIT");
+      exec("BEGIN");
+      frames_in_txn_ = 0;
+    }
+  }
+
+  void metrics(const TickMetrics& m) override {
+    sqlite3_stmt* s = metric_.get();
+    sqlite3_bind_int64(s, 1, static_cast<int64_t>(m.tick));
+    sqlite3_bind_int64(s, 2, static_cast<int64_t>(m.agents));
+    sqlite3_bind_int64(s, 3, static_cast<int64_t>(m.arrived));
+    sqlite3_bind_int64(s, 4, static_cast<int64_t>(m.frozen));
+    sqlite3_bind_int64(s, 5, static_cast<int64_t>(m.freeze_iterations));
+    sqlite3_bind_int64(s, 6, static_cast<int64_t>(m.overlapping_pairs));
+    sqlite3_bind_int64(s, 7, static_cast<int64_t>(m.obstacle_overlaps));
+    sqlite3_bind_int64(s, 8, static_cast<int64_t>(m.gridlocked));
+    sqlite3_bind_double(s, 9, m.seconds);
+    const std::string h = hex(m.state_hash);
+    sqlite3_bind_text(s, 10, h.c_str(), -1, SQLITE_TRANSIENT);
+    step(metric_);
+  }
+
+  void finish(const RunInfo& info) override {
+    {
+      Statement run(db_, "INSERT INTO crowddb_run VALUES (?, ?)", path_.string());
+      for (const auto& [k, v] :
+           {std::pair<std::string, std::string>{"crowddb_version", info.crowddb_version},
+            {"threads", std::to_string(info.threads)},
+            {"ticks", std::to_string(info.ticks)},
+            {"final_state_hash", hex(info.final_hash)},
+            {"run_seconds", num(info.seconds)}})
+        insert_text(run, k, v);
+    }
+    // Indices after the bulk load: cheaper than maintaining them row by row.
+    exec("CREATE INDEX frame_id_idx ON trajectory_data(frame, id)");
+    exec("CREATE INDEX state_frame_id_idx ON crowddb_agent_state(frame, id)");
+    exec("COMMIT");
+    release_statements();
+    exec("PRAGMA journal_mode=DELETE");  // checkpoints the WAL and leaves one self-contained file
+    if (sqlite3_close(db_) != SQLITE_OK)
+      throw Error(Error::Kind::io, path_.string() + ": cannot close output");
+    db_ = nullptr;
+    std::error_code ec;
+    std::filesystem::rename(partial_, path_, ec);
+    if (ec)
+      throw Error(Error::Kind::io,
+                  path_.string() + ": cannot move output into place: " + ec.message());
+  }
+
+  void abort() noexcept override {
+    release_statements();
+    if (db_) sqlite3_close(db_);
+    db_ = nullptr;
+    remove_partial();
+  }
+
+ private:
+  static std::string num(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return buf;
+  }
+
+  void release_statements() noexcept {
+    for (Statement* s : {&traj_, &state_, &frame_, &metric_}) *s = Statement();
+  }
+
+  void remove_partial() noexcept {
+    std::error_code ec;
+    for (const char* suffix : {"", "-wal", "-shm", "-journal"})
+      std::filesystem::remove(partial_ + suffix, ec);
+  }
+
+  void exec(const char* sql) {
+    char* err = nullptr;
+    if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
+      const std::string msg = err ? err : "unknown error";
+      sqlite3_free(err);
+      throw Error(Error::Kind::io, path_.string() + ": " + msg);
+    }
+  }
+
+  void step(const Statement& s) {
+    if (sqlite3_step(s.get()) != SQLITE_DONE)
+      throw Error(Error::Kind::io, path_.string() + ": " + sqlite3_errmsg(db_));
+    sqlite3_reset(s.get());
+  }
+
+  void insert_text(const Statement& s, const std::string& k, const std::string& v) {
+    sqlite3_bind_text(s.get(), 1, k.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(s.get(), 2, v.c_str(), -1, SQLITE_TRANSIENT);
+    step(s);
+  }
+
+  std::filesystem::path path_;
+  std::string partial_;
+  uint32_t every_;
+  sqlite3* db_ = nullptr;
+  Statement traj_, state_, frame_, metric_;
+  std::string wkt_;
+  int64_t geometry_hash_ = 0;
+  uint64_t frames_in_txn_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<TrajectoryWriter> make_sqlite_writer(const std::filesystem::path& path,
+                                                     uint32_t every) {
+  return std::make_unique<SqliteWriter>(path, every);
+}
+
+}  // namespace crowddb::io
