@@ -536,7 +536,9 @@ void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratc
     // from which a member could still reach the query before the answer so far lies strictly
     // inside the cell below, no sibling further up can hold a winner: stop.
     for (uint32_t below = leaf; below != 0; below = nodes_[below].parent) {
-      const double cap = best.kind == Kind::none ? horizon : std::min(horizon, best.t);
+      // (Overlaps count at t = 0 even when the horizon is negative: the reach is at least R.)
+      const double cap =
+          std::max(0.0, best.kind == Kind::none ? horizon : std::min(horizon, best.t));
       const double hx =
           reach_r_ + q.ar + f.delta0 + (std::fabs(q.avx) + reach_vx_ + f.delta1) * cap;
       const double hy =

@@ -204,7 +204,7 @@ TEST(FtcIndex, BigCrunchAndPerturbed) {
 
 TEST(FtcIndex, HorizonZeroAndInfinite) {
   const DiscTable t = build::uniform(400, {0, 0, 800, 800}, 10, 1, 3, 12);
-  for (double h : {0.0, 1e-9, 0.5, 1e6, double{INFINITY}}) {
+  for (double h : {-1.0, 0.0, 1e-9, 0.5, 1e6, double{INFINITY}}) {
     FtcIndex probe;
     probe.build(t.view(), kNoScene, h);
     EXPECT_EQ(probe.uses_chord_bound(), h > 0 && std::isfinite(h)) << h;
