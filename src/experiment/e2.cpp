@@ -92,7 +92,8 @@ void run_e2(const Options& opt) {
   }
   csv.close();
 
-  const std::string note = machine_note(opt.threads);
+  const std::string note =
+      machine_note(opt.threads) + "; times: " + ftc::RunClock(opt.threads).what();
   {
     std::ofstream txt(opt.out_dir / "e2.txt");
     txt << "crowddb experiment e2" << (quick ? " --quick" : "") << " --seed " << opt.seed << "\n"

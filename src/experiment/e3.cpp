@@ -75,7 +75,8 @@ void run_e3(const Options& opt) {
   }
   csv.close();
 
-  const std::string note = machine_note(opt.threads);
+  const std::string note =
+      machine_note(opt.threads) + "; times: " + ftc::RunClock(opt.threads).what();
   {
     std::ofstream txt(opt.out_dir / "e3.txt");
     txt << "crowddb experiment e3" << (quick ? " --quick" : "") << " --seed " << opt.seed << "\n"
