@@ -24,7 +24,7 @@ void run_e2(const Options& opt) {
   using namespace ftc;
   const bool quick = opt.quick;
   const std::vector<std::size_t> sizes =
-      quick ? std::vector<std::size_t>{500, 1000}
+      quick ? std::vector<std::size_t>{300, 600}
             : std::vector<std::size_t>{1000, 3000, 5000, 7500, 10000, 12500, 15000};
   const int index_runs = quick ? 2 : 50, thesis_runs = quick ? 2 : 20;
   const double budget = quick ? 4e6 : 3e8;
