@@ -110,6 +110,19 @@ std::vector<Opt> all_options() {
   return v;
 }
 
+// A few contrasting option sets, for the larger tables.
+std::vector<Opt> some_options() {
+  Opt thesis;  // the thesis's search: frustum, best-first from the root, one agent per leaf
+  thesis.bound = Opt::Bound::frustum;
+  thesis.order = Opt::Order::best_first;
+  thesis.leaf_size = 1;
+  thesis.seed_own_leaf = false;
+  thesis.overlaps_first = false;
+  return {Opt{}, Opt{.bound = Opt::Bound::frustum},
+          Opt{.slices = 1, .order = Opt::Order::bottom_up},
+          Opt{.leaf_size = 3, .slices = 7, .order = Opt::Order::nearer_first}, thesis};
+}
+
 const StaticScene kNoScene;
 
 TEST(FtcIndex, EmptyAndTinyTables) {
@@ -151,7 +164,7 @@ TEST(FtcIndex, LatticeWithExactTies) {
   // Spacing 4, radius 1: neighbours approaching at closing speed 2 meet at exactly t = 1, and
   // many pairs tie in time: the smaller id must win.
   for (uint64_t seed : {1, 2}) {
-    DiscTable t = build::lattice(900, 4, 1, 1, seed);
+    DiscTable t = build::lattice(400, 4, 1, 1, seed);
     for (const Opt& o : all_options()) EXPECT_EQ(compare(t, kNoScene, 30, o), 0);
     build::shuffle_ids(t, seed + 10);
     for (const Opt& o : all_options()) EXPECT_EQ(compare(t, kNoScene, 30, o), 0);
@@ -198,7 +211,7 @@ TEST(FtcIndex, BigCrunchAndPerturbed) {
     }
     // Sparse: small discs far apart, so the collision times crowd just before the arrival.
     const DiscTable sparse = build::big_crunch(500, {0, 0, 3000, 2000}, 20, 0.1, 0.3, perturb, 4);
-    for (const Opt& o : all_options()) EXPECT_EQ(compare(sparse, kNoScene, 30, o), 0) << perturb;
+    for (const Opt& o : some_options()) EXPECT_EQ(compare(sparse, kNoScene, 30, o), 0) << perturb;
   }
 }
 
@@ -232,7 +245,7 @@ StaticScene obstacle_scene(uint64_t seed, std::size_t circles, std::size_t polyg
 TEST(FtcIndex, StaticObstacles) {
   for (uint64_t seed : {1, 2, 3}) {
     const StaticScene scene = obstacle_scene(seed, 40, 12);
-    const DiscTable t = build::uniform(500, {}, 20, 1, 3, seed);
+    const DiscTable t = build::uniform(300, {}, 20, 1, 3, seed);
     for (const Opt& o : all_options()) EXPECT_EQ(compare(t, scene, 30, o), 0) << seed;
     const DiscTable sparse = build::uniform(60, {}, 20, 1, 3, seed + 7);
     EXPECT_EQ(compare(sparse, scene, 30), 0);
