@@ -60,37 +60,22 @@ uint64_t checksum(const std::vector<FtcHit>& hits) {
 }
 
 FtcIndexOptions options_for(int variant) {
-  FtcIndexOptions o;
+  using O = FtcIndexOptions;
+  O o;
   switch (variant) {
-    case 1:
-      o.bound = FtcIndexOptions::Bound::frustum;
-      break;
-    case 2:
-      o.order = FtcIndexOptions::Order::best_first;
-      break;
-    case 3:
-      o.slices = 2;
-      break;
-    case 4:
-      o.slices = 4;
-      break;
-    case 5:
-      o.order = FtcIndexOptions::Order::nearer_first;
-      break;
-    case 6:
-      o.leaf_size = 4;
-      break;
-    case 7:
-      o.leaf_size = 6;
-      break;
-    case 8:
-      o.leaf_size = 12;
-      break;
-    case 9:
-      o.leaf_size = 16;
+    case 1: o.bound = O::Bound::frustum; break;
+    case 2: o.order = O::Order::best_first; break;
+    case 3: o.slices = 1; break;
+    case 4: o.slices = 2; break;
+    case 5: o.order = O::Order::nearer_first; break;
+    case 6: o.order = O::Order::bottom_up; break;
+    case 7: o.overlaps_first = false; break;
+    case 8:  // the thesis's search made exact
+      o = {.leaf_size = 1, .bound = O::Bound::frustum, .slices = 1, .order = O::Order::best_first,
+           .seed_own_leaf = false, .overlaps_first = false};
       break;
     default:
-      if (variant >= 100) o.leaf_size = static_cast<std::size_t>(variant - 100);  // ad-hoc sweeps
+      if (variant >= 100) o.leaf_size = static_cast<std::size_t>(variant - 100);  // leaf sweeps
       break;
   }
   return o;
@@ -171,13 +156,14 @@ void BM_Naive(benchmark::State& state) {
 }
 
 // Args: n, world (0 uniform, 1 Big Crunch, 2 perturbed: all at the E1 density; 3 uniform on the
-// fixed 640 x 480 plane), variant (0 default, 1 frustum bound,
-// 2 pure best-first order, 3/4 chord with 2/4 slices, 5 top-down nearer-first order,
-// 6..9 leaf size 4, 6, 12, 16).
+// fixed 640 x 480 plane), variant (0 default: chord K = 4, leaf_queue, leaf 16; 1 frustum bound;
+// 2 best-first order from the root; 3 K = 1; 4 K = 2; 5 nearer-first from the root; 6 bottom-up;
+// 7 no overlap-first phase; 8 the thesis's search (frustum, best-first, one agent per leaf);
+// 100 + L: leaf size L).
 void sizes(benchmark::internal::Benchmark* b) {
   for (int w : {uniform_w, crunch_w, perturbed_w})
     for (int64_t n : {1000, 15000, 100000, 1000000}) b->Args({n, w, 0});
-  for (int v : {1, 2, 3, 4, 5, 6, 7, 8, 9})
+  for (int v : {1, 2, 3, 4, 5, 6, 7, 8})
     for (int w : {uniform_w, crunch_w, perturbed_w}) b->Args({15000, w, v});
   b->Unit(benchmark::kMillisecond);
 }
