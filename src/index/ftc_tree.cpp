@@ -1,0 +1,842 @@
+// The kinetic k-d tree of first-to-collide. The design (invariant, bound, complexity, why the
+// Big Crunch does not degrade) is in ftc_tree.hpp.
+#include "index/ftc_tree.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <numeric>
+#include <vector>
+
+#include "crowddb/error.hpp"
+#include "query/ftc_geometry.hpp"
+#include "util/stopwatch.hpp"
+
+namespace crowddb {
+namespace {
+
+using Kind = Collider::Kind;
+
+// Relative slack of the bounds against rounding (see "Floating point" in ftc_tree.hpp). The pair
+// times carry errors of order sqrt(eps) * M in position for near-grazing pairs; 1e-6 leaves a
+// margin of more than ten.
+constexpr double kSlack = 1e-6;
+constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+
+// The time axis every tree of one build shares.
+struct Frame {
+  double ox = 0, oy = 0;      // local origin: node boxes are stored relative to it
+  std::vector<double> knots;  // chord: 0 = t_0 < ... < t_K = horizon; frustum: {0, +inf}
+  bool chord = true;
+  double delta0 = 0, delta1 = 0;  // every node box is inflated by delta0 + delta1 * t
+  int slices() const { return static_cast<int>(knots.size()) - 1; }
+};
+
+// A node's bounds on one time slice [t_j, t_j+1]: its members lie in
+// [lo + slo (t - t_j), hi + shi (t - t_j)] per axis (frame coordinates, inflated).
+struct Slice {
+  double lo_x, lo_y, hi_x, hi_y;
+  double slo_x, slo_y, shi_x, shi_y;
+};
+
+struct Node {
+  double rmax;          // largest member radius
+  uint64_t min_key;     // smallest member key (agent id or obstacle row)
+  uint32_t begin, end;  // members: perm[begin, end)
+  uint32_t right;       // right child; the left child is this node + 1; 0 for a leaf
+  uint32_t parent;      // kNone for the root
+  bool leaf() const { return right == 0; }
+};
+
+// A node's cell: the split half-planes of its ancestors, cut down to the root's bounding box
+// (frame coordinates, at t = 0). Every member outside the subtree lies outside its interior.
+struct Cell {
+  double x0, y0, x1, y1;
+};
+
+// The probe: the query disc, raw (for the exact pair times) and in frame coordinates (bounds).
+struct Probe {
+  double ax, ay, avx, avy, ar;  // the query row's columns, untouched
+  double fx, fy;                // position in the frame
+  uint32_t self;                // own row in the agent tree, or kNone
+};
+
+// The running answer, ordered lexicographically by (time, kind, key, row): the naive loop keeps
+// the first of equal (time, kind, key) in row order, i.e. the smallest row.
+struct Best {
+  double t = INFINITY;
+  Kind kind = Kind::none;
+  uint64_t key = 0;
+  uint32_t row = 0;
+
+  void offer(double time, Kind k, uint64_t key2, uint32_t row2) {
+    if (time == INFINITY) return;
+    if (kind == Kind::none || precedes(time, k, key2, t, kind, key) ||
+        (time == t && k == kind && key2 == key && row2 < row))
+      *this = {time, k, key2, row2};
+  }
+  // True when every candidate (time >= b, kind k, key >= min_key) loses to the answer so far.
+  bool beats(double b, Kind k, uint64_t min_key) const {
+    return kind != Kind::none && precedes(t, kind, key, b, k, min_key);
+  }
+};
+
+struct Counters {
+  uint64_t pair_tests = 0, visited = 0, pushes = 0, pops = 0;
+};
+
+struct Entry {
+  double bound;
+  uint64_t key;
+  uint32_t node;
+};
+// std heap functions build a max-heap: "less" means "later".
+struct Later {
+  bool operator()(const Entry& a, const Entry& b) const {
+    return a.bound != b.bound ? a.bound > b.bound : a.key > b.key;
+  }
+};
+
+struct Scratch {
+  std::vector<Entry> heap;
+};
+
+// The bound on one slice: the first t in [t0, t0 + span] at which the box comes within
+// Chebyshev distance R of the probe's centre, or +inf. (qx, qy): the probe's centre at t0. The
+// four edges are lines in t in the probe's frame; an edge outside reach must close its gap within
+// the slice, an edge inside must not leave before the others arrive. Rejection needs no division.
+inline double slice_bound(const Slice& b, double qx, double qy, const Probe& q, double R, double t0,
+                          double span) {
+  const double p[4] = {b.lo_x - qx, qx - b.hi_x, b.lo_y - qy, qy - b.hi_y};
+  // Common case first: within reach already at the slice start.
+  if (p[0] <= R && p[1] <= R && p[2] <= R && p[3] <= R) return t0;
+  const double v[4] = {b.slo_x - q.avx, q.avx - b.shi_x, b.slo_y - q.avy, q.avy - b.shi_y};
+  bool ok = true;
+  for (int e = 0; e < 4; ++e)
+    if (p[e] > R && (!(v[e] < 0) || p[e] - R > span * -v[e])) ok = false;
+  if (!ok) return INFINITY;
+  double lo = 0;
+  for (int e = 0; e < 4; ++e)
+    if (p[e] > R) lo = std::max(lo, (p[e] - R) / -v[e]);
+  for (int e = 0; e < 4; ++e)
+    if (p[e] <= R && v[e] > 0 && p[e] + v[e] * lo > R) ok = false;
+  return ok && lo <= span ? t0 + lo : INFINITY;
+}
+
+// Earliest t in [0, tcap] at which the node's box comes within reach of the probe, or +inf: a
+// lower bound on every member's pair time with radius sum <= R. s[j * stride]: the slice j.
+inline double node_bound(const Slice* s, std::size_t stride, const Frame& f, const Probe& q,
+                         double R, double tcap) {
+  const int K = f.slices();
+  if (K == 1) return slice_bound(s[0], q.fx, q.fy, q, R, 0, std::min(f.knots[1], tcap));
+  for (int j = 0; j < K; ++j) {
+    const double t0 = f.knots[j];
+    if (t0 > tcap) break;
+    const double qx = j == 0 ? q.fx : q.fx + q.avx * t0;
+    const double qy = j == 0 ? q.fy : q.fy + q.avy * t0;
+    const double t = slice_bound(s[static_cast<std::size_t>(j) * stride], qx, qy, q, R, t0,
+                                 std::min(f.knots[j + 1], tcap) - t0);
+    if (t != INFINITY) return t;
+  }
+  return INFINITY;
+}
+
+// ------------------------------------------------------------------- member sources
+
+struct AgentSource {
+  static constexpr Kind kind = Kind::agent;
+  const DiscView* d = nullptr;
+  std::size_t size() const { return d->n; }
+  double x(uint32_t i) const { return d->x[i]; }
+  double y(uint32_t i) const { return d->y[i]; }
+  double vx(uint32_t i) const { return d->vx[i]; }
+  double vy(uint32_t i) const { return d->vy[i]; }
+  double r(uint32_t i) const { return d->radius[i]; }
+  uint64_t key(uint32_t i) const { return d->id[i]; }
+  void prefetch(uint32_t i) const {
+    __builtin_prefetch(d->x + i);
+    __builtin_prefetch(d->y + i);
+    __builtin_prefetch(d->vx + i);
+    __builtin_prefetch(d->vy + i);
+    __builtin_prefetch(d->radius + i);
+    __builtin_prefetch(d->id + i);
+  }
+  // Exactly the naive path's expressions (ftc_naive.cpp, ray_disc_time), so times are
+  // bit-identical: overlaps() is ray_disc_time's own test for time 0.
+  bool overlaps(const Probe& a, uint32_t b) const {
+    const double dx = d->x[b] - a.ax, dy = d->y[b] - a.ay, R = a.ar + d->radius[b];
+    return dx * dx + dy * dy - R * R < 0;
+  }
+  double time(const Probe& a, uint32_t b, double horizon) const {
+    return ray_disc_time(d->x[b] - a.ax, d->y[b] - a.ay, d->vx[b] - a.avx, d->vy[b] - a.avy,
+                         a.ar + d->radius[b], horizon);
+  }
+};
+
+struct CircleSource {
+  static constexpr Kind kind = Kind::circle;
+  std::span<const CircleObstacle> c;
+  std::size_t size() const { return c.size(); }
+  double x(uint32_t i) const { return c[i].x; }
+  double y(uint32_t i) const { return c[i].y; }
+  double vx(uint32_t) const { return 0; }
+  double vy(uint32_t) const { return 0; }
+  double r(uint32_t i) const { return c[i].radius; }
+  uint64_t key(uint32_t i) const { return i; }
+  void prefetch(uint32_t i) const { __builtin_prefetch(c.data() + i); }
+  bool overlaps(const Probe& a, uint32_t b) const {
+    const double dx = c[b].x - a.ax, dy = c[b].y - a.ay, R = a.ar + c[b].radius;
+    return dx * dx + dy * dy - R * R < 0;
+  }
+  double time(const Probe& a, uint32_t b, double horizon) const {
+    return ray_disc_time(c[b].x - a.ax, c[b].y - a.ay, -a.avx, -a.avy, a.ar + c[b].radius, horizon);
+  }
+};
+
+// ------------------------------------------------------------------- the tree
+
+template <class Src>
+class KineticTree {
+ public:
+  void build(const Src& src, const Frame& f, std::size_t leaf_size);
+  using Order = FtcIndexOptions::Order;
+  // Adds this tree's members to `best`. self_pos: the query's position in tree order (it is
+  // skipped as a member, and its leaf is scanned first), or kNone.
+  // OverlapOnly: only the members that overlap the query now (pair time 0) count; the bounds
+  // and the pair tests shrink to the t = 0 checks (see "Overlaps first" in ftc_tree.hpp).
+  template <bool OverlapOnly>
+  void search(const Probe& q, double horizon, Best& best, Scratch& sc, Counters& c, Order order,
+              uint32_t self_pos, bool seed) const;
+  std::string validate(const Frame& f) const;
+
+  bool empty() const { return nodes_.empty(); }
+  std::size_t node_count() const { return nodes_.size(); }
+  const std::vector<uint32_t>& perm() const { return perm_; }
+  uint32_t pos_of(uint32_t row) const { return pos_of_[row]; }
+  uint32_t leaf_at(uint32_t pos) const { return leaf_at_[pos]; }
+  bool leaf_begins_at(uint32_t leaf, uint32_t pos) const { return nodes_[leaf].begin == pos; }
+  // Asks the cache for the rows of node k if it is a leaf (a hint only; no effect on results).
+  void prefetch_leaf(uint32_t k) const {
+    if (k >= nodes_.size() || !nodes_[k].leaf()) return;
+    for (uint32_t i = nodes_[k].begin; i < nodes_[k].end; ++i) src_->prefetch(perm_[i]);
+  }
+
+ private:
+  // A member during the build, with the columns the bounds need: read once in row order, so
+  // the build never gathers columns at random (the index keeps none of this afterwards).
+  struct Item {
+    double x, y;  // frame coordinates at t = 0
+    double vx, vy, r;
+    uint64_t key;
+    uint32_t row;
+  };
+  // Raw (uninflated) bounds during the build: K + 1 knot boxes, or box + velocity bounds.
+  struct Raw {
+    double lo_x, lo_y, hi_x, hi_y;
+  };
+  uint32_t build_node(uint32_t b, uint32_t e, uint32_t parent, Cell cell);
+  // Nodes of the tree over n members (median splits until at most leaf_size_ remain).
+  std::size_t count_nodes(std::size_t n) const {
+    return n <= leaf_size_ ? 1 : 1 + count_nodes(n / 2) + count_nodes(n - n / 2);
+  }
+  void leaf_bounds(uint32_t node);
+  void merge_bounds(uint32_t node, uint32_t l, uint32_t r);
+  void finish_bounds(uint32_t node);
+  template <bool OverlapOnly>
+  void scan(uint32_t node, const Probe& q, double horizon, Best& best, Counters& c) const;
+
+  const Src* src_ = nullptr;
+  const Frame* f_ = nullptr;
+  std::size_t leaf_size_ = 8;
+  std::vector<Node> nodes_;
+  // Slice j of node k at [j * nodes + k]: slice 0 of all nodes (the one most searches need)
+  // lies together.
+  std::vector<Slice> slices_;
+  std::size_t stride_ = 0;         // number of nodes
+  std::vector<uint32_t> perm_;     // rows in tree order
+  std::vector<uint32_t> pos_of_;   // row -> its position in perm_
+  std::vector<uint32_t> leaf_at_;  // position in perm_ -> its leaf
+  std::vector<Cell> cells_;        // per node
+  // Reach of any member: largest radius and speeds per axis (for the bottom-up walk's stop).
+  double reach_r_ = 0, reach_vx_ = 0, reach_vy_ = 0;
+  // build scratch
+  std::vector<Item> items_;
+  std::vector<Raw> raw_;  // (K + 1) per node (chord) or 2 per node (frustum: box, velocity box)
+};
+
+template <class Src>
+void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_size) {
+  src_ = &src;
+  f_ = &f;
+  leaf_size_ = std::max<std::size_t>(leaf_size, 1);
+  nodes_.clear();
+  slices_.clear();
+  raw_.clear();
+  const auto n = static_cast<uint32_t>(src.size());
+  perm_.resize(n);
+  pos_of_.resize(n);
+  leaf_at_.resize(n);
+  cells_.clear();
+  if (n == 0) return;
+  items_.resize(n);
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  for (uint32_t i = 0; i < n; ++i) {
+    items_[i] = {src.x(i) - f.ox, src.y(i) - f.oy, src.vx(i), src.vy(i), src.r(i), src.key(i), i};
+    x0 = std::min(x0, items_[i].x);
+    x1 = std::max(x1, items_[i].x);
+    y0 = std::min(y0, items_[i].y);
+    y1 = std::max(y1, items_[i].y);
+  }
+  // Median splits leave at least leaf_size / 2 members per leaf: at most 4n / leaf + 2 nodes.
+  const std::size_t most = 4 * n / leaf_size_ + 2;
+  nodes_.reserve(most);
+  stride_ = count_nodes(n);
+  slices_.resize(stride_ * static_cast<std::size_t>(f.slices()));
+  raw_.reserve(most * (f.chord ? f.knots.size() : 2));
+  cells_.reserve(most);
+  build_node(0, n, kNone, {x0, y0, x1, y1});
+  for (uint32_t i = 0; i < n; ++i) perm_[i] = items_[i].row;
+  for (uint32_t i = 0; i < n; ++i) pos_of_[perm_[i]] = i;
+  for (uint32_t k = 0; k < nodes_.size(); ++k)
+    if (nodes_[k].leaf())
+      for (uint32_t i = nodes_[k].begin; i < nodes_[k].end; ++i) leaf_at_[i] = k;
+  reach_r_ = nodes_[0].rmax;
+  reach_vx_ = reach_vy_ = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    reach_vx_ = std::max(reach_vx_, std::fabs(src.vx(i)));
+    reach_vy_ = std::max(reach_vy_, std::fabs(src.vy(i)));
+  }
+  items_.clear();
+  raw_.clear();
+}
+
+template <class Src>
+uint32_t KineticTree<Src>::build_node(uint32_t b, uint32_t e, uint32_t parent, Cell cell) {
+  const auto idx = static_cast<uint32_t>(nodes_.size());
+  nodes_.push_back({0, 0, b, e, 0, parent});
+  cells_.push_back(cell);
+  const std::size_t per = f_->chord ? f_->knots.size() : 2;
+  raw_.resize(raw_.size() + per);
+  if (e - b <= leaf_size_) {
+    // Members by key, so a scan can stop at the first key that can no longer win.
+    std::sort(items_.begin() + b, items_.begin() + e, [](const Item& p, const Item& q) {
+      return p.key != q.key ? p.key < q.key : p.row < q.row;
+    });
+    leaf_bounds(idx);
+  } else {
+    // Split the cell's wider side at the median: balanced, depth ceil(log2(n / leaf)).
+    const bool by_x = cell.x1 - cell.x0 >= cell.y1 - cell.y0;
+    const uint32_t mid = b + (e - b) / 2;
+    if (by_x)
+      std::nth_element(items_.begin() + b, items_.begin() + mid, items_.begin() + e,
+                       [](const Item& p, const Item& q) { return p.x < q.x; });
+    else
+      std::nth_element(items_.begin() + b, items_.begin() + mid, items_.begin() + e,
+                       [](const Item& p, const Item& q) { return p.y < q.y; });
+    // Left members have coordinate <= cut, right ones >= cut (ties may fall either side).
+    const double cut = by_x ? items_[mid].x : items_[mid].y;
+    Cell lc = cell, rc = cell;
+    (by_x ? lc.x1 : lc.y1) = cut;
+    (by_x ? rc.x0 : rc.y0) = cut;
+    const uint32_t l = build_node(b, mid, idx, lc);
+    const uint32_t r = build_node(mid, e, idx, rc);
+    nodes_[idx].right = r;
+    merge_bounds(idx, l, r);
+  }
+  finish_bounds(idx);
+  return idx;
+}
+
+template <class Src>
+void KineticTree<Src>::leaf_bounds(uint32_t node) {
+  Node& nd = nodes_[node];
+  const Frame& f = *f_;
+  const std::size_t per = f.chord ? f.knots.size() : 2;
+  Raw* raw = &raw_[node * per];
+  for (std::size_t j = 0; j < per; ++j) raw[j] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+  nd.rmax = 0;
+  nd.min_key = std::numeric_limits<uint64_t>::max();
+  for (uint32_t i = nd.begin; i < nd.end; ++i) {
+    const Item& it = items_[i];
+    const double x = it.x, y = it.y, vx = it.vx, vy = it.vy;
+    nd.rmax = std::max(nd.rmax, it.r);
+    nd.min_key = std::min(nd.min_key, it.key);
+    if (f.chord) {
+      for (std::size_t j = 0; j < per; ++j) {
+        const double t = f.knots[j];
+        const double px = x + vx * t, py = y + vy * t;
+        raw[j] = {std::min(raw[j].lo_x, px), std::min(raw[j].lo_y, py), std::max(raw[j].hi_x, px),
+                  std::max(raw[j].hi_y, py)};
+      }
+    } else {
+      raw[0] = {std::min(raw[0].lo_x, x), std::min(raw[0].lo_y, y), std::max(raw[0].hi_x, x),
+                std::max(raw[0].hi_y, y)};
+      raw[1] = {std::min(raw[1].lo_x, vx), std::min(raw[1].lo_y, vy), std::max(raw[1].hi_x, vx),
+                std::max(raw[1].hi_y, vy)};
+    }
+  }
+}
+
+template <class Src>
+void KineticTree<Src>::merge_bounds(uint32_t node, uint32_t l, uint32_t r) {
+  const std::size_t per = f_->chord ? f_->knots.size() : 2;
+  Raw* out = &raw_[node * per];
+  const Raw* a = &raw_[l * per];
+  const Raw* b = &raw_[r * per];
+  for (std::size_t j = 0; j < per; ++j)
+    out[j] = {std::min(a[j].lo_x, b[j].lo_x), std::min(a[j].lo_y, b[j].lo_y),
+              std::max(a[j].hi_x, b[j].hi_x), std::max(a[j].hi_y, b[j].hi_y)};
+  nodes_[node].rmax = std::max(nodes_[l].rmax, nodes_[r].rmax);
+  nodes_[node].min_key = std::min(nodes_[l].min_key, nodes_[r].min_key);
+}
+
+// Inflates the raw bounds by delta0 + delta1 t and turns them into per-slice lines.
+template <class Src>
+void KineticTree<Src>::finish_bounds(uint32_t node) {
+  const Frame& f = *f_;
+  const int K = f.slices();
+  auto at = [&](int j) -> Slice& { return slices_[static_cast<std::size_t>(j) * stride_ + node]; };
+  if (!f.chord) {
+    const Raw& box = raw_[node * 2];
+    const Raw& vel = raw_[node * 2 + 1];
+    at(0) = {box.lo_x - f.delta0, box.lo_y - f.delta0, box.hi_x + f.delta0, box.hi_y + f.delta0,
+             vel.lo_x - f.delta1, vel.lo_y - f.delta1, vel.hi_x + f.delta1, vel.hi_y + f.delta1};
+    return;
+  }
+  const Raw* raw = &raw_[node * f.knots.size()];
+  auto inflated = [&](int j) {
+    const double d = f.delta0 + f.delta1 * f.knots[j];
+    return Raw{raw[j].lo_x - d, raw[j].lo_y - d, raw[j].hi_x + d, raw[j].hi_y + d};
+  };
+  Raw a = inflated(0);
+  for (int j = 0; j < K; ++j) {
+    const Raw b = inflated(j + 1);
+    // Rounding of the slopes moves the lines by far less than the inflation (see the header).
+    const double inv = 1 / (f.knots[j + 1] - f.knots[j]);
+    at(j) = {a.lo_x,
+             a.lo_y,
+             a.hi_x,
+             a.hi_y,
+             (b.lo_x - a.lo_x) * inv,
+             (b.lo_y - a.lo_y) * inv,
+             (b.hi_x - a.hi_x) * inv,
+             (b.hi_y - a.hi_y) * inv};
+    a = b;
+  }
+}
+
+template <class Src>
+template <bool OverlapOnly>
+void KineticTree<Src>::scan(uint32_t node, const Probe& q, double horizon, Best& best,
+                            Counters& c) const {
+  const Node& nd = nodes_[node];
+  for (uint32_t i = nd.begin; i < nd.end; ++i) {
+    const uint32_t row = perm_[i];
+    const uint64_t key = src_->key(row);
+    // Leaves are sorted by key: once the answer beats (t = 0, key), it beats the rest too.
+    if (best.beats(0, Src::kind, key)) break;
+    if (row == q.self) continue;
+    ++c.pair_tests;
+    if constexpr (OverlapOnly) {
+      if (src_->overlaps(q, row)) best.offer(0.0, Src::kind, key, row);
+    } else {
+      best.offer(src_->time(q, row, horizon), Src::kind, key, row);
+    }
+  }
+}
+
+template <class Src>
+template <bool OverlapOnly>
+void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratch& sc, Counters& c,
+                              Order order, uint32_t self_pos, bool seed) const {
+  if (nodes_.empty()) return;
+  const Frame& f = *f_;
+  constexpr Kind kind = Src::kind;
+  if constexpr (OverlapOnly) horizon = 0;
+  auto bound_of = [&](uint32_t k) {
+    const double R = q.ar + nodes_[k].rmax;
+    if constexpr (OverlapOnly) {  // within reach at t = 0, or out
+      const Slice& b = slices_[k];
+      return b.lo_x - q.fx <= R && q.fx - b.hi_x <= R && b.lo_y - q.fy <= R && q.fy - b.hi_y <= R
+                 ? 0.0
+                 : INFINITY;
+    } else {
+      const double cap = best.kind == Kind::none ? horizon : std::min(horizon, best.t);
+      return node_bound(&slices_[k], stride_, f, q, R, cap);
+    }
+  };
+  auto pruned = [&](double b, uint64_t min_key) {
+    return b == INFINITY || best.beats(b, kind, min_key);
+  };
+  auto push = [&](double b, uint32_t k) {
+    sc.heap.push_back({b, nodes_[k].min_key, k});
+    std::push_heap(sc.heap.begin(), sc.heap.end(), Later{});
+    ++c.pushes;
+  };
+  // Searches the subtree at `start` (not pruned when called). Any visiting order is exact: a
+  // node is skipped only when the answer so far beats its bound, and the answer only improves.
+  // start == kNone: continue with the queue as it is.
+  auto explore = [&](uint32_t start, double start_bound, uint32_t skip_leaf) {
+    if (start != kNone) sc.heap.clear();
+    uint32_t node = start;
+    if (order == Order::best_first) {
+      push(start_bound, start);
+      node = kNone;
+    }
+    for (;;) {
+      if (node == kNone) {
+        if (sc.heap.empty()) return;
+        std::pop_heap(sc.heap.begin(), sc.heap.end(), Later{});
+        const Entry e = sc.heap.back();
+        sc.heap.pop_back();
+        ++c.pops;
+        if (pruned(e.bound, e.key)) return;  // the smallest bound left cannot win: nothing can
+        node = e.node;
+      }
+      const Node& nd = nodes_[node];
+      if (nd.leaf()) {
+        if (node != skip_leaf) {
+          ++c.visited;
+          scan<OverlapOnly>(node, q, horizon, best, c);
+        }
+        node = kNone;
+        continue;
+      }
+      ++c.visited;
+      const uint32_t l = node + 1, r = nd.right;
+      const double bl = bound_of(l), br = bound_of(r);
+      const bool keep_l = !pruned(bl, nodes_[l].min_key), keep_r = !pruned(br, nodes_[r].min_key);
+      node = kNone;
+      if (order == Order::best_first) {
+        if (keep_l) push(bl, l);
+        if (keep_r) push(br, r);
+      } else if (keep_l && keep_r) {
+        const bool l_first = bl != br ? bl < br : nodes_[l].min_key <= nodes_[r].min_key;
+        push(l_first ? br : bl, l_first ? r : l);
+        node = l_first ? l : r;
+      } else if (keep_l) {
+        node = l;
+      } else if (keep_r) {
+        node = r;
+      }
+    }
+  };
+
+  // The query's own leaf first: its neighbours give an early best time.
+  sc.heap.clear();
+  uint32_t leaf = kNone;
+  if (self_pos != kNone && (seed || order == Order::bottom_up || order == Order::leaf_queue)) {
+    leaf = leaf_at_[self_pos];
+    ++c.visited;
+    scan<OverlapOnly>(leaf, q, horizon, best, c);
+  }
+  if ((order == Order::bottom_up || order == Order::leaf_queue) && leaf != kNone) {
+    // Then the siblings of the path to the root, nearest (deepest) first. Once every position
+    // from which a member could still reach the query before the answer so far lies strictly
+    // inside the cell below, no sibling further up can hold a winner: stop.
+    for (uint32_t below = leaf; below != 0; below = nodes_[below].parent) {
+      // (Overlaps count at t = 0 even when the horizon is negative: the reach is at least R.)
+      const double cap =
+          std::max(0.0, best.kind == Kind::none ? horizon : std::min(horizon, best.t));
+      const double hx =
+          reach_r_ + q.ar + f.delta0 + (std::fabs(q.avx) + reach_vx_ + f.delta1) * cap;
+      const double hy =
+          reach_r_ + q.ar + f.delta0 + (std::fabs(q.avy) + reach_vy_ + f.delta1) * cap;
+      const Cell& cell = cells_[below];
+      if (q.fx - hx > cell.x0 && q.fx + hx < cell.x1 && q.fy - hy > cell.y0 && q.fy + hy < cell.y1)
+        break;
+      const uint32_t p = nodes_[below].parent;
+      const uint32_t sib = below == p + 1 ? nodes_[p].right : p + 1;
+      const double b = bound_of(sib);
+      if (pruned(b, nodes_[sib].min_key)) continue;
+      if (order == Order::bottom_up)
+        explore(sib, b, kNone);  // searched at once, deepest sibling first
+      else
+        push(b, sib);  // searched below in bound order
+    }
+    if (order == Order::leaf_queue) explore(kNone, 0, kNone);
+    return;
+  }
+  const double b0 = bound_of(0);
+  if (!pruned(b0, nodes_[0].min_key)) explore(0, b0, leaf);
+}
+
+template <class Src>
+std::string KineticTree<Src>::validate(const Frame& f) const {
+  const Src& s = *src_;
+  const std::size_t K = static_cast<std::size_t>(f.slices());
+  std::vector<uint32_t> seen(perm_.size(), 0);
+  for (uint32_t row : perm_) {
+    if (row >= seen.size() || seen[row]++) return "perm is not a permutation";
+  }
+  for (uint32_t k = 0; k < nodes_.size(); ++k) {
+    const Node& nd = nodes_[k];
+    if (nd.begin >= nd.end || nd.end > perm_.size())
+      return "node " + std::to_string(k) + ": bad range";
+    if (!nd.leaf()) {
+      const Node& l = nodes_[k + 1];
+      const Node& r = nodes_[nd.right];
+      if (l.parent != k || r.parent != k)
+        return "node " + std::to_string(k) + ": wrong parent links";
+      if (l.begin != nd.begin || l.end != r.begin || r.end != nd.end)
+        return "node " + std::to_string(k) + ": children do not partition its range";
+    } else if (nd.end - nd.begin > leaf_size_) {
+      return "leaf " + std::to_string(k) + ": too many members";
+    }
+    auto sl = [&](std::size_t j) -> const Slice& { return slices_[j * stride_ + k]; };
+    for (uint32_t i = nd.begin; i < nd.end; ++i) {
+      const uint32_t row = perm_[i];
+      if (s.r(row) > nd.rmax) return "node " + std::to_string(k) + ": rmax below a member's radius";
+      if (s.key(row) < nd.min_key)
+        return "node " + std::to_string(k) + ": min_key above a member's key";
+      if (pos_of_[row] != i) return "row " + std::to_string(row) + ": pos_of is wrong";
+      if (nd.leaf() && leaf_at_[i] != k)
+        return "position " + std::to_string(i) + ": leaf_at is wrong";
+      const double fx = s.x(row) - f.ox, fy = s.y(row) - f.oy;
+      const Cell& cl = cells_[k];
+      if (fx < cl.x0 || fx > cl.x1 || fy < cl.y0 || fy > cl.y1)
+        return "node " + std::to_string(k) + ": row " + std::to_string(row) + " outside its cell";
+      // Each member at each slice's two ends (and its middle) lies inside the slice's box.
+      for (std::size_t j = 0; j < K; ++j) {
+        const double t0 = f.knots[j];
+        const double len = std::isfinite(f.knots[j + 1]) ? f.knots[j + 1] - t0 : 1e3;
+        for (double u : {0.0, len / 2, len}) {
+          const double t = t0 + u;
+          const double px = (s.x(row) - f.ox) + s.vx(row) * t,
+                       py = (s.y(row) - f.oy) + s.vy(row) * t;
+          const Slice& b = sl(j);
+          if (px < b.lo_x + b.slo_x * u || px > b.hi_x + b.shi_x * u || py < b.lo_y + b.slo_y * u ||
+              py > b.hi_y + b.shi_y * u)
+            return "node " + std::to_string(k) + ": row " + std::to_string(row) +
+                   " leaves the box at t=" + std::to_string(t);
+        }
+      }
+    }
+  }
+  return "";
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------- FtcIndex
+
+struct FtcIndex::Impl {
+  FtcIndexOptions opt;
+  DiscView discs;
+  const StaticScene* scene = nullptr;
+  double horizon = 0;
+  Frame frame;
+  AgentSource agents;
+  CircleSource circles;
+  KineticTree<AgentSource> agent_tree;
+  KineticTree<CircleSource> circle_tree;
+  std::vector<Slice> polygon_boxes;  // one static slice per polygon (frustum form)
+  mutable Scratch scratch;           // for query()
+
+  void make_frame();
+  // The answer for one row; pos: its position in the agent tree's order.
+  FtcHit probe(uint32_t row, uint32_t pos, Scratch& sc, Counters& c) const;
+};
+
+void FtcIndex::Impl::make_frame() {
+  const DiscView& d = discs;
+  const auto circ = scene->circles();
+  const auto boxes = scene->polygon_boxes();
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  double ra = 0, rc = 0, v = 0;
+  auto take = [&](double x, double y) {
+    x0 = std::min(x0, x);
+    x1 = std::max(x1, x);
+    y0 = std::min(y0, y);
+    y1 = std::max(y1, y);
+  };
+  for (std::size_t i = 0; i < d.n; ++i) {
+    take(d.x[i], d.y[i]);
+    ra = std::max(ra, d.radius[i]);
+    v = std::max(v, std::fabs(d.vx[i]) + std::fabs(d.vy[i]));
+  }
+  for (const auto& c : circ) {
+    take(c.x, c.y);
+    rc = std::max(rc, c.radius);
+  }
+  for (const auto& b : boxes) {
+    take(b.xmin, b.ymin);
+    take(b.xmax, b.ymax);
+  }
+  Frame& f = frame;
+  f = Frame{};
+  if (x0 <= x1) {
+    f.ox = x0 + (x1 - x0) / 2;
+    f.oy = y0 + (y1 - y0) / 2;
+  }
+  // M0 bounds |d| + R for every pair (agents, circles, polygon corners); V bounds |w|.
+  const double extent = (x1 - x0) + (y1 - y0);
+  const double m0 = (x0 <= x1 ? 2 * extent : 0) + 2 * (ra + rc);
+  const double vmax = 2 * v;
+  f.delta0 = kSlack * m0;
+  f.delta1 = kSlack * vmax;
+  const int K = std::max(opt.slices, 1);
+  f.chord = opt.bound == FtcIndexOptions::Bound::chord && horizon > 0 && std::isfinite(horizon) &&
+            std::isfinite(m0 + vmax * horizon) && m0 + vmax * horizon < 1e300;
+  if (f.chord) {
+    f.knots.resize(static_cast<std::size_t>(K) + 1);
+    for (int j = 0; j <= K; ++j) f.knots[static_cast<std::size_t>(j)] = horizon * j / K;
+    f.knots.back() = horizon;
+  } else {
+    f.knots = {0.0, INFINITY};
+  }
+}
+
+FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, Scratch& sc, Counters& c) const {
+  const DiscView& d = discs;
+  Probe q{d.x[row],
+          d.y[row],
+          d.vx[row],
+          d.vy[row],
+          d.radius[row],
+          d.x[row] - frame.ox,
+          d.y[row] - frame.oy,
+          row};
+  Best best;
+  if (opt.overlaps_first) {
+    // An agent overlapping the query now wins outright (time 0, agents before obstacles); only
+    // the smallest such id is wanted, and only t = 0 checks are needed to find it.
+    agent_tree.search<true>(q, horizon, best, sc, c, opt.order, pos, opt.seed_own_leaf);
+    if (best.kind != Kind::none) return {{best.kind, best.row}, best.t};
+  }
+  agent_tree.search<false>(q, horizon, best, sc, c, opt.order, pos, opt.seed_own_leaf);
+  q.self = kNone;
+  circle_tree.search<false>(q, horizon, best, sc, c, opt.order, kNone, false);
+  const auto polys = scene->polygons();
+  const auto boxes = scene->polygon_boxes();
+  for (std::size_t p = 0; p < polys.size(); ++p) {
+    // The naive path's filter first (same inputs, so the same polygons reach ray_polygon_time).
+    const auto& bx = boxes[p];
+    const double ax = q.ax, ay = q.ay, avx = q.avx, avy = q.avy, ar = q.ar;
+    const double ex0 = ax + std::fmin(0.0, avx * horizon) - ar,
+                 ex1 = ax + std::fmax(0.0, avx * horizon) + ar;
+    const double ey0 = ay + std::fmin(0.0, avy * horizon) - ar,
+                 ey1 = ay + std::fmax(0.0, avy * horizon) + ar;
+    if (ex1 < bx.xmin || ex0 > bx.xmax || ey1 < bx.ymin || ey0 > bx.ymax) continue;
+    const double cap = best.kind == Kind::none ? horizon : std::min(horizon, best.t);
+    static const Frame static_frame{0, 0, {0.0, INFINITY}, false, 0, 0};
+    const double b = node_bound(&polygon_boxes[p], 1, static_frame, q, ar, cap);
+    if (b == INFINITY || best.beats(b, Kind::polygon, p)) continue;
+    ++c.pair_tests;
+    best.offer(ray_polygon_time(polys[p].vertices, ax, ay, avx, avy, ar, horizon), Kind::polygon, p,
+               static_cast<uint32_t>(p));
+  }
+  return best.kind == Kind::none ? FtcHit{} : FtcHit{{best.kind, best.row}, best.t};
+}
+
+FtcIndex::FtcIndex(FtcIndexOptions options) : impl_(std::make_unique<Impl>()) {
+  if (options.leaf_size < 1) options.leaf_size = 1;
+  if (options.slices < 1) options.slices = 1;
+  impl_->opt = options;
+}
+
+FtcIndex::~FtcIndex() = default;
+
+void FtcIndex::build(const DiscView& discs, const StaticScene& scene, double horizon) {
+  Impl& m = *impl_;
+  if (discs.n >= kNone) throw Error(Error::Kind::input, "first-to-collide index: too many discs");
+  for (std::size_t i = 0; i < discs.n; ++i) {
+    const char* bad = !std::isfinite(discs.x[i])        ? "x"
+                      : !std::isfinite(discs.y[i])      ? "y"
+                      : !std::isfinite(discs.vx[i])     ? "vx"
+                      : !std::isfinite(discs.vy[i])     ? "vy"
+                      : !std::isfinite(discs.radius[i]) ? "radius"
+                                                        : nullptr;
+    if (bad)
+      throw InvalidRow(bad, "first-to-collide index: row " + std::to_string(i) + ": field " + bad +
+                                " is not a finite number");
+  }
+  if (std::isnan(horizon))
+    throw Error(Error::Kind::input, "first-to-collide index: horizon is NaN");
+  m.discs = discs;
+  m.scene = &scene;
+  m.horizon = horizon;
+  m.make_frame();
+  m.agents.d = &m.discs;
+  m.circles.c = scene.circles();
+  m.agent_tree.build(m.agents, m.frame, m.opt.leaf_size);
+  m.circle_tree.build(m.circles, m.frame, m.opt.leaf_size);
+  m.polygon_boxes.clear();
+  const double d0 = m.frame.delta0, d1 = m.frame.delta1;
+  for (const auto& b : scene.polygon_boxes())
+    m.polygon_boxes.push_back({b.xmin - m.frame.ox - d0, b.ymin - m.frame.oy - d0,
+                               b.xmax - m.frame.ox + d0, b.ymax - m.frame.oy + d0, -d1, -d1, d1,
+                               d1});
+}
+
+void FtcIndex::query_all(std::span<FtcHit> out, Executor& ex, QueryStats& stats) const {
+  const Impl& m = *impl_;
+  const auto& order = m.agent_tree.perm();
+  std::mutex mu;
+  Counters total;
+  ex.for_each_chunk(order.size(), 256, [&](std::size_t begin, std::size_t end) {
+    Scratch sc;
+    Counters c;
+    for (std::size_t i = begin; i < end; ++i) {
+      // Queries run leaf by leaf in tree order; fetch the next leaf's rows while this one runs.
+      const auto pos = static_cast<uint32_t>(i);
+      const uint32_t leaf = m.agent_tree.leaf_at(pos);
+      if (m.agent_tree.leaf_begins_at(leaf, pos)) m.agent_tree.prefetch_leaf(leaf + 1);
+      out[order[i]] = m.probe(order[i], pos, sc, c);
+    }
+    std::lock_guard lock(mu);  // integer sums: the total does not depend on the order
+    total.pair_tests += c.pair_tests;
+    total.visited += c.visited;
+    total.pushes += c.pushes;
+    total.pops += c.pops;
+  });
+  stats.rows += order.size();
+  stats.pair_tests += total.pair_tests;
+  stats.nodes_visited += total.visited;
+  stats.queue_pushes += total.pushes;
+  stats.queue_pops += total.pops;
+}
+
+FtcHit FtcIndex::query(std::size_t row, QueryStats* stats) const {
+  Counters c;
+  const auto r = static_cast<uint32_t>(row);
+  const FtcHit h = impl_->probe(r, impl_->agent_tree.pos_of(r), impl_->scratch, c);
+  if (stats) {
+    stats->rows += 1;
+    stats->pair_tests += c.pair_tests;
+    stats->nodes_visited += c.visited;
+    stats->queue_pushes += c.pushes;
+    stats->queue_pops += c.pops;
+  }
+  return h;
+}
+
+void FtcIndex::run(const DiscView& discs, const StaticScene& scene, double horizon,
+                   std::span<FtcHit> out, Executor& ex, QueryStats& stats) {
+  Stopwatch sw;
+  build(discs, scene, horizon);
+  stats.build_seconds += sw.seconds();
+  sw.restart();
+  query_all(out, ex, stats);
+  stats.query_seconds += sw.seconds();
+}
+
+std::string FtcIndex::validate() const {
+  const Impl& m = *impl_;
+  std::string s = m.agent_tree.validate(m.frame);
+  if (s.empty()) s = m.circle_tree.validate(m.frame);
+  return s;
+}
+
+std::size_t FtcIndex::node_count() const {
+  return impl_->agent_tree.node_count();
+}
+bool FtcIndex::uses_chord_bound() const {
+  return impl_->frame.chord;
+}
+const FtcIndexOptions& FtcIndex::options() const {
+  return impl_->opt;
+}
+
+}  // namespace crowddb

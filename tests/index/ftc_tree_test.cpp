@@ -1,0 +1,384 @@
+// The first-to-collide index against the naive oracle: same collider and bit-identical time for
+// every disc, on random and adversarial tables, with every index option.
+#include "index/ftc_tree.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "crowddb/error.hpp"
+#include "query/naive_paths.hpp"
+#include "scenario/builders.hpp"
+#include "util/rng.hpp"
+
+namespace crowddb {
+namespace {
+
+using Opt = FtcIndexOptions;
+
+std::vector<FtcHit> naive(const DiscView& d, const StaticScene& s, double horizon) {
+  FtcNaive path;
+  Executor ex(1);
+  QueryStats st;
+  std::vector<FtcHit> out(d.n);
+  path.run(d, s, horizon, out, ex, st);
+  return out;
+}
+
+// The oracle's answer for the last input seen: the option sweeps below ask for it many times.
+const std::vector<FtcHit>& naive_cached(const DiscView& d, const StaticScene& s, double horizon) {
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&](const void* p, std::size_t bytes) {
+    const auto* c = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < bytes; ++i) h = (h ^ c[i]) * 1099511628211ull;
+  };
+  for (const double* col : {d.x, d.y, d.vx, d.vy, d.radius}) mix(col, d.n * sizeof(double));
+  mix(d.id, d.n * sizeof(uint64_t));
+  mix(&horizon, sizeof horizon);
+  for (const auto& c : s.circles()) mix(&c, sizeof c);
+  for (const auto& p : s.polygons()) mix(p.vertices.data(), p.vertices.size() * sizeof(Vec2));
+  static uint64_t key = 0;
+  static std::size_t rows = 0;
+  static std::vector<FtcHit> answer;
+  if (key != h || rows != d.n || answer.size() != d.n) {
+    answer = naive(d, s, horizon);
+    key = h;
+    rows = d.n;
+  }
+  return answer;
+}
+
+std::string describe(const FtcHit& h) {
+  return "kind " + std::to_string(static_cast<int>(h.with.kind)) + " row " +
+         std::to_string(h.with.row) + " t " + std::to_string(h.time);
+}
+
+bool same_bits(double a, double b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+// Index (with `opt`, on `threads` threads) == naive for every row; returns how many rows differ.
+int compare(const DiscTable& t, const StaticScene& s, double horizon, Opt opt = {}, int threads = 1,
+            QueryStats* stats_out = nullptr) {
+  const DiscView d = t.view();
+  const auto& want = naive_cached(d, s, horizon);
+  FtcIndex index(opt);
+  Executor ex(threads);
+  QueryStats st;
+  std::vector<FtcHit> got(d.n);
+  index.run(d, s, horizon, got, ex, st);
+  EXPECT_EQ(index.validate(), "");
+  EXPECT_EQ(st.rows, d.n);
+  int bad = 0;
+  for (std::size_t i = 0; i < d.n; ++i) {
+    if (got[i].with == want[i].with && same_bits(got[i].time, want[i].time)) continue;
+    if (++bad <= 5)
+      ADD_FAILURE() << "row " << i << " (id " << d.id[i] << "): index " << describe(got[i])
+                    << ", naive " << describe(want[i]);
+  }
+  if (stats_out) *stats_out = st;
+  return bad;
+}
+
+// Every option combination the index offers.
+std::vector<Opt> all_options() {
+  std::vector<Opt> v;
+  for (auto bound : {Opt::Bound::chord, Opt::Bound::frustum})
+    for (auto order : {Opt::Order::bottom_up, Opt::Order::leaf_queue, Opt::Order::nearer_first,
+                       Opt::Order::best_first})
+      for (int slices : {1, 3})
+        for (std::size_t leaf : {1, 8})
+          for (bool seed : {true, false}) {
+            if (bound == Opt::Bound::frustum && slices != 1) continue;
+            if ((order == Opt::Order::bottom_up || order == Opt::Order::leaf_queue) && !seed)
+              continue;  // start at the leaf
+            Opt o;
+            o.bound = bound;
+            o.order = order;
+            o.slices = slices;
+            o.leaf_size = leaf;
+            o.seed_own_leaf = seed;
+            v.push_back(o);
+            if (slices == 1) {  // and without the overlap-first phase
+              o.overlaps_first = false;
+              v.push_back(o);
+            }
+          }
+  return v;
+}
+
+// A few contrasting option sets, for the larger tables.
+std::vector<Opt> some_options() {
+  Opt thesis;  // the thesis's search: frustum, best-first from the root, one agent per leaf
+  thesis.bound = Opt::Bound::frustum;
+  thesis.order = Opt::Order::best_first;
+  thesis.leaf_size = 1;
+  thesis.seed_own_leaf = false;
+  thesis.overlaps_first = false;
+  return {Opt{}, Opt{.bound = Opt::Bound::frustum},
+          Opt{.slices = 1, .order = Opt::Order::bottom_up},
+          Opt{.leaf_size = 3, .slices = 7, .order = Opt::Order::nearer_first}, thesis};
+}
+
+const StaticScene kNoScene;
+
+TEST(FtcIndex, EmptyAndTinyTables) {
+  DiscTable t;
+  EXPECT_EQ(compare(t, kNoScene, 30), 0);
+  t.push_back(7, 0, 0, 1, 0, 1);
+  EXPECT_EQ(compare(t, kNoScene, 30), 0);
+  t.push_back(3, 10, 0, -1, 0, 1);  // head-on: gap 8, closing speed 2 -> t = 4
+  EXPECT_EQ(compare(t, kNoScene, 30), 0);
+  FtcIndex index;
+  index.build(t.view(), kNoScene, 30);
+  const FtcHit h = index.query(0);
+  EXPECT_EQ(h.with, (Collider{Collider::Kind::agent, 1}));
+  EXPECT_EQ(h.time, 4.0);
+  for (const Opt& o : all_options()) EXPECT_EQ(compare(t, kNoScene, 30, o), 0);
+}
+
+TEST(FtcIndex, UniformE1Setup) {
+  for (uint64_t seed : {1, 2, 3}) {
+    const DiscTable t = build::uniform(2000, {}, 50, 1, 3, seed);
+    QueryStats st;
+    EXPECT_EQ(compare(t, kNoScene, 30, {}, 1, &st), 0) << "seed " << seed;
+    // The index must actually prune: far fewer pair tests than the nested loop's n(n-1).
+    EXPECT_LT(st.pair_tests, 2000u * 1999u / 20);
+  }
+}
+
+TEST(FtcIndex, SparseUniformAndManyOptions) {
+  const DiscTable t = build::uniform(600, {0, 0, 3000, 3000}, 5, 0.5, 2, 11);
+  for (const Opt& o : all_options()) EXPECT_EQ(compare(t, kNoScene, 40, o), 0);
+}
+
+TEST(FtcIndex, Clustered) {
+  const DiscTable t = build::clustered(1500, {}, 6, 30, 20, 1, 3, 5);
+  for (const Opt& o : all_options()) EXPECT_EQ(compare(t, kNoScene, 30, o), 0);
+}
+
+TEST(FtcIndex, LatticeWithExactTies) {
+  // Spacing 4, radius 1: neighbours approaching at closing speed 2 meet at exactly t = 1, and
+  // many pairs tie in time: the smaller id must win.
+  for (uint64_t seed : {1, 2}) {
+    DiscTable t = build::lattice(400, 4, 1, 1, seed);
+    for (const Opt& o : all_options()) EXPECT_EQ(compare(t, kNoScene, 30, o), 0);
+    build::shuffle_ids(t, seed + 10);
+    for (const Opt& o : all_options()) EXPECT_EQ(compare(t, kNoScene, 30, o), 0);
+  }
+  // Touching lattice (spacing = 2 radii): grazing contact is no collision, overlaps are.
+  DiscTable touching = build::lattice(400, 2, 0, 1, 3);
+  EXPECT_EQ(compare(touching, kNoScene, 30), 0);
+  DiscTable overlapping = build::lattice(400, 1.5, 0.5, 1, 3);
+  build::shuffle_ids(overlapping, 4);
+  for (const Opt& o : all_options()) EXPECT_EQ(compare(overlapping, kNoScene, 30, o), 0);
+}
+
+TEST(FtcIndex, DuplicatePositionsAndZeroVelocities) {
+  DiscTable t = build::duplicates(500, 37, {}, 10, 1.5, 9);
+  build::shuffle_ids(t, 2);
+  for (const Opt& o : all_options()) EXPECT_EQ(compare(t, kNoScene, 30, o), 0);
+  DiscTable still = build::uniform(800, {}, 0, 1, 3, 4);  // vmax 0: only overlaps at t = 0 count
+  for (const Opt& o : all_options()) EXPECT_EQ(compare(still, kNoScene, 30, o), 0);
+  // Every disc at one point.
+  DiscTable same;
+  for (uint64_t i = 0; i < 50; ++i) same.push_back(100 - i, 5, 5, 0, 0, 1);
+  EXPECT_EQ(compare(same, kNoScene, 30), 0);
+}
+
+TEST(FtcIndex, CoordinatesOffsetByAMillion) {
+  for (double off : {1e6, -1e6, 3e7}) {
+    DiscTable t = build::uniform(1500, {}, 50, 1, 3, 8);
+    build::offset(t, off, -off / 2);
+    EXPECT_EQ(compare(t, kNoScene, 30), 0) << off;
+    DiscTable l = build::lattice(400, 4, 1, 1, 6);
+    build::offset(l, off, off);
+    for (const Opt& o : all_options()) EXPECT_EQ(compare(l, kNoScene, 30, o), 0) << off;
+  }
+}
+
+TEST(FtcIndex, BigCrunchAndPerturbed) {
+  for (double perturb : {0.0, 1.0}) {
+    for (double arrival : {10.0, 30.0, 45.0}) {
+      DiscTable t = build::big_crunch(1200, {}, arrival, 1, 3, perturb, 21);
+      build::shuffle_ids(t, 3);
+      EXPECT_EQ(compare(t, kNoScene, 30), 0) << perturb << " " << arrival;
+      EXPECT_EQ(compare(t, kNoScene, 30, {.bound = Opt::Bound::frustum}), 0)
+          << perturb << " " << arrival;
+    }
+    // Sparse: small discs far apart, so the collision times crowd just before the arrival.
+    const DiscTable sparse = build::big_crunch(500, {0, 0, 3000, 2000}, 20, 0.1, 0.3, perturb, 4);
+    for (const Opt& o : some_options()) EXPECT_EQ(compare(sparse, kNoScene, 30, o), 0) << perturb;
+  }
+}
+
+TEST(FtcIndex, HorizonZeroAndInfinite) {
+  const DiscTable t = build::uniform(400, {0, 0, 800, 800}, 10, 1, 3, 12);
+  for (double h : {-1.0, 0.0, 1e-9, 0.5, 1e6, double{INFINITY}}) {
+    FtcIndex probe;
+    probe.build(t.view(), kNoScene, h);
+    EXPECT_EQ(probe.uses_chord_bound(), h > 0 && std::isfinite(h)) << h;
+    for (const Opt& o : all_options()) EXPECT_EQ(compare(t, kNoScene, h, o), 0) << h;
+  }
+}
+
+StaticScene obstacle_scene(uint64_t seed, std::size_t circles, std::size_t polygons) {
+  Rng rng(seed);
+  std::vector<CircleObstacle> cs;
+  for (std::size_t i = 0; i < circles; ++i)
+    cs.push_back({rng.uniform(0, 640), rng.uniform(0, 480), rng.uniform(2, 25), 1});
+  std::vector<PolygonObstacle> ps;
+  for (std::size_t i = 0; i < polygons; ++i) {
+    const double x = rng.uniform(0, 600), y = rng.uniform(0, 440), w = rng.uniform(2, 60),
+                 h = rng.uniform(2, 60);
+    if (i % 3 == 2)  // a triangle
+      ps.push_back({{{x, y}, {x + w, y}, {x + w / 2, y + h}}, 1});
+    else
+      ps.push_back({{{x, y}, {x + w, y}, {x + w, y + h}, {x, y + h}}, 1});
+  }
+  return StaticScene(std::move(cs), std::move(ps), 1.0);
+}
+
+TEST(FtcIndex, StaticObstacles) {
+  for (uint64_t seed : {1, 2, 3}) {
+    const StaticScene scene = obstacle_scene(seed, 40, 12);
+    const DiscTable t = build::uniform(300, {}, 20, 1, 3, seed);
+    for (const Opt& o : all_options()) EXPECT_EQ(compare(t, scene, 30, o), 0) << seed;
+    const DiscTable sparse = build::uniform(60, {}, 20, 1, 3, seed + 7);
+    EXPECT_EQ(compare(sparse, scene, 30), 0);
+  }
+  // Obstacles only, no agents.
+  EXPECT_EQ(compare(DiscTable{}, obstacle_scene(4, 5, 5), 30), 0);
+  // Exact three-way tie at t = 8: an agent, a circle and a polygon. The agent wins; without it the
+  // circle wins; without both the polygon.
+  const StaticScene both({{10, 0, 1, 1}}, {{{{9, -0.5}, {11, -0.5}, {11, 0.5}, {9, 0.5}}, 1}}, 1.0);
+  const StaticScene square({}, {{{{9, -0.5}, {11, -0.5}, {11, 0.5}, {9, 0.5}}, 1}}, 1.0);
+  DiscTable t;
+  t.push_back(1, 0, 0, 1, 0, 1);
+  DiscTable t2 = t;
+  t2.push_back(2, 18, 0, -1, 0, 1);
+  for (const Opt& o : all_options()) {
+    EXPECT_EQ(compare(t, both, 30, o), 0);
+    EXPECT_EQ(compare(t2, both, 30, o), 0);
+    EXPECT_EQ(compare(t, square, 30, o), 0);
+  }
+  FtcIndex index;
+  index.build(t2.view(), both, 30);
+  EXPECT_EQ(index.query(0), (FtcHit{{Collider::Kind::agent, 1}, 8.0}));
+  index.build(t.view(), both, 30);
+  EXPECT_EQ(index.query(0), (FtcHit{{Collider::Kind::circle, 0}, 8.0}));
+  index.build(t.view(), square, 30);
+  EXPECT_EQ(index.query(0), (FtcHit{{Collider::Kind::polygon, 0}, 8.0}));
+}
+
+// Exactly grazing and nearly grazing pairs, where the pair time is most sensitive to rounding.
+TEST(FtcIndex, GrazingPairs) {
+  Rng rng(77);
+  for (double off : {0.0, 1e6}) {
+    DiscTable t;
+    for (uint64_t i = 0; i < 400; ++i) {
+      const double x = off + rng.uniform(0, 200), y = off + rng.uniform(0, 200);
+      // A partner passing at closest distance R (1 + e) with e tiny, either side.
+      const double e = (rng.uniform() - 0.5) * 1e-12 * static_cast<double>(i % 7);
+      const double r = rng.uniform(0.5, 2);
+      t.push_back(2 * i, x, y, 1, 0, r);
+      t.push_back(2 * i + 1, x + 20, y + 2 * r * (1 + e), -1, 0, r);
+    }
+    EXPECT_EQ(compare(t, kNoScene, 30), 0);
+    EXPECT_EQ(compare(t, kNoScene, 30, {.bound = Opt::Bound::frustum}), 0);
+  }
+}
+
+TEST(FtcIndex, SameAnswerOnAnyThreadCount) {
+  const DiscTable t = build::uniform(3000, {}, 50, 1, 3, 31);
+  QueryStats s1, s3;
+  EXPECT_EQ(compare(t, kNoScene, 30, {}, 1, &s1), 0);
+  EXPECT_EQ(compare(t, kNoScene, 30, {}, 3, &s3), 0);
+  EXPECT_EQ(s1.nodes_visited, s3.nodes_visited);
+  EXPECT_EQ(s1.queue_pops, s3.queue_pops);
+}
+
+TEST(FtcIndex, StatisticsAddUp) {
+  const DiscTable t = build::uniform(1000, {}, 50, 1, 3, 2);
+  FtcIndex index;
+  index.build(t.view(), kNoScene, 30);
+  QueryStats one;
+  for (std::size_t i = 0; i < t.size(); ++i) index.query(i, &one);
+  QueryStats all;
+  Executor ex(1);
+  std::vector<FtcHit> out(t.size());
+  index.query_all(out, ex, all);
+  EXPECT_EQ(one.rows, all.rows);
+  EXPECT_EQ(one.nodes_visited, all.nodes_visited);
+  EXPECT_EQ(one.queue_pushes, all.queue_pushes);
+  EXPECT_EQ(one.queue_pops, all.queue_pops);
+  EXPECT_EQ(one.pair_tests, all.pair_tests);
+  EXPECT_GT(all.nodes_visited, 0u);
+  EXPECT_LE(all.queue_pops, all.queue_pushes);
+  // Best-first sends every visited node through the queue.
+  FtcIndex bf({.order = Opt::Order::best_first});
+  bf.build(t.view(), kNoScene, 30);
+  QueryStats b;
+  bf.query_all(out, ex, b);
+  EXPECT_GE(b.queue_pops, b.nodes_visited - b.rows);  // minus the seeded own leaves
+}
+
+TEST(FtcIndex, RejectsNonFiniteRows) {
+  DiscTable t = build::uniform(10, {}, 5, 1, 2, 1);
+  t.vy[4] = NAN;
+  FtcIndex index;
+  try {
+    index.build(t.view(), kNoScene, 30);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidRow& e) {
+    EXPECT_EQ(e.field(), "vy");
+    EXPECT_NE(std::string(e.what()).find("row 4"), std::string::npos) << e.what();
+  }
+}
+
+// Random tables of every shape, random options: the property test.
+TEST(FtcIndex, PropertyManySeeds) {
+  const auto options = all_options();
+  int failures = 0;
+  for (uint64_t seed = 0; seed < 150 && failures == 0; ++seed) {
+    Rng rng(seed * 7919 + 1);
+    const std::size_t n = rng.below(300);
+    const double side = rng.uniform(5, 1000);
+    const double vmax = rng.below(4) == 0 ? 0 : rng.uniform(0.1, 60);
+    const double rmin = rng.uniform(0.01, 3), rmax = rmin + rng.uniform(0, 3);
+    DiscTable t;
+    switch (rng.below(5)) {
+      case 0:
+        t = build::uniform(n, {0, 0, side, side}, vmax, rmin, rmax, seed);
+        break;
+      case 1:
+        t = build::clustered(n, {0, 0, side, side}, 1 + rng.below(5), side / 20, vmax, rmin, rmax,
+                             seed);
+        break;
+      case 2:
+        t = build::lattice(n, rng.uniform(0.5, 5), static_cast<double>(rng.below(3)), rmin, seed);
+        break;
+      case 3:
+        t = build::big_crunch(n, {0, 0, side, side}, rng.uniform(1, 60), rmin, rmax,
+                              static_cast<double>(rng.below(2)), seed);
+        break;
+      default:
+        t = build::duplicates(n, 1 + rng.below(20), {0, 0, side, side}, vmax, rmin, seed);
+        break;
+    }
+    if (rng.below(2)) build::shuffle_ids(t, seed);
+    if (rng.below(4) == 0) build::offset(t, 1e6, -1e6);
+    const double horizon = rng.below(8) == 0 ? INFINITY : rng.uniform(0, 50);
+    const StaticScene scene =
+        rng.below(3) == 0 ? obstacle_scene(seed, rng.below(10), rng.below(4)) : StaticScene{};
+    const Opt& o = options[rng.below(options.size())];
+    failures += compare(t, scene, horizon, o, 1 + static_cast<int>(rng.below(2)));
+    if (failures) ADD_FAILURE() << "seed " << seed;
+  }
+}
+
+}  // namespace
+}  // namespace crowddb
