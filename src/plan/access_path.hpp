@@ -39,8 +39,8 @@ class CollisionPath {
   virtual ~CollisionPath() = default;
   // All overlapping pairs among the discs and between discs and obstacles (exact methods), or
   // the pairs the method finds (heuristics, which may miss some but never invent one).
-  virtual void run(const DiscView& discs, const StaticScene& scene, CollisionPairs& out, Executor& ex,
-                   QueryStats& stats) = 0;
+  virtual void run(const DiscView& discs, const StaticScene& scene, CollisionPairs& out,
+                   Executor& ex, QueryStats& stats) = 0;
 };
 
 // What the planner knows about a registered method.
@@ -70,6 +70,10 @@ struct FieldMethod {
 struct CollisionQueryShape {
   std::size_t rows = 0;
   bool equal_radii = false;
+  // The consumer needs every overlapping pair, not just the collision set: overlap counts, or a
+  // backoff that must tell new overlaps from pairs that already overlapped at the start of the
+  // tick. Methods that return only the set exactly (nn) do not support such queries.
+  bool need_all_pairs = false;
 };
 
 struct CollisionMethod {
@@ -85,7 +89,8 @@ const std::vector<CollisionMethod>& collision_registry();
 // Lookup by name; throws Error(usage) naming the valid choices when unknown.
 const FtcMethod& find_ftc_method(std::string_view name);
 const FieldMethod& find_field_method(std::string_view name, const PotentialSpec& spec);
-const CollisionMethod& find_collision_method(std::string_view name, const CollisionQueryShape& shape);
+const CollisionMethod& find_collision_method(std::string_view name,
+                                             const CollisionQueryShape& shape);
 
 // The planner's choice for "auto".
 const FtcMethod& choose_ftc_method(std::size_t rows);

@@ -2,6 +2,10 @@
 // one entry here; no stage of the tick changes.
 #include <algorithm>
 
+#include "index/collisions_delaunay.hpp"
+#include "index/collisions_grid.hpp"
+#include "index/collisions_nn.hpp"
+#include "index/collisions_sweep.hpp"
 #include "plan/access_path.hpp"
 #include "query/naive_paths.hpp"
 
@@ -27,7 +31,8 @@ template <class M, class Ok>
 const M& pick(const std::vector<M>& registry, std::size_t rows, Ok ok) {
   const M* best = &registry.front();
   for (const auto& m : registry)
-    if (m.info.in_auto && m.info.exact && rows >= m.info.auto_min_rows && ok(m) && m.info.auto_rank > best->info.auto_rank)
+    if (m.info.in_auto && m.info.exact && rows >= m.info.auto_min_rows && ok(m) &&
+        m.info.auto_rank > best->info.auto_rank)
       best = &m;
   return *best;
 }
@@ -36,7 +41,8 @@ const M& pick(const std::vector<M>& registry, std::size_t rows, Ok ok) {
 
 const std::vector<FtcMethod>& ftc_registry() {
   static const std::vector<FtcMethod> methods = {
-      {{"naive", "nested loop over all pairs, O(n^2)"}, [] { return std::make_unique<FtcNaive>(); }},
+      {{"naive", "nested loop over all pairs, O(n^2)"},
+       [] { return std::make_unique<FtcNaive>(); }},
   };
   return methods;
 }
@@ -55,34 +61,63 @@ const std::vector<CollisionMethod>& collision_registry() {
       {{"naive", "nested loop over all pairs, O(n^2)"},
        [](const CollisionQueryShape&) { return true; },
        [] { return std::make_unique<CollisionNaive>(); }},
+      {{"grid", "uniform grid, cell = 2 x max radius per radius class, O(n + k)", true, 2, 32},
+       [](const CollisionQueryShape&) { return true; },
+       [] { return std::make_unique<index::CollisionGrid>(); }},
+      {{"sweep", "plane sweep over bounding boxes with exact check, O(n log n + k)", true, 1, 32},
+       [](const CollisionQueryShape&) { return true; },
+       [] { return std::make_unique<index::CollisionSweep>(); }},
+      {{"nn", "nearest neighbour per agent, equal radii only; gives the set, not every pair", true,
+        3, 32},
+       [](const CollisionQueryShape& s) { return s.equal_radii && !s.need_all_pairs; },
+       [] { return std::make_unique<index::CollisionNn>(); }},
+      {{"delaunay", "Delaunay edges plus diagonals (CGAL), heuristic: may miss pairs", false, 0, 0,
+        false},
+       [](const CollisionQueryShape&) { return true; },
+       [] { return std::make_unique<index::CollisionDelaunay>(); }},
   };
   return methods;
 }
 
 const FtcMethod& find_ftc_method(std::string_view name) {
   if (const auto* m = by_name(ftc_registry(), name)) return *m;
-  throw Error(Error::Kind::usage,
-              "unknown first-to-collide method '" + std::string(name) + "' (choose from " + choices(ftc_registry()) + ")");
+  throw Error(Error::Kind::usage, "unknown first-to-collide method '" + std::string(name) +
+                                      "' (choose from " + choices(ftc_registry()) + ")");
 }
 
 const FieldMethod& find_field_method(std::string_view name, const PotentialSpec& spec) {
   const auto* m = by_name(field_registry(), name);
   if (!m)
-    throw Error(Error::Kind::usage,
-                "unknown field method '" + std::string(name) + "' (choose from " + choices(field_registry()) + ")");
+    throw Error(Error::Kind::usage, "unknown field method '" + std::string(name) +
+                                        "' (choose from " + choices(field_registry()) + ")");
   if (!m->supports(spec))
-    throw Error(Error::Kind::usage, "field method '" + std::string(name) + "' does not support this kernel and metric");
+    throw Error(Error::Kind::usage,
+                "field method '" + std::string(name) + "' does not support this kernel and metric");
   return *m;
 }
 
-const CollisionMethod& find_collision_method(std::string_view name, const CollisionQueryShape& shape) {
+const CollisionMethod& find_collision_method(std::string_view name,
+                                             const CollisionQueryShape& shape) {
   const auto* m = by_name(collision_registry(), name);
   if (!m)
-    throw Error(Error::Kind::usage, "unknown collision method '" + std::string(name) + "' (choose from " +
+    throw Error(Error::Kind::usage, "unknown collision method '" + std::string(name) +
+                                        "' (choose from " + choices(collision_registry()) + ")");
+  if (!m->supports(shape)) {
+    // Name the fact that rules it out, by asking the method about the query without it.
+    CollisionQueryShape relaxed = shape;
+    relaxed.equal_radii = true;
+    std::string why;
+    if (!shape.equal_radii && m->supports(relaxed))
+      why = "it needs all agents to have the same radius";
+    relaxed = shape;
+    relaxed.need_all_pairs = false;
+    if (why.empty() && shape.need_all_pairs && m->supports(relaxed))
+      why = "it finds the collision set, not every overlapping pair, and this use needs every pair";
+    if (why.empty()) why = m->info.description;
+    throw Error(Error::Kind::usage, "collision method '" + std::string(name) +
+                                        "' does not apply here: " + why + " (choose from " +
                                         choices(collision_registry()) + ")");
-  if (!m->supports(shape))
-    throw Error(Error::Kind::usage, "collision method '" + std::string(name) + "' does not apply here (" +
-                                        m->info.description + ")");
+  }
   return *m;
 }
 
@@ -95,7 +130,8 @@ const FieldMethod& choose_field_method(std::size_t rows, const PotentialSpec& sp
 }
 
 const CollisionMethod& choose_collision_method(const CollisionQueryShape& shape) {
-  return pick(collision_registry(), shape.rows, [&](const CollisionMethod& m) { return m.supports(shape); });
+  return pick(collision_registry(), shape.rows,
+              [&](const CollisionMethod& m) { return m.supports(shape); });
 }
 
 }  // namespace crowddb

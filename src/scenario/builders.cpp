@@ -33,8 +33,8 @@ DiscTable uniform(std::size_t n, Box box, double vmax, double rmin, double rmax,
   return t;
 }
 
-DiscTable clustered(std::size_t n, Box box, std::size_t clusters, double spread, double vmax, double rmin,
-                    double rmax, uint64_t seed) {
+DiscTable clustered(std::size_t n, Box box, std::size_t clusters, double spread, double vmax,
+                    double rmin, double rmax, uint64_t seed) {
   Rng rng(seed);
   clusters = std::max<std::size_t>(clusters, 1);
   std::vector<double> cx(clusters), cy(clusters);
@@ -60,7 +60,8 @@ DiscTable lattice(std::size_t n, double spacing, double v, double radius, uint64
   const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
   DiscTable t;
   for (std::size_t i = 0; i < n; ++i) {
-    const double x = static_cast<double>(i % side) * spacing, y = static_cast<double>(i / side) * spacing;
+    const double x = static_cast<double>(i % side) * spacing,
+                 y = static_cast<double>(i / side) * spacing;
     const double vx = (static_cast<double>(rng.below(3)) - 1) * v;
     const double vy = (static_cast<double>(rng.below(3)) - 1) * v;
     t.push_back(i, x, y, vx, vy, radius);
@@ -68,8 +69,8 @@ DiscTable lattice(std::size_t n, double spacing, double v, double radius, uint64
   return t;
 }
 
-DiscTable big_crunch(std::size_t n, Box box, double arrival, double rmin, double rmax, double perturb,
-                     uint64_t seed) {
+DiscTable big_crunch(std::size_t n, Box box, double arrival, double rmin, double rmax,
+                     double perturb, uint64_t seed) {
   Rng rng(seed);
   const double cx = (box.xmin + box.xmax) / 2, cy = (box.ymin + box.ymax) / 2;
   DiscTable t;
@@ -85,7 +86,8 @@ DiscTable big_crunch(std::size_t n, Box box, double arrival, double rmin, double
   return t;
 }
 
-DiscTable duplicates(std::size_t n, std::size_t distinct, Box box, double vmax, double radius, uint64_t seed) {
+DiscTable duplicates(std::size_t n, std::size_t distinct, Box box, double vmax, double radius,
+                     uint64_t seed) {
   DiscTable base = uniform(std::max<std::size_t>(distinct, 1), box, vmax, radius, radius, seed);
   DiscTable t;
   for (std::size_t i = 0; i < n; ++i) {
@@ -93,6 +95,36 @@ DiscTable duplicates(std::size_t n, std::size_t distinct, Box box, double vmax, 
     t.push_back(i, base.x[j], base.y[j], base.vx[j], base.vy[j], base.radius[j], base.charge[j]);
   }
   return t;
+}
+
+DiscTable touching(std::size_t pairs, Box box, uint64_t seed) {
+  Rng rng(seed);
+  DiscTable t;
+  // Integer-valued coordinates and radii keep every quantity exact: the distance is exactly the
+  // sum of radii. Directions (3, 4) / 5 and (5, 12) / 13, in all four quadrants.
+  const double dirs[2][3] = {{3, 4, 5}, {5, 12, 13}};
+  for (std::size_t p = 0; p < pairs; ++p) {
+    const double x = std::floor(rng.uniform(box.xmin, box.xmax)),
+                 y = std::floor(rng.uniform(box.ymin, box.ymax));
+    const auto& d = dirs[rng.below(2)];
+    const double k = static_cast<double>(1 + rng.below(4));  // distance k * d[2]
+    const double sx = rng.below(2) ? 1 : -1, sy = rng.below(2) ? 1 : -1;
+    const double r1 = static_cast<double>(1 + rng.below(static_cast<uint64_t>(k * d[2]) - 1));
+    const double r2 = k * d[2] - r1;
+    double bx = x + sx * k * d[0], by = y + sy * k * d[1];
+    if (p % 2) bx = std::nextafter(bx, x);  // one ulp closer: overlapping by a hair
+    t.push_back(2 * p, x, y, 0, 0, r1);
+    t.push_back(2 * p + 1, bx, by, 0, 0, r2);
+  }
+  return t;
+}
+
+void add_giants(DiscTable& t, std::size_t count, Box box, double rmin, double rmax, uint64_t seed) {
+  Rng rng(seed);
+  for (std::size_t i = 0; i < count; ++i) {
+    const double x = rng.uniform(box.xmin, box.xmax), y = rng.uniform(box.ymin, box.ymax);
+    t.push_back(t.size(), x, y, 0, 0, rng.uniform(rmin, rmax));
+  }
 }
 
 void offset(DiscTable& t, double dx, double dy) {
