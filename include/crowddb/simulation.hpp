@@ -22,10 +22,10 @@ namespace crowddb {
 
 // The steering rule of DESIGN.md §3.1. Every weight is a scenario parameter.
 struct SteeringParams {
-  double tau = 2;        // attraction: ticks to relax towards the preferred velocity (> 0)
-  double w_apf = 1;      // inner avoidance weight (>= 0; 0 switches the query off)
-  double w_ftc = 1;      // outer avoidance weight (>= 0; 0 switches the query off)
-  double horizon = 30;   // first-to-collide look-ahead [ticks] (> 0)
+  double tau = 2;       // attraction: ticks to relax towards the preferred velocity (> 0)
+  double w_apf = 1;     // inner avoidance weight (>= 0; 0 switches the query off)
+  double w_ftc = 1;     // outer avoidance weight (>= 0; 0 switches the query off)
+  double horizon = 30;  // first-to-collide look-ahead [ticks] (> 0)
   PotentialSpec potential;
   ObstacleCharges obstacle_charges = ObstacleCharges::boundary;
 };
@@ -58,23 +58,29 @@ struct SimConfig {
   // random angle of 45-90 degrees to either side (seeded by seed, id and tick), so a frozen
   // cluster does not repeat the same colliding moves for ever. 0 switches nudging off.
   uint32_t nudge_after = 2;
-  double waypoint_radius = 0;    // advance to the next waypoint within this distance; 0: the agent's radius
+  double waypoint_radius =
+      0;  // advance to the next waypoint within this distance; 0: the agent's radius
   // Throws Error(input) naming the field when a value is out of range.
   void validate() const;
 };
 
 // What one tick did. Counts are rows of the agents table.
 struct TickMetrics {
-  uint64_t tick = 0;             // ticks completed so far (1 after the first step)
-  std::size_t agents = 0;        // rows after the tick
-  std::size_t arrived = 0;       // agents that reached their goal in this tick
-  std::size_t frozen = 0;        // agents the backoff loop froze in this tick
-  std::size_t freeze_iterations = 0;
+  uint64_t tick = 0;        // ticks completed so far (1 after the first step)
+  std::size_t agents = 0;   // rows after the tick
+  std::size_t arrived = 0;  // agents that reached their goal in this tick
+  std::size_t frozen = 0;   // agents the backoff loop froze in this tick
+  std::size_t freeze_iterations =
+      0;  // rounds of the freeze loop (1: nothing to freeze; 0: backoff off)
   std::size_t overlapping_pairs = 0;  // agent-agent pairs overlapping after the tick
   std::size_t obstacle_overlaps = 0;  // agent-obstacle (and agent-wall) overlaps after the tick
-  std::size_t gridlocked = 0;    // agents frozen for >= gridlock_ticks consecutive ticks
-  double seconds = 0;            // wall time of the tick
-  uint64_t state_hash = 0;       // hash of the committed state (ids, positions, velocities, states)
+  std::size_t gridlocked = 0;         // agents frozen for >= gridlock_ticks consecutive ticks
+  std::size_t gridlock_started =
+      0;                           // agents whose frozen streak reached gridlock_ticks in this tick
+  std::size_t longest_frozen = 0;  // longest current frozen streak [ticks] among the agents
+  std::size_t nudged = 0;          // agents that sidestepped in this tick (SimConfig::nudge_after)
+  double seconds = 0;              // wall time of the tick
+  uint64_t state_hash = 0;  // hash of the committed state (ids, positions, velocities, states)
 };
 
 class Simulation {

@@ -19,7 +19,9 @@ void require(bool ok, const char* field, const std::string& what) {
   if (!ok) throw InvalidRow(field, std::string(field) + " " + what);
 }
 
-const char* kernel_name(Kernel k) { return k == Kernel::exp ? "exp" : "inv"; }
+const char* kernel_name(Kernel k) {
+  return k == Kernel::exp ? "exp" : "inv";
+}
 const char* metric_name(Metric m) {
   return m == Metric::l1 ? "l1" : (m == Metric::l2 ? "l2" : "radial");
 }
@@ -44,7 +46,8 @@ void SimConfig::validate() const {
   require(p.radial_frames >= 1 && p.radial_frames <= 16, "frames", "must be in 1..16");
   require(std::isfinite(p.inv_floor) && p.inv_floor > 0, "inv_floor", "must be > 0");
   require(threads >= 1 && threads <= 256, "threads", "must be in 1..256");
-  require(std::isfinite(waypoint_radius) && waypoint_radius >= 0, "waypoint_radius", "must be >= 0");
+  require(std::isfinite(waypoint_radius) && waypoint_radius >= 0, "waypoint_radius",
+          "must be >= 0");
 }
 
 // Per-operator EXPLAIN ANALYZE counters.
@@ -61,6 +64,7 @@ struct TickPlan {
   const FtcMethod* ftc = nullptr;      // null: outer avoidance off (w_ftc = 0)
   const FieldMethod* field = nullptr;  // null: inner avoidance off (w_apf = 0)
   const CollisionMethod* collisions = nullptr;
+  bool collisions_fallback = false;  // the forced method does not apply to this tick (see plan())
 };
 
 struct Simulation::Engine {
@@ -80,21 +84,56 @@ struct Simulation::Engine {
   enum Op { kApply, kAttraction, kInner, kOuter, kIntegrate, kBackoff, kCommit, kOpCount };
   OperatorStats ops[kOpCount];
   std::map<std::string, uint64_t> method_ticks;  // "field=naive" -> ticks it was chosen
+  // The agents are known to overlap nowhere at the start of the next tick: the last tick ended
+  // (with backoff on) without an overlapping agent pair and no agent was inserted since. Only
+  // then is a method that finds the collision set but not every pair (nn) exact for the
+  // backoff: every overlap is new, so the set is all the freeze loop needs.
+  bool start_clean = false;
 
-  TickPlan plan(const World& w, const SimConfig& cfg) const {
+  // The access paths for the next tick. A collision method forced by name that does not apply
+  // to this tick (nn while agents still overlap from before, or radii that stopped being equal
+  // through inserts) is replaced by the planner's exact choice for the tick and EXPLAIN ANALYZE
+  // counts it; `strict` (construction) instead rejects a forced method that can never apply:
+  // nn with unequal radii or with backoff off (overlap counts need every pair).
+  TickPlan plan(const World& w, const SimConfig& cfg, bool strict = false) const {
+    return plan(w, cfg, start_clean, strict);
+  }
+  TickPlan plan(const World& w, const SimConfig& cfg, bool clean, bool strict) const {
     TickPlan p;
     const AgentTable& t = w.agents();
     p.rows = t.size();
     if (cfg.steering.w_ftc > 0)
-      p.ftc = cfg.access.ftc == "auto" ? &choose_ftc_method(p.rows) : &find_ftc_method(cfg.access.ftc);
+      p.ftc =
+          cfg.access.ftc == "auto" ? &choose_ftc_method(p.rows) : &find_ftc_method(cfg.access.ftc);
     if (cfg.steering.w_apf > 0)
-      p.field = cfg.access.field == "auto" ? &choose_field_method(p.rows, cfg.steering.potential)
-                                           : &find_field_method(cfg.access.field, cfg.steering.potential);
+      p.field = cfg.access.field == "auto"
+                    ? &choose_field_method(p.rows, cfg.steering.potential)
+                    : &find_field_method(cfg.access.field, cfg.steering.potential);
     CollisionQueryShape shape;
     shape.rows = p.rows;
-    shape.equal_radii = std::all_of(t.radius.begin(), t.radius.end(), [&](double r) { return r == t.radius[0]; });
-    p.collisions = cfg.access.collisions == "auto" ? &choose_collision_method(shape)
-                                                   : &find_collision_method(cfg.access.collisions, shape);
+    shape.equal_radii =
+        std::all_of(t.radius.begin(), t.radius.end(), [&](double r) { return r == t.radius[0]; });
+    shape.need_all_pairs = !(cfg.backoff && clean);
+    if (cfg.access.collisions == "auto") {
+      p.collisions = &choose_collision_method(shape);
+      return p;
+    }
+    CollisionQueryShape at_best = shape;
+    at_best.need_all_pairs = !cfg.backoff;
+    if (strict) find_collision_method(cfg.access.collisions, at_best);  // throws Error(usage)
+    const CollisionMethod* forced = nullptr;
+    for (const auto& m : collision_registry())
+      if (m.info.name == cfg.access.collisions) forced = &m;
+    if (!forced) {
+      p.collisions = &find_collision_method(cfg.access.collisions, shape);  // throws: unknown name
+      return p;
+    }
+    if (forced->supports(shape)) {
+      p.collisions = forced;
+    } else {
+      p.collisions = &choose_collision_method(shape);
+      p.collisions_fallback = true;
+    }
     return p;
   }
 
@@ -113,8 +152,9 @@ struct Simulation::Engine {
     if (!std::isfinite(rmin)) rmin = 1;
     if (rmin >= scene_spacing) return;
     scene_spacing = rmin;
-    scene = StaticScene({w.circles().begin(), w.circles().end()}, {w.polygons().begin(), w.polygons().end()},
-                        scene_spacing, cfg.steering.obstacle_charges, cfg.walls ? &w.bounds() : nullptr);
+    scene = StaticScene({w.circles().begin(), w.circles().end()},
+                        {w.polygons().begin(), w.polygons().end()}, scene_spacing,
+                        cfg.steering.obstacle_charges, cfg.walls ? &w.bounds() : nullptr);
   }
 };
 
@@ -124,7 +164,7 @@ Simulation::Simulation(World world, SimConfig config)
   engine_ = std::make_unique<Engine>(config_.threads);
   world_.apply_pending();
   engine_->refresh_scene(world_, config_);
-  engine_->plan(world_, config_);  // reject unknown or unsupported methods now, not mid-run
+  engine_->plan(world_, config_, true);  // reject unknown or unsupported methods now, not mid-run
   last_.agents = world_.agents().size();
   last_.state_hash = sim::state_hash(world_.agents(), 0);
 }
@@ -133,7 +173,9 @@ Simulation::~Simulation() = default;
 Simulation::Simulation(Simulation&&) noexcept = default;
 Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 
-uint64_t Simulation::state_hash() const { return sim::state_hash(world_.agents(), last_.tick); }
+uint64_t Simulation::state_hash() const {
+  return sim::state_hash(world_.agents(), last_.tick);
+}
 
 const TickMetrics& Simulation::step() {
   Engine& e = *engine_;
@@ -150,7 +192,10 @@ const TickMetrics& Simulation::step() {
   };
 
   // 0. apply the buffered inserts, deletes and re-targets as one batch
-  timed(Engine::kApply, world_.pending_changes(), [&] { world_.apply_pending(); });
+  std::size_t applied = 0;
+  timed(Engine::kApply, world_.pending_changes(), [&] { applied = world_.apply_pending(); });
+  if (applied)
+    e.start_clean = false;  // an insert may overlap (erases and re-targets cannot, but are rare)
   e.refresh_scene(world_, cfg);
   const TickPlan plan = e.plan(world_, cfg);
   AgentTable& t = world_.agents_for_tick();
@@ -160,11 +205,16 @@ const TickMetrics& Simulation::step() {
   e.next.resize(n);
 
   // 1-3. the steering queries, each into its own effect columns
-  timed(Engine::kAttraction, n, [&] { sim::attraction(t, world_.goals(), cfg, m.tick, e.fx, e.ex); });
+  if (cfg.nudge_after > 0)
+    for (std::size_t i = 0; i < n; ++i)
+      m.nudged += t.state[i] != AgentState::arrived && t.frozen_ticks[i] >= cfg.nudge_after;
+  timed(Engine::kAttraction, n,
+        [&] { sim::attraction(t, world_.goals(), cfg, m.tick, e.fx, e.ex); });
   if (plan.field) {
     ++e.method_ticks["field=" + plan.field->info.name];
     timed(Engine::kInner, n, [&] {
-      e.path(e.field_paths, *plan.field).run(view, e.scene, cfg.steering.potential, e.field, e.ex, e.ops[Engine::kInner].query);
+      e.path(e.field_paths, *plan.field)
+          .run(view, e.scene, cfg.steering.potential, e.field, e.ex, e.ops[Engine::kInner].query);
       sim::inner_avoidance(e.field, cfg, e.fx, e.ex);
     });
   }
@@ -172,7 +222,8 @@ const TickMetrics& Simulation::step() {
     ++e.method_ticks["ftc=" + plan.ftc->info.name];
     timed(Engine::kOuter, n, [&] {
       e.hits.assign(n, FtcHit{});
-      e.path(e.ftc_paths, *plan.ftc).run(view, e.scene, cfg.steering.horizon, e.hits, e.ex, e.ops[Engine::kOuter].query);
+      e.path(e.ftc_paths, *plan.ftc)
+          .run(view, e.scene, cfg.steering.horizon, e.hits, e.ex, e.ops[Engine::kOuter].query);
       sim::outer_avoidance(t, e.scene, e.hits, cfg, e.fx, e.ex);
     });
   }
@@ -180,7 +231,8 @@ const TickMetrics& Simulation::step() {
   timed(Engine::kIntegrate, n, [&] { sim::combine_integrate(t, e.fx, cfg, e.next, e.ex); });
 
   // 5. backoff (or, without it, just measure the overlaps)
-  ++e.method_ticks["collisions=" + plan.collisions->info.name];
+  ++e.method_ticks["collisions=" + plan.collisions->info.name +
+                   (plan.collisions_fallback ? " (instead of " + cfg.access.collisions + ")" : "")];
   CollisionPath& cpath = e.path(e.collision_paths, *plan.collisions);
   sim::OverlapReport overlaps;
   timed(Engine::kBackoff, n, [&] {
@@ -193,6 +245,7 @@ const TickMetrics& Simulation::step() {
   });
   m.overlapping_pairs = overlaps.agent_pairs;
   m.obstacle_overlaps = overlaps.obstacle_hits;
+  e.start_clean = cfg.backoff && overlaps.agent_pairs == 0;
 
   // 6. commit: swap in the next state, advance waypoints, arrivals
   timed(Engine::kCommit, n, [&] {
@@ -207,13 +260,16 @@ const TickMetrics& Simulation::step() {
         ++m.frozen;
         t.state[i] = AgentState::frozen;
         ++t.frozen_ticks[i];
+        if (t.frozen_ticks[i] == cfg.gridlock_ticks) ++m.gridlock_started;
+        m.longest_frozen = std::max<std::size_t>(m.longest_frozen, t.frozen_ticks[i]);
       } else {
         t.state[i] = AgentState::active;
         t.frozen_ticks[i] = 0;
       }
       if (t.frozen_ticks[i] >= cfg.gridlock_ticks) ++m.gridlocked;
       const double reach = cfg.waypoint_radius > 0 ? cfg.waypoint_radius : t.radius[i];
-      while (!t.route[i].empty() && std::hypot(t.route[i].front().x - t.x[i], t.route[i].front().y - t.y[i]) <= reach) {
+      while (!t.route[i].empty() &&
+             std::hypot(t.route[i].front().x - t.x[i], t.route[i].front().y - t.y[i]) <= reach) {
         t.route[i].erase(t.route[i].begin());
         world_.refresh_target(i);
       }
@@ -253,42 +309,72 @@ std::string Simulation::explain() const {
   const SteeringParams& s = config_.steering;
   std::ostringstream os;
   os << "TICK PLAN  rows=" << p.rows << " agents, " << world_.circles().size() << " circles, "
-      << world_.polygons().size() << " polygons" << (config_.walls ? " + 4 walls" : "") << " (" << e.scene.point_count() << " charged points), "
-     << world_.goals().size() << " goals; threads=" << config_.threads << "\n";
-  os << "  0 apply_batch        buffered inserts, deletes, re-targets (" << world_.pending_changes() << " pending)\n";
-  os << "  1 Q1 attraction      per row: v_pref towards waypoint, (v_pref - v)/tau, tau=" << num(s.tau);
+     << world_.polygons().size() << " polygons" << (config_.walls ? " + 4 walls" : "") << " ("
+     << e.scene.point_count() << " charged points), " << world_.goals().size()
+     << " goals; threads=" << config_.threads << "\n";
+  os << "  0 apply_batch        buffered inserts, deletes, re-targets (" << world_.pending_changes()
+     << " pending)\n";
+  os << "  1 Q1 attraction      per row: v_pref towards waypoint, (v_pref - v)/tau, tau="
+     << num(s.tau);
   if (config_.nudge_after) os << "; sidestep after " << config_.nudge_after << " frozen ticks";
   os << "\n";
   if (p.field)
     os << "  2 Q2 inner avoidance potential field " << kernel_name(s.potential.kernel) << "-"
-       << metric_name(s.potential.metric) << " A=" << num(s.potential.A) << " k=" << num(s.potential.k)
-       << " w_apf=" << num(s.w_apf) << "\n       access path: " << p.field->info.name << " (" << p.field->info.description << ")\n";
+       << metric_name(s.potential.metric) << " A=" << num(s.potential.A)
+       << " k=" << num(s.potential.k) << " w_apf=" << num(s.w_apf)
+       << "\n       access path: " << p.field->info.name << " (" << p.field->info.description
+       << ")\n";
   else
     os << "  2 Q2 inner avoidance off (w_apf = 0)\n";
   if (p.ftc)
-    os << "  3 Q3 outer avoidance first-to-collide, horizon=" << num(s.horizon) << " w_ftc=" << num(s.w_ftc)
-       << "\n       access path: " << p.ftc->info.name << " (" << p.ftc->info.description << ")\n";
+    os << "  3 Q3 outer avoidance first-to-collide, horizon=" << num(s.horizon)
+       << " w_ftc=" << num(s.w_ftc) << "\n       access path: " << p.ftc->info.name << " ("
+       << p.ftc->info.description << ")\n";
   else
     os << "  3 Q3 outer avoidance off (w_ftc = 0)\n";
-  os << "  4 combine+integrate  sum effects; |a| <= max_accel; |v| <= max_speed; p += v dt, dt=" << num(config_.dt) << "\n";
-  os << "  5 " << (config_.backoff ? "backoff            freeze the collision set until empty"
-                                    : "overlap count      backoff off: overlaps are only counted")
+  os << "  4 combine+integrate  sum effects; |a| <= max_accel; |v| <= max_speed; p += v dt, dt="
+     << num(config_.dt) << "\n";
+  os << "  5 "
+     << (config_.backoff
+             ? "backoff            freeze the collision set until empty; one full query, then"
+               " probes of the agents frozen last"
+             : "overlap count      backoff off: overlaps are only counted")
      << "\n       access path: " << p.collisions->info.name << " ("
-     << p.collisions->info.description << ")\n";
+     << p.collisions->info.description << ")";
+  if (p.collisions_fallback)
+    os << " instead of " << config_.access.collisions << ": agents overlap at the start";
+  if (!p.collisions->info.exact) os << "; inexact: the zero-overlap invariant is not guaranteed";
+  os << "\n";
+  // A method that only finds the set (nn) serves once a tick starts with no overlapping agents.
+  const TickPlan clean = e.plan(world_, config_, true, false);
+  if (clean.collisions != p.collisions)
+    os << "       then " << clean.collisions->info.name << " ("
+       << clean.collisions->info.description
+       << ") on ticks that start with no overlapping agents\n";
   os << "  6 commit             swap columns, waypoints, arrivals ("
-     << (config_.arrival == ArrivalPolicy::remove ? "remove" : config_.arrival == ArrivalPolicy::idle ? "idle" : "retarget") << "), state hash\n";
+     << (config_.arrival == ArrivalPolicy::remove ? "remove"
+         : config_.arrival == ArrivalPolicy::idle ? "idle"
+                                                  : "retarget")
+     << "), state hash\n";
   return os.str();
 }
 
 std::string Simulation::explain_analyze() const {
   const Engine& e = *engine_;
-  static const char* names[] = {"apply_batch", "Q1 attraction", "Q2 inner avoidance", "Q3 outer avoidance",
-                                "combine+integrate", config_.backoff ? "backoff" : "overlap count", "commit"};
+  static const char* names[] = {"apply_batch",
+                                "Q1 attraction",
+                                "Q2 inner avoidance",
+                                "Q3 outer avoidance",
+                                "combine+integrate",
+                                config_.backoff ? "backoff" : "overlap count",
+                                "commit"};
   std::ostringstream os;
   char line[256];
-  std::snprintf(line, sizeof line, "EXPLAIN ANALYZE  %llu ticks\n", static_cast<unsigned long long>(last_.tick));
+  std::snprintf(line, sizeof line, "EXPLAIN ANALYZE  %llu ticks\n",
+                static_cast<unsigned long long>(last_.tick));
   os << line;
-  std::snprintf(line, sizeof line, "  %-20s %8s %12s %12s %12s\n", "operator", "loops", "rows", "total ms", "ms/loop");
+  std::snprintf(line, sizeof line, "  %-20s %8s %12s %12s %12s\n", "operator", "loops", "rows",
+                "total ms", "ms/loop");
   os << line;
   double total = 0;
   for (int op = 0; op < Engine::kOpCount; ++op) total += e.ops[op].seconds;
@@ -301,14 +387,17 @@ std::string Simulation::explain_analyze() const {
     os << line;
     const QueryStats& q = s.query;
     if (q.pair_tests || q.nodes_visited || q.queue_pops) {
-      std::snprintf(line, sizeof line, "  %-20s pair tests %llu, nodes %llu, queue pushes %llu, pops %llu\n", "",
-                    static_cast<unsigned long long>(q.pair_tests), static_cast<unsigned long long>(q.nodes_visited),
-                    static_cast<unsigned long long>(q.queue_pushes), static_cast<unsigned long long>(q.queue_pops));
+      std::snprintf(line, sizeof line,
+                    "  %-20s pair tests %llu, nodes %llu, queue pushes %llu, pops %llu\n", "",
+                    static_cast<unsigned long long>(q.pair_tests),
+                    static_cast<unsigned long long>(q.nodes_visited),
+                    static_cast<unsigned long long>(q.queue_pushes),
+                    static_cast<unsigned long long>(q.queue_pops));
       os << line;
     }
     if (q.build_seconds > 0) {
-      std::snprintf(line, sizeof line, "  %-20s index build %.3f ms, probes %.3f ms\n", "", q.build_seconds * 1e3,
-                    q.query_seconds * 1e3);
+      std::snprintf(line, sizeof line, "  %-20s index build %.3f ms, probes %.3f ms\n", "",
+                    q.build_seconds * 1e3, q.query_seconds * 1e3);
       os << line;
     }
   }

@@ -19,7 +19,9 @@ namespace crowddb::cli {
 namespace {
 
 std::atomic<bool> g_interrupted{false};
-extern "C" void on_interrupt(int) { g_interrupted = true; }
+extern "C" void on_interrupt(int) {
+  g_interrupted = true;
+}
 
 struct RunOptions {
   std::string scenario;
@@ -29,6 +31,7 @@ struct RunOptions {
   bool explain = false, analyze = false, quiet = false, no_backoff = false;
   int threads = 0;
   int64_t every = 0;
+  int64_t nudge_after = -1;
   std::string ftc, field, collisions;
 };
 
@@ -39,7 +42,8 @@ std::string hex(uint64_t v) {
 }
 
 void print_warnings(const Scenario& sc) {
-  for (const auto& w : sc.warnings) std::cerr << "crowddb: warning: " << sc.source << ": " << w << "\n";
+  for (const auto& w : sc.warnings)
+    std::cerr << "crowddb: warning: " << sc.source << ": " << w << "\n";
 }
 
 // Applies the command-line overrides to a loaded scenario.
@@ -47,6 +51,7 @@ void apply_overrides(Scenario& sc, const RunOptions& o) {
   if (o.ticks >= 0) sc.ticks = static_cast<uint64_t>(o.ticks);
   if (o.threads > 0) sc.config.threads = o.threads;
   if (o.no_backoff) sc.config.backoff = false;
+  if (o.nudge_after >= 0) sc.config.nudge_after = static_cast<uint32_t>(o.nudge_after);
   if (!o.ftc.empty()) sc.config.access.ftc = o.ftc;
   if (!o.field.empty()) sc.config.access.field = o.field;
   if (!o.collisions.empty()) sc.config.access.collisions = o.collisions;
@@ -55,7 +60,8 @@ void apply_overrides(Scenario& sc, const RunOptions& o) {
     const bool csv = o.out.size() >= 4 && o.out.compare(o.out.size() - 4, 4, ".csv") == 0;
     sc.output.format = csv ? OutputSpec::Format::csv : OutputSpec::Format::sqlite;
   }
-  if (!o.format.empty()) sc.output.format = o.format == "csv" ? OutputSpec::Format::csv : OutputSpec::Format::sqlite;
+  if (!o.format.empty())
+    sc.output.format = o.format == "csv" ? OutputSpec::Format::csv : OutputSpec::Format::sqlite;
   if (o.every > 0) sc.output.every = static_cast<uint32_t>(o.every);
   if (o.no_output) sc.output.path.clear();
 }
@@ -81,25 +87,36 @@ int run(const RunOptions& o) {
   const std::size_t agents_at_start = sim.world().agents().size();
   std::vector<double> tick_seconds;
   std::size_t max_pairs = 0, max_obstacle = 0, frozen_total = 0;
+  std::size_t iterations_total = 0, iterations_max = 0, gridlock_max = 0, gridlock_streaks = 0;
+  std::size_t longest_frozen = 0, nudged_total = 0;
   Stopwatch clock, progress_clock;
   try {
     if (writer) writer->frame(0, sim.world());
     for (uint64_t t = 1; t <= sc.ticks; ++t) {
-      if (g_interrupted) throw Error(Error::Kind::io, "interrupted at tick " + std::to_string(t - 1) + "; no output kept");
+      if (g_interrupted)
+        throw Error(Error::Kind::io,
+                    "interrupted at tick " + std::to_string(t - 1) + "; no output kept");
       const TickMetrics& m = sim.step();
       tick_seconds.push_back(m.seconds);
       max_pairs = std::max(max_pairs, m.overlapping_pairs);
       max_obstacle = std::max(max_obstacle, m.obstacle_overlaps);
       frozen_total += m.frozen;
+      iterations_total += m.freeze_iterations;
+      iterations_max = std::max(iterations_max, m.freeze_iterations);
+      gridlock_max = std::max(gridlock_max, m.gridlocked);
+      gridlock_streaks += m.gridlock_started;
+      longest_frozen = std::max(longest_frozen, m.longest_frozen);
+      nudged_total += m.nudged;
       if (writer) {
         writer->frame(t, sim.world());  // the writer keeps every n-th frame
         writer->metrics(m);
       }
       if (tty && (progress_clock.seconds() > 0.2 || t == sc.ticks)) {
         progress_clock.restart();
-        std::fprintf(stderr, "\rtick %llu/%llu  agents %zu  arrived %zu  overlaps %zu  %.1f ticks/s   ",
-                     static_cast<unsigned long long>(t), static_cast<unsigned long long>(sc.ticks), m.agents,
-                     sim.arrived_total(), m.overlapping_pairs, static_cast<double>(t) / clock.seconds());
+        std::fprintf(
+            stderr, "\rtick %llu/%llu  agents %zu  arrived %zu  overlaps %zu  %.1f ticks/s   ",
+            static_cast<unsigned long long>(t), static_cast<unsigned long long>(sc.ticks), m.agents,
+            sim.arrived_total(), m.overlapping_pairs, static_cast<double>(t) / clock.seconds());
       }
     }
     if (tty) std::fprintf(stderr, "\n");
@@ -135,15 +152,30 @@ int run(const RunOptions& o) {
        << 1e3 * experiment::median(tick_seconds) << " ms; " << sc.config.threads << " thread"
        << (sc.config.threads > 1 ? "s" : "") << ")";
   }
-  os << "\n  agents: " << agents_at_start << " at start, " << sim.world().agents().size() << " at end; arrived "
-     << sim.arrived_total() << "\n  overlaps after a tick: at most " << max_pairs << " agent pairs and " << max_obstacle
-     << " agent-obstacle; at the end " << sim.last_metrics().overlapping_pairs << " pairs\n  backoff: "
-     << (sc.config.backoff ? "on" : "off") << ", " << frozen_total << " agent-ticks frozen, "
-     << sim.last_metrics().gridlocked << " agents gridlocked at the end\n  final state hash " << hex(sim.state_hash())
-     << "\n";
+  os << "\n  agents: " << agents_at_start << " at start, " << sim.world().agents().size()
+     << " at end; arrived " << sim.arrived_total() << "\n  overlaps after a tick: at most "
+     << max_pairs << " agent pairs and " << max_obstacle << " agent-obstacle; at the end "
+     << sim.last_metrics().overlapping_pairs
+     << " pairs\n  backoff: " << (sc.config.backoff ? "on" : "off") << ", " << frozen_total
+     << " agent-ticks frozen";
+  if (sc.config.backoff && sc.ticks > 0)
+    os << ", freeze rounds per tick mean "
+       << static_cast<double>(iterations_total) / static_cast<double>(sc.ticks) << " max "
+       << iterations_max;
+  os << "\n  gridlock (frozen " << sc.config.gridlock_ticks
+     << "+ ticks in a row): " << gridlock_streaks << " streaks reached it, at most " << gridlock_max
+     << " agents at once, " << sim.last_metrics().gridlocked
+     << " at the end; longest frozen streak " << longest_frozen << " ticks\n  nudge: ";
+  if (sc.config.nudge_after)
+    os << "sidestep after " << sc.config.nudge_after << " frozen ticks, " << nudged_total
+       << " agent-ticks nudged";
+  else
+    os << "off (nudge_after = 0)";
+  os << "\n  final state hash " << hex(sim.state_hash()) << "\n";
   if (writer)
     os << "  trajectories: " << sc.output.path << " ("
-       << (sc.output.format == OutputSpec::Format::csv ? "csv" : "sqlite, JuPedSim format v3") << ")\n";
+       << (sc.output.format == OutputSpec::Format::csv ? "csv" : "sqlite, JuPedSim format v3")
+       << ")\n";
   std::cout << os.str();
   if (o.analyze) std::cout << sim.explain() << sim.explain_analyze();
   return 0;
@@ -155,16 +187,23 @@ void add_run_command(CLI::App& app, Action& action) {
   static RunOptions o;
   auto* sub = app.add_subcommand("run", "simulate a scenario file (see docs/scenario-format.md)");
   sub->add_option("scenario", o.scenario, "scenario JSON file")->required();
-  sub->add_option("--ticks", o.ticks, "number of ticks (overrides the file)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--ticks", o.ticks, "number of ticks (overrides the file)")
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--out", o.out, "trajectory output: FILE.sqlite (JuPedSim format) or FILE.csv");
   sub->add_option("--format", o.format, "output format when the extension does not say")
       ->check(CLI::IsMember({"sqlite", "csv"}));
   sub->add_flag("--no-output", o.no_output, "write no trajectories");
   sub->add_option("--every", o.every, "write every n-th frame")->check(CLI::PositiveNumber);
   sub->add_flag("--explain", o.explain, "print the tick's query plan and exit");
-  sub->add_flag("--explain-analyze", o.analyze, "run, then print the plan with rows and time per operator");
-  sub->add_option("--threads", o.threads, "threads (results do not depend on it)")->check(CLI::Range(1, 256));
+  sub->add_flag("--explain-analyze", o.analyze,
+                "run, then print the plan with rows and time per operator");
+  sub->add_option("--threads", o.threads, "threads (results do not depend on it)")
+      ->check(CLI::Range(1, 256));
   sub->add_flag("--no-backoff", o.no_backoff, "switch the backoff freeze loop off");
+  sub->add_option("--nudge-after", o.nudge_after,
+                  "sidestep agents frozen this many ticks in a row; 0 = never (overrides the "
+                  "file's nudge_after)")
+      ->check(CLI::Range(int64_t{0}, int64_t{1} << 30));
   sub->add_option("--ftc", o.ftc, "first-to-collide access path (auto, naive, ...)");
   sub->add_option("--field", o.field, "potential-field access path (auto, naive, ...)");
   sub->add_option("--collisions", o.collisions, "collision-set access path (auto, naive, ...)");
@@ -183,9 +222,9 @@ void add_validate_command(CLI::App& app, Action& action) {
       const std::size_t agents = sc.world.agents().size(), goals = sc.world.goals().size();
       const std::size_t circles = sc.world.circles().size(), polygons = sc.world.polygons().size();
       Simulation sim(std::move(sc.world), sc.config);  // also checks the access-path choices
-      std::cout << file << ": ok: " << (sc.name.empty() ? "(unnamed)" : sc.name) << ", " << agents << " agents, "
-                << goals << " goals, " << circles << " circles, " << polygons << " polygons, " << sc.ticks
-                << " ticks\n";
+      std::cout << file << ": ok: " << (sc.name.empty() ? "(unnamed)" : sc.name) << ", " << agents
+                << " agents, " << goals << " goals, " << circles << " circles, " << polygons
+                << " polygons, " << sc.ticks << " ticks\n";
       return 0;
     };
   });
