@@ -9,7 +9,7 @@
 #include "crowddb/query.hpp"
 #include "scenario/builders.hpp"
 
-namespace crowddb::testing {
+namespace crowddb::test {
 
 struct CollisionCase {
   std::string name;
@@ -132,4 +132,4 @@ inline std::vector<uint32_t> rows_of(const CollisionPairs& p) {
   return rows;
 }
 
-}  // namespace crowddb::testing
+}  // namespace crowddb::test

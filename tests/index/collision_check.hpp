@@ -8,7 +8,7 @@
 #include "index/collision_cases.hpp"
 #include "query/naive_paths.hpp"
 
-namespace crowddb::testing {
+namespace crowddb::test {
 
 inline build::Box box_of(const DiscTable& t) {
   if (t.size() == 0) return build::Box{0, 0, 10, 10};
@@ -62,4 +62,4 @@ inline std::size_t count_naive_pairs(uint64_t seed) {
   return total;
 }
 
-}  // namespace crowddb::testing
+}  // namespace crowddb::test

@@ -8,18 +8,18 @@
 namespace crowddb::index {
 namespace {
 
-using testing::collision_cases;
+using test::collision_cases;
 
 TEST(CollisionGrid, EqualsNaiveOnRandomAndAdversarialCases) {
   CollisionGrid grid;
-  for (uint64_t seed : {1u, 2u, 3u}) testing::expect_exact_on_all_cases(grid, seed);
+  for (uint64_t seed : {1u, 2u, 3u}) test::expect_exact_on_all_cases(grid, seed);
 }
 
 TEST(CollisionGrid, CasesContainOverlapsAndTouchingPairs) {
   // The touching-pair generator: exactly touching pairs never overlap; pairs nudged one ulp
   // closer overlap (but for the odd one whose nudge vanishes in the rounding of dx^2 + dy^2).
   const DiscTable t = build::touching(200, build::Box{0, 0, 1000, 1000}, 5);
-  const CollisionPairs p = testing::naive_pairs(t.view(), StaticScene());
+  const CollisionPairs p = test::naive_pairs(t.view(), StaticScene());
   std::size_t nudged = 0, touching = 0;
   for (auto [i, j] : p.agents) {
     if (i / 2 != j / 2) continue;
@@ -27,7 +27,7 @@ TEST(CollisionGrid, CasesContainOverlapsAndTouchingPairs) {
   }
   EXPECT_EQ(touching, 0u);
   EXPECT_GE(nudged, 95u);
-  EXPECT_GT(testing::count_naive_pairs(1), 5000u);
+  EXPECT_GT(test::count_naive_pairs(1), 5000u);
 }
 
 TEST(DiscGrid, OverlapQueryEqualsBruteForce) {
@@ -63,7 +63,7 @@ TEST(CollisionGrid, NonFiniteInputFallsBackInsteadOfHanging) {
   QueryStats st;
   CollisionPairs got;
   grid.run(t.view(), StaticScene(), got, ex, st);
-  EXPECT_EQ(got.agents, testing::naive_pairs(t.view(), StaticScene()).agents);
+  EXPECT_EQ(got.agents, test::naive_pairs(t.view(), StaticScene()).agents);
 }
 
 }  // namespace

@@ -28,17 +28,17 @@ TEST(CollisionNn, SetEqualsNaiveAndPairsAreNearestNeighbours) {
   Executor ex(1);
   std::size_t cases = 0;
   for (uint64_t seed : {1u, 2u, 3u}) {
-    for (const auto& c : testing::collision_cases(seed)) {
+    for (const auto& c : test::collision_cases(seed)) {
       if (!c.equal_radii) continue;
       ++cases;
-      for (const auto& [scene_name, scene] : testing::collision_scenes(testing::box_of(c.discs))) {
+      for (const auto& [scene_name, scene] : test::collision_scenes(test::box_of(c.discs))) {
         SCOPED_TRACE(c.name + " / " + scene_name);
         const DiscView d = c.discs.view();
-        const CollisionPairs want = testing::naive_pairs(d, scene);
+        const CollisionPairs want = test::naive_pairs(d, scene);
         CollisionPairs got;
         QueryStats st;
         nn.run(d, scene, got, ex, st);
-        EXPECT_EQ(testing::rows_of(got), testing::rows_of(want));  // the collision set: exact
+        EXPECT_EQ(test::rows_of(got), test::rows_of(want));  // the collision set: exact
         EXPECT_TRUE(got.obstacles == want.obstacles);
         EXPECT_EQ(got.agents.empty(), want.agents.empty());
         // Exactly the pairs (i, NN(i)) for every i with a neighbour closer than 2R.
@@ -70,8 +70,8 @@ TEST(CollisionNn, ReportsNearestNeighbourPairsNotEveryPair) {
   CollisionPairs got;
   nn.run(t.view(), StaticScene(), got, ex, st);
   EXPECT_EQ(got.agents, (Pairs{{0, 1}, {1, 2}}));
-  EXPECT_EQ(testing::naive_pairs(t.view(), StaticScene()).agents, (Pairs{{0, 1}, {0, 2}, {1, 2}}));
-  EXPECT_EQ(testing::rows_of(got), (std::vector<uint32_t>{0, 1, 2}));
+  EXPECT_EQ(test::naive_pairs(t.view(), StaticScene()).agents, (Pairs{{0, 1}, {0, 2}, {1, 2}}));
+  EXPECT_EQ(test::rows_of(got), (std::vector<uint32_t>{0, 1, 2}));
   // Ties go to the smaller row: 1 and 2 equally near to 0.
   t.x[1] = 1.5;
   t.x[2] = -1.5;

@@ -9,7 +9,7 @@ namespace {
 
 TEST(CollisionSweep, EqualsNaiveOnRandomAndAdversarialCases) {
   CollisionSweep sweep;
-  for (uint64_t seed : {1u, 2u, 3u}) testing::expect_exact_on_all_cases(sweep, seed);
+  for (uint64_t seed : {1u, 2u, 3u}) test::expect_exact_on_all_cases(sweep, seed);
 }
 
 TEST(CollisionSweep, SameXForEveryDiscStillExact) {
@@ -22,7 +22,7 @@ TEST(CollisionSweep, SameXForEveryDiscStillExact) {
   CollisionPairs got;
   sweep.run(t.view(), StaticScene(), got, ex, st);
   EXPECT_EQ(got.agents.size(), 499u);
-  EXPECT_EQ(got.agents, testing::naive_pairs(t.view(), StaticScene()).agents);
+  EXPECT_EQ(got.agents, test::naive_pairs(t.view(), StaticScene()).agents);
   EXPECT_LT(st.pair_tests, 5000u);  // slabs keep far-apart discs out of each other's way
 }
 

@@ -9,8 +9,8 @@ namespace crowddb::index {
 namespace {
 
 TEST(ObstacleIndex, EqualsTheOracleObstacleLoop) {
-  for (const auto& c : testing::collision_cases(3)) {
-    for (const auto& [scene_name, scene] : testing::collision_scenes(testing::box_of(c.discs))) {
+  for (const auto& c : test::collision_cases(3)) {
+    for (const auto& [scene_name, scene] : test::collision_scenes(test::box_of(c.discs))) {
       SCOPED_TRACE(c.name + " / " + scene_name);
       const DiscView d = c.discs.view();
       std::vector<std::pair<uint32_t, Collider>> want, got;

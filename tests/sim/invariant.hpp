@@ -18,7 +18,7 @@
 #include "query/naive_paths.hpp"
 #include "world/geometry.hpp"
 
-namespace crowddb::testing {
+namespace crowddb::test {
 
 struct Snapshot {
   std::map<uint64_t, std::size_t> row;  // id -> index into x, y, r
@@ -138,4 +138,4 @@ Scenario load_edited(const std::string& name, Edit&& edit) {
   return parse_scenario(j.dump(), path);
 }
 
-}  // namespace crowddb::testing
+}  // namespace crowddb::test
