@@ -1,7 +1,7 @@
 // Collision-set methods (DESIGN.md §3.2) at n = 10^3 ... 10^6 on fixed-seed inputs:
 //   uniform   radii 1-3, square side chosen for ~10% of the discs in collision (the target)
 //   equal     radius 2, ~10% in collision (the only input nn accepts)
-//   clustered radii 1-3, 1 cluster per 2,000 discs, dense cores
+//   clustered radii 1-3, 1 cluster per 2,000 discs (spread 120), dense cores
 //   mixed     radii 0.5-50, ~10% in collision
 //   giants    uniform radii 1-3 plus one disc in 10^4 of radius 100-1000
 // Counters: pairs and a pair checksum (a fast wrong change shows), in_collision (fraction of
@@ -9,6 +9,7 @@
 // missed_agents: fractions of the exact pairs / set; computed outside the timed loop).
 //
 //   build/bench/collisions_bench --benchmark_filter='uniform/1000000' --benchmark_repetitions=5
+//   build/bench/collisions_bench --benchmark_filter='^small/'   (naive-to-index crossover)
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -143,6 +144,15 @@ std::string loadavg() {
 
 int main(int argc, char** argv) {
   const std::size_t sizes[] = {1000, 10000, 100000, 1000000};
+  // Small tables, for the planner's crossover from naive to an index (auto_min_rows).
+  for (const std::string dist : {"uniform", "equal"})
+    for (const std::string method : {"naive", "grid", "sweep", "nn"})
+      for (std::size_t n : {16, 32, 64, 128, 256, 512}) {
+        if (method == "nn" && dist != "equal") continue;
+        benchmark::RegisterBenchmark(("small/" + method + "/" + dist + "/" + std::to_string(n)).c_str(),
+                                     [=](benchmark::State& s) { run(s, method, dist, n); })
+            ->Unit(benchmark::kMicrosecond);
+      }
   for (const std::string dist : {"uniform", "equal", "clustered", "mixed", "giants"})
     for (const std::string method : {"naive", "grid", "sweep", "nn", "delaunay"})
       for (std::size_t n : sizes) {

@@ -82,47 +82,10 @@ void CellIndex::build(const DiscView& d, std::span<const uint32_t> rows, const F
 }
 
 void CellIndex::pairs(PairList& out, uint64_t& tests) const {
-  const std::size_t n = key_.size();
-  const auto W = static_cast<uint64_t>(W_);
-  auto test_block = [&](std::size_t a0, std::size_t a1, std::size_t b0, std::size_t b1) {
-    for (std::size_t a = a0; a < a1; ++a) {
-      const double xa = x_[a], ya = y_[a], ra = r_[a];
-      for (std::size_t b = b0; b < b1; ++b)
-        if (discs_overlap(x_[b] - xa, y_[b] - ya, ra + r_[b]))
-          out.push_back(ordered(row_[a], row_[b]));
-    }
-    tests += (a1 - a0) * (b1 - b0);
-  };
-  std::size_t next_row = 0;  // first entry with key >= (this key + W - 1): monotone in this key
-  for (std::size_t i = 0; i < n;) {
-    const uint64_t k = key_[i];
-    std::size_t e = i + 1;
-    while (e < n && key_[e] == k) ++e;
-    const uint64_t cx = k % W, cy = k / W;
-    // Within the cell: each pair once.
-    for (std::size_t a = i; a < e; ++a) {
-      const double xa = x_[a], ya = y_[a], ra = r_[a];
-      for (std::size_t b = a + 1; b < e; ++b)
-        if (discs_overlap(x_[b] - xa, y_[b] - ya, ra + r_[b]))
-          out.push_back(ordered(row_[a], row_[b]));
-    }
-    tests += (e - i) * (e - i - 1) / 2;
-    // East neighbour: the next run, when it is the next cell of the same row.
-    if (cx + 1 < W && e < n && key_[e] == k + 1) {
-      std::size_t f = e + 1;
-      while (f < n && key_[f] == k + 1) ++f;
-      test_block(i, e, e, f);
-    }
-    // The three cells of the next row (north-west, north, north-east).
-    if (cy + 1 < static_cast<uint64_t>(H_)) {
-      const uint64_t lo = k + W - (cx > 0 ? 1 : 0), hi = k + W + (cx + 1 < W ? 1 : 0);
-      while (next_row < n && key_[next_row] < lo) ++next_row;
-      std::size_t f = next_row;
-      while (f < n && key_[f] <= hi) ++f;
-      if (f > next_row) test_block(i, e, next_row, f);
-    }
-    i = e;
-  }
+  tests += for_each_candidate([&](std::size_t a, std::size_t b) {
+    if (discs_overlap(x_[b] - x_[a], y_[b] - y_[a], r_[a] + r_[b]))
+      out.push_back(ordered(row_[a], row_[b]));
+  });
 }
 
 }  // namespace crowddb::index

@@ -41,6 +41,12 @@ class CellIndex {
   template <class F>
   void for_each_near(double qx, double qy, double qr, F&& fn) const;
 
+  // Calls fn(a, b) for every pair of entries (positions in key order) in the same or adjacent
+  // cells, each pair once: a cell with itself and with its east, north-west, north and
+  // north-east neighbours. Returns the number of pairs.
+  template <class F>
+  uint64_t for_each_candidate(F&& fn) const;
+
   // Calls fn(begin, end, nb) for every non-empty cell in key order, where [begin, end) are its
   // entries and nb[0..2] the entry ranges {first, last} of the 3 x 3 block around it, one per
   // row of cells (row below, own row, row above). O(n) in total: monotone pointers, no search.
@@ -84,6 +90,42 @@ void CellIndex::for_each_near(double qx, double qy, double qr, F&& fn) const {
     auto it = std::lower_bound(key_.begin(), key_.end(), lo);
     for (; it != key_.end() && *it <= hi; ++it) fn(static_cast<std::size_t>(it - key_.begin()));
   }
+}
+
+template <class F>
+uint64_t CellIndex::for_each_candidate(F&& fn) const {
+  const std::size_t n = key_.size();
+  const auto W = static_cast<uint64_t>(W_), H = static_cast<uint64_t>(H_);
+  uint64_t count = 0;
+  auto block = [&](std::size_t a0, std::size_t a1, std::size_t b0, std::size_t b1) {
+    for (std::size_t a = a0; a < a1; ++a)
+      for (std::size_t b = b0; b < b1; ++b) fn(a, b);
+    count += (a1 - a0) * (b1 - b0);
+  };
+  std::size_t next_row = 0;  // first entry with key >= (this key + W - 1): monotone in this key
+  for (std::size_t i = 0; i < n;) {
+    const uint64_t k = key_[i];
+    std::size_t e = i + 1;
+    while (e < n && key_[e] == k) ++e;
+    const uint64_t cx = k % W, cy = k / W;
+    for (std::size_t a = i; a < e; ++a)  // within the cell
+      for (std::size_t b = a + 1; b < e; ++b) fn(a, b);
+    count += (e - i) * (e - i - 1) / 2;
+    if (cx + 1 < W && e < n && key_[e] == k + 1) {  // east: the next run, if it is the next cell
+      std::size_t f = e + 1;
+      while (f < n && key_[f] == k + 1) ++f;
+      block(i, e, e, f);
+    }
+    if (cy + 1 < H) {  // the three cells of the next row
+      const uint64_t lo = k + W - (cx > 0 ? 1 : 0), hi = k + W + (cx + 1 < W ? 1 : 0);
+      while (next_row < n && key_[next_row] < lo) ++next_row;
+      std::size_t f = next_row;
+      while (f < n && key_[f] <= hi) ++f;
+      if (f > next_row) block(i, e, next_row, f);
+    }
+    i = e;
+  }
+  return count;
 }
 
 template <class F>

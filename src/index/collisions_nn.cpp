@@ -4,6 +4,11 @@
 #include "util/stopwatch.hpp"
 
 namespace crowddb::index {
+namespace {
+
+constexpr uint32_t kNone = UINT32_MAX;
+
+}  // namespace
 
 void CollisionNn::run(const DiscView& d, const StaticScene& scene, CollisionPairs& out,
                       Executor& ex, QueryStats& stats) {
@@ -24,30 +29,28 @@ void CollisionNn::run(const DiscView& d, const StaticScene& scene, CollisionPair
   cells_.build_all(d, frame, R);
   stats.build_seconds += sw.seconds();
   sw.restart();
+  // Each candidate pair once (half neighbourhood), updating both discs' nearest neighbour:
+  // the order of updates does not matter, (distance, row) is a total order.
   const double rsum = R + R, limit = rsum * rsum;
-  constexpr uint32_t kNone = UINT32_MAX;
-  uint64_t tests = 0;
-  cells_.for_each_block([&](std::size_t begin, std::size_t end, const std::size_t(&nb)[3][2]) {
-    for (std::size_t a = begin; a < end; ++a) {
-      const double xa = cells_.x(a), ya = cells_.y(a);
-      const uint32_t ra = cells_.row(a);
-      double best = limit;
-      uint32_t best_row = kNone;
-      for (const auto& range : nb)
-        for (std::size_t b = range[0]; b < range[1]; ++b) {
-          if (b == a) continue;
-          const double dx = cells_.x(b) - xa, dy = cells_.y(b) - ya;
-          const double d2 = dx * dx + dy * dy;
-          const uint32_t rb = cells_.row(b);
-          if (d2 < best || (d2 == best && best_row != kNone && rb < best_row)) {
-            best = d2;
-            best_row = rb;
-          }
-        }
-      tests += (nb[0][1] - nb[0][0]) + (nb[1][1] - nb[1][0]) + (nb[2][1] - nb[2][0]) - 1;
-      if (best_row != kNone) out.agents.push_back(ordered(ra, best_row));
+  const std::size_t m = cells_.size();
+  best_.assign(m, limit);
+  best_row_.assign(m, kNone);
+  auto offer = [&](std::size_t k, double d2, uint32_t row) {
+    if (d2 < best_[k] || (d2 == best_[k] && best_row_[k] != kNone && row < best_row_[k])) {
+      best_[k] = d2;
+      best_row_[k] = row;
+    }
+  };
+  uint64_t tests = cells_.for_each_candidate([&](std::size_t a, std::size_t b) {
+    const double dx = cells_.x(b) - cells_.x(a), dy = cells_.y(b) - cells_.y(a);
+    const double d2 = dx * dx + dy * dy;  // as discs_overlap computes it
+    if (d2 < limit) {
+      offer(a, d2, cells_.row(b));
+      offer(b, d2, cells_.row(a));
     }
   });
+  for (std::size_t k = 0; k < m; ++k)
+    if (best_row_[k] != kNone) out.agents.push_back(ordered(cells_.row(k), best_row_[k]));
   finish_pairs(out.agents);
   if (!scene.empty()) {
     obstacles_.build(scene, frame);

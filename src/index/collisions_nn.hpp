@@ -12,8 +12,9 @@
 //
 // The query is bounded: only neighbours closer than 2R matter, and they lie in the 3 x 3 block of
 // cells of side >= 2R around the disc, so a single-level CellIndex answers it exactly in
-// O(n + candidates). Distances are compared as the oracle computes them (dx*dx + dy*dy against
-// (R + R)^2), so "closer than 2R" agrees with discs_overlap bit for bit.
+// O(n + candidates), each candidate pair examined once for both discs. Distances are compared as
+// the oracle computes them (dx*dx + dy*dy against (R + R)^2), so "closer than 2R" agrees with
+// discs_overlap bit for bit.
 #pragma once
 
 #include "index/cell_index.hpp"
@@ -31,6 +32,8 @@ class CollisionNn final : public CollisionPath {
  private:
   CellIndex cells_;
   ObstacleIndex obstacles_;
+  std::vector<double> best_;  // per entry: squared distance to its nearest neighbour so far
+  std::vector<uint32_t> best_row_;
 };
 
 }  // namespace crowddb::index
