@@ -1,7 +1,7 @@
 // Collision-set methods (DESIGN.md §3.2) at n = 10^3 ... 10^6 on fixed-seed inputs:
 //   uniform   radii 1-3, square side chosen for ~10% of the discs in collision (the target)
 //   equal     radius 2, ~10% in collision (the only input nn accepts)
-//   clustered radii 1-3, 1 cluster per 2,000 discs (spread 120), dense cores
+//   clustered radii 1-3, 1 cluster per 2,000 discs (spread 500), dense cores
 //   mixed     radii 0.5-50, ~10% in collision
 //   giants    uniform radii 1-3 plus one disc in 10^4 of radius 100-1000
 // Counters: pairs and a pair checksum (a fast wrong change shows), in_collision (fraction of
@@ -45,10 +45,10 @@ DiscTable make(const std::string& dist, std::size_t n) {
     const double s = side_for(n, 2, 2, 0.10);
     return build::uniform(n, build::Box{0, 0, s, s}, 1, 2, 2, seed);
   }
-  if (dist == "clustered") {
+  if (dist == "clustered") {  // 2,000 discs per cluster, spread 500: dense cores, empty between
     const double s = side_for(n, 1, 3, 0.02);
-    return build::clustered(n, build::Box{0, 0, s, s}, std::max<std::size_t>(1, n / 2000), 60, 1, 1,
-                            3, seed);
+    return build::clustered(n, build::Box{0, 0, s, s}, std::max<std::size_t>(1, n / 2000), 500, 1,
+                            1, 3, seed);
   }
   if (dist == "mixed") {
     const double s = side_for(n, 0.5, 50, 0.10);
@@ -149,8 +149,9 @@ int main(int argc, char** argv) {
     for (const std::string method : {"naive", "grid", "sweep", "nn"})
       for (std::size_t n : {16, 32, 64, 128, 256, 512}) {
         if (method == "nn" && dist != "equal") continue;
-        benchmark::RegisterBenchmark(("small/" + method + "/" + dist + "/" + std::to_string(n)).c_str(),
-                                     [=](benchmark::State& s) { run(s, method, dist, n); })
+        benchmark::RegisterBenchmark(
+            ("small/" + method + "/" + dist + "/" + std::to_string(n)).c_str(),
+            [=](benchmark::State& s) { run(s, method, dist, n); })
             ->Unit(benchmark::kMicrosecond);
       }
   for (const std::string dist : {"uniform", "equal", "clustered", "mixed", "giants"})

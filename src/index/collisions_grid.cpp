@@ -8,7 +8,8 @@
 namespace crowddb::index {
 namespace {
 
-constexpr double kClassRatio = 4;  // radii within one class differ by less than this factor
+constexpr double kClassRatio = 4;     // radii within one class differ by less than this factor
+constexpr double kMaxCandidates = 8;  // one class while it costs fewer candidates per disc
 
 }  // namespace
 
@@ -18,7 +19,13 @@ void DiscGrid::build(const DiscView& d) {
     levels_.clear();
     return;
   }
-  if (frame_.rmax <= kClassRatio * frame_.rmin) {
+  // One class when the radii are close, or when even the largest disc's cell would hold few
+  // centres (sparse tables with mixed radii: classes would only add cross-class probes).
+  // Expected candidates per disc in one class: ~4.5 cells x density x cell^2.
+  const double cell = 2 * frame_.reach(frame_.rmax);
+  const double area = frame_.width * frame_.height;
+  const double per_disc = area > 0 ? 4.5 * static_cast<double>(d.n) / area * cell * cell : INFINITY;
+  if (frame_.rmax <= kClassRatio * frame_.rmin || per_disc <= kMaxCandidates) {
     levels_.resize(1);
     levels_[0].build_all(d, frame_, frame_.rmax);
     return;

@@ -4,7 +4,8 @@
 // cell and its half neighbourhood; a pair across classes is found by the smaller disc probing
 // the larger class's cells (at most 3 x 3 of them, since those cells are wider than both discs).
 // A handful of giant discs thus form their own class and cost O(log n) per probing disc instead
-// of making every cell giant; ordinary inputs (radii within a factor of 4) use one class.
+// of making every cell giant; ordinary inputs (radii within a factor of 4, or sparse enough that
+// the widest cell still holds few centres) use one class.
 //
 // Exact: every candidate is decided by the oracle's discs_overlap on the original doubles and
 // the cell reach carries the rounding margins of collision_common.hpp. Obstacles go through

@@ -82,9 +82,8 @@ void CollisionSweep::run(const DiscView& d, const StaticScene& scene, CollisionP
     const double expire = key == 0 ? -INFINITY : xlo_min + (static_cast<double>(key) - 1) * quantum;
     const double reach = frame.reach(a.r);
     const double u = a.x - frame.x0, v = a.y - frame.y0;
-    const Active me{u + reach, v - reach, v + reach, a, 0};
     const double xlo = u - reach;
-    const uint32_t s0 = slab_of(me.ylo), s1 = slab_of(me.yhi);
+    const uint32_t s0 = slab_of(v - reach), s1 = slab_of(v + reach);
     for (uint32_t s = s0; s <= s1; ++s) {
       std::vector<Active>& slab = slabs_[s];
       std::size_t keep = 0;
@@ -93,17 +92,16 @@ void CollisionSweep::run(const DiscView& d, const StaticScene& scene, CollisionP
         if (b.xhi < expire) continue;  // the sweep line has passed it for good
         if (keep != e) slab[keep] = b;
         ++keep;
-        if (b.xhi < xlo || b.yhi < me.ylo || b.ylo > me.yhi || std::max(b.slab0, s0) != s) continue;
+        // Boxes meet in y iff the centres are at most the two reaches apart (the reaches carry
+        // the rounding margins, so this never drops a pair the exact test accepts).
+        if (b.xhi < xlo || std::abs(b.y - a.y) > b.reach + reach || std::max(b.slab0, s0) != s) continue;
         ++tests;
-        if (discs_overlap(b.disc.x - a.x, b.disc.y - a.y, b.disc.r + a.r))
-          out.agents.push_back(ordered(b.disc.row, a.row));
+        if (discs_overlap(b.x - a.x, b.y - a.y, b.r + a.r)) out.agents.push_back(ordered(b.row, a.row));
       }
       slab.resize(keep);
     }
-    for (uint32_t s = s0; s <= s1; ++s) {
-      slabs_[s].push_back(me);
-      slabs_[s].back().slab0 = s0;
-    }
+    const Active me{u + reach, reach, a.x, a.y, a.r, a.row, s0};
+    for (uint32_t s = s0; s <= s1; ++s) slabs_[s].push_back(me);
   }
   finish_pairs(out.agents);
   if (!scene.empty()) {

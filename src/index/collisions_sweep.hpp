@@ -34,10 +34,12 @@ class CollisionSweep final : public CollisionPath {
     double x, y, r;
     uint32_t row;
   };
-  // An active box carries its disc, so the exact test reads nothing else.
+  // An active box carries its disc, so the filters and the exact test read nothing else.
   struct Active {
-    double xhi, ylo, yhi;  // frame coordinates, grown by the rounding margins
-    Disc disc;
+    double xhi;    // right edge, frame coordinates, grown by the rounding margins
+    double reach;  // Frame::reach(r)
+    double x, y, r;
+    uint32_t row;
     uint32_t slab0;  // its lowest slab
   };
   std::vector<uint64_t> order_, scratch_;
