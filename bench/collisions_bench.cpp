@@ -20,7 +20,9 @@
 #include <numbers>
 #include <string>
 
+#include "index/obstacle_index.hpp"
 #include "plan/access_path.hpp"
+#include "query/naive_paths.hpp"
 #include "scenario/builders.hpp"
 #include "util/executor.hpp"
 
@@ -133,6 +135,36 @@ void run(benchmark::State& state, const std::string& method, const std::string& 
   }
 }
 
+// The obstacle half alone: the oracle's loop over every obstacle against ObstacleIndex, on the
+// uniform table with an airport-like scene scaled to its box (24 pillars, 5 boxes, 4 walls).
+void obstacles(benchmark::State& state, bool indexed, std::size_t n) {
+  const DiscTable& t = data("uniform", n);
+  const DiscView d = t.view();
+  const double side = side_for(n, 1, 3, 0.10);
+  std::vector<CircleObstacle> circles;
+  std::vector<PolygonObstacle> polys;
+  for (int i = 0; i < 24; ++i)
+    circles.push_back(
+        {side * (0.1 + 0.15 * (i % 6)), side * (0.15 + 0.2 * (i / 6)), side * 0.03, 1});
+  for (int i = 0; i < 5; ++i) {
+    const double x = side * (0.05 + 0.18 * i), y = side * 0.92, w = side * 0.05;
+    polys.push_back({{{x, y}, {x + w, y}, {x + w, y + w / 4}, {x, y + w / 4}}, 1});
+  }
+  const Bounds walls{side * 0.01, side * 0.01, side * 0.99, side * 0.99};
+  const StaticScene scene(circles, polys, side, ObstacleCharges::centres, &walls);
+  std::vector<std::pair<uint32_t, Collider>> hits;
+  for (auto _ : state) {
+    hits.clear();
+    QueryStats st;
+    if (indexed)
+      index::obstacle_overlaps(d, scene, index::Frame::of(d), hits, st);
+    else
+      disc_obstacle_overlaps(d, scene, 0, d.n, hits);
+    benchmark::DoNotOptimize(hits.data());
+  }
+  state.counters["hits"] = static_cast<double>(hits.size());
+}
+
 std::string loadavg() {
   std::ifstream f("/proc/loadavg");
   std::string a, b, c;
@@ -165,6 +197,12 @@ int main(int argc, char** argv) {
         b->Unit(benchmark::kMillisecond);
         if (n >= 1000000) b->Iterations(method == "delaunay" ? 2 : 10);
       }
+  for (std::size_t n : sizes)
+    for (bool indexed : {false, true})
+      benchmark::RegisterBenchmark(
+          ((indexed ? "obstacles/index/" : "obstacles/loop/") + std::to_string(n)).c_str(),
+          [=](benchmark::State& s) { obstacles(s, indexed, n); })
+          ->Unit(benchmark::kMillisecond);
   benchmark::Initialize(&argc, argv);
   benchmark::AddCustomContext("loadavg_at_start", loadavg());
   benchmark::RunSpecifiedBenchmarks();

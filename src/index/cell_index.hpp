@@ -32,6 +32,7 @@ class CellIndex {
 
   std::size_t size() const { return key_.size(); }
   double max_radius() const { return R_; }
+  double cell() const { return cell_; }
 
   // Appends every overlapping pair within the level (rows, i < j; unsorted).
   void pairs(PairList& out, uint64_t& tests) const;

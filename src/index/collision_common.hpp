@@ -31,10 +31,12 @@ struct Frame {
   double width = 0, height = 0;  // of the centres' bounding box
   double extent = 0;             // max(width, height)
   double rmin = 0, rmax = 0;
+  std::size_t count = 0;  // discs
   bool finite = true;
 
   static Frame of(const DiscView& d) {
     Frame f;
+    f.count = d.n;
     if (d.n == 0) return f;
     double xmin = INFINITY, ymin = INFINITY, xmax = -INFINITY, ymax = -INFINITY;
     double rlo = INFINITY, rhi = -INFINITY;

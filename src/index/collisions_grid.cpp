@@ -63,15 +63,23 @@ void DiscGrid::pairs(PairList& out, uint64_t& tests) const {
   for (std::size_t j = 0; j < levels_.size(); ++j) {
     const CellIndex& small = levels_[j];
     small.pairs(out, tests);
-    // Across classes: each disc of the smaller class probes every larger class.
+    // Across classes: the side with less work probes the other. A small disc probes at most
+    // 3 rows of the larger class's cells; a large one about (2 R_big + 2 R_small) / cell rows of
+    // the smaller class's. So a few giants probe the small discs, and many large discs are
+    // probed by fewer small ones.
     for (std::size_t k = j + 1; k < levels_.size(); ++k) {
       const CellIndex& big = levels_[k];
-      for (std::size_t a = 0; a < small.size(); ++a) {
-        const double xa = small.x(a), ya = small.y(a), ra = small.r(a);
-        big.for_each_near(xa, ya, ra, [&](std::size_t b) {
+      const double rows = std::ceil(2 * (big.max_radius() + small.max_radius()) / small.cell()) + 1;
+      const bool big_probes =
+          static_cast<double>(big.size()) * rows < 3 * static_cast<double>(small.size());
+      const CellIndex& probing = big_probes ? big : small;
+      const CellIndex& probed = big_probes ? small : big;
+      for (std::size_t a = 0; a < probing.size(); ++a) {
+        const double xa = probing.x(a), ya = probing.y(a), ra = probing.r(a);
+        probed.for_each_near(xa, ya, ra, [&](std::size_t b) {
           ++tests;
-          if (discs_overlap(big.x(b) - xa, big.y(b) - ya, ra + big.r(b)))
-            out.push_back(ordered(small.row(a), big.row(b)));
+          if (discs_overlap(probed.x(b) - xa, probed.y(b) - ya, ra + probed.r(b)))
+            out.push_back(ordered(probing.row(a), probed.row(b)));
         });
       }
     }

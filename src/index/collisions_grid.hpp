@@ -1,11 +1,12 @@
 // Collision sets with a uniform grid (the game-engine baseline of DESIGN.md §3.2), made robust
 // to mixed radii: discs are split into radius classes (a factor of 4 apart), each class a
 // CellIndex whose cell is twice the class's largest radius. Pairs within a class come from each
-// cell and its half neighbourhood; a pair across classes is found by the smaller disc probing
-// the larger class's cells (at most 3 x 3 of them, since those cells are wider than both discs).
-// A handful of giant discs thus form their own class and cost O(log n) per probing disc instead
-// of making every cell giant; ordinary inputs (radii within a factor of 4, or sparse enough that
-// the widest cell still holds few centres) use one class.
+// cell and its half neighbourhood; a pair across classes is found by probing one class's cells
+// with the other's discs, whichever side costs less: a small disc meets at most 3 x 3 cells of
+// a larger class, a large disc (2 R_big + 2 R_small) / cell rows of a smaller one. A handful of
+// giant discs thus form their own class and probe the rest, instead of making every cell giant;
+// ordinary inputs (radii within a factor of 4, or sparse enough that the widest cell still holds
+// few centres) use one class.
 //
 // Exact: every candidate is decided by the oracle's discs_overlap on the original doubles and
 // the cell reach carries the rounding margins of collision_common.hpp. Obstacles go through

@@ -94,9 +94,11 @@ void CollisionSweep::run(const DiscView& d, const StaticScene& scene, CollisionP
         ++keep;
         // Boxes meet in y iff the centres are at most the two reaches apart (the reaches carry
         // the rounding margins, so this never drops a pair the exact test accepts).
-        if (b.xhi < xlo || std::abs(b.y - a.y) > b.reach + reach || std::max(b.slab0, s0) != s) continue;
+        if (b.xhi < xlo || std::abs(b.y - a.y) > b.reach + reach || std::max(b.slab0, s0) != s)
+          continue;
         ++tests;
-        if (discs_overlap(b.x - a.x, b.y - a.y, b.r + a.r)) out.agents.push_back(ordered(b.row, a.row));
+        if (discs_overlap(b.x - a.x, b.y - a.y, b.r + a.r))
+          out.agents.push_back(ordered(b.row, a.row));
       }
       slab.resize(keep);
     }

@@ -26,8 +26,10 @@ void ObstacleIndex::build(const StaticScene& scene, const Frame& frame) {
   start_.clear();
   ids_.clear();
   if (m == 0 || !frame.finite) return;
-  side_ = std::clamp<int64_t>(
-      4 * static_cast<int64_t>(std::ceil(std::sqrt(static_cast<double>(m + 1)))), 8, 512);
+  // Finer for more discs (fewer candidates each), coarser for few (cheaper to build).
+  const double fine = std::sqrt(static_cast<double>(frame.count)) / 8;
+  const double base = 4 * std::ceil(std::sqrt(static_cast<double>(m + 1)));
+  side_ = static_cast<int64_t>(std::clamp(std::max(fine, base), 8.0, 512.0));
   cell_ = std::max(frame.extent / static_cast<double>(side_), frame.rmax);
   if (!(cell_ > 0)) cell_ = 1;
   side_ = std::min<int64_t>(side_, static_cast<int64_t>(std::floor(frame.extent / cell_)) + 1);
