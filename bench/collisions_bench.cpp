@@ -4,6 +4,7 @@
 //   clustered radii 1-3, 1 cluster per 2,000 discs (spread 500), dense cores
 //   mixed     radii 0.5-50, ~10% in collision
 //   giants    uniform radii 1-3 plus one disc in 10^4 of radius 100-1000
+//   dense, densemixed  radii 1-3 / 0.5-50 with ~50% in collision (Delaunay miss rates)
 // Counters: pairs and a pair checksum (a fast wrong change shows), in_collision (fraction of
 // discs in the set), and for delaunay its misses against the exact answer (missed_pairs,
 // missed_agents: fractions of the exact pairs / set; computed outside the timed loop).
@@ -54,6 +55,14 @@ DiscTable make(const std::string& dist, std::size_t n) {
   }
   if (dist == "mixed") {
     const double s = side_for(n, 0.5, 50, 0.10);
+    return build::uniform(n, build::Box{0, 0, s, s}, 1, 0.5, 50, seed);
+  }
+  if (dist == "dense") {  // radii 1-3, about half the discs in collision
+    const double s = side_for(n, 1, 3, 0.50);
+    return build::uniform(n, build::Box{0, 0, s, s}, 1, 1, 3, seed);
+  }
+  if (dist == "densemixed") {  // radii 0.5-50, about half in collision
+    const double s = side_for(n, 0.5, 50, 0.50);
     return build::uniform(n, build::Box{0, 0, s, s}, 1, 0.5, 50, seed);
   }
   // giants
@@ -186,7 +195,8 @@ int main(int argc, char** argv) {
             [=](benchmark::State& s) { run(s, method, dist, n); })
             ->Unit(benchmark::kMicrosecond);
       }
-  for (const std::string dist : {"uniform", "equal", "clustered", "mixed", "giants"})
+  for (const std::string dist :
+       {"uniform", "equal", "clustered", "mixed", "giants", "dense", "densemixed"})
     for (const std::string method : {"naive", "grid", "sweep", "nn", "delaunay"})
       for (std::size_t n : sizes) {
         if (method == "naive" && n > 10000) continue;     // O(n^2): 10^5 takes seconds per run

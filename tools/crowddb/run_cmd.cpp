@@ -89,6 +89,7 @@ int run(const RunOptions& o) {
   std::size_t max_pairs = 0, max_obstacle = 0, frozen_total = 0;
   std::size_t iterations_total = 0, iterations_max = 0, gridlock_max = 0, gridlock_streaks = 0;
   std::size_t longest_frozen = 0, nudged_total = 0;
+  uint64_t last_arrival = 0;
   Stopwatch clock, progress_clock;
   try {
     if (writer) writer->frame(0, sim.world());
@@ -107,6 +108,7 @@ int run(const RunOptions& o) {
       gridlock_streaks += m.gridlock_started;
       longest_frozen = std::max(longest_frozen, m.longest_frozen);
       nudged_total += m.nudged;
+      if (m.arrived) last_arrival = m.tick;
       if (writer) {
         writer->frame(t, sim.world());  // the writer keeps every n-th frame
         writer->metrics(m);
@@ -153,7 +155,9 @@ int run(const RunOptions& o) {
        << (sc.config.threads > 1 ? "s" : "") << ")";
   }
   os << "\n  agents: " << agents_at_start << " at start, " << sim.world().agents().size()
-     << " at end; arrived " << sim.arrived_total() << "\n  overlaps after a tick: at most "
+     << " at end; arrived " << sim.arrived_total();
+  if (last_arrival) os << " (the last at tick " << last_arrival << ")";
+  os << "\n  overlaps after a tick: at most "
      << max_pairs << " agent pairs and " << max_obstacle << " agent-obstacle; at the end "
      << sim.last_metrics().overlapping_pairs
      << " pairs\n  backoff: " << (sc.config.backoff ? "on" : "off") << ", " << frozen_total
