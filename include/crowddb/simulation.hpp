@@ -70,11 +70,16 @@ struct TickMetrics {
   std::size_t agents = 0;   // rows after the tick
   std::size_t arrived = 0;  // agents that reached their goal in this tick
   std::size_t frozen = 0;   // agents the backoff loop froze in this tick
-  std::size_t freeze_iterations = 0;
+  std::size_t freeze_iterations =
+      0;  // rounds of the freeze loop (1: nothing to freeze; 0: backoff off)
   std::size_t overlapping_pairs = 0;  // agent-agent pairs overlapping after the tick
   std::size_t obstacle_overlaps = 0;  // agent-obstacle (and agent-wall) overlaps after the tick
   std::size_t gridlocked = 0;         // agents frozen for >= gridlock_ticks consecutive ticks
-  double seconds = 0;                 // wall time of the tick
+  std::size_t gridlock_started =
+      0;                           // agents whose frozen streak reached gridlock_ticks in this tick
+  std::size_t longest_frozen = 0;  // longest current frozen streak [ticks] among the agents
+  std::size_t nudged = 0;          // agents that sidestepped in this tick (SimConfig::nudge_after)
+  double seconds = 0;              // wall time of the tick
   uint64_t state_hash = 0;  // hash of the committed state (ids, positions, velocities, states)
 };
 

@@ -75,6 +75,10 @@ struct FieldMethod {
 struct CollisionQueryShape {
   std::size_t rows = 0;
   bool equal_radii = false;
+  // The consumer needs every overlapping pair, not just the collision set: overlap counts, or a
+  // backoff that must tell new overlaps from pairs that already overlapped at the start of the
+  // tick. Methods that return only the set exactly (nn) do not support such queries.
+  bool need_all_pairs = false;
 };
 
 struct CollisionMethod {

@@ -2,6 +2,10 @@
 // one entry here; no stage of the tick changes.
 #include <algorithm>
 
+#include "index/collisions_delaunay.hpp"
+#include "index/collisions_grid.hpp"
+#include "index/collisions_nn.hpp"
+#include "index/collisions_sweep.hpp"
 #include "index/field_bh.hpp"
 #include "index/field_index.hpp"
 #include "index/ftc_tree.hpp"
@@ -88,6 +92,24 @@ const std::vector<CollisionMethod>& collision_registry() {
       {{"naive", "nested loop over all pairs, O(n^2)"},
        [](const CollisionQueryShape&) { return true; },
        [] { return std::make_unique<CollisionNaive>(); }},
+      // auto_min_rows: where each overtakes the nested loop (bench/collisions_bench, small/*:
+      // grid and nn from ~64 rows, sweep from ~128). nn ranks first on request of the design
+      // (thesis §3.2) although it measures 1.0-1.4x slower than grid: it only ever serves where
+      // it is exact (equal radii, and a tick that starts overlap-free: need_all_pairs false).
+      {{"grid", "uniform grid, cell = 2 x max radius per radius class, O(n + k)", true, 2, 64},
+       [](const CollisionQueryShape&) { return true; },
+       [] { return std::make_unique<index::CollisionGrid>(); }},
+      {{"sweep", "plane sweep over bounding boxes with exact check, O(n log n + k)", true, 1, 128},
+       [](const CollisionQueryShape&) { return true; },
+       [] { return std::make_unique<index::CollisionSweep>(); }},
+      {{"nn", "nearest neighbour per agent, equal radii only; gives the set, not every pair", true,
+        3, 64},
+       [](const CollisionQueryShape& s) { return s.equal_radii && !s.need_all_pairs; },
+       [] { return std::make_unique<index::CollisionNn>(); }},
+      {{"delaunay", "Delaunay edges plus diagonals (CGAL), heuristic: may miss pairs", false, 0, 0,
+        false},
+       [](const CollisionQueryShape&) { return true; },
+       [] { return std::make_unique<index::CollisionDelaunay>(); }},
   };
   return methods;
 }
@@ -115,9 +137,22 @@ const CollisionMethod& find_collision_method(std::string_view name,
   if (!m)
     throw Error(Error::Kind::usage, "unknown collision method '" + std::string(name) +
                                         "' (choose from " + choices(collision_registry()) + ")");
-  if (!m->supports(shape))
+  if (!m->supports(shape)) {
+    // Name the fact that rules it out, by asking the method about the query without it.
+    CollisionQueryShape relaxed = shape;
+    relaxed.equal_radii = true;
+    std::string why;
+    if (!shape.equal_radii && m->supports(relaxed))
+      why = "it needs all agents to have the same radius";
+    relaxed = shape;
+    relaxed.need_all_pairs = false;
+    if (why.empty() && shape.need_all_pairs && m->supports(relaxed))
+      why = "it finds the collision set, not every overlapping pair, and this use needs every pair";
+    if (why.empty()) why = m->info.description;
     throw Error(Error::Kind::usage, "collision method '" + std::string(name) +
-                                        "' does not apply here (" + m->info.description + ")");
+                                        "' does not apply here: " + why + " (choose from " +
+                                        choices(collision_registry()) + ")");
+  }
   return *m;
 }
 

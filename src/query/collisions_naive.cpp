@@ -14,16 +14,13 @@ void disc_obstacle_overlaps(const DiscView& d, const StaticScene& scene, std::si
   for (std::size_t i = begin; i < end; ++i) {
     const double x = d.x[i], y = d.y[i], r = d.radius[i];
     for (std::size_t c = 0; c < circles.size(); ++c)
-      if (discs_overlap(circles[c].x - x, circles[c].y - y, r + circles[c].radius))
+      if (disc_hits_circle(circles[c], x, y, r))
         out.push_back(
             {static_cast<uint32_t>(i), {Collider::Kind::circle, static_cast<uint32_t>(c)}});
-    for (std::size_t p = 0; p < polygons.size(); ++p) {
-      const auto& b = boxes[p];
-      if (x + r <= b.xmin || x - r >= b.xmax || y + r <= b.ymin || y - r >= b.ymax) continue;
-      if (disc_overlaps_polygon(polygons[p].vertices, x, y, r))
+    for (std::size_t p = 0; p < polygons.size(); ++p)
+      if (disc_hits_polygon(polygons[p], boxes[p], x, y, r))
         out.push_back(
             {static_cast<uint32_t>(i), {Collider::Kind::polygon, static_cast<uint32_t>(p)}});
-    }
   }
 }
 

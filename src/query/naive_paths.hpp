@@ -2,6 +2,7 @@
 #pragma once
 
 #include "plan/access_path.hpp"
+#include "world/geometry.hpp"
 
 namespace crowddb {
 
@@ -25,6 +26,19 @@ class CollisionNaive final : public CollisionPath {
   void run(const DiscView& discs, const StaticScene& scene, CollisionPairs& out, Executor& ex,
            QueryStats& stats) override;
 };
+
+// The exact disc-against-obstacle tests of a collision query. Every method calls these for
+// every (disc, obstacle) candidate it keeps, so that all methods agree bit for bit.
+inline bool disc_hits_circle(const CircleObstacle& c, double x, double y, double r) {
+  return discs_overlap(c.x - x, c.y - y, r + c.radius);
+}
+// The bounding-box rejection is part of the definition (as the naive loop applies it), so an
+// index that pre-filters more loosely must still call this, not disc_overlaps_polygon directly.
+inline bool disc_hits_polygon(const PolygonObstacle& p, const StaticScene::Box& b, double x,
+                              double y, double r) {
+  if (x + r <= b.xmin || x - r >= b.xmax || y + r <= b.ymin || y - r >= b.ymax) return false;
+  return disc_overlaps_polygon(p.vertices, x, y, r);
+}
 
 // The obstacle half of a collision query (disc against circles and polygons), shared by every
 // collision method: obstacles are few and static, so methods differ only in the disc-disc part.

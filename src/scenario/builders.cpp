@@ -117,6 +117,36 @@ FieldWorld e5_world(std::size_t n, uint64_t seed) {
   return w;
 }
 
+DiscTable touching(std::size_t pairs, Box box, uint64_t seed) {
+  Rng rng(seed);
+  DiscTable t;
+  // Integer-valued coordinates and radii keep every quantity exact: the distance is exactly the
+  // sum of radii. Directions (3, 4) / 5 and (5, 12) / 13, in all four quadrants.
+  const double dirs[2][3] = {{3, 4, 5}, {5, 12, 13}};
+  for (std::size_t p = 0; p < pairs; ++p) {
+    const double x = std::floor(rng.uniform(box.xmin, box.xmax)),
+                 y = std::floor(rng.uniform(box.ymin, box.ymax));
+    const auto& d = dirs[rng.below(2)];
+    const double k = static_cast<double>(1 + rng.below(4));  // distance k * d[2]
+    const double sx = rng.below(2) ? 1 : -1, sy = rng.below(2) ? 1 : -1;
+    const double r1 = static_cast<double>(1 + rng.below(static_cast<uint64_t>(k * d[2]) - 1));
+    const double r2 = k * d[2] - r1;
+    double bx = x + sx * k * d[0], by = y + sy * k * d[1];
+    if (p % 2) bx = std::nextafter(bx, x);  // one ulp closer: overlapping by a hair
+    t.push_back(2 * p, x, y, 0, 0, r1);
+    t.push_back(2 * p + 1, bx, by, 0, 0, r2);
+  }
+  return t;
+}
+
+void add_giants(DiscTable& t, std::size_t count, Box box, double rmin, double rmax, uint64_t seed) {
+  Rng rng(seed);
+  for (std::size_t i = 0; i < count; ++i) {
+    const double x = rng.uniform(box.xmin, box.xmax), y = rng.uniform(box.ymin, box.ymax);
+    t.push_back(t.size(), x, y, 0, 0, rng.uniform(rmin, rmax));
+  }
+}
+
 void offset(DiscTable& t, double dx, double dy) {
   for (auto& x : t.x) x += dx;
   for (auto& y : t.y) y += dy;

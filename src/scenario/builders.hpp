@@ -49,6 +49,15 @@ struct FieldWorld {
 };
 FieldWorld e5_world(std::size_t n, uint64_t seed);
 
+// Pairs of discs that touch exactly in double arithmetic (centre distance == sum of radii, no
+// overlap by the strict test) along 3-4-5 and 5-12-13 directions, half of them nudged one ulp
+// closer so that they overlap by a hair: the adversarial boundary of every collision filter.
+// 2 * pairs rows, pairs scattered uniformly in the box.
+DiscTable touching(std::size_t pairs, Box box, uint64_t seed);
+
+// Appends `count` giant discs (radius uniform in [rmin, rmax]) at uniform positions in the box.
+void add_giants(DiscTable& t, std::size_t count, Box box, double rmin, double rmax, uint64_t seed);
+
 // Shifts every position by (dx, dy): the far-offset variants (e.g. 1e6).
 void offset(DiscTable& t, double dx, double dy);
 

@@ -64,6 +64,7 @@ struct TickPlan {
   const FtcMethod* ftc = nullptr;      // null: outer avoidance off (w_ftc = 0)
   const FieldMethod* field = nullptr;  // null: inner avoidance off (w_apf = 0)
   const CollisionMethod* collisions = nullptr;
+  bool collisions_fallback = false;  // the forced method does not apply to this tick (see plan())
 };
 
 struct Simulation::Engine {
@@ -83,8 +84,21 @@ struct Simulation::Engine {
   enum Op { kApply, kAttraction, kInner, kOuter, kIntegrate, kBackoff, kCommit, kOpCount };
   OperatorStats ops[kOpCount];
   std::map<std::string, uint64_t> method_ticks;  // "field=naive" -> ticks it was chosen
+  // The agents are known to overlap nowhere at the start of the next tick: the last tick ended
+  // (with backoff on) without an overlapping agent pair and no agent was inserted since. Only
+  // then is a method that finds the collision set but not every pair (nn) exact for the
+  // backoff: every overlap is new, so the set is all the freeze loop needs.
+  bool start_clean = false;
 
-  TickPlan plan(const World& w, const SimConfig& cfg) const {
+  // The access paths for the next tick. A collision method forced by name that does not apply
+  // to this tick (nn while agents still overlap from before, or radii that stopped being equal
+  // through inserts) is replaced by the planner's exact choice for the tick and EXPLAIN ANALYZE
+  // counts it; `strict` (construction) instead rejects a forced method that can never apply:
+  // nn with unequal radii or with backoff off (overlap counts need every pair).
+  TickPlan plan(const World& w, const SimConfig& cfg, bool strict = false) const {
+    return plan(w, cfg, start_clean, strict);
+  }
+  TickPlan plan(const World& w, const SimConfig& cfg, bool clean, bool strict) const {
     TickPlan p;
     const AgentTable& t = w.agents();
     p.rows = t.size();
@@ -99,9 +113,27 @@ struct Simulation::Engine {
     shape.rows = p.rows;
     shape.equal_radii =
         std::all_of(t.radius.begin(), t.radius.end(), [&](double r) { return r == t.radius[0]; });
-    p.collisions = cfg.access.collisions == "auto"
-                       ? &choose_collision_method(shape)
-                       : &find_collision_method(cfg.access.collisions, shape);
+    shape.need_all_pairs = !(cfg.backoff && clean);
+    if (cfg.access.collisions == "auto") {
+      p.collisions = &choose_collision_method(shape);
+      return p;
+    }
+    CollisionQueryShape at_best = shape;
+    at_best.need_all_pairs = !cfg.backoff;
+    if (strict) find_collision_method(cfg.access.collisions, at_best);  // throws Error(usage)
+    const CollisionMethod* forced = nullptr;
+    for (const auto& m : collision_registry())
+      if (m.info.name == cfg.access.collisions) forced = &m;
+    if (!forced) {
+      p.collisions = &find_collision_method(cfg.access.collisions, shape);  // throws: unknown name
+      return p;
+    }
+    if (forced->supports(shape)) {
+      p.collisions = forced;
+    } else {
+      p.collisions = &choose_collision_method(shape);
+      p.collisions_fallback = true;
+    }
     return p;
   }
 
@@ -132,7 +164,7 @@ Simulation::Simulation(World world, SimConfig config)
   engine_ = std::make_unique<Engine>(config_.threads);
   world_.apply_pending();
   engine_->refresh_scene(world_, config_);
-  engine_->plan(world_, config_);  // reject unknown or unsupported methods now, not mid-run
+  engine_->plan(world_, config_, true);  // reject unknown or unsupported methods now, not mid-run
   last_.agents = world_.agents().size();
   last_.state_hash = sim::state_hash(world_.agents(), 0);
 }
@@ -160,7 +192,10 @@ const TickMetrics& Simulation::step() {
   };
 
   // 0. apply the buffered inserts, deletes and re-targets as one batch
-  timed(Engine::kApply, world_.pending_changes(), [&] { world_.apply_pending(); });
+  std::size_t applied = 0;
+  timed(Engine::kApply, world_.pending_changes(), [&] { applied = world_.apply_pending(); });
+  if (applied)
+    e.start_clean = false;  // an insert may overlap (erases and re-targets cannot, but are rare)
   e.refresh_scene(world_, cfg);
   const TickPlan plan = e.plan(world_, cfg);
   AgentTable& t = world_.agents_for_tick();
@@ -170,6 +205,9 @@ const TickMetrics& Simulation::step() {
   e.next.resize(n);
 
   // 1-3. the steering queries, each into its own effect columns
+  if (cfg.nudge_after > 0)
+    for (std::size_t i = 0; i < n; ++i)
+      m.nudged += t.state[i] != AgentState::arrived && t.frozen_ticks[i] >= cfg.nudge_after;
   timed(Engine::kAttraction, n,
         [&] { sim::attraction(t, world_.goals(), cfg, m.tick, e.fx, e.ex); });
   if (plan.field) {
@@ -193,7 +231,8 @@ const TickMetrics& Simulation::step() {
   timed(Engine::kIntegrate, n, [&] { sim::combine_integrate(t, e.fx, cfg, e.next, e.ex); });
 
   // 5. backoff (or, without it, just measure the overlaps)
-  ++e.method_ticks["collisions=" + plan.collisions->info.name];
+  ++e.method_ticks["collisions=" + plan.collisions->info.name +
+                   (plan.collisions_fallback ? " (instead of " + cfg.access.collisions + ")" : "")];
   CollisionPath& cpath = e.path(e.collision_paths, *plan.collisions);
   sim::OverlapReport overlaps;
   timed(Engine::kBackoff, n, [&] {
@@ -206,6 +245,7 @@ const TickMetrics& Simulation::step() {
   });
   m.overlapping_pairs = overlaps.agent_pairs;
   m.obstacle_overlaps = overlaps.obstacle_hits;
+  e.start_clean = cfg.backoff && overlaps.agent_pairs == 0;
 
   // 6. commit: swap in the next state, advance waypoints, arrivals
   timed(Engine::kCommit, n, [&] {
@@ -220,6 +260,8 @@ const TickMetrics& Simulation::step() {
         ++m.frozen;
         t.state[i] = AgentState::frozen;
         ++t.frozen_ticks[i];
+        if (t.frozen_ticks[i] == cfg.gridlock_ticks) ++m.gridlock_started;
+        m.longest_frozen = std::max<std::size_t>(m.longest_frozen, t.frozen_ticks[i]);
       } else {
         t.state[i] = AgentState::active;
         t.frozen_ticks[i] = 0;
@@ -293,10 +335,22 @@ std::string Simulation::explain() const {
   os << "  4 combine+integrate  sum effects; |a| <= max_accel; |v| <= max_speed; p += v dt, dt="
      << num(config_.dt) << "\n";
   os << "  5 "
-     << (config_.backoff ? "backoff            freeze the collision set until empty"
-                         : "overlap count      backoff off: overlaps are only counted")
+     << (config_.backoff
+             ? "backoff            freeze the collision set until empty; one full query, then"
+               " probes of the agents frozen last"
+             : "overlap count      backoff off: overlaps are only counted")
      << "\n       access path: " << p.collisions->info.name << " ("
-     << p.collisions->info.description << ")\n";
+     << p.collisions->info.description << ")";
+  if (p.collisions_fallback)
+    os << " instead of " << config_.access.collisions << ": agents overlap at the start";
+  if (!p.collisions->info.exact) os << "; inexact: the zero-overlap invariant is not guaranteed";
+  os << "\n";
+  // A method that only finds the set (nn) serves once a tick starts with no overlapping agents.
+  const TickPlan clean = e.plan(world_, config_, true, false);
+  if (clean.collisions != p.collisions)
+    os << "       then " << clean.collisions->info.name << " ("
+       << clean.collisions->info.description
+       << ") on ticks that start with no overlapping agents\n";
   os << "  6 commit             swap columns, waypoints, arrivals ("
      << (config_.arrival == ArrivalPolicy::remove ? "remove"
          : config_.arrival == ArrivalPolicy::idle ? "idle"

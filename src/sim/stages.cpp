@@ -17,12 +17,6 @@ bool idle(const AgentTable& t, std::size_t i) {
   return t.state[i] == AgentState::arrived;
 }
 
-// Penetration depth of a disc into a polygon (> 0: overlapping).
-double polygon_depth(std::span<const Vec2> ring, double x, double y, double r) {
-  const double d = std::sqrt(dist2_to_boundary(ring, x, y));
-  return point_in_polygon(ring, x, y) ? r + d : r - d;
-}
-
 }  // namespace
 
 void Effects::reset(std::size_t n) {
@@ -154,66 +148,6 @@ void combine_integrate(const AgentTable& t, const Effects& fx, const SimConfig& 
       next.y[i] = t.y[i] + vy * dt;
     }
   });
-}
-
-OverlapReport find_overlaps(const AgentTable& t, const NextState& next, const StaticScene& scene,
-                            CollisionPath& path, Executor& ex, QueryStats& stats) {
-  const DiscView view{t.size(),       next.x.data(),   next.y.data(),   next.vx.data(),
-                      next.vy.data(), t.radius.data(), t.charge.data(), t.id.data()};
-  CollisionPairs pairs;
-  path.run(view, scene, pairs, ex, stats);
-  OverlapReport r;
-  r.agent_pairs = pairs.agents.size();
-  r.obstacle_hits = pairs.obstacles.size();
-  // A pair that already overlapped at the start of the tick is tolerated while it gets no deeper.
-  for (auto [i, j] : pairs.agents) {
-    const double sx = t.x[j] - t.x[i], sy = t.y[j] - t.y[i];
-    const double nx = next.x[j] - next.x[i], ny = next.y[j] - next.y[i];
-    if (discs_overlap(sx, sy, t.radius[i] + t.radius[j]) && nx * nx + ny * ny >= sx * sx + sy * sy)
-      continue;
-    r.violators.push_back(i);
-    r.violators.push_back(j);
-  }
-  for (const auto& [i, with] : pairs.obstacles) {
-    const double r_i = t.radius[i];
-    bool tolerated;
-    if (with.kind == Collider::Kind::circle) {
-      const CircleObstacle& c = scene.circles()[with.row];
-      const double sx = c.x - t.x[i], sy = c.y - t.y[i], nx = c.x - next.x[i], ny = c.y - next.y[i];
-      tolerated = discs_overlap(sx, sy, r_i + c.radius) && nx * nx + ny * ny >= sx * sx + sy * sy;
-    } else {
-      const auto& ring = scene.polygons()[with.row].vertices;
-      const double before = polygon_depth(ring, t.x[i], t.y[i], r_i);
-      tolerated = before > 0 && polygon_depth(ring, next.x[i], next.y[i], r_i) <= before;
-    }
-    if (!tolerated) r.violators.push_back(i);
-  }
-  std::sort(r.violators.begin(), r.violators.end());
-  r.violators.erase(std::unique(r.violators.begin(), r.violators.end()), r.violators.end());
-  return r;
-}
-
-OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& scene,
-                      CollisionPath& path, Executor& ex, QueryStats& stats,
-                      std::size_t& iterations) {
-  iterations = 0;
-  for (;;) {
-    OverlapReport r = find_overlaps(t, next, scene, path, ex, stats);
-    ++iterations;
-    bool froze = false;
-    for (uint32_t i : r.violators) {
-      if (next.frozen[i]) continue;
-      // Freezing returns the agent to its start-of-tick position with zero velocity. The frozen
-      // set only grows and an all-frozen world is the previous (valid) state, so this ends.
-      next.frozen[i] = 1;
-      next.x[i] = t.x[i];
-      next.y[i] = t.y[i];
-      next.vx[i] = 0;
-      next.vy[i] = 0;
-      froze = true;
-    }
-    if (!froze) return r;
-  }
 }
 
 uint64_t state_hash(const AgentTable& t, uint64_t tick) {

@@ -56,15 +56,35 @@ struct OverlapReport {
   std::vector<uint32_t> violators;  // rows in a new or deepened overlap, sorted, unique
 };
 
-// Finds overlaps among the next-state positions with the planned collision method.
+// Is the overlapping pair (i, j) (next-state positions) a violation: new, or deeper than at the
+// start of the tick? A pair that already overlapped is tolerated while its centres get no closer.
+bool pair_violates(const AgentTable& t, const NextState& next, uint32_t i, uint32_t j);
+// The same for agent i overlapping an obstacle (depth for polygons, centre distance for circles).
+bool obstacle_violates(const AgentTable& t, const NextState& next, const StaticScene& scene,
+                       uint32_t i, Collider with);
+
+// Finds overlaps among the next-state positions with the planned collision method (one query).
 OverlapReport find_overlaps(const AgentTable& t, const NextState& next, const StaticScene& scene,
                             CollisionPath& path, Executor& ex, QueryStats& stats);
 
-// Backoff: freeze the violators (back to the start position, zero velocity) until none is left.
-// Returns the overlaps of the final state and the number of iterations in `iterations`.
+// Backoff (DESIGN.md §3.2): freeze the violators (back to the start position, zero velocity)
+// until none is left. Returns the overlaps of the final state (exact counts, and no violators)
+// and the number of iterations in `iterations` (1 when nothing had to be frozen).
+//
+// One full collision query, then only probes: after a freeze, a pair can only become a new
+// violation if one of its agents moved, i.e. was frozen in the previous iteration, so iteration
+// k+1 asks just for the overlaps of the agents frozen in iteration k (through a DiscGrid over the
+// current positions). The frozen sets, iterations and final counts are those of the plain loop
+// that re-runs the full query every iteration (backoff_reference; tested equal).
 OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& scene,
                       CollisionPath& path, Executor& ex, QueryStats& stats,
                       std::size_t& iterations);
+
+// The plain loop of DESIGN.md §3.2: find the violators with a full query, freeze them, repeat.
+// The oracle for backoff() (tests), and the thesis's algorithm as written.
+OverlapReport backoff_reference(const AgentTable& t, NextState& next, const StaticScene& scene,
+                                CollisionPath& path, Executor& ex, QueryStats& stats,
+                                std::size_t& iterations);
 
 // Hash of the committed state: tick, then per row id, position, velocity and state bits.
 uint64_t state_hash(const AgentTable& t, uint64_t tick);

@@ -31,6 +31,7 @@ struct RunOptions {
   bool explain = false, analyze = false, quiet = false, no_backoff = false;
   int threads = 0;
   int64_t every = 0;
+  int64_t nudge_after = -1;
   std::string ftc, field, collisions;
 };
 
@@ -50,6 +51,7 @@ void apply_overrides(Scenario& sc, const RunOptions& o) {
   if (o.ticks >= 0) sc.ticks = static_cast<uint64_t>(o.ticks);
   if (o.threads > 0) sc.config.threads = o.threads;
   if (o.no_backoff) sc.config.backoff = false;
+  if (o.nudge_after >= 0) sc.config.nudge_after = static_cast<uint32_t>(o.nudge_after);
   if (!o.ftc.empty()) sc.config.access.ftc = o.ftc;
   if (!o.field.empty()) sc.config.access.field = o.field;
   if (!o.collisions.empty()) sc.config.access.collisions = o.collisions;
@@ -85,6 +87,9 @@ int run(const RunOptions& o) {
   const std::size_t agents_at_start = sim.world().agents().size();
   std::vector<double> tick_seconds;
   std::size_t max_pairs = 0, max_obstacle = 0, frozen_total = 0;
+  std::size_t iterations_total = 0, iterations_max = 0, gridlock_max = 0, gridlock_streaks = 0;
+  std::size_t longest_frozen = 0, nudged_total = 0;
+  uint64_t last_arrival = 0;
   Stopwatch clock, progress_clock;
   try {
     if (writer) writer->frame(0, sim.world());
@@ -97,6 +102,13 @@ int run(const RunOptions& o) {
       max_pairs = std::max(max_pairs, m.overlapping_pairs);
       max_obstacle = std::max(max_obstacle, m.obstacle_overlaps);
       frozen_total += m.frozen;
+      iterations_total += m.freeze_iterations;
+      iterations_max = std::max(iterations_max, m.freeze_iterations);
+      gridlock_max = std::max(gridlock_max, m.gridlocked);
+      gridlock_streaks += m.gridlock_started;
+      longest_frozen = std::max(longest_frozen, m.longest_frozen);
+      nudged_total += m.nudged;
+      if (m.arrived) last_arrival = m.tick;
       if (writer) {
         writer->frame(t, sim.world());  // the writer keeps every n-th frame
         writer->metrics(m);
@@ -143,12 +155,27 @@ int run(const RunOptions& o) {
        << (sc.config.threads > 1 ? "s" : "") << ")";
   }
   os << "\n  agents: " << agents_at_start << " at start, " << sim.world().agents().size()
-     << " at end; arrived " << sim.arrived_total() << "\n  overlaps after a tick: at most "
+     << " at end; arrived " << sim.arrived_total();
+  if (last_arrival) os << " (the last at tick " << last_arrival << ")";
+  os << "\n  overlaps after a tick: at most "
      << max_pairs << " agent pairs and " << max_obstacle << " agent-obstacle; at the end "
      << sim.last_metrics().overlapping_pairs
      << " pairs\n  backoff: " << (sc.config.backoff ? "on" : "off") << ", " << frozen_total
-     << " agent-ticks frozen, " << sim.last_metrics().gridlocked
-     << " agents gridlocked at the end\n  final state hash " << hex(sim.state_hash()) << "\n";
+     << " agent-ticks frozen";
+  if (sc.config.backoff && sc.ticks > 0)
+    os << ", freeze rounds per tick mean "
+       << static_cast<double>(iterations_total) / static_cast<double>(sc.ticks) << " max "
+       << iterations_max;
+  os << "\n  gridlock (frozen " << sc.config.gridlock_ticks
+     << "+ ticks in a row): " << gridlock_streaks << " streaks reached it, at most " << gridlock_max
+     << " agents at once, " << sim.last_metrics().gridlocked
+     << " at the end; longest frozen streak " << longest_frozen << " ticks\n  nudge: ";
+  if (sc.config.nudge_after)
+    os << "sidestep after " << sc.config.nudge_after << " frozen ticks, " << nudged_total
+       << " agent-ticks nudged";
+  else
+    os << "off (nudge_after = 0)";
+  os << "\n  final state hash " << hex(sim.state_hash()) << "\n";
   if (writer)
     os << "  trajectories: " << sc.output.path << " ("
        << (sc.output.format == OutputSpec::Format::csv ? "csv" : "sqlite, JuPedSim format v3")
@@ -177,6 +204,10 @@ void add_run_command(CLI::App& app, Action& action) {
   sub->add_option("--threads", o.threads, "threads (results do not depend on it)")
       ->check(CLI::Range(1, 256));
   sub->add_flag("--no-backoff", o.no_backoff, "switch the backoff freeze loop off");
+  sub->add_option("--nudge-after", o.nudge_after,
+                  "sidestep agents frozen this many ticks in a row; 0 = never (overrides the "
+                  "file's nudge_after)")
+      ->check(CLI::Range(int64_t{0}, int64_t{1} << 30));
   sub->add_option("--ftc", o.ftc, "first-to-collide access path (auto, naive, ...)");
   sub->add_option("--field", o.field, "potential-field access path (auto, naive, ...)");
   sub->add_option("--collisions", o.collisions, "collision-set access path (auto, naive, ...)");

@@ -1,0 +1,221 @@
+// The backoff stage: classification of overlaps, the incremental freeze loop, and the plain loop
+// it is tested against. See stages.hpp for the contract.
+#include <algorithm>
+#include <cmath>
+
+#include "index/collisions_grid.hpp"
+#include "query/naive_paths.hpp"
+#include "sim/stages.hpp"
+#include "world/geometry.hpp"
+
+namespace crowddb::sim {
+namespace {
+
+// Penetration depth of a disc into a polygon (> 0: overlapping).
+double polygon_depth(std::span<const Vec2> ring, double x, double y, double r) {
+  const double d = std::sqrt(dist2_to_boundary(ring, x, y));
+  return point_in_polygon(ring, x, y) ? r + d : r - d;
+}
+
+DiscView next_view(const AgentTable& t, const NextState& next) {
+  return {t.size(),       next.x.data(),   next.y.data(),   next.vx.data(),
+          next.vy.data(), t.radius.data(), t.charge.data(), t.id.data()};
+}
+
+void freeze(const AgentTable& t, NextState& next, uint32_t i) {
+  // Back to the start-of-tick position with zero velocity. The frozen set only grows and an
+  // all-frozen world is the previous (valid) state, so the loop ends.
+  next.frozen[i] = 1;
+  next.x[i] = t.x[i];
+  next.y[i] = t.y[i];
+  next.vx[i] = 0;
+  next.vy[i] = 0;
+}
+
+// Overlaps of single discs against the current (next-state) positions of all agents, for the
+// probes of the freeze loop. Agents frozen after the grid was built sit elsewhere now: their
+// grid entries are skipped and they are checked one by one until there are enough of them to
+// rebuild. Small probe batches on small tables skip the grid altogether.
+class OverlapProbe {
+ public:
+  explicit OverlapProbe(const DiscView& view) : view_(view), stale_(view.n, 0) {}
+
+  void prepare(std::size_t probes) {
+    if (built_ || probes * view_.n <= kBruteWork) return;
+    grid_.build(view_);
+    built_ = grid_.usable();
+  }
+  void moved(std::span<const uint32_t> rows) {
+    if (!built_) return;
+    for (uint32_t r : rows)
+      if (!stale_[r]) {
+        stale_[r] = 1;
+        moved_.push_back(r);
+      }
+    if (moved_.size() > std::max<std::size_t>(64, view_.n / 8)) {
+      grid_.build(view_);
+      for (uint32_t r : moved_) stale_[r] = 0;
+      moved_.clear();
+    }
+  }
+  template <class F>
+  void for_each_overlap(uint32_t a, F&& fn) const {
+    const double x = view_.x[a], y = view_.y[a], r = view_.radius[a];
+    auto test = [&](uint32_t b) {
+      if (b != a && discs_overlap(view_.x[b] - x, view_.y[b] - y, r + view_.radius[b])) fn(b);
+    };
+    if (!built_) {
+      for (std::size_t b = 0; b < view_.n; ++b) test(static_cast<uint32_t>(b));
+      return;
+    }
+    grid_.for_each_overlap(x, y, r, [&](uint32_t b) {
+      if (!stale_[b] && b != a) fn(b);
+    });
+    for (uint32_t b : moved_) test(b);
+  }
+
+ private:
+  static constexpr std::size_t kBruteWork = 1 << 16;  // pair tests below which a scan is cheaper
+  DiscView view_;
+  index::DiscGrid grid_;
+  bool built_ = false;
+  std::vector<uint8_t> stale_;
+  std::vector<uint32_t> moved_;
+};
+
+}  // namespace
+
+bool pair_violates(const AgentTable& t, const NextState& next, uint32_t i, uint32_t j) {
+  const double sx = t.x[j] - t.x[i], sy = t.y[j] - t.y[i];
+  const double nx = next.x[j] - next.x[i], ny = next.y[j] - next.y[i];
+  return !(discs_overlap(sx, sy, t.radius[i] + t.radius[j]) &&
+           nx * nx + ny * ny >= sx * sx + sy * sy);
+}
+
+bool obstacle_violates(const AgentTable& t, const NextState& next, const StaticScene& scene,
+                       uint32_t i, Collider with) {
+  const double r_i = t.radius[i];
+  if (with.kind == Collider::Kind::circle) {
+    const CircleObstacle& c = scene.circles()[with.row];
+    const double sx = c.x - t.x[i], sy = c.y - t.y[i], nx = c.x - next.x[i], ny = c.y - next.y[i];
+    return !(discs_overlap(sx, sy, r_i + c.radius) && nx * nx + ny * ny >= sx * sx + sy * sy);
+  }
+  const auto& ring = scene.polygons()[with.row].vertices;
+  const double before = polygon_depth(ring, t.x[i], t.y[i], r_i);
+  return !(before > 0 && polygon_depth(ring, next.x[i], next.y[i], r_i) <= before);
+}
+
+namespace {
+
+OverlapReport classify(const AgentTable& t, const NextState& next, const StaticScene& scene,
+                       const CollisionPairs& pairs) {
+  OverlapReport r;
+  r.agent_pairs = pairs.agents.size();
+  r.obstacle_hits = pairs.obstacles.size();
+  for (auto [i, j] : pairs.agents)
+    if (pair_violates(t, next, i, j)) {
+      r.violators.push_back(i);
+      r.violators.push_back(j);
+    }
+  for (const auto& [i, with] : pairs.obstacles)
+    if (obstacle_violates(t, next, scene, i, with)) r.violators.push_back(i);
+  std::sort(r.violators.begin(), r.violators.end());
+  r.violators.erase(std::unique(r.violators.begin(), r.violators.end()), r.violators.end());
+  return r;
+}
+
+}  // namespace
+
+OverlapReport find_overlaps(const AgentTable& t, const NextState& next, const StaticScene& scene,
+                            CollisionPath& path, Executor& ex, QueryStats& stats) {
+  CollisionPairs pairs;
+  path.run(next_view(t, next), scene, pairs, ex, stats);
+  return classify(t, next, scene, pairs);
+}
+
+OverlapReport backoff_reference(const AgentTable& t, NextState& next, const StaticScene& scene,
+                                CollisionPath& path, Executor& ex, QueryStats& stats,
+                                std::size_t& iterations) {
+  iterations = 0;
+  for (;;) {
+    OverlapReport r = find_overlaps(t, next, scene, path, ex, stats);
+    ++iterations;
+    bool froze = false;
+    for (uint32_t i : r.violators)
+      if (!next.frozen[i]) {
+        freeze(t, next, i);
+        froze = true;
+      }
+    if (!froze) return r;
+  }
+}
+
+OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& scene,
+                      CollisionPath& path, Executor& ex, QueryStats& stats,
+                      std::size_t& iterations) {
+  const DiscView view = next_view(t, next);
+  CollisionPairs first;
+  path.run(view, scene, first, ex, stats);
+  iterations = 1;
+  OverlapReport report = classify(t, next, scene, first);
+  if (report.violators.empty()) return report;
+
+  // stamp[i]: the iteration that froze i (0: never). Agents already frozen on entry keep 0 and
+  // are treated as unmoved: the loop only tracks what it moves itself.
+  std::vector<uint32_t> stamp(t.size(), 0);
+  std::vector<uint32_t> newly;
+  for (uint32_t i : report.violators)
+    if (!next.frozen[i]) {
+      freeze(t, next, i);
+      stamp[i] = 1;
+      newly.push_back(i);
+    }
+  // Pairs found by probes, with the stamp of the probing agent: such a pair still holds at the
+  // end iff its other agent did not move later (never frozen, or frozen no later).
+  struct Found {
+    uint32_t a, b, k;
+  };
+  std::vector<Found> found;
+  OverlapProbe probe(view);
+  std::vector<uint32_t> next_new;
+  uint32_t k = 1;
+  while (!newly.empty()) {
+    ++iterations;
+    probe.moved(newly);  // only matters when the grid was built before they were frozen
+    probe.prepare(newly.size());
+    next_new.clear();
+    for (uint32_t a : newly) {
+      probe.for_each_overlap(a, [&](uint32_t b) {
+        if (stamp[b] == k && b < a) return;  // frozen together: found from b's side
+        found.push_back({a, b, k});
+        if (!next.frozen[b] && pair_violates(t, next, std::min(a, b), std::max(a, b)))
+          next_new.push_back(b);
+      });
+    }
+    std::sort(next_new.begin(), next_new.end());
+    next_new.erase(std::unique(next_new.begin(), next_new.end()), next_new.end());
+    ++k;
+    for (uint32_t b : next_new) {
+      freeze(t, next, b);
+      stamp[b] = k;
+    }
+    newly.swap(next_new);
+    stats.rows += newly.size();
+  }
+
+  // Final overlaps: pairs of the first query whose agents both stayed, plus the probe pairs that
+  // still hold; obstacle hits of agents that stayed, plus those of the moved agents where they are.
+  report = {};
+  for (auto [i, j] : first.agents) report.agent_pairs += stamp[i] == 0 && stamp[j] == 0;
+  for (const Found& f : found) report.agent_pairs += stamp[f.b] == 0 || stamp[f.b] <= f.k;
+  for (const auto& hit : first.obstacles) report.obstacle_hits += stamp[hit.first] == 0;
+  if (!scene.empty()) {
+    std::vector<std::pair<uint32_t, Collider>> hits;
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (stamp[i]) disc_obstacle_overlaps(view, scene, i, i + 1, hits);
+    report.obstacle_hits += hits.size();
+  }
+  return report;
+}
+
+}  // namespace crowddb::sim

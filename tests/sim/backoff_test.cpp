@@ -1,0 +1,336 @@
+// The freeze loop (DESIGN.md §3.2): the incremental loop equals the plain one; the metrics; the
+// invariant on short runs of the shipped scenarios (the long runs: backoff_slow_test.cpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "plan/access_path.hpp"
+#include "sim/invariant.hpp"
+#include "sim/stages.hpp"
+#include "util/rng.hpp"
+
+namespace crowddb::sim {
+namespace {
+
+// A tick frozen just before the backoff: start positions in `t`, tentative ones in `next`.
+struct Tentative {
+  AgentTable t;
+  NextState next;
+  StaticScene scene;
+};
+
+// n agents; start positions on a jittered lattice (overlap-free unless `spawn_overlaps`), each
+// moving up to `reach` lattice spacings this tick; some idle. Circles, a polygon and walls.
+Tentative make_tick(std::size_t n, uint64_t seed, bool equal_radii, bool spawn_overlaps,
+                    double reach) {
+  Rng rng(seed);
+  Tentative k;
+  AgentTable& t = k.t;
+  const double rmax = 1.5, spacing = 2 * rmax + 0.2;
+  const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = equal_radii ? rmax : rng.uniform(0.6, rmax);
+    double x = static_cast<double>(i % side) * spacing + rng.uniform(-0.1, 0.1);
+    double y = static_cast<double>(i / side) * spacing + rng.uniform(-0.1, 0.1);
+    if (spawn_overlaps && i % 7 == 0) x += spacing * 0.6;  // overlaps its east neighbour
+    t.x.push_back(x);
+    t.y.push_back(y);
+    t.vx.push_back(0);
+    t.vy.push_back(0);
+    t.radius.push_back(r);
+    t.charge.push_back(1);
+    t.id.push_back(1000 + i);
+  }
+  k.next.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    double vx = 0, vy = 0;
+    if (i % 11 != 0) {  // every 11th agent stays put (as idle agents do)
+      vx = rng.uniform(-1, 1) * reach * spacing;
+      vy = rng.uniform(-1, 1) * reach * spacing;
+    }
+    k.next.vx[i] = vx;
+    k.next.vy[i] = vy;
+    k.next.x[i] = t.x[i] + vx;
+    k.next.y[i] = t.y[i] + vy;
+  }
+  const double w = static_cast<double>(side) * spacing;
+  std::vector<CircleObstacle> circles = {{w * 0.3, w * 0.3, 4, 1}, {w * 0.7, w * 0.6, 6, 1}};
+  std::vector<PolygonObstacle> polys = {
+      {{{w * 0.5, w * 0.1}, {w * 0.6, w * 0.1}, {w * 0.55, w * 0.25}}, 1}};
+  const Bounds walls{-1, -1, w, w};
+  k.scene = StaticScene(circles, polys, 1, ObstacleCharges::centres, &walls);
+  return k;
+}
+
+std::unique_ptr<CollisionPath> make_path(const std::string& name) {
+  CollisionQueryShape any;
+  any.equal_radii = true;
+  return find_collision_method(name, any).make();
+}
+
+TEST(Backoff, IncrementalLoopEqualsThePlainLoop) {
+  Executor ex(1);
+  std::size_t cascades = 0, grid_probes = 0;
+  const std::pair<std::size_t, uint64_t> sizes[] = {{40, 1},  {40, 2},  {40, 3},  {600, 1},
+                                                    {600, 2}, {600, 3}, {4000, 1}};
+  for (const auto& [n, seed] : sizes)
+    for (bool equal : {false, true})
+      for (bool spawn : {false, true})
+        for (double reach : {0.3, 1.0}) {
+          SCOPED_TRACE("n " + std::to_string(n) + " seed " + std::to_string(seed) +
+                       (equal ? " equal" : "") + (spawn ? " spawned overlaps" : "") + " reach " +
+                       std::to_string(reach));
+          const Tentative k = make_tick(n, seed, equal, spawn, reach);
+          NextState plain = k.next;
+          std::size_t plain_iter = 0;
+          QueryStats st;
+          const OverlapReport want =
+              backoff_reference(k.t, plain, k.scene, *make_path("naive"), ex, st, plain_iter);
+          ASSERT_TRUE(want.violators.empty());
+          cascades += plain_iter >= 3;
+          grid_probes += n * 50 > (1 << 16) && plain_iter >= 2;
+          std::vector<std::string> methods = {"naive", "grid", "sweep"};
+          if (equal && !spawn) methods.push_back("nn");  // nn is exact for the backoff only then
+          for (const std::string& m : methods) {
+            SCOPED_TRACE(m);
+            NextState got = k.next;
+            std::size_t iter = 0;
+            const OverlapReport r = backoff(k.t, got, k.scene, *make_path(m), ex, st, iter);
+            EXPECT_EQ(iter, plain_iter);
+            EXPECT_EQ(r.agent_pairs, want.agent_pairs);
+            EXPECT_EQ(r.obstacle_hits, want.obstacle_hits);
+            EXPECT_TRUE(r.violators.empty());
+            EXPECT_EQ(got.frozen, plain.frozen);
+            EXPECT_EQ(got.x, plain.x);
+            EXPECT_EQ(got.y, plain.y);
+            EXPECT_EQ(got.vx, plain.vx);
+            EXPECT_EQ(got.vy, plain.vy);
+          }
+        }
+  EXPECT_GT(cascades, 20u);    // freezes that cause further freezes
+  EXPECT_GE(grid_probes, 6u);  // large enough for the probes to use the grid
+}
+
+TEST(Backoff, ChainOfFreezesTakesOneIterationPerLink) {
+  // Four discs of radius 1 in a row, 2.5 apart. The last stays; each other one steps right,
+  // clear of its neighbour's tentative position but not of its start position: 2 and 3 clash,
+  // then freezing 2 traps 1, then freezing 1 traps 0. Four rounds, all four frozen.
+  Tentative k;
+  for (int i = 0; i < 4; ++i) {
+    k.t.x.push_back(2.5 * i);
+    k.t.y.push_back(0);
+    k.t.vx.push_back(0);
+    k.t.vy.push_back(0);
+    k.t.radius.push_back(1);
+    k.t.charge.push_back(1);
+    k.t.id.push_back(i);
+  }
+  k.next.resize(4);
+  const double to[4] = {0.9, 3.3, 5.6, 7.5};
+  for (int i = 0; i < 4; ++i) {
+    k.next.x[i] = to[i];
+    k.next.y[i] = 0;
+    k.next.vx[i] = to[i] - k.t.x[i];
+    k.next.vy[i] = 0;
+  }
+  Executor ex(1);
+  QueryStats st;
+  for (const std::string m : {"naive", "grid", "sweep", "nn"}) {
+    NextState s = k.next;
+    std::size_t iter = 0;
+    const OverlapReport r = backoff(k.t, s, k.scene, *make_path(m), ex, st, iter);
+    EXPECT_EQ(iter, 4u) << m;
+    EXPECT_EQ(s.frozen, (std::vector<uint8_t>{1, 1, 1, 1})) << m;
+    EXPECT_EQ(s.x, k.t.x) << m;
+    EXPECT_EQ(r.agent_pairs, 0u) << m;
+  }
+}
+
+World two_agents_head_on() {
+  World w(Bounds{0, 0, 100, 100});
+  w.add_goal({"east", 90, 50, 1, 1});
+  w.add_goal({"west", 10, 50, 1, 1});
+  AgentSpec a;
+  a.x = 40;
+  a.y = 50;
+  a.max_speed = 1;
+  a.goal = 0;
+  w.insert(a);
+  a.x = 60;
+  a.goal = 1;
+  w.insert(a);
+  return w;
+}
+
+TEST(Backoff, TickMetricsCountFrozenAgentsAndIterations) {
+  SimConfig cfg;
+  cfg.steering.w_apf = 0;  // no avoidance: they walk into each other
+  cfg.steering.w_ftc = 0;
+  cfg.nudge_after = 0;
+  cfg.gridlock_ticks = 5;
+  Simulation sim(two_agents_head_on(), cfg);
+  std::size_t first_freeze = 0, streak = 0;
+  for (int k = 1; k <= 40; ++k) {
+    const auto before = sim.world().agents().x;
+    const TickMetrics& m = sim.step();
+    if (m.frozen && !first_freeze) {
+      first_freeze = static_cast<std::size_t>(k);
+      EXPECT_EQ(m.frozen, 2u);
+      EXPECT_EQ(m.freeze_iterations, 2u);  // one round freezes both, the next finds nothing
+      EXPECT_EQ(sim.world().agents().x, before);
+      EXPECT_EQ(sim.world().agents().vx, (std::vector<double>{0, 0}));
+    }
+    if (!m.frozen) {
+      EXPECT_EQ(m.freeze_iterations, 1u);
+    }
+    EXPECT_EQ(m.overlapping_pairs, 0u);
+    // Both or neither are frozen; gridlock: 5 frozen ticks in a row.
+    EXPECT_TRUE(m.frozen == 0 || m.frozen == 2);
+    streak = m.frozen ? streak + 1 : 0;
+    EXPECT_EQ(m.longest_frozen, streak);
+    EXPECT_EQ(m.gridlocked, streak >= 5 ? 2u : 0u);
+    EXPECT_EQ(m.gridlock_started, streak == 5 ? 2u : 0u);
+  }
+  EXPECT_GT(first_freeze, 5u);
+  EXPECT_LT(first_freeze, 20u);
+  EXPECT_GE(streak, 10u);  // head-on without a sidestep: they stay stuck
+}
+
+TEST(Backoff, NudgingBreaksAHeadOnDeadlock) {
+  SimConfig cfg;
+  cfg.steering.w_apf = 0;
+  cfg.steering.w_ftc = 0;
+  cfg.nudge_after = 2;
+  Simulation sim(two_agents_head_on(), cfg);
+  std::size_t nudged = 0;
+  for (int k = 0; k < 200 && sim.world().agents().size(); ++k) nudged += sim.step().nudged;
+  EXPECT_GT(nudged, 0u);
+  EXPECT_EQ(sim.arrived_total(), 2u);  // both got past each other
+}
+
+// Agents spawned overlapping in clumps: the tolerated overlaps never deepen, new ones never
+// appear, and the overlap metrics equal the brute-force counts.
+World spawned_overlapping(bool equal_radii) {
+  World w(Bounds{0, 0, 120, 120});
+  w.add_goal({"a", 110, 110, 1, 3});
+  w.add_goal({"b", 10, 110, 1, 3});
+  Rng rng(9);
+  for (int c = 0; c < 12; ++c) {
+    const double cx = rng.uniform(20, 100), cy = rng.uniform(20, 100);
+    for (int i = 0; i < 6; ++i) {
+      AgentSpec s;
+      s.x = cx + rng.uniform(-1.5, 1.5);
+      s.y = cy + rng.uniform(-1.5, 1.5);
+      s.radius = equal_radii ? 1.2 : rng.uniform(0.8, 1.6);
+      s.max_speed = 1;
+      s.max_accel = 0.5;
+      s.goal = static_cast<uint32_t>(c % 2);
+      w.insert(s);
+    }
+  }
+  return w;
+}
+
+TEST(Backoff, PreExistingOverlapsNeverDeepen) {
+  for (bool equal : {false, true}) {
+    SimConfig cfg;
+    cfg.steering.w_apf = 2;
+    cfg.steering.w_ftc = 2;
+    cfg.arrival = ArrivalPolicy::idle;
+    Simulation sim(spawned_overlapping(equal), cfg);
+    ASSERT_FALSE(test::initially_overlap_free(sim.world(), cfg));
+    const test::RunResult r = test::run_checked(sim, 150);
+    EXPECT_EQ(r.bad, 0u);
+    EXPECT_EQ(r.metric_mismatch, 0u);
+    EXPECT_GT(r.overlaps_at_end,
+              50u);  // the spawned overlaps persist for a while: the case is real
+  }
+}
+
+TEST(Backoff, ForcedNnFallsBackWhileAgentsOverlapAndMatchesGrid) {
+  SimConfig cfg;
+  cfg.steering.w_apf = 2;
+  cfg.steering.w_ftc = 2;
+  cfg.arrival = ArrivalPolicy::idle;
+  cfg.access.collisions = "nn";
+  Simulation nn(spawned_overlapping(true), cfg);
+  const test::RunResult a = test::run_checked(nn, 150);
+  cfg.access.collisions = "grid";
+  Simulation grid(spawned_overlapping(true), cfg);
+  const test::RunResult b = test::run_checked(grid, 150, false);
+  EXPECT_EQ(a.bad, 0u);
+  EXPECT_EQ(a.hashes, b.hashes);
+  const std::string plan = nn.explain_analyze();
+  EXPECT_NE(plan.find("(instead of nn)"), std::string::npos) << plan;
+  EXPECT_NE(plan.find("collisions=nn x"), std::string::npos) << plan;  // used once clean
+}
+
+TEST(Backoff, ForcedNnIsRejectedWhereItCanNeverServe) {
+  SimConfig cfg;
+  cfg.access.collisions = "nn";
+  EXPECT_THROW(Simulation(spawned_overlapping(false), cfg), Error);  // unequal radii
+  cfg.backoff = false;  // overlap counts need every pair
+  EXPECT_THROW(Simulation(spawned_overlapping(true), cfg), Error);
+}
+
+// Short runs of the shipped scenarios; backoff_slow_test.cpp runs > 10^4 ticks of them.
+struct ScenarioRun {
+  std::string name;
+  uint64_t ticks;
+  std::function<void(nlohmann::json&)> edit;
+};
+
+TEST(Backoff, ShippedScenariosKeepTheInvariantAndAllExactMethodsAgree) {
+  const std::vector<ScenarioRun> runs = {
+      {"circle", 250, [](nlohmann::json&) {}},
+      {"bottleneck", 300, [](nlohmann::json&) {}},
+      {"airport", 60,
+       [](nlohmann::json& j) {  // a denser, smaller hall: 500 travellers on 250 x 250, field off
+         j["bounds"] = {0, 0, 250, 250};
+         j["groups"][0]["count"] = 500;
+         j["groups"][0]["placement"]["region"] = {8, 8, 242, 242};
+         for (auto& g : j["goals"]) {
+           g["x"] = g["x"].get<double>() / 2;
+           g["y"] = g["y"].get<double>() / 2;
+         }
+         for (auto& o : j["obstacles"]) {
+           o["x"] = o["x"].get<double>() / 2;
+           o["y"] = o["y"].get<double>() / 2;
+           o["radius"] = o["radius"].get<double>() / 2;
+         }
+         j["steering"]["w_apf"] = 0;
+       }},
+  };
+  for (const auto& run : runs) {
+    SCOPED_TRACE(run.name);
+    std::vector<uint64_t> reference;
+    std::size_t frozen = 0;
+    for (const std::string m : {"naive", "grid", "sweep", "nn"}) {
+      Scenario sc = test::load_edited(run.name, [&](nlohmann::json& j) {
+        run.edit(j);
+        j["access"]["collisions"] = m;
+      });
+      const bool equal =
+          std::all_of(sc.world.agents().radius.begin(), sc.world.agents().radius.end(),
+                      [&](double r) { return r == sc.world.agents().radius.front(); });
+      if (m == "nn" && !equal) continue;
+      sc.world.apply_pending();
+      ASSERT_TRUE(test::initially_overlap_free(sc.world, sc.config));
+      Simulation sim(std::move(sc.world), sc.config);
+      const test::RunResult r = test::run_checked(sim, run.ticks, m == "naive" || m == "grid");
+      EXPECT_EQ(r.bad, 0u) << m;
+      EXPECT_EQ(r.overlaps_at_end, 0u) << m;
+      EXPECT_EQ(r.metric_mismatch, 0u) << m;
+      if (reference.empty()) {
+        reference = r.hashes;
+        frozen = r.frozen_total;
+      } else {
+        EXPECT_EQ(r.hashes, reference) << m;
+      }
+    }
+    EXPECT_GT(frozen, 0u);  // the backoff had work to do
+  }
+}
+
+}  // namespace
+}  // namespace crowddb::sim
