@@ -26,7 +26,7 @@ struct RunOptions {
   int64_t ticks = -1;
   std::string out, format;
   bool no_output = false;
-  bool explain = false, analyze = false, quiet = false, no_backoff = false;
+  bool explain = false, analyze = false, quiet = false, no_backoff = false, no_navigation = false;
   int threads = 0;
   int64_t every = 0;
   std::string ftc, field, collisions;
@@ -47,6 +47,7 @@ void apply_overrides(Scenario& sc, const RunOptions& o) {
   if (o.ticks >= 0) sc.ticks = static_cast<uint64_t>(o.ticks);
   if (o.threads > 0) sc.config.threads = o.threads;
   if (o.no_backoff) sc.config.backoff = false;
+  if (o.no_navigation) sc.config.navigation.enabled = false;
   if (!o.ftc.empty()) sc.config.access.ftc = o.ftc;
   if (!o.field.empty()) sc.config.access.field = o.field;
   if (!o.collisions.empty()) sc.config.access.collisions = o.collisions;
@@ -165,6 +166,8 @@ void add_run_command(CLI::App& app, Action& action) {
   sub->add_flag("--explain-analyze", o.analyze, "run, then print the plan with rows and time per operator");
   sub->add_option("--threads", o.threads, "threads (results do not depend on it)")->check(CLI::Range(1, 256));
   sub->add_flag("--no-backoff", o.no_backoff, "switch the backoff freeze loop off");
+  sub->add_flag("--no-navigation", o.no_navigation,
+                "switch the path service off (agents steer straight at their goals)");
   sub->add_option("--ftc", o.ftc, "first-to-collide access path (auto, naive, ...)");
   sub->add_option("--field", o.field, "potential-field access path (auto, naive, ...)");
   sub->add_option("--collisions", o.collisions, "collision-set access path (auto, naive, ...)");
