@@ -35,7 +35,8 @@ struct DiscView {
 
   std::size_t count() const { return n; }
   static DiscView of(const AgentTable& t) {
-    return {t.size(), t.x.data(), t.y.data(), t.vx.data(), t.vy.data(), t.radius.data(), t.charge.data(), t.id.data()};
+    return {t.size(),    t.x.data(),      t.y.data(),      t.vx.data(),
+            t.vy.data(), t.radius.data(), t.charge.data(), t.id.data()};
   }
 };
 
@@ -46,7 +47,8 @@ struct DiscTable {
   std::vector<uint64_t> id;
 
   std::size_t size() const { return x.size(); }
-  void push_back(uint64_t row_id, double px, double py, double pvx, double pvy, double r, double c = 1) {
+  void push_back(uint64_t row_id, double px, double py, double pvx, double pvy, double r,
+                 double c = 1) {
     id.push_back(row_id);
     x.push_back(px);
     y.push_back(py);
@@ -56,13 +58,15 @@ struct DiscTable {
     charge.push_back(c);
   }
   DiscView view() const {
-    return {x.size(), x.data(), y.data(), vx.data(), vy.data(), radius.data(), charge.data(), id.data()};
+    return {x.size(),  x.data(),      y.data(),      vx.data(),
+            vy.data(), radius.data(), charge.data(), id.data()};
   }
 };
 
 // How static obstacles contribute charged points to the potential field.
 enum class ObstacleCharges {
-  centres,   // one charged point per circle at its centre (the thesis's model; `crowddb query field`)
+  centres,   // one charged point per circle at its centre (the thesis's model; `crowddb query
+             // field`)
   boundary,  // circles and polygons sampled along their boundary (the simulation's default)
 };
 
@@ -72,7 +76,8 @@ class StaticScene {
  public:
   StaticScene() = default;
   // `spacing`: largest gap between charged points sampled along polygon edges (and circle
-  // boundaries with ObstacleCharges::boundary); DESIGN.md: no larger than the smallest agent radius.
+  // boundaries with ObstacleCharges::boundary); DESIGN.md: no larger than the smallest agent
+  // radius.
   //
   // `walls`: the world's bounds as solid walls, appended to the polygons as four rectangles
   // outside the bounds (as thick as the world is wide, so nothing tunnels through them); their
@@ -111,8 +116,8 @@ struct QueryStats {
   uint64_t nodes_visited = 0;  // index nodes expanded
   uint64_t queue_pushes = 0;
   uint64_t queue_pops = 0;
-  double build_seconds = 0;    // index construction
-  double query_seconds = 0;    // probes
+  double build_seconds = 0;  // index construction
+  double query_seconds = 0;  // probes
   QueryStats& operator+=(const QueryStats& o);
 };
 
@@ -127,17 +132,17 @@ struct Collider {
 };
 
 struct FtcHit {
-  Collider with;             // kind none: no collision within the horizon
-  double time = INFINITY;    // [ticks], in [0, horizon]; 0 when already overlapping
+  Collider with;           // kind none: no collision within the horizon
+  double time = INFINITY;  // [ticks], in [0, horizon]; 0 when already overlapping
   friend bool operator==(const FtcHit&, const FtcHit&) = default;
 };
 
 // For each disc, the first agent or obstacle it collides with within `horizon` ticks, moving on
 // rays p + v t. Ties in time go to agents before obstacles, then the smaller id (agents) or row
 // (obstacles). Exact: every method returns the same hits.
-std::vector<FtcHit> first_to_collide(const DiscView& discs, const StaticScene& scene, double horizon,
-                                     std::string_view method = "auto", int threads = 1,
-                                     QueryStats* stats = nullptr);
+std::vector<FtcHit> first_to_collide(const DiscView& discs, const StaticScene& scene,
+                                     double horizon, std::string_view method = "auto",
+                                     int threads = 1, QueryStats* stats = nullptr);
 
 // ---------------------------------------------------------------- potential field (§4)
 
@@ -149,8 +154,9 @@ struct PotentialSpec {
   Metric metric = Metric::l1;
   double A = 0.929328;  // thesis values: A e^{-k x} fitted to 1/x
   double k = 0.272194;
-  int radial_frames = 2;   // m rotated frames for the radial metric
-  double inv_floor = 0.1;  // inv kernel: distance floored here (> 0) so coincident points stay finite
+  int radial_frames = 2;  // m rotated frames for the radial metric
+  double inv_floor =
+      0.1;  // inv kernel: distance floored here (> 0) so coincident points stay finite
 };
 
 // Potential and its gradient with respect to the probe's position, per disc.
@@ -165,9 +171,9 @@ struct FieldColumns {
 
 // P(p) = sum over q != p of A c_p c_q K(d(p, q)), over the other discs and the scene's charged
 // points, with its analytic gradient (sign(0) = 0 for L1 terms, 0 at coincident points for L2).
-FieldColumns potential_field(const DiscView& discs, const StaticScene& scene, const PotentialSpec& spec,
-                             std::string_view method = "auto", int threads = 1,
-                             QueryStats* stats = nullptr);
+FieldColumns potential_field(const DiscView& discs, const StaticScene& scene,
+                             const PotentialSpec& spec, std::string_view method = "auto",
+                             int threads = 1, QueryStats* stats = nullptr);
 
 // ---------------------------------------------------------------- collision sets (§3.2)
 
@@ -175,7 +181,7 @@ FieldColumns potential_field(const DiscView& discs, const StaticScene& scene, co
 // overlaps a circle obstacle likewise and a polygon when its centre is inside or its boundary
 // is closer than the radius.
 struct CollisionPairs {
-  std::vector<std::pair<uint32_t, uint32_t>> agents;  // (i, j) rows, i < j, sorted
+  std::vector<std::pair<uint32_t, uint32_t>> agents;     // (i, j) rows, i < j, sorted
   std::vector<std::pair<uint32_t, Collider>> obstacles;  // (agent row, obstacle), sorted
   void clear() {
     agents.clear();

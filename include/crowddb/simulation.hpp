@@ -22,10 +22,10 @@ namespace crowddb {
 
 // The steering rule of DESIGN.md §3.1. Every weight is a scenario parameter.
 struct SteeringParams {
-  double tau = 2;        // attraction: ticks to relax towards the preferred velocity (> 0)
-  double w_apf = 1;      // inner avoidance weight (>= 0; 0 switches the query off)
-  double w_ftc = 1;      // outer avoidance weight (>= 0; 0 switches the query off)
-  double horizon = 30;   // first-to-collide look-ahead [ticks] (> 0)
+  double tau = 2;       // attraction: ticks to relax towards the preferred velocity (> 0)
+  double w_apf = 1;     // inner avoidance weight (>= 0; 0 switches the query off)
+  double w_ftc = 1;     // outer avoidance weight (>= 0; 0 switches the query off)
+  double horizon = 30;  // first-to-collide look-ahead [ticks] (> 0)
   PotentialSpec potential;
   ObstacleCharges obstacle_charges = ObstacleCharges::boundary;
 };
@@ -84,16 +84,16 @@ struct SimConfig {
 
 // What one tick did. Counts are rows of the agents table.
 struct TickMetrics {
-  uint64_t tick = 0;             // ticks completed so far (1 after the first step)
-  std::size_t agents = 0;        // rows after the tick
-  std::size_t arrived = 0;       // agents that reached their goal in this tick
-  std::size_t frozen = 0;        // agents the backoff loop froze in this tick
+  uint64_t tick = 0;        // ticks completed so far (1 after the first step)
+  std::size_t agents = 0;   // rows after the tick
+  std::size_t arrived = 0;  // agents that reached their goal in this tick
+  std::size_t frozen = 0;   // agents the backoff loop froze in this tick
   std::size_t freeze_iterations = 0;
   std::size_t overlapping_pairs = 0;  // agent-agent pairs overlapping after the tick
   std::size_t obstacle_overlaps = 0;  // agent-obstacle (and agent-wall) overlaps after the tick
-  std::size_t gridlocked = 0;    // agents frozen for >= gridlock_ticks consecutive ticks
-  double seconds = 0;            // wall time of the tick
-  uint64_t state_hash = 0;       // hash of the committed state (ids, positions, velocities, states)
+  std::size_t gridlocked = 0;         // agents frozen for >= gridlock_ticks consecutive ticks
+  double seconds = 0;                 // wall time of the tick
+  uint64_t state_hash = 0;  // hash of the committed state (ids, positions, velocities, states)
 };
 
 class Simulation {

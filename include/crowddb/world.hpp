@@ -48,11 +48,11 @@ enum class AgentState : uint8_t {
 struct AgentSpec {
   double x = 0, y = 0;
   double vx = 0, vy = 0;
-  double radius = 1;         // > 0
-  double max_speed = 1;      // > 0
+  double radius = 1;                                           // > 0
+  double max_speed = 1;                                        // > 0
   double max_accel = std::numeric_limits<double>::infinity();  // > 0, may be infinite
-  double charge = 1;         // repulsive strength in the potential field, finite, >= 0
-  uint32_t goal = 0;         // row of the goals table
+  double charge = 1;  // repulsive strength in the potential field, finite, >= 0
+  uint32_t goal = 0;  // row of the goals table
 };
 
 struct Goal {
@@ -84,18 +84,18 @@ struct Bounds {
 // for reading; only World and the tick write them. Hot per-tick columns first.
 struct AgentTable {
   // hot: read or written every tick
-  std::vector<double> x, y;           // position [length]
-  std::vector<double> vx, vy;         // velocity [length/tick]
-  std::vector<double> radius;         // [length]
-  std::vector<double> max_speed;      // [length/tick]
-  std::vector<double> max_accel;      // [length/tick^2], may be +inf
-  std::vector<double> charge;         // potential-field charge
+  std::vector<double> x, y;                // position [length]
+  std::vector<double> vx, vy;              // velocity [length/tick]
+  std::vector<double> radius;              // [length]
+  std::vector<double> max_speed;           // [length/tick]
+  std::vector<double> max_accel;           // [length/tick^2], may be +inf
+  std::vector<double> charge;              // potential-field charge
   std::vector<double> target_x, target_y;  // current waypoint (the goal when there is no route)
-  std::vector<uint32_t> goal;         // row of the goals table
+  std::vector<uint32_t> goal;              // row of the goals table
   std::vector<AgentState> state;
   std::vector<uint32_t> frozen_ticks;  // consecutive ticks frozen by backoff (gridlock detection)
   // cold: bookkeeping
-  std::vector<uint64_t> id;           // AgentId::value()
+  std::vector<uint64_t> id;              // AgentId::value()
   std::vector<std::vector<Vec2>> route;  // intermediate waypoints still ahead of the goal
   // path service (DESIGN.md §6); only read when navigation is on
   static constexpr uint32_t kNoPath = std::numeric_limits<uint32_t>::max();
@@ -156,15 +156,15 @@ class World {
  private:
   struct Slot {
     uint32_t generation = 0;
-    uint32_t row = kNoRow;    // dense row, or kNoRow
-    bool pending = false;     // reserved by insert(), not applied yet
-    bool doomed = false;      // erase() buffered: no further changes accepted
+    uint32_t row = kNoRow;  // dense row, or kNoRow
+    bool pending = false;   // reserved by insert(), not applied yet
+    bool doomed = false;    // erase() buffered: no further changes accepted
   };
   static constexpr uint32_t kNoRow = std::numeric_limits<uint32_t>::max();
   struct Change {
     enum class Kind : uint8_t { insert, erase, retarget } kind;
     AgentId id;
-    AgentSpec spec;  // insert only
+    AgentSpec spec;     // insert only
     uint32_t goal = 0;  // retarget only
   };
 

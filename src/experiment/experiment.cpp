@@ -16,7 +16,8 @@ const Experiment& find(std::string_view name) {
     if (e.name == name) return e;
   std::string names;
   for (const auto& e : registry()) names += (names.empty() ? "" : ", ") + e.name;
-  throw Error(Error::Kind::usage, "unknown experiment '" + std::string(name) + "' (choose from " + names + ")");
+  throw Error(Error::Kind::usage,
+              "unknown experiment '" + std::string(name) + "' (choose from " + names + ")");
 }
 
 CsvWriter::CsvWriter(const std::filesystem::path& path, std::span<const std::string> header)
@@ -44,14 +45,16 @@ void CsvWriter::close() {
   if (!out_) throw Error(Error::Kind::io, path_.string() + ": write failed");
 }
 
-void plot(const std::filesystem::path& out_dir, const std::string& name, const std::string& script) {
+void plot(const std::filesystem::path& out_dir, const std::string& name,
+          const std::string& script) {
   const auto gp = out_dir / (name + ".gp");
   {
     std::ofstream f(gp);
     f << script;
     if (!f) throw Error(Error::Kind::io, gp.string() + ": cannot write");
   }
-  const std::string cmd = "cd '" + out_dir.string() + "' && gnuplot '" + gp.filename().string() + "' 2>&1";
+  const std::string cmd =
+      "cd '" + out_dir.string() + "' && gnuplot '" + gp.filename().string() + "' 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) throw Error(Error::Kind::io, "cannot run gnuplot");
   std::string output;
@@ -59,7 +62,8 @@ void plot(const std::filesystem::path& out_dir, const std::string& name, const s
   while (fgets(buf, sizeof buf, p)) output += buf;
   const int status = pclose(p);
   if (status != 0)
-    throw Error(Error::Kind::io, "gnuplot failed on " + gp.string() + ": " + output.substr(0, output.find('\n')));
+    throw Error(Error::Kind::io,
+                "gnuplot failed on " + gp.string() + ": " + output.substr(0, output.find('\n')));
 }
 
 MeanSd mean_sd(std::span<const double> v) {

@@ -3,14 +3,18 @@
 // library's own float parser does not) and lets us reject NaN and infinities by name.
 #define CSV_IO_NO_THREAD
 // The library's bounded file-name copy trips -Wstringop-truncation where it is inlined.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wstringop-truncation"
-#include <libfccp/csv.h>
-
+#endif
 #include "io/csv_tables.hpp"
+
+#include <libfccp/csv.h>
 
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <unordered_set>
 
 #include "crowddb/error.hpp"
@@ -18,24 +22,36 @@
 namespace crowddb::io {
 namespace {
 
-std::string where(const std::filesystem::path& path, unsigned line, const char* field) {
-  return path.string() + ":" + std::to_string(line) + ": field " + field;
+std::string where(const std::string& path, unsigned line, const char* field) {
+  return path + ":" + std::to_string(line) + ": field " + field;
+}
+
+std::string read_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw Error(Error::Kind::io, path.string() + ": is a directory");
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw Error(Error::Kind::io, path.string() + ": cannot open file");
+  std::ostringstream os;
+  os << f.rdbuf();
+  return os.str();
 }
 
 // One-line message of a library error, without its trailing period.
-[[noreturn]] void rethrow_csv(const std::filesystem::path& path, const std::exception& e) {
+[[noreturn]] void rethrow_csv(const std::string& path, const std::exception& e) {
   std::string msg = e.what();
   while (!msg.empty() && (msg.back() == '.' || msg.back() == '\n')) msg.pop_back();
-  if (dynamic_cast<const ::io::error::can_not_open_file*>(&e))
-    throw Error(Error::Kind::io, path.string() + ": cannot open file");
-  throw Error(Error::Kind::input, path.string() + ": " + msg);
+  for (char& c : msg)
+    if (c == '\n' || c == '\r') c = ' ';
+  throw Error(Error::Kind::input, path + ": " + msg);
 }
 
 template <class Reader>
-void require_columns(Reader& in, const std::filesystem::path& path, std::initializer_list<const char*> names) {
+void require_columns(Reader& in, const std::string& path,
+                     std::initializer_list<const char*> names) {
   for (const char* n : names)
     if (!in.has_column(n))
-      throw Error(Error::Kind::input, path.string() + ": missing column '" + n + "' in the header");
+      throw Error(Error::Kind::input, path + ": missing column '" + n + "' in the header");
 }
 
 }  // namespace
@@ -49,34 +65,49 @@ double parse_number(const char* text, const std::string& at) {
   auto [ptr, ec] = std::from_chars(begin, end, v);
   if (begin == end || ec != std::errc() || ptr != end)
     throw Error(Error::Kind::input, at + ": '" + std::string(text) + "' is not a number");
-  if (!std::isfinite(v)) throw Error(Error::Kind::input, at + ": must be finite (got " + std::string(text) + ")");
+  if (!std::isfinite(v))
+    throw Error(Error::Kind::input, at + ": must be finite (got " + std::string(text) + ")");
   return v;
 }
 
 DiscTable read_agents_csv(const std::filesystem::path& path) {
+  return parse_agents_csv(read_file(path), path.string());
+}
+
+std::vector<CircleObstacle> read_obstacles_csv(const std::filesystem::path& path) {
+  return parse_obstacles_csv(read_file(path), path.string());
+}
+
+DiscTable parse_agents_csv(std::string_view text, const std::string& path) {
   DiscTable t;
   try {
-    ::io::CSVReader<7, ::io::trim_chars<' ', '\t'>, ::io::no_quote_escape<','>> in(path.string());
+    ::io::CSVReader<7, ::io::trim_chars<' ', '\t'>, ::io::no_quote_escape<','>> in(
+        path, text.data(), text.data() + text.size());
     in.read_header(::io::ignore_missing_column, "id", "x", "y", "vx", "vy", "radius", "charge");
     require_columns(in, path, {"id", "x", "y", "vx", "vy", "radius"});
     const bool has_charge = in.has_column("charge");
     std::unordered_set<uint64_t> seen;
-    char *id = nullptr, *x = nullptr, *y = nullptr, *vx = nullptr, *vy = nullptr, *r = nullptr, *c = nullptr;
+    char *id = nullptr, *x = nullptr, *y = nullptr, *vx = nullptr, *vy = nullptr, *r = nullptr,
+         *c = nullptr;
     while (in.read_row(id, x, y, vx, vy, r, c)) {
       const unsigned line = in.get_file_line();
       uint64_t idv = 0;
       const char* idend = id + std::strlen(id);
       auto [p, ec] = std::from_chars(id, idend, idv);
       if (id == idend || ec != std::errc() || p != idend)
-        throw Error(Error::Kind::input, where(path, line, "id") + ": '" + id + "' is not a non-negative integer");
+        throw Error(Error::Kind::input,
+                    where(path, line, "id") + ": '" + id + "' is not a non-negative integer");
       if (!seen.insert(idv).second)
-        throw Error(Error::Kind::input, where(path, line, "id") + ": duplicate id " + std::to_string(idv));
+        throw Error(Error::Kind::input,
+                    where(path, line, "id") + ": duplicate id " + std::to_string(idv));
       const double px = parse_number(x, where(path, line, "x"));
       const double py = parse_number(y, where(path, line, "y"));
       const double pvx = parse_number(vx, where(path, line, "vx"));
       const double pvy = parse_number(vy, where(path, line, "vy"));
       const double pr = parse_number(r, where(path, line, "radius"));
-      if (!(pr > 0)) throw Error(Error::Kind::input, where(path, line, "radius") + ": must be > 0 (got " + r + ")");
+      if (!(pr > 0))
+        throw Error(Error::Kind::input,
+                    where(path, line, "radius") + ": must be > 0 (got " + r + ")");
       const double pc = has_charge ? parse_number(c, where(path, line, "charge")) : 1.0;
       t.push_back(idv, px, py, pvx, pvy, pr, pc);
     }
@@ -88,10 +119,11 @@ DiscTable read_agents_csv(const std::filesystem::path& path) {
   return t;
 }
 
-std::vector<CircleObstacle> read_obstacles_csv(const std::filesystem::path& path) {
+std::vector<CircleObstacle> parse_obstacles_csv(std::string_view text, const std::string& path) {
   std::vector<CircleObstacle> out;
   try {
-    ::io::CSVReader<4, ::io::trim_chars<' ', '\t'>, ::io::no_quote_escape<','>> in(path.string());
+    ::io::CSVReader<4, ::io::trim_chars<' ', '\t'>, ::io::no_quote_escape<','>> in(
+        path, text.data(), text.data() + text.size());
     in.read_header(::io::ignore_missing_column, "x", "y", "radius", "charge");
     require_columns(in, path, {"x", "y", "radius"});
     const bool has_charge = in.has_column("charge");
@@ -102,7 +134,9 @@ std::vector<CircleObstacle> read_obstacles_csv(const std::filesystem::path& path
       o.x = parse_number(x, where(path, line, "x"));
       o.y = parse_number(y, where(path, line, "y"));
       o.radius = parse_number(r, where(path, line, "radius"));
-      if (!(o.radius > 0)) throw Error(Error::Kind::input, where(path, line, "radius") + ": must be > 0 (got " + r + ")");
+      if (!(o.radius > 0))
+        throw Error(Error::Kind::input,
+                    where(path, line, "radius") + ": must be > 0 (got " + r + ")");
       o.charge = has_charge ? parse_number(c, where(path, line, "charge")) : 1.0;
       out.push_back(o);
     }

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "crowddb/query.hpp"
@@ -13,6 +15,10 @@ namespace crowddb::io {
 
 DiscTable read_agents_csv(const std::filesystem::path& path);
 std::vector<CircleObstacle> read_obstacles_csv(const std::filesystem::path& path);
+
+// The same over text in memory; `name` stands for the file in messages.
+DiscTable parse_agents_csv(std::string_view text, const std::string& name);
+std::vector<CircleObstacle> parse_obstacles_csv(std::string_view text, const std::string& name);
 
 // Parses a whole field as a finite double, or throws Error(input) with `where` prefixed.
 double parse_number(const char* text, const std::string& where);

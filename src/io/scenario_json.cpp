@@ -27,7 +27,8 @@ using nlohmann::json;
 // every key was used.
 class Node {
  public:
-  Node(const json& j, std::string pointer, const std::string* file) : j_(j), ptr_(std::move(pointer)), file_(file) {
+  Node(const json& j, std::string pointer, const std::string* file)
+      : j_(j), ptr_(std::move(pointer)), file_(file) {
     if (!j_.is_object()) fail("", "expected an object");
   }
 
@@ -39,8 +40,10 @@ class Node {
   bool has(const std::string& key) const { return j_.contains(key); }
 
   const json& raw(const std::string& key) {
+    const auto it = j_.find(key);
+    if (it == j_.end()) fail(key, "missing");
     used_.insert(key);
-    return j_.at(key);
+    return *it;
   }
 
   double number(const std::string& key, std::optional<double> fallback = std::nullopt) {
@@ -74,7 +77,8 @@ class Node {
   double positive_or_inf(const std::string& key, double fallback) {
     if (!has(key)) return fallback;
     const json& v = raw(key);
-    if (v.is_string() && v.get<std::string>() == "inf") return std::numeric_limits<double>::infinity();
+    if (v.is_string() && v.get<std::string>() == "inf")
+      return std::numeric_limits<double>::infinity();
     const double d = number_of(v, key);
     if (!(d > 0)) fail(key, "must be > 0 or \"inf\" (got " + fmt(d) + ")");
     return d;
@@ -111,7 +115,8 @@ class Node {
     return v.get<std::string>();
   }
 
-  std::string choice(const std::string& key, std::initializer_list<const char*> options, const char* fallback) {
+  std::string choice(const std::string& key, std::initializer_list<const char*> options,
+                     const char* fallback) {
     const std::string s = string(key, std::string(fallback));
     for (const char* o : options)
       if (s == o) return s;
@@ -123,9 +128,11 @@ class Node {
   // [a, b, ...] of exactly `n` finite numbers.
   std::vector<double> numbers(const std::string& key, std::size_t n) {
     const json& v = raw(key);
-    if (!v.is_array() || v.size() != n) fail(key, "expected an array of " + std::to_string(n) + " numbers");
+    if (!v.is_array() || v.size() != n)
+      fail(key, "expected an array of " + std::to_string(n) + " numbers");
     std::vector<double> out;
-    for (std::size_t i = 0; i < n; ++i) out.push_back(number_of(v[i], key + "/" + std::to_string(i)));
+    for (std::size_t i = 0; i < n; ++i)
+      out.push_back(number_of(v[i], key + "/" + std::to_string(i)));
     return out;
   }
 
@@ -216,7 +223,8 @@ class DiscGrid {
     cells_[key(cell_of(x), cell_of(y))].push_back(i);
   }
   // Index of a placed disc overlapping (x, y, r) with the extra gap, or npos.
-  std::size_t overlapping(double x, double y, double r, double gap = 0, std::size_t skip = SIZE_MAX) const {
+  std::size_t overlapping(double x, double y, double r, double gap = 0,
+                          std::size_t skip = SIZE_MAX) const {
     const double reach = r + rmax_ + gap;
     const int64_t x0 = cell_of(x - reach), x1 = cell_of(x + reach);
     const int64_t y0 = cell_of(y - reach), y1 = cell_of(y + reach);
@@ -239,7 +247,8 @@ class DiscGrid {
           auto it = cells_.find(key(cx, cy));
           if (it == cells_.end()) continue;
           for (std::size_t j : it->second)
-            if (j > i && discs_overlap(xs_[j] - xs_[i], ys_[j] - ys_[i], rs_[i] + rs_[j])) out.push_back({i, j});
+            if (j > i && discs_overlap(xs_[j] - xs_[i], ys_[j] - ys_[i], rs_[i] + rs_[j]))
+              out.push_back({i, j});
         }
     }
     std::sort(out.begin(), out.end());
@@ -444,15 +453,18 @@ struct Loader {
         pool.push_back(goal_named(g, "goal", g.string("goal")));
       } else {
         Node rule = g.child("goals");
-        assign = rule.choice("assign", {"round_robin", "random", "nearest", "antipodal"}, "round_robin");
+        assign =
+            rule.choice("assign", {"round_robin", "random", "nearest", "antipodal"}, "round_robin");
         if (assign == "antipodal") {
           antipodal_radius = rule.positive("arrival_radius", 1.0);
           antipodal_charge = rule.number("charge", 1.0);
         } else if (rule.has("from")) {
           const json& names = rule.array("from");
           for (std::size_t k = 0; k < names.size(); ++k) {
-            if (!names[k].is_string()) rule.fail("from/" + std::to_string(k), "expected a goal name");
-            pool.push_back(goal_named(rule, "from/" + std::to_string(k), names[k].get<std::string>()));
+            if (!names[k].is_string())
+              rule.fail("from/" + std::to_string(k), "expected a goal name");
+            pool.push_back(
+                goal_named(rule, "from/" + std::to_string(k), names[k].get<std::string>()));
           }
         } else {
           for (uint32_t k = 0; k < sc.world.goals().size(); ++k) pool.push_back(k);
@@ -470,7 +482,8 @@ struct Loader {
       std::pair<double, double> spacing{0, 0};
       if (type == "uniform" || type == "grid") {
         region = pl.numbers("region", 4);
-        if (!(region[2] > region[0] && region[3] > region[1])) pl.fail("region", "needs x1 > x0 and y1 > y0");
+        if (!(region[2] > region[0] && region[3] > region[1]))
+          pl.fail("region", "needs x1 > x0 and y1 > y0");
       }
       if (type == "uniform") {
         gap = pl.non_negative("gap", 0.0);
@@ -491,39 +504,49 @@ struct Loader {
         if (!(spacing.first > 0 && spacing.second > 0)) pl.fail("spacing", "must be > 0");
       }
       pl.finish();
-      if (assign == "antipodal" && type != "circle") g.fail("goals", "antipodal goals need a circle placement");
+      if (assign == "antipodal" && type != "circle")
+        g.fail("goals", "antipodal goals need a circle placement");
       g.finish();
 
       // Grid capacity is known up front.
       if (type == "grid") {
-        const auto cols = static_cast<uint64_t>(std::floor((region[2] - region[0]) / spacing.first)) + 1;
-        const auto rows = static_cast<uint64_t>(std::floor((region[3] - region[1]) / spacing.second)) + 1;
+        const auto cols =
+            static_cast<uint64_t>(std::floor((region[2] - region[0]) / spacing.first)) + 1;
+        const auto rows =
+            static_cast<uint64_t>(std::floor((region[3] - region[1]) / spacing.second)) + 1;
         if (cols * rows < count)
-          pl.fail("spacing", "the grid holds " + std::to_string(cols * rows) + " agents, fewer than count " +
-                                 std::to_string(count));
+          pl.fail("spacing", "the grid holds " + std::to_string(cols * rows) +
+                                 " agents, fewer than count " + std::to_string(count));
       }
 
       for (uint64_t i = 0; i < count; ++i) {
         AgentSpec s = base;
-        s.radius = radius.first == radius.second ? radius.first : rng.uniform(radius.first, radius.second);
+        s.radius =
+            radius.first == radius.second ? radius.first : rng.uniform(radius.first, radius.second);
         // Position.
         if (type == "uniform") {
           bool ok = false;
           for (uint64_t a = 0; a < attempts && !ok; ++a) {
-            s.x = rng.uniform(region[0] + s.radius, std::max(region[0] + s.radius, region[2] - s.radius));
-            s.y = rng.uniform(region[1] + s.radius, std::max(region[1] + s.radius, region[3] - s.radius));
-            ok = placed->overlapping(s.x, s.y, s.radius, gap) == SIZE_MAX && !blocked_by_obstacle(s.x, s.y, s.radius, gap);
+            s.x = rng.uniform(region[0] + s.radius,
+                              std::max(region[0] + s.radius, region[2] - s.radius));
+            s.y = rng.uniform(region[1] + s.radius,
+                              std::max(region[1] + s.radius, region[3] - s.radius));
+            ok = placed->overlapping(s.x, s.y, s.radius, gap) == SIZE_MAX &&
+                 !blocked_by_obstacle(s.x, s.y, s.radius, gap);
           }
           if (!ok)
-            pl.fail("", "could not place agent " + std::to_string(i + 1) + " of " + std::to_string(count) +
-                            " without overlaps in " + std::to_string(attempts) +
+            pl.fail("", "could not place agent " + std::to_string(i + 1) + " of " +
+                            std::to_string(count) + " without overlaps in " +
+                            std::to_string(attempts) +
                             " attempts (region too crowded: enlarge it, lower count or radius)");
         } else if (type == "circle") {
-          const double a = 2 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(count);
+          const double a =
+              2 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(count);
           s.x = centre.x + ring * std::cos(a);
           s.y = centre.y + ring * std::sin(a);
         } else {
-          const auto cols = static_cast<uint64_t>(std::floor((region[2] - region[0]) / spacing.first)) + 1;
+          const auto cols =
+              static_cast<uint64_t>(std::floor((region[2] - region[0]) / spacing.first)) + 1;
           s.x = region[0] + static_cast<double>(i % cols) * spacing.first;
           s.y = region[1] + static_cast<double>(i / cols) * spacing.second;
         }
@@ -555,7 +578,8 @@ struct Loader {
           }
         }
         // Initial velocity.
-        const double v = speed.first == speed.second ? speed.first : rng.uniform(speed.first, speed.second);
+        const double v =
+            speed.first == speed.second ? speed.first : rng.uniform(speed.first, speed.second);
         double angle = rng.uniform(0, 2 * std::numbers::pi);
         if (heading == "goal") {
           const Goal& gl = sc.world.goals()[s.goal];
@@ -575,18 +599,21 @@ struct Loader {
     for (const AgentSpec& s : agents) all.add(s.x, s.y, s.radius);
     const auto pairs = all.pairs();
     if (!pairs.empty())
-      sc.warnings.push_back("agents spawned overlapping: " + std::to_string(pairs.size()) +
-                            " pairs (first: agents " + std::to_string(pairs[0].first) + " and " +
-                            std::to_string(pairs[0].second) +
-                            " in spawn order); they are allowed to separate but not to overlap deeper");
+      sc.warnings.push_back(
+          "agents spawned overlapping: " + std::to_string(pairs.size()) + " pairs (first: agents " +
+          std::to_string(pairs[0].first) + " and " + std::to_string(pairs[0].second) +
+          " in spawn order); they are allowed to separate but not to overlap deeper");
     std::size_t blocked = 0, outside = 0;
     const Bounds& b = sc.world.bounds();
     for (const AgentSpec& s : agents) {
       blocked += blocked_by_obstacle(s.x, s.y, s.radius, 0);
-      outside += s.x - s.radius < b.xmin || s.x + s.radius > b.xmax || s.y - s.radius < b.ymin || s.y + s.radius > b.ymax;
+      outside += s.x - s.radius < b.xmin || s.x + s.radius > b.xmax || s.y - s.radius < b.ymin ||
+                 s.y + s.radius > b.ymax;
     }
-    if (blocked) sc.warnings.push_back(std::to_string(blocked) + " agents spawned overlapping an obstacle");
-    if (outside && sc.config.walls) sc.warnings.push_back(std::to_string(outside) + " agents spawned outside the bounds");
+    if (blocked)
+      sc.warnings.push_back(std::to_string(blocked) + " agents spawned overlapping an obstacle");
+    if (outside && sc.config.walls)
+      sc.warnings.push_back(std::to_string(outside) + " agents spawned outside the bounds");
   }
 };
 
@@ -599,8 +626,9 @@ void read_steering(Node& root, SimConfig& cfg) {
   p.w_ftc = s.non_negative("w_ftc", p.w_ftc);
   p.horizon = s.positive("horizon", p.horizon);
   p.obstacle_charges =
-      s.choice("obstacle_charges", {"boundary", "centres"}, "boundary") == "centres" ? ObstacleCharges::centres
-                                                                                       : ObstacleCharges::boundary;
+      s.choice("obstacle_charges", {"boundary", "centres"}, "boundary") == "centres"
+          ? ObstacleCharges::centres
+          : ObstacleCharges::boundary;
   if (s.has("potential")) {
     Node pot = s.child("potential");
     PotentialSpec& ps = p.potential;
@@ -630,15 +658,18 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
     doc = json::parse(text, [&](int, json::parse_event_t event, json& parsed) {
       if (event == json::parse_event_t::object_start) keys.emplace_back();
       if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
-      if (event == json::parse_event_t::key && !keys.empty() && !keys.back().insert(parsed.get<std::string>()).second)
-        throw Error(Error::Kind::input, source + ": duplicate key \"" + parsed.get<std::string>() + "\"");
+      if (event == json::parse_event_t::key && !keys.empty() &&
+          !keys.back().insert(parsed.get<std::string>()).second)
+        throw Error(Error::Kind::input,
+                    source + ": duplicate key \"" + parsed.get<std::string>() + "\"");
       return true;
     });
   } catch (const json::parse_error& e) {
     std::string what = e.what();
     const auto colon = what.rfind(": ");
-    throw Error(Error::Kind::input, source + ":" + line_col(text, e.byte ? e.byte - 1 : 0) +
-                                        ": malformed JSON: " + (colon == std::string::npos ? what : what.substr(colon + 2)));
+    throw Error(Error::Kind::input,
+                source + ":" + line_col(text, e.byte ? e.byte - 1 : 0) + ": malformed JSON: " +
+                    (colon == std::string::npos ? what : what.substr(colon + 2)));
   } catch (const json::exception& e) {
     throw Error(Error::Kind::input, source + ": malformed JSON: " + e.what());
   }
@@ -690,8 +721,9 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
   cfg.backoff = root.boolean("backoff", true);
   cfg.walls = root.boolean("walls", true);
   const std::string arrival = root.choice("arrival", {"remove", "idle", "retarget"}, "remove");
-  cfg.arrival = arrival == "idle" ? ArrivalPolicy::idle
-                                  : (arrival == "retarget" ? ArrivalPolicy::retarget : ArrivalPolicy::remove);
+  cfg.arrival = arrival == "idle"
+                    ? ArrivalPolicy::idle
+                    : (arrival == "retarget" ? ArrivalPolicy::retarget : ArrivalPolicy::remove);
   cfg.threads = static_cast<int>(root.integer("threads", 1, 256));
   if (cfg.threads < 1) root.fail("threads", "must be >= 1");
   cfg.gridlock_ticks = static_cast<uint32_t>(root.integer("gridlock_ticks", 50, 1u << 30));
@@ -725,8 +757,9 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
   if (root.has("output")) {
     Node o = root.child("output");
     sc.output.path = o.string("path", std::string());
-    sc.output.format = o.choice("format", {"sqlite", "csv"}, "sqlite") == "csv" ? OutputSpec::Format::csv
-                                                                              : OutputSpec::Format::sqlite;
+    sc.output.format = o.choice("format", {"sqlite", "csv"}, "sqlite") == "csv"
+                           ? OutputSpec::Format::csv
+                           : OutputSpec::Format::sqlite;
     sc.output.every = static_cast<uint32_t>(o.integer("every", 1, 1u << 30));
     if (sc.output.every == 0) o.fail("every", "must be >= 1");
     o.finish();
@@ -745,7 +778,8 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
       if (g.is_object() && g.contains("radius")) {
         const json& r = g["radius"];
         if (r.is_number()) rmax = std::max(rmax, r.get<double>());
-        if (r.is_array() && r.size() == 2 && r[1].is_number()) rmax = std::max(rmax, r[1].get<double>());
+        if (r.is_array() && r.size() == 2 && r[1].is_number())
+          rmax = std::max(rmax, r[1].get<double>());
       }
   if (std::isfinite(rmax)) loader.placed = std::make_unique<DiscGrid>(2 * rmax);
   loader.read_agents(root);
@@ -781,7 +815,8 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
 Scenario load_scenario(const std::filesystem::path& path) {
   std::ifstream f(path, std::ios::binary);
   if (!f) throw Error(Error::Kind::io, path.string() + ": cannot open file");
-  if (std::filesystem::is_directory(path)) throw Error(Error::Kind::io, path.string() + ": is a directory");
+  if (std::filesystem::is_directory(path))
+    throw Error(Error::Kind::io, path.string() + ": is a directory");
   std::ostringstream os;
   os << f.rdbuf();
   return parse_scenario(os.str(), path.string());

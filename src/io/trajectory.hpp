@@ -38,8 +38,10 @@ class TrajectoryWriter {
   virtual void abort() noexcept = 0;
 };
 
-std::unique_ptr<TrajectoryWriter> make_sqlite_writer(const std::filesystem::path& path, uint32_t every);
-std::unique_ptr<TrajectoryWriter> make_csv_writer(const std::filesystem::path& path, uint32_t every);
+std::unique_ptr<TrajectoryWriter> make_sqlite_writer(const std::filesystem::path& path,
+                                                     uint32_t every);
+std::unique_ptr<TrajectoryWriter> make_csv_writer(const std::filesystem::path& path,
+                                                  uint32_t every);
 
 inline std::unique_ptr<TrajectoryWriter> make_writer(const OutputSpec& out) {
   return out.format == OutputSpec::Format::csv ? make_csv_writer(out.path, out.every)

@@ -12,7 +12,8 @@ namespace {
 
 class CsvWriter final : public TrajectoryWriter {
  public:
-  CsvWriter(std::filesystem::path path, uint32_t every) : path_(std::move(path)), every_(every ? every : 1) {
+  CsvWriter(std::filesystem::path path, uint32_t every)
+      : path_(std::move(path)), every_(every ? every : 1) {
     metrics_path_ = path_;
     metrics_path_.replace_extension(".metrics.csv");
   }
@@ -21,7 +22,8 @@ class CsvWriter final : public TrajectoryWriter {
   void begin(const Scenario&, const World&) override {
     open(traj_, partial(path_), "frame,id,x,y,vx,vy,radius,state,goal\n");
     open(metrics_, partial(metrics_path_),
-         "tick,agents,arrived,frozen,freeze_iterations,overlapping_pairs,obstacle_overlaps,gridlocked,tick_seconds,"
+         "tick,agents,arrived,frozen,freeze_iterations,overlapping_pairs,obstacle_overlaps,"
+         "gridlocked,tick_seconds,"
          "state_hash\n");
   }
 
@@ -46,9 +48,9 @@ class CsvWriter final : public TrajectoryWriter {
   void metrics(const TickMetrics& m) override {
     char hash[24];
     std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(m.state_hash));
-    metrics_ << m.tick << "," << m.agents << "," << m.arrived << "," << m.frozen << "," << m.freeze_iterations << ","
-             << m.overlapping_pairs << "," << m.obstacle_overlaps << "," << m.gridlocked << "," << num(m.seconds)
-             << "," << hash << "\n";
+    metrics_ << m.tick << "," << m.agents << "," << m.arrived << "," << m.frozen << ","
+             << m.freeze_iterations << "," << m.overlapping_pairs << "," << m.obstacle_overlaps
+             << "," << m.gridlocked << "," << num(m.seconds) << "," << hash << "\n";
     check(metrics_, metrics_path_);
   }
 
@@ -60,7 +62,9 @@ class CsvWriter final : public TrajectoryWriter {
     for (const auto* p : {&path_, &metrics_path_}) {
       std::error_code ec;
       std::filesystem::rename(partial(*p), *p, ec);
-      if (ec) throw Error(Error::Kind::io, p->string() + ": cannot move output into place: " + ec.message());
+      if (ec)
+        throw Error(Error::Kind::io,
+                    p->string() + ": cannot move output into place: " + ec.message());
     }
   }
 
@@ -73,7 +77,9 @@ class CsvWriter final : public TrajectoryWriter {
   }
 
  private:
-  static std::filesystem::path partial(const std::filesystem::path& p) { return p.string() + ".partial"; }
+  static std::filesystem::path partial(const std::filesystem::path& p) {
+    return p.string() + ".partial";
+  }
   static std::string num(double v) {
     char buf[32];
     auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
@@ -95,7 +101,8 @@ class CsvWriter final : public TrajectoryWriter {
 
 }  // namespace
 
-std::unique_ptr<TrajectoryWriter> make_csv_writer(const std::filesystem::path& path, uint32_t every) {
+std::unique_ptr<TrajectoryWriter> make_csv_writer(const std::filesystem::path& path,
+                                                  uint32_t every) {
   return std::make_unique<CsvWriter>(path, every);
 }
 

@@ -60,7 +60,8 @@ class SqliteWriter final : public TrajectoryWriter {
 
   void begin(const Scenario& sc, const World& world) override {
     remove_partial();
-    if (sqlite3_open_v2(partial_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) != SQLITE_OK) {
+    if (sqlite3_open_v2(partial_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
+                        nullptr) != SQLITE_OK) {
       const std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
       sqlite3_close(db_);
       db_ = nullptr;
@@ -69,33 +70,46 @@ class SqliteWriter final : public TrajectoryWriter {
     exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA synchronous=NORMAL");
     exec("BEGIN");
-    exec("CREATE TABLE trajectory_data (frame INTEGER NOT NULL, id INTEGER NOT NULL, pos_x REAL NOT NULL, "
-         "pos_y REAL NOT NULL)");
+    exec(
+        "CREATE TABLE trajectory_data (frame INTEGER NOT NULL, id INTEGER NOT NULL, pos_x REAL NOT "
+        "NULL, "
+        "pos_y REAL NOT NULL)");
     exec("CREATE TABLE metadata (key TEXT NOT NULL UNIQUE PRIMARY KEY, value TEXT NOT NULL)");
     exec("CREATE TABLE geometry (hash INTEGER NOT NULL, wkt TEXT NOT NULL)");
     exec("CREATE UNIQUE INDEX geometry_hash ON geometry(hash)");
     exec("CREATE TABLE frame_data (frame INTEGER NOT NULL, geometry_hash INTEGER NOT NULL)");
-    exec("CREATE TABLE crowddb_agent_state (frame INTEGER NOT NULL, id INTEGER NOT NULL, vel_x REAL NOT NULL, "
-         "vel_y REAL NOT NULL, radius REAL NOT NULL, state TEXT NOT NULL, goal INTEGER NOT NULL)");
-    exec("CREATE TABLE crowddb_tick_metrics (tick INTEGER PRIMARY KEY, agents INTEGER NOT NULL, "
-         "arrived INTEGER NOT NULL, frozen INTEGER NOT NULL, freeze_iterations INTEGER NOT NULL, "
-         "overlapping_pairs INTEGER NOT NULL, obstacle_overlaps INTEGER NOT NULL, gridlocked INTEGER NOT NULL, "
-         "tick_seconds REAL NOT NULL, state_hash TEXT NOT NULL)");
+    exec(
+        "CREATE TABLE crowddb_agent_state (frame INTEGER NOT NULL, id INTEGER NOT NULL, vel_x REAL "
+        "NOT NULL, "
+        "vel_y REAL NOT NULL, radius REAL NOT NULL, state TEXT NOT NULL, goal INTEGER NOT NULL)");
+    exec(
+        "CREATE TABLE crowddb_tick_metrics (tick INTEGER PRIMARY KEY, agents INTEGER NOT NULL, "
+        "arrived INTEGER NOT NULL, frozen INTEGER NOT NULL, freeze_iterations INTEGER NOT NULL, "
+        "overlapping_pairs INTEGER NOT NULL, obstacle_overlaps INTEGER NOT NULL, gridlocked "
+        "INTEGER NOT NULL, "
+        "tick_seconds REAL NOT NULL, state_hash TEXT NOT NULL)");
     exec("CREATE TABLE crowddb_run (key TEXT NOT NULL UNIQUE PRIMARY KEY, value TEXT NOT NULL)");
-    exec("CREATE TABLE crowddb_goals (goal INTEGER PRIMARY KEY, name TEXT NOT NULL, x REAL NOT NULL, "
-         "y REAL NOT NULL, arrival_radius REAL NOT NULL)");
+    exec(
+        "CREATE TABLE crowddb_goals (goal INTEGER PRIMARY KEY, name TEXT NOT NULL, x REAL NOT "
+        "NULL, "
+        "y REAL NOT NULL, arrival_radius REAL NOT NULL)");
 
     const Bounds& b = world.bounds();
     const double fps = 1.0 / (sc.config.dt * every_);
     Statement meta(db_, "INSERT INTO metadata VALUES (?, ?)", path_.string());
-    for (const auto& [k, v] : {std::pair<std::string, std::string>{"version", "3"}, {"fps", num(fps)},
-                               {"xmin", num(b.xmin)}, {"xmax", num(b.xmax)}, {"ymin", num(b.ymin)},
+    for (const auto& [k, v] : {std::pair<std::string, std::string>{"version", "3"},
+                               {"fps", num(fps)},
+                               {"xmin", num(b.xmin)},
+                               {"xmax", num(b.xmax)},
+                               {"ymin", num(b.ymin)},
                                {"ymax", num(b.ymax)}})
       insert_text(meta, k, v);
     Statement run(db_, "INSERT INTO crowddb_run VALUES (?, ?)", path_.string());
     for (const auto& [k, v] : {std::pair<std::string, std::string>{"scenario_name", sc.name},
-                               {"scenario_source", sc.source}, {"scenario_json", sc.text},
-                               {"seed", std::to_string(sc.config.seed)}, {"dt", num(sc.config.dt)},
+                               {"scenario_source", sc.source},
+                               {"scenario_json", sc.text},
+                               {"seed", std::to_string(sc.config.seed)},
+                               {"dt", num(sc.config.dt)},
                                {"frame_every", std::to_string(every_)}})
       insert_text(run, k, v);
     wkt_ = walkable_area_wkt(world);
@@ -115,9 +129,12 @@ class SqliteWriter final : public TrajectoryWriter {
       step(goals);
     }
     traj_ = Statement(db_, "INSERT INTO trajectory_data VALUES (?, ?, ?, ?)", path_.string());
-    state_ = Statement(db_, "INSERT INTO crowddb_agent_state VALUES (?, ?, ?, ?, ?, ?, ?)", path_.string());
+    state_ = Statement(db_, "INSERT INTO crowddb_agent_state VALUES (?, ?, ?, ?, ?, ?, ?)",
+                       path_.string());
     frame_ = Statement(db_, "INSERT INTO frame_data VALUES (?, ?)", path_.string());
-    metric_ = Statement(db_, "INSERT INTO crowddb_tick_metrics VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)", path_.string());
+    metric_ =
+        Statement(db_, "INSERT INTO crowddb_tick_metrics VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                  path_.string());
   }
 
   void frame(uint64_t tick, const World& world) override {
@@ -170,9 +187,12 @@ class SqliteWriter final : public TrajectoryWriter {
   void finish(const RunInfo& info) override {
     {
       Statement run(db_, "INSERT INTO crowddb_run VALUES (?, ?)", path_.string());
-      for (const auto& [k, v] : {std::pair<std::string, std::string>{"crowddb_version", info.crowddb_version},
-                                 {"threads", std::to_string(info.threads)}, {"ticks", std::to_string(info.ticks)},
-                                 {"final_state_hash", hex(info.final_hash)}, {"run_seconds", num(info.seconds)}})
+      for (const auto& [k, v] :
+           {std::pair<std::string, std::string>{"crowddb_version", info.crowddb_version},
+            {"threads", std::to_string(info.threads)},
+            {"ticks", std::to_string(info.ticks)},
+            {"final_state_hash", hex(info.final_hash)},
+            {"run_seconds", num(info.seconds)}})
         insert_text(run, k, v);
     }
     // Indices after the bulk load: cheaper than maintaining them row by row.
@@ -181,11 +201,14 @@ class SqliteWriter final : public TrajectoryWriter {
     exec("COMMIT");
     release_statements();
     exec("PRAGMA journal_mode=DELETE");  // checkpoints the WAL and leaves one self-contained file
-    if (sqlite3_close(db_) != SQLITE_OK) throw Error(Error::Kind::io, path_.string() + ": cannot close output");
+    if (sqlite3_close(db_) != SQLITE_OK)
+      throw Error(Error::Kind::io, path_.string() + ": cannot close output");
     db_ = nullptr;
     std::error_code ec;
     std::filesystem::rename(partial_, path_, ec);
-    if (ec) throw Error(Error::Kind::io, path_.string() + ": cannot move output into place: " + ec.message());
+    if (ec)
+      throw Error(Error::Kind::io,
+                  path_.string() + ": cannot move output into place: " + ec.message());
   }
 
   void abort() noexcept override {
@@ -208,7 +231,8 @@ class SqliteWriter final : public TrajectoryWriter {
 
   void remove_partial() noexcept {
     std::error_code ec;
-    for (const char* suffix : {"", "-wal", "-shm", "-journal"}) std::filesystem::remove(partial_ + suffix, ec);
+    for (const char* suffix : {"", "-wal", "-shm", "-journal"})
+      std::filesystem::remove(partial_ + suffix, ec);
   }
 
   void exec(const char* sql) {
@@ -221,7 +245,8 @@ class SqliteWriter final : public TrajectoryWriter {
   }
 
   void step(const Statement& s) {
-    if (sqlite3_step(s.get()) != SQLITE_DONE) throw Error(Error::Kind::io, path_.string() + ": " + sqlite3_errmsg(db_));
+    if (sqlite3_step(s.get()) != SQLITE_DONE)
+      throw Error(Error::Kind::io, path_.string() + ": " + sqlite3_errmsg(db_));
     sqlite3_reset(s.get());
   }
 
@@ -243,7 +268,8 @@ class SqliteWriter final : public TrajectoryWriter {
 
 }  // namespace
 
-std::unique_ptr<TrajectoryWriter> make_sqlite_writer(const std::filesystem::path& path, uint32_t every) {
+std::unique_ptr<TrajectoryWriter> make_sqlite_writer(const std::filesystem::path& path,
+                                                     uint32_t every) {
   return std::make_unique<SqliteWriter>(path, every);
 }
 

@@ -4,7 +4,9 @@
 #include "world/geometry.hpp"
 
 // Boost 1.74's rescale policy trips GCC 12's -Wmaybe-uninitialized where it is inlined here.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <algorithm>
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/multi_polygon.hpp>
@@ -37,7 +39,8 @@ Polygon ring_polygon(const std::vector<Vec2>& pts) {
 std::string walkable_area_wkt(const World& world) {
   const Bounds& b = world.bounds();
   Multi area;
-  area.push_back(ring_polygon({{b.xmin, b.ymin}, {b.xmax, b.ymin}, {b.xmax, b.ymax}, {b.xmin, b.ymax}}));
+  area.push_back(
+      ring_polygon({{b.xmin, b.ymin}, {b.xmax, b.ymin}, {b.xmax, b.ymax}, {b.xmin, b.ymax}}));
   auto subtract = [&](const Polygon& hole) {
     Multi out;
     bg::difference(area, hole, out);

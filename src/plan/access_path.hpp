@@ -39,8 +39,8 @@ class CollisionPath {
   virtual ~CollisionPath() = default;
   // All overlapping pairs among the discs and between discs and obstacles (exact methods), or
   // the pairs the method finds (heuristics, which may miss some but never invent one).
-  virtual void run(const DiscView& discs, const StaticScene& scene, CollisionPairs& out, Executor& ex,
-                   QueryStats& stats) = 0;
+  virtual void run(const DiscView& discs, const StaticScene& scene, CollisionPairs& out,
+                   Executor& ex, QueryStats& stats) = 0;
 };
 
 // What the planner knows about a registered method.
@@ -85,7 +85,8 @@ const std::vector<CollisionMethod>& collision_registry();
 // Lookup by name; throws Error(usage) naming the valid choices when unknown.
 const FtcMethod& find_ftc_method(std::string_view name);
 const FieldMethod& find_field_method(std::string_view name, const PotentialSpec& spec);
-const CollisionMethod& find_collision_method(std::string_view name, const CollisionQueryShape& shape);
+const CollisionMethod& find_collision_method(std::string_view name,
+                                             const CollisionQueryShape& shape);
 
 // The planner's choice for "auto".
 const FtcMethod& choose_ftc_method(std::size_t rows);

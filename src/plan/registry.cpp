@@ -27,7 +27,8 @@ template <class M, class Ok>
 const M& pick(const std::vector<M>& registry, std::size_t rows, Ok ok) {
   const M* best = &registry.front();
   for (const auto& m : registry)
-    if (m.info.in_auto && m.info.exact && rows >= m.info.auto_min_rows && ok(m) && m.info.auto_rank > best->info.auto_rank)
+    if (m.info.in_auto && m.info.exact && rows >= m.info.auto_min_rows && ok(m) &&
+        m.info.auto_rank > best->info.auto_rank)
       best = &m;
   return *best;
 }
@@ -36,7 +37,8 @@ const M& pick(const std::vector<M>& registry, std::size_t rows, Ok ok) {
 
 const std::vector<FtcMethod>& ftc_registry() {
   static const std::vector<FtcMethod> methods = {
-      {{"naive", "nested loop over all pairs, O(n^2)"}, [] { return std::make_unique<FtcNaive>(); }},
+      {{"naive", "nested loop over all pairs, O(n^2)"},
+       [] { return std::make_unique<FtcNaive>(); }},
   };
   return methods;
 }
@@ -61,28 +63,30 @@ const std::vector<CollisionMethod>& collision_registry() {
 
 const FtcMethod& find_ftc_method(std::string_view name) {
   if (const auto* m = by_name(ftc_registry(), name)) return *m;
-  throw Error(Error::Kind::usage,
-              "unknown first-to-collide method '" + std::string(name) + "' (choose from " + choices(ftc_registry()) + ")");
+  throw Error(Error::Kind::usage, "unknown first-to-collide method '" + std::string(name) +
+                                      "' (choose from " + choices(ftc_registry()) + ")");
 }
 
 const FieldMethod& find_field_method(std::string_view name, const PotentialSpec& spec) {
   const auto* m = by_name(field_registry(), name);
   if (!m)
-    throw Error(Error::Kind::usage,
-                "unknown field method '" + std::string(name) + "' (choose from " + choices(field_registry()) + ")");
+    throw Error(Error::Kind::usage, "unknown field method '" + std::string(name) +
+                                        "' (choose from " + choices(field_registry()) + ")");
   if (!m->supports(spec))
-    throw Error(Error::Kind::usage, "field method '" + std::string(name) + "' does not support this kernel and metric");
+    throw Error(Error::Kind::usage,
+                "field method '" + std::string(name) + "' does not support this kernel and metric");
   return *m;
 }
 
-const CollisionMethod& find_collision_method(std::string_view name, const CollisionQueryShape& shape) {
+const CollisionMethod& find_collision_method(std::string_view name,
+                                             const CollisionQueryShape& shape) {
   const auto* m = by_name(collision_registry(), name);
   if (!m)
-    throw Error(Error::Kind::usage, "unknown collision method '" + std::string(name) + "' (choose from " +
-                                        choices(collision_registry()) + ")");
+    throw Error(Error::Kind::usage, "unknown collision method '" + std::string(name) +
+                                        "' (choose from " + choices(collision_registry()) + ")");
   if (!m->supports(shape))
-    throw Error(Error::Kind::usage, "collision method '" + std::string(name) + "' does not apply here (" +
-                                        m->info.description + ")");
+    throw Error(Error::Kind::usage, "collision method '" + std::string(name) +
+                                        "' does not apply here (" + m->info.description + ")");
   return *m;
 }
 
@@ -95,7 +99,8 @@ const FieldMethod& choose_field_method(std::size_t rows, const PotentialSpec& sp
 }
 
 const CollisionMethod& choose_collision_method(const CollisionQueryShape& shape) {
-  return pick(collision_registry(), shape.rows, [&](const CollisionMethod& m) { return m.supports(shape); });
+  return pick(collision_registry(), shape.rows,
+              [&](const CollisionMethod& m) { return m.supports(shape); });
 }
 
 }  // namespace crowddb

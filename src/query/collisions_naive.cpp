@@ -15,18 +15,20 @@ void disc_obstacle_overlaps(const DiscView& d, const StaticScene& scene, std::si
     const double x = d.x[i], y = d.y[i], r = d.radius[i];
     for (std::size_t c = 0; c < circles.size(); ++c)
       if (discs_overlap(circles[c].x - x, circles[c].y - y, r + circles[c].radius))
-        out.push_back({static_cast<uint32_t>(i), {Collider::Kind::circle, static_cast<uint32_t>(c)}});
+        out.push_back(
+            {static_cast<uint32_t>(i), {Collider::Kind::circle, static_cast<uint32_t>(c)}});
     for (std::size_t p = 0; p < polygons.size(); ++p) {
       const auto& b = boxes[p];
       if (x + r <= b.xmin || x - r >= b.xmax || y + r <= b.ymin || y - r >= b.ymax) continue;
       if (disc_overlaps_polygon(polygons[p].vertices, x, y, r))
-        out.push_back({static_cast<uint32_t>(i), {Collider::Kind::polygon, static_cast<uint32_t>(p)}});
+        out.push_back(
+            {static_cast<uint32_t>(i), {Collider::Kind::polygon, static_cast<uint32_t>(p)}});
     }
   }
 }
 
-void CollisionNaive::run(const DiscView& d, const StaticScene& scene, CollisionPairs& out, Executor& ex,
-                         QueryStats& stats) {
+void CollisionNaive::run(const DiscView& d, const StaticScene& scene, CollisionPairs& out,
+                         Executor& ex, QueryStats& stats) {
   out.clear();
   // Per-chunk buffers concatenated in chunk order keep the output sorted and thread-independent.
   constexpr std::size_t kGrain = 64;

@@ -9,7 +9,9 @@
 
 namespace crowddb {
 
-inline double sgn(double v) { return static_cast<double>((v > 0) - (v < 0)); }
+inline double sgn(double v) {
+  return static_cast<double>((v > 0) - (v < 0));
+}
 
 // Precomputed per-spec constants.
 struct PairKernel {

@@ -17,7 +17,8 @@ void FieldNaive::run(const DiscView& d, const StaticScene& scene, const Potentia
         if (q == p) continue;
         kernel.add(px - d.x[q], py - d.y[q], ac * d.charge[q], pot, gx, gy);
       }
-      for (std::size_t q = 0; q < qx.size(); ++q) kernel.add(px - qx[q], py - qy[q], ac * qc[q], pot, gx, gy);
+      for (std::size_t q = 0; q < qx.size(); ++q)
+        kernel.add(px - qx[q], py - qy[q], ac * qc[q], pot, gx, gy);
       out.potential[p] = pot;
       out.grad_x[p] = gx;
       out.grad_y[p] = gy;

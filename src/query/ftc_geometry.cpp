@@ -18,7 +18,7 @@ double ray_polygon_time(std::span<const Vec2> ring, double px, double py, double
     const double ex = b.x - a.x, ey = b.y - a.y;
     const double len = std::sqrt(ex * ex + ey * ey);
     if (len == 0) continue;
-    const double nx = -ey / len, ny = ex / len;       // unit normal
+    const double nx = -ey / len, ny = ex / len;           // unit normal
     const double s0 = nx * (px - a.x) + ny * (py - a.y);  // signed distance to the edge's line
     const double sv = nx * vx + ny * vy;
     const double gap = std::fabs(s0) - r;

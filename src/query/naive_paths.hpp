@@ -13,8 +13,8 @@ class FtcNaive final : public FtcPath {
 
 class FieldNaive final : public FieldPath {
  public:
-  void run(const DiscView& discs, const StaticScene& scene, const PotentialSpec& spec, FieldColumns& out,
-           Executor& ex, QueryStats& stats) override;
+  void run(const DiscView& discs, const StaticScene& scene, const PotentialSpec& spec,
+           FieldColumns& out, Executor& ex, QueryStats& stats) override;
 };
 
 class CollisionNaive final : public CollisionPath {

@@ -1,8 +1,9 @@
 // The public, stand-alone entry points of the steering queries: look the method up in the
 // registry, run it once on a private executor.
+#include "crowddb/query.hpp"
+
 #include <algorithm>
 
-#include "crowddb/query.hpp"
 #include "plan/access_path.hpp"
 #include "util/stopwatch.hpp"
 
@@ -30,8 +31,9 @@ CollisionQueryShape shape_of(const DiscView& d) {
 
 }  // namespace
 
-std::vector<FtcHit> first_to_collide(const DiscView& discs, const StaticScene& scene, double horizon,
-                                     std::string_view method, int threads, QueryStats* stats) {
+std::vector<FtcHit> first_to_collide(const DiscView& discs, const StaticScene& scene,
+                                     double horizon, std::string_view method, int threads,
+                                     QueryStats* stats) {
   const FtcMethod& m = method == "auto" ? choose_ftc_method(discs.n) : find_ftc_method(method);
   auto path = m.make();
   Executor ex(threads);
@@ -42,9 +44,11 @@ std::vector<FtcHit> first_to_collide(const DiscView& discs, const StaticScene& s
   return out;
 }
 
-FieldColumns potential_field(const DiscView& discs, const StaticScene& scene, const PotentialSpec& spec,
-                             std::string_view method, int threads, QueryStats* stats) {
-  const FieldMethod& m = method == "auto" ? choose_field_method(discs.n, spec) : find_field_method(method, spec);
+FieldColumns potential_field(const DiscView& discs, const StaticScene& scene,
+                             const PotentialSpec& spec, std::string_view method, int threads,
+                             QueryStats* stats) {
+  const FieldMethod& m =
+      method == "auto" ? choose_field_method(discs.n, spec) : find_field_method(method, spec);
   auto path = m.make();
   Executor ex(threads);
   QueryStats local;
@@ -54,8 +58,8 @@ FieldColumns potential_field(const DiscView& discs, const StaticScene& scene, co
   return out;
 }
 
-std::vector<uint32_t> collision_set(const DiscView& discs, const StaticScene& scene, std::string_view method,
-                                    int threads, QueryStats* stats) {
+std::vector<uint32_t> collision_set(const DiscView& discs, const StaticScene& scene,
+                                    std::string_view method, int threads, QueryStats* stats) {
   const CollisionQueryShape shape = shape_of(discs);
   const CollisionMethod& m =
       method == "auto" ? choose_collision_method(shape) : find_collision_method(method, shape);

@@ -8,8 +8,8 @@ namespace crowddb {
 
 namespace {
 
-void sample_segment(const Vec2& a, const Vec2& e, double spacing, double charge, std::vector<double>& px,
-                    std::vector<double>& py, std::vector<double>& pc) {
+void sample_segment(const Vec2& a, const Vec2& e, double spacing, double charge,
+                    std::vector<double>& px, std::vector<double>& py, std::vector<double>& pc) {
   const double len = std::hypot(e.x - a.x, e.y - a.y);
   const auto m = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(len / spacing)));
   for (std::size_t k = 0; k < m; ++k) {
@@ -45,7 +45,8 @@ StaticScene::StaticScene(std::vector<CircleObstacle> circles, std::vector<Polygo
   }
   for (const PolygonObstacle& p : polygons_) {
     const std::size_t n = p.vertices.size();
-    for (std::size_t i = 0; i < n; ++i) sample_segment(p.vertices[i], p.vertices[(i + 1) % n], spacing, p.charge, px_, py_, pc_);
+    for (std::size_t i = 0; i < n; ++i)
+      sample_segment(p.vertices[i], p.vertices[(i + 1) % n], spacing, p.charge, px_, py_, pc_);
   }
   if (walls) {
     const Bounds& b = *walls;
@@ -63,7 +64,8 @@ StaticScene::StaticScene(std::vector<CircleObstacle> circles, std::vector<Polygo
   for (const PolygonObstacle& p : polygons_) {
     Box b{INFINITY, INFINITY, -INFINITY, -INFINITY};
     for (const Vec2& a : p.vertices)
-      b = {std::min(b.xmin, a.x), std::min(b.ymin, a.y), std::max(b.xmax, a.x), std::max(b.ymax, a.y)};
+      b = {std::min(b.xmin, a.x), std::min(b.ymin, a.y), std::max(b.xmax, a.x),
+           std::max(b.ymax, a.y)};
     boxes_.push_back(b);
   }
 }

@@ -33,8 +33,8 @@ DiscTable uniform(std::size_t n, Box box, double vmax, double rmin, double rmax,
   return t;
 }
 
-DiscTable clustered(std::size_t n, Box box, std::size_t clusters, double spread, double vmax, double rmin,
-                    double rmax, uint64_t seed) {
+DiscTable clustered(std::size_t n, Box box, std::size_t clusters, double spread, double vmax,
+                    double rmin, double rmax, uint64_t seed) {
   Rng rng(seed);
   clusters = std::max<std::size_t>(clusters, 1);
   std::vector<double> cx(clusters), cy(clusters);
@@ -60,7 +60,8 @@ DiscTable lattice(std::size_t n, double spacing, double v, double radius, uint64
   const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
   DiscTable t;
   for (std::size_t i = 0; i < n; ++i) {
-    const double x = static_cast<double>(i % side) * spacing, y = static_cast<double>(i / side) * spacing;
+    const double x = static_cast<double>(i % side) * spacing,
+                 y = static_cast<double>(i / side) * spacing;
     const double vx = (static_cast<double>(rng.below(3)) - 1) * v;
     const double vy = (static_cast<double>(rng.below(3)) - 1) * v;
     t.push_back(i, x, y, vx, vy, radius);
@@ -68,8 +69,8 @@ DiscTable lattice(std::size_t n, double spacing, double v, double radius, uint64
   return t;
 }
 
-DiscTable big_crunch(std::size_t n, Box box, double arrival, double rmin, double rmax, double perturb,
-                     uint64_t seed) {
+DiscTable big_crunch(std::size_t n, Box box, double arrival, double rmin, double rmax,
+                     double perturb, uint64_t seed) {
   Rng rng(seed);
   const double cx = (box.xmin + box.xmax) / 2, cy = (box.ymin + box.ymax) / 2;
   DiscTable t;
@@ -85,7 +86,8 @@ DiscTable big_crunch(std::size_t n, Box box, double arrival, double rmin, double
   return t;
 }
 
-DiscTable duplicates(std::size_t n, std::size_t distinct, Box box, double vmax, double radius, uint64_t seed) {
+DiscTable duplicates(std::size_t n, std::size_t distinct, Box box, double vmax, double radius,
+                     uint64_t seed) {
   DiscTable base = uniform(std::max<std::size_t>(distinct, 1), box, vmax, radius, radius, seed);
   DiscTable t;
   for (std::size_t i = 0; i < n; ++i) {

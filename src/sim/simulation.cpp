@@ -20,7 +20,9 @@ void require(bool ok, const char* field, const std::string& what) {
   if (!ok) throw InvalidRow(field, std::string(field) + " " + what);
 }
 
-const char* kernel_name(Kernel k) { return k == Kernel::exp ? "exp" : "inv"; }
+const char* kernel_name(Kernel k) {
+  return k == Kernel::exp ? "exp" : "inv";
+}
 const char* metric_name(Metric m) {
   return m == Metric::l1 ? "l1" : (m == Metric::l2 ? "l2" : "radial");
 }
@@ -108,15 +110,19 @@ struct Simulation::Engine {
     const AgentTable& t = w.agents();
     p.rows = t.size();
     if (cfg.steering.w_ftc > 0)
-      p.ftc = cfg.access.ftc == "auto" ? &choose_ftc_method(p.rows) : &find_ftc_method(cfg.access.ftc);
+      p.ftc =
+          cfg.access.ftc == "auto" ? &choose_ftc_method(p.rows) : &find_ftc_method(cfg.access.ftc);
     if (cfg.steering.w_apf > 0)
-      p.field = cfg.access.field == "auto" ? &choose_field_method(p.rows, cfg.steering.potential)
-                                           : &find_field_method(cfg.access.field, cfg.steering.potential);
+      p.field = cfg.access.field == "auto"
+                    ? &choose_field_method(p.rows, cfg.steering.potential)
+                    : &find_field_method(cfg.access.field, cfg.steering.potential);
     CollisionQueryShape shape;
     shape.rows = p.rows;
-    shape.equal_radii = std::all_of(t.radius.begin(), t.radius.end(), [&](double r) { return r == t.radius[0]; });
-    p.collisions = cfg.access.collisions == "auto" ? &choose_collision_method(shape)
-                                                   : &find_collision_method(cfg.access.collisions, shape);
+    shape.equal_radii =
+        std::all_of(t.radius.begin(), t.radius.end(), [&](double r) { return r == t.radius[0]; });
+    p.collisions = cfg.access.collisions == "auto"
+                       ? &choose_collision_method(shape)
+                       : &find_collision_method(cfg.access.collisions, shape);
     return p;
   }
 
@@ -135,8 +141,9 @@ struct Simulation::Engine {
     if (!std::isfinite(rmin)) rmin = 1;
     if (rmin >= scene_spacing) return;
     scene_spacing = rmin;
-    scene = StaticScene({w.circles().begin(), w.circles().end()}, {w.polygons().begin(), w.polygons().end()},
-                        scene_spacing, cfg.steering.obstacle_charges, cfg.walls ? &w.bounds() : nullptr);
+    scene = StaticScene({w.circles().begin(), w.circles().end()},
+                        {w.polygons().begin(), w.polygons().end()}, scene_spacing,
+                        cfg.steering.obstacle_charges, cfg.walls ? &w.bounds() : nullptr);
   }
 };
 
@@ -160,7 +167,9 @@ Simulation::~Simulation() = default;
 Simulation::Simulation(Simulation&&) noexcept = default;
 Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 
-uint64_t Simulation::state_hash() const { return sim::state_hash(world_.agents(), last_.tick); }
+uint64_t Simulation::state_hash() const {
+  return sim::state_hash(world_.agents(), last_.tick);
+}
 
 const TickMetrics& Simulation::step() {
   Engine& e = *engine_;
@@ -197,7 +206,8 @@ const TickMetrics& Simulation::step() {
   if (plan.field) {
     ++e.method_ticks["field=" + plan.field->info.name];
     timed(Engine::kInner, n, [&] {
-      e.path(e.field_paths, *plan.field).run(view, e.scene, cfg.steering.potential, e.field, e.ex, e.ops[Engine::kInner].query);
+      e.path(e.field_paths, *plan.field)
+          .run(view, e.scene, cfg.steering.potential, e.field, e.ex, e.ops[Engine::kInner].query);
       sim::inner_avoidance(e.field, cfg, e.fx, e.ex);
     });
   }
@@ -205,7 +215,8 @@ const TickMetrics& Simulation::step() {
     ++e.method_ticks["ftc=" + plan.ftc->info.name];
     timed(Engine::kOuter, n, [&] {
       e.hits.assign(n, FtcHit{});
-      e.path(e.ftc_paths, *plan.ftc).run(view, e.scene, cfg.steering.horizon, e.hits, e.ex, e.ops[Engine::kOuter].query);
+      e.path(e.ftc_paths, *plan.ftc)
+          .run(view, e.scene, cfg.steering.horizon, e.hits, e.ex, e.ops[Engine::kOuter].query);
       sim::outer_avoidance(t, e.scene, e.hits, cfg, e.fx, e.ex);
     });
   }
@@ -252,7 +263,8 @@ const TickMetrics& Simulation::step() {
         world_.refresh_target(i);
       }
       const double reach = cfg.waypoint_radius > 0 ? cfg.waypoint_radius : t.radius[i];
-      while (!t.route[i].empty() && std::hypot(t.route[i].front().x - t.x[i], t.route[i].front().y - t.y[i]) <= reach) {
+      while (!t.route[i].empty() &&
+             std::hypot(t.route[i].front().x - t.x[i], t.route[i].front().y - t.y[i]) <= reach) {
         t.route[i].erase(t.route[i].begin());
         world_.refresh_target(i);
       }
@@ -324,18 +336,23 @@ std::string Simulation::explain() const {
        << (nv.skip_visible ? " or when the next one is in sight (Detour raycast)" : "") << "\n";
   if (p.field)
     os << "  2 Q2 inner avoidance potential field " << kernel_name(s.potential.kernel) << "-"
-       << metric_name(s.potential.metric) << " A=" << num(s.potential.A) << " k=" << num(s.potential.k)
-       << " w_apf=" << num(s.w_apf) << "\n       access path: " << p.field->info.name << " (" << p.field->info.description << ")\n";
+       << metric_name(s.potential.metric) << " A=" << num(s.potential.A)
+       << " k=" << num(s.potential.k) << " w_apf=" << num(s.w_apf)
+       << "\n       access path: " << p.field->info.name << " (" << p.field->info.description
+       << ")\n";
   else
     os << "  2 Q2 inner avoidance off (w_apf = 0)\n";
   if (p.ftc)
-    os << "  3 Q3 outer avoidance first-to-collide, horizon=" << num(s.horizon) << " w_ftc=" << num(s.w_ftc)
-       << "\n       access path: " << p.ftc->info.name << " (" << p.ftc->info.description << ")\n";
+    os << "  3 Q3 outer avoidance first-to-collide, horizon=" << num(s.horizon)
+       << " w_ftc=" << num(s.w_ftc) << "\n       access path: " << p.ftc->info.name << " ("
+       << p.ftc->info.description << ")\n";
   else
     os << "  3 Q3 outer avoidance off (w_ftc = 0)\n";
-  os << "  4 combine+integrate  sum effects; |a| <= max_accel; |v| <= max_speed; p += v dt, dt=" << num(config_.dt) << "\n";
-  os << "  5 " << (config_.backoff ? "backoff            freeze the collision set until empty"
-                                    : "overlap count      backoff off: overlaps are only counted")
+  os << "  4 combine+integrate  sum effects; |a| <= max_accel; |v| <= max_speed; p += v dt, dt="
+     << num(config_.dt) << "\n";
+  os << "  5 "
+     << (config_.backoff ? "backoff            freeze the collision set until empty"
+                         : "overlap count      backoff off: overlaps are only counted")
      << "\n       access path: " << p.collisions->info.name << " ("
      << p.collisions->info.description << ")\n";
   os << "  6 commit             swap columns, waypoints, arrivals ("
@@ -363,9 +380,11 @@ std::string Simulation::explain_analyze() const {
                                 "path requests"};
   std::ostringstream os;
   char line[256];
-  std::snprintf(line, sizeof line, "EXPLAIN ANALYZE  %llu ticks\n", static_cast<unsigned long long>(last_.tick));
+  std::snprintf(line, sizeof line, "EXPLAIN ANALYZE  %llu ticks\n",
+                static_cast<unsigned long long>(last_.tick));
   os << line;
-  std::snprintf(line, sizeof line, "  %-20s %8s %12s %12s %12s\n", "operator", "loops", "rows", "total ms", "ms/loop");
+  std::snprintf(line, sizeof line, "  %-20s %8s %12s %12s %12s\n", "operator", "loops", "rows",
+                "total ms", "ms/loop");
   os << line;
   double total = 0;
   for (int op = 0; op < Engine::kOpCount; ++op) total += e.ops[op].seconds;
@@ -378,14 +397,17 @@ std::string Simulation::explain_analyze() const {
     os << line;
     const QueryStats& q = s.query;
     if (q.pair_tests || q.nodes_visited || q.queue_pops) {
-      std::snprintf(line, sizeof line, "  %-20s pair tests %llu, nodes %llu, queue pushes %llu, pops %llu\n", "",
-                    static_cast<unsigned long long>(q.pair_tests), static_cast<unsigned long long>(q.nodes_visited),
-                    static_cast<unsigned long long>(q.queue_pushes), static_cast<unsigned long long>(q.queue_pops));
+      std::snprintf(line, sizeof line,
+                    "  %-20s pair tests %llu, nodes %llu, queue pushes %llu, pops %llu\n", "",
+                    static_cast<unsigned long long>(q.pair_tests),
+                    static_cast<unsigned long long>(q.nodes_visited),
+                    static_cast<unsigned long long>(q.queue_pushes),
+                    static_cast<unsigned long long>(q.queue_pops));
       os << line;
     }
     if (q.build_seconds > 0) {
-      std::snprintf(line, sizeof line, "  %-20s index build %.3f ms, probes %.3f ms\n", "", q.build_seconds * 1e3,
-                    q.query_seconds * 1e3);
+      std::snprintf(line, sizeof line, "  %-20s index build %.3f ms, probes %.3f ms\n", "",
+                    q.build_seconds * 1e3, q.query_seconds * 1e3);
       os << line;
     }
   }

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <numbers>
 
 #include "path/navigation.hpp"
@@ -15,7 +14,9 @@ namespace {
 
 constexpr std::size_t kGrain = 256;
 
-bool idle(const AgentTable& t, std::size_t i) { return t.state[i] == AgentState::arrived; }
+bool idle(const AgentTable& t, std::size_t i) {
+  return t.state[i] == AgentState::arrived;
+}
 
 // Penetration depth of a disc into a polygon (> 0: overlapping).
 double polygon_depth(std::span<const Vec2> ring, double x, double y, double r) {
@@ -67,7 +68,8 @@ void attraction(const AgentTable& t, std::span<const Goal> goals, const SimConfi
       }
       if (cfg.nudge_after > 0 && t.frozen_ticks[i] >= cfg.nudge_after) {
         Rng rng = Rng::stream(cfg.seed ^ (tick * 0xd6e8feb86659fd93ull), t.id[i]);
-        const double turn = rng.uniform(std::numbers::pi / 4, std::numbers::pi / 2) * (rng.below(2) ? 1 : -1);
+        const double turn =
+            rng.uniform(std::numbers::pi / 4, std::numbers::pi / 2) * (rng.below(2) ? 1 : -1);
         const double c = std::cos(turn), s = std::sin(turn);
         const double rx = c * px - s * py, ry = s * px + c * py;
         px = rx;
@@ -99,7 +101,7 @@ void outer_avoidance(const AgentTable& t, const StaticScene& scene, std::span<co
       if (h.with.kind == Collider::Kind::none || idle(t, i)) continue;
       const double ts = h.time;
       const double ax = t.x[i] + t.vx[i] * ts, ay = t.y[i] + t.vy[i] * ts;  // a at t*
-      double bx, by, bvx = 0, bvy = 0;                                     // b at t*
+      double bx, by, bvx = 0, bvy = 0;                                      // b at t*
       switch (h.with.kind) {
         case Collider::Kind::agent:
           bvx = t.vx[h.with.row];
@@ -122,7 +124,8 @@ void outer_avoidance(const AgentTable& t, const StaticScene& scene, std::span<co
       }
       double nx = ax - bx, ny = ay - by;
       double len = std::sqrt(nx * nx + ny * ny);
-      if (len == 0) {  // centres coincide at t*: sidestep, counter-clockwise of the relative velocity
+      if (len ==
+          0) {  // centres coincide at t*: sidestep, counter-clockwise of the relative velocity
         nx = -(t.vy[i] - bvy);
         ny = t.vx[i] - bvx;
         len = std::sqrt(nx * nx + ny * ny);
@@ -135,8 +138,8 @@ void outer_avoidance(const AgentTable& t, const StaticScene& scene, std::span<co
   });
 }
 
-void combine_integrate(const AgentTable& t, const Effects& fx, const SimConfig& cfg, NextState& next,
-                       Executor& ex) {
+void combine_integrate(const AgentTable& t, const Effects& fx, const SimConfig& cfg,
+                       NextState& next, Executor& ex) {
   const double dt = cfg.dt;
   ex.for_each_chunk(t.size(), kGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
@@ -170,8 +173,8 @@ void combine_integrate(const AgentTable& t, const Effects& fx, const SimConfig& 
 
 OverlapReport find_overlaps(const AgentTable& t, const NextState& next, const StaticScene& scene,
                             CollisionPath& path, Executor& ex, QueryStats& stats) {
-  const DiscView view{t.size(), next.x.data(), next.y.data(), next.vx.data(), next.vy.data(),
-                      t.radius.data(), t.charge.data(), t.id.data()};
+  const DiscView view{t.size(),       next.x.data(),   next.y.data(),   next.vx.data(),
+                      next.vy.data(), t.radius.data(), t.charge.data(), t.id.data()};
   CollisionPairs pairs;
   path.run(view, scene, pairs, ex, stats);
   OverlapReport r;
@@ -181,7 +184,8 @@ OverlapReport find_overlaps(const AgentTable& t, const NextState& next, const St
   for (auto [i, j] : pairs.agents) {
     const double sx = t.x[j] - t.x[i], sy = t.y[j] - t.y[i];
     const double nx = next.x[j] - next.x[i], ny = next.y[j] - next.y[i];
-    if (discs_overlap(sx, sy, t.radius[i] + t.radius[j]) && nx * nx + ny * ny >= sx * sx + sy * sy) continue;
+    if (discs_overlap(sx, sy, t.radius[i] + t.radius[j]) && nx * nx + ny * ny >= sx * sx + sy * sy)
+      continue;
     r.violators.push_back(i);
     r.violators.push_back(j);
   }
@@ -204,8 +208,9 @@ OverlapReport find_overlaps(const AgentTable& t, const NextState& next, const St
   return r;
 }
 
-OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& scene, CollisionPath& path,
-                      Executor& ex, QueryStats& stats, std::size_t& iterations) {
+OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& scene,
+                      CollisionPath& path, Executor& ex, QueryStats& stats,
+                      std::size_t& iterations) {
   iterations = 0;
   for (;;) {
     OverlapReport r = find_overlaps(t, next, scene, path, ex, stats);

@@ -53,15 +53,15 @@ void outer_avoidance(const AgentTable& t, const StaticScene& scene, std::span<co
 
 // Sum the effects, clamp |a| <= max_accel, v' = v + a dt clamped to max_speed, p' = p + v' dt.
 // Idle agents stay put with zero velocity.
-void combine_integrate(const AgentTable& t, const Effects& fx, const SimConfig& cfg, NextState& next,
-                       Executor& ex);
+void combine_integrate(const AgentTable& t, const Effects& fx, const SimConfig& cfg,
+                       NextState& next, Executor& ex);
 
 // Overlaps among the next-state positions, split into those the backoff must resolve and those
 // it tolerates (pairs that overlapped at the start of the tick and did not get deeper).
 struct OverlapReport {
-  std::size_t agent_pairs = 0;     // all overlapping agent pairs
-  std::size_t obstacle_hits = 0;   // all agent-obstacle overlaps (walls are obstacles)
-  std::vector<uint32_t> violators; // rows in a new or deepened overlap, sorted, unique
+  std::size_t agent_pairs = 0;      // all overlapping agent pairs
+  std::size_t obstacle_hits = 0;    // all agent-obstacle overlaps (walls are obstacles)
+  std::vector<uint32_t> violators;  // rows in a new or deepened overlap, sorted, unique
 };
 
 // Finds overlaps among the next-state positions with the planned collision method.
@@ -70,8 +70,9 @@ OverlapReport find_overlaps(const AgentTable& t, const NextState& next, const St
 
 // Backoff: freeze the violators (back to the start position, zero velocity) until none is left.
 // Returns the overlaps of the final state and the number of iterations in `iterations`.
-OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& scene, CollisionPath& path,
-                      Executor& ex, QueryStats& stats, std::size_t& iterations);
+OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& scene,
+                      CollisionPath& path, Executor& ex, QueryStats& stats,
+                      std::size_t& iterations);
 
 // Hash of the committed state: tick, then per row id, position, velocity and state bits.
 uint64_t state_hash(const AgentTable& t, uint64_t tick);

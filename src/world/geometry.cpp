@@ -25,7 +25,8 @@ bool segments_touch(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) 
 
 }  // namespace
 
-std::optional<std::pair<std::size_t, std::size_t>> first_self_intersection(std::span<const Vec2> ring) {
+std::optional<std::pair<std::size_t, std::size_t>> first_self_intersection(
+    std::span<const Vec2> ring) {
   const std::size_t n = ring.size();
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2& a = ring[i];

@@ -23,7 +23,9 @@ inline double signed_area(std::span<const Vec2> ring) {
   return a / 2;
 }
 
-inline double cross(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
+inline double cross(double ax, double ay, double bx, double by) {
+  return ax * by - ay * bx;
+}
 
 // Closest point of segment [a, b] to p, as the parameter in [0, 1].
 inline double segment_param(const Vec2& a, const Vec2& b, double px, double py) {
@@ -61,7 +63,8 @@ inline bool point_in_polygon(std::span<const Vec2> ring, double px, double py) {
 }
 
 // Squared distance from p to the polygon's boundary, and the closest boundary point.
-inline double dist2_to_boundary(std::span<const Vec2> ring, double px, double py, Vec2* closest = nullptr) {
+inline double dist2_to_boundary(std::span<const Vec2> ring, double px, double py,
+                                Vec2* closest = nullptr) {
   double best = INFINITY;
   for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
     const Vec2& a = ring[i];
@@ -88,6 +91,7 @@ inline bool discs_overlap(double dx, double dy, double rsum) {
 }
 
 // The first pair of non-adjacent edges (i, j), i < j, that touch or cross, if any. O(v^2).
-std::optional<std::pair<std::size_t, std::size_t>> first_self_intersection(std::span<const Vec2> ring);
+std::optional<std::pair<std::size_t, std::size_t>> first_self_intersection(
+    std::span<const Vec2> ring);
 
 }  // namespace crowddb

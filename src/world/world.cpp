@@ -18,7 +18,8 @@ std::string fmt(double v) {
 }
 
 void require_finite(const char* field, double v) {
-  if (!std::isfinite(v)) throw InvalidRow(field, std::string(field) + " must be finite (got " + fmt(v) + ")");
+  if (!std::isfinite(v))
+    throw InvalidRow(field, std::string(field) + " must be finite (got " + fmt(v) + ")");
 }
 
 void require_positive(const char* field, double v) {
@@ -36,7 +37,8 @@ void World::validate_spec(const AgentSpec& s, std::size_t goal_count) {
   require_positive("radius", s.radius);
   require_positive("max_speed", s.max_speed);
   if (std::isnan(s.max_accel) || !(s.max_accel > 0))
-    throw InvalidRow("max_accel", "max_accel must be > 0 or infinite (got " + fmt(s.max_accel) + ")");
+    throw InvalidRow("max_accel",
+                     "max_accel must be > 0 or infinite (got " + fmt(s.max_accel) + ")");
   require_finite("charge", s.charge);
   if (s.goal >= goal_count)
     throw InvalidRow("goal", "goal " + std::to_string(s.goal) + " does not exist (the world has " +
@@ -123,14 +125,17 @@ AgentId World::insert(const AgentSpec& spec) {
 
 void World::erase(AgentId id) {
   Slot* s = const_cast<Slot*>(live_slot(id));
-  if (!s) throw Error(Error::Kind::input, "erase: agent " + std::to_string(id.value()) + " does not exist");
+  if (!s)
+    throw Error(Error::Kind::input,
+                "erase: agent " + std::to_string(id.value()) + " does not exist");
   s->doomed = true;
   pending_.push_back({Change::Kind::erase, id, {}, 0});
 }
 
 void World::retarget(AgentId id, uint32_t goal) {
   if (!live_slot(id))
-    throw Error(Error::Kind::input, "retarget: agent " + std::to_string(id.value()) + " does not exist");
+    throw Error(Error::Kind::input,
+                "retarget: agent " + std::to_string(id.value()) + " does not exist");
   if (goal >= goals_.size())
     throw InvalidRow("goal", "goal " + std::to_string(goal) + " does not exist (the world has " +
                                  std::to_string(goals_.size()) + " goals)");
@@ -284,7 +289,8 @@ void World::validate() const {
     if (id.index >= slots_.size() || slots_[id.index].row != r ||
         slots_[id.index].generation != id.generation)
       throw std::logic_error("slot map does not point back at row " + std::to_string(r));
-    if (t.goal[r] >= goals_.size()) throw std::logic_error("row " + std::to_string(r) + " has a bad goal");
+    if (t.goal[r] >= goals_.size())
+      throw std::logic_error("row " + std::to_string(r) + " has a bad goal");
   }
   for (const Slot& s : slots_) live += s.row != kNoRow;
   if (live != n) throw std::logic_error("slot map and rows disagree on the agent count");

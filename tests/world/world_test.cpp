@@ -36,7 +36,8 @@ TEST(World, InsertsAreBufferedUntilApplied) {
 
 TEST(World, EraseSwapsLastRowInAndKeepsHandlesValid) {
   World w = world_with_goals();
-  const AgentId a = w.insert(spec_at(1, 0)), b = w.insert(spec_at(2, 0)), c = w.insert(spec_at(3, 0));
+  const AgentId a = w.insert(spec_at(1, 0)), b = w.insert(spec_at(2, 0)),
+                c = w.insert(spec_at(3, 0));
   w.apply_pending();
   w.erase(a);
   EXPECT_TRUE(w.contains(a));  // still there until the batch is applied
@@ -147,7 +148,8 @@ TEST(World, InvalidStaticRowsAreRejected) {
   EXPECT_THROW(w.add_obstacle(PolygonObstacle{{{0, 0}, {1, 1}}, 1}), InvalidRow);
   // A bow tie is not a simple polygon.
   EXPECT_THROW(w.add_obstacle(PolygonObstacle{{{0, 0}, {2, 2}, {2, 0}, {0, 2}}, 1}), InvalidRow);
-  EXPECT_THROW(w.add_obstacle(PolygonObstacle{{{0, 0}, {1, 0}, {2, 0}}, 1}), InvalidRow);  // zero area
+  EXPECT_THROW(w.add_obstacle(PolygonObstacle{{{0, 0}, {1, 0}, {2, 0}}, 1}),
+               InvalidRow);  // zero area
   EXPECT_EQ(w.goals().size(), 2u);
   EXPECT_TRUE(w.circles().empty());
   EXPECT_TRUE(w.polygons().empty());

@@ -9,12 +9,14 @@
 namespace crowddb::cli {
 
 void add_experiment_command(CLI::App& app, Action& action) {
-  auto* sub = app.add_subcommand("experiment", "reproduce an experiment of the thesis (CSV + PNG plots)");
+  auto* sub =
+      app.add_subcommand("experiment", "reproduce an experiment of the thesis (CSV + PNG plots)");
   static std::string name, out;
   static experiment::Options opts;
   std::string names;
   for (const auto& e : experiment::registry()) names += "\n  " + e.name + ": " + e.description;
-  sub->add_option("name", name, "experiment:" + (names.empty() ? std::string(" (none registered yet)") : names))
+  sub->add_option("name", name,
+                  "experiment:" + (names.empty() ? std::string(" (none registered yet)") : names))
       ->required();
   sub->add_option("--out", out, "output folder (created if missing)")->required();
   sub->add_flag("--quick", opts.quick, "small sizes, for tests and a first look");

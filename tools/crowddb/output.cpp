@@ -1,9 +1,10 @@
+#include <unistd.h>
+
 #include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <unistd.h>
 
 #include "commands.hpp"
 #include "crowddb/error.hpp"

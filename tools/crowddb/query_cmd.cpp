@@ -18,9 +18,11 @@ struct Common {
 void add_common(CLI::App* sub, Common& c, bool method_required = false) {
   sub->add_option("--agents", c.agents, "agents CSV: id,x,y,vx,vy,radius[,charge]")->required();
   sub->add_option("--obstacles", c.obstacles, "obstacles CSV: x,y,radius[,charge] (named o<row>)");
-  auto* m = sub->add_option("--method", c.method, "access path: auto, naive or an index (see --help of run)");
+  auto* m = sub->add_option("--method", c.method,
+                            "access path: auto, naive or an index (see --help of run)");
   if (method_required) m->required();
-  sub->add_option("--threads", c.threads, "threads (the answer does not depend on it)")->check(CLI::Range(1, 256));
+  sub->add_option("--threads", c.threads, "threads (the answer does not depend on it)")
+      ->check(CLI::Range(1, 256));
   sub->add_option("--out", c.out, "output file ('-' for stdout)");
 }
 
@@ -40,7 +42,8 @@ Inputs load(const Common& c, ObstacleCharges charges) {
   in.scene = StaticScene(std::move(circles), {}, std::isfinite(rmin) ? rmin : 1.0, charges);
   in.by_id.resize(in.agents.size());
   std::iota(in.by_id.begin(), in.by_id.end(), std::size_t{0});
-  std::sort(in.by_id.begin(), in.by_id.end(), [&](auto a, auto b) { return in.agents.id[a] < in.agents.id[b]; });
+  std::sort(in.by_id.begin(), in.by_id.end(),
+            [&](auto a, auto b) { return in.agents.id[a] < in.agents.id[b]; });
   return in;
 }
 
@@ -51,7 +54,8 @@ void add_query_commands(CLI::App& app, Action& action) {
   query->require_subcommand(1);
 
   // ---- first-to-collide
-  auto* ftc = query->add_subcommand("ftc", "first agent or obstacle each agent collides with (CSV id,first_id,time)");
+  auto* ftc = query->add_subcommand(
+      "ftc", "first agent or obstacle each agent collides with (CSV id,first_id,time)");
   static Common fc;
   static double horizon = 30;
   add_common(ftc, fc);
@@ -61,7 +65,8 @@ void add_query_commands(CLI::App& app, Action& action) {
   ftc->callback([&action] {
     action = [] {
       Inputs in = load(fc, ObstacleCharges::centres);
-      const auto hits = first_to_collide(in.agents.view(), in.scene, horizon, fc.method, fc.threads);
+      const auto hits =
+          first_to_collide(in.agents.view(), in.scene, horizon, fc.method, fc.threads);
       std::string text = "id,first_id,time\n";
       for (std::size_t row : in.by_id) {
         const FtcHit& h = hits[row];
@@ -86,32 +91,39 @@ void add_query_commands(CLI::App& app, Action& action) {
   });
 
   // ---- potential field
-  auto* field = query->add_subcommand("field", "potential and gradient at every agent (CSV id,potential,grad_x,grad_y)");
+  auto* field = query->add_subcommand(
+      "field", "potential and gradient at every agent (CSV id,potential,grad_x,grad_y)");
   static Common pc;
   static std::string kernel = "exp", metric = "l1";
   static PotentialSpec spec;
   static double floor_value = 0;
   add_common(field, pc);
-  field->add_option("--kernel", kernel, "exp (A e^{-k d}) or inv (A / d)")->check(CLI::IsMember({"exp", "inv"}));
-  field->add_option("--metric", metric, "distance: l1, l2 or radial")->check(CLI::IsMember({"l1", "l2", "radial"}));
+  field->add_option("--kernel", kernel, "exp (A e^{-k d}) or inv (A / d)")
+      ->check(CLI::IsMember({"exp", "inv"}));
+  field->add_option("--metric", metric, "distance: l1, l2 or radial")
+      ->check(CLI::IsMember({"l1", "l2", "radial"}));
   field->add_option("--A", spec.A, "kernel scale A")->capture_default_str();
   field->add_option("--k", spec.k, "exp kernel rate k")->capture_default_str();
   field->add_option("--frames", spec.radial_frames, "rotated frames of the radial metric")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
-  field->add_option("--floor", floor_value, "inv kernel: distance floor (default: a tenth of the smallest radius)")
+  field
+      ->add_option("--floor", floor_value,
+                   "inv kernel: distance floor (default: a tenth of the smallest radius)")
       ->check(CLI::PositiveNumber);
   field->callback([&action] {
     action = [] {
       Inputs in = load(pc, ObstacleCharges::centres);
       spec.kernel = kernel == "inv" ? Kernel::inv : Kernel::exp;
-      spec.metric = metric == "l2" ? Metric::l2 : (metric == "radial" ? Metric::radial : Metric::l1);
+      spec.metric =
+          metric == "l2" ? Metric::l2 : (metric == "radial" ? Metric::radial : Metric::l1);
       if (!std::isfinite(spec.A) || !std::isfinite(spec.k))
         throw Error(Error::Kind::usage, "--A and --k must be finite numbers");
       double rmin = std::numeric_limits<double>::infinity();
       for (double r : in.agents.radius) rmin = std::min(rmin, r);
       spec.inv_floor = floor_value > 0 ? floor_value : (std::isfinite(rmin) ? rmin / 10 : 0.1);
-      const FieldColumns f = potential_field(in.agents.view(), in.scene, spec, pc.method, pc.threads);
+      const FieldColumns f =
+          potential_field(in.agents.view(), in.scene, spec, pc.method, pc.threads);
       std::string text = "id,potential,grad_x,grad_y\n";
       for (std::size_t row : in.by_id)
         text += std::to_string(in.agents.id[row]) + "," + format_number(f.potential[row]) + "," +
@@ -122,7 +134,8 @@ void add_query_commands(CLI::App& app, Action& action) {
   });
 
   // ---- collision set
-  auto* col = query->add_subcommand("collisions", "ids of agents that overlap another agent or an obstacle");
+  auto* col = query->add_subcommand("collisions",
+                                    "ids of agents that overlap another agent or an obstacle");
   static Common cc;
   add_common(col, cc);
   col->callback([&action] {

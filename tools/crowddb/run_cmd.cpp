@@ -19,7 +19,9 @@ namespace crowddb::cli {
 namespace {
 
 std::atomic<bool> g_interrupted{false};
-extern "C" void on_interrupt(int) { g_interrupted = true; }
+extern "C" void on_interrupt(int) {
+  g_interrupted = true;
+}
 
 struct RunOptions {
   std::string scenario;
@@ -39,7 +41,8 @@ std::string hex(uint64_t v) {
 }
 
 void print_warnings(const Scenario& sc) {
-  for (const auto& w : sc.warnings) std::cerr << "crowddb: warning: " << sc.source << ": " << w << "\n";
+  for (const auto& w : sc.warnings)
+    std::cerr << "crowddb: warning: " << sc.source << ": " << w << "\n";
 }
 
 // Applies the command-line overrides to a loaded scenario.
@@ -56,7 +59,8 @@ void apply_overrides(Scenario& sc, const RunOptions& o) {
     const bool csv = o.out.size() >= 4 && o.out.compare(o.out.size() - 4, 4, ".csv") == 0;
     sc.output.format = csv ? OutputSpec::Format::csv : OutputSpec::Format::sqlite;
   }
-  if (!o.format.empty()) sc.output.format = o.format == "csv" ? OutputSpec::Format::csv : OutputSpec::Format::sqlite;
+  if (!o.format.empty())
+    sc.output.format = o.format == "csv" ? OutputSpec::Format::csv : OutputSpec::Format::sqlite;
   if (o.every > 0) sc.output.every = static_cast<uint32_t>(o.every);
   if (o.no_output) sc.output.path.clear();
 }
@@ -86,7 +90,9 @@ int run(const RunOptions& o) {
   try {
     if (writer) writer->frame(0, sim.world());
     for (uint64_t t = 1; t <= sc.ticks; ++t) {
-      if (g_interrupted) throw Error(Error::Kind::io, "interrupted at tick " + std::to_string(t - 1) + "; no output kept");
+      if (g_interrupted)
+        throw Error(Error::Kind::io,
+                    "interrupted at tick " + std::to_string(t - 1) + "; no output kept");
       const TickMetrics& m = sim.step();
       tick_seconds.push_back(m.seconds);
       max_pairs = std::max(max_pairs, m.overlapping_pairs);
@@ -98,9 +104,10 @@ int run(const RunOptions& o) {
       }
       if (tty && (progress_clock.seconds() > 0.2 || t == sc.ticks)) {
         progress_clock.restart();
-        std::fprintf(stderr, "\rtick %llu/%llu  agents %zu  arrived %zu  overlaps %zu  %.1f ticks/s   ",
-                     static_cast<unsigned long long>(t), static_cast<unsigned long long>(sc.ticks), m.agents,
-                     sim.arrived_total(), m.overlapping_pairs, static_cast<double>(t) / clock.seconds());
+        std::fprintf(
+            stderr, "\rtick %llu/%llu  agents %zu  arrived %zu  overlaps %zu  %.1f ticks/s   ",
+            static_cast<unsigned long long>(t), static_cast<unsigned long long>(sc.ticks), m.agents,
+            sim.arrived_total(), m.overlapping_pairs, static_cast<double>(t) / clock.seconds());
       }
     }
     if (tty) std::fprintf(stderr, "\n");
@@ -136,15 +143,17 @@ int run(const RunOptions& o) {
        << 1e3 * experiment::median(tick_seconds) << " ms; " << sc.config.threads << " thread"
        << (sc.config.threads > 1 ? "s" : "") << ")";
   }
-  os << "\n  agents: " << agents_at_start << " at start, " << sim.world().agents().size() << " at end; arrived "
-     << sim.arrived_total() << "\n  overlaps after a tick: at most " << max_pairs << " agent pairs and " << max_obstacle
-     << " agent-obstacle; at the end " << sim.last_metrics().overlapping_pairs << " pairs\n  backoff: "
-     << (sc.config.backoff ? "on" : "off") << ", " << frozen_total << " agent-ticks frozen, "
-     << sim.last_metrics().gridlocked << " agents gridlocked at the end\n  final state hash " << hex(sim.state_hash())
-     << "\n";
+  os << "\n  agents: " << agents_at_start << " at start, " << sim.world().agents().size()
+     << " at end; arrived " << sim.arrived_total() << "\n  overlaps after a tick: at most "
+     << max_pairs << " agent pairs and " << max_obstacle << " agent-obstacle; at the end "
+     << sim.last_metrics().overlapping_pairs
+     << " pairs\n  backoff: " << (sc.config.backoff ? "on" : "off") << ", " << frozen_total
+     << " agent-ticks frozen, " << sim.last_metrics().gridlocked
+     << " agents gridlocked at the end\n  final state hash " << hex(sim.state_hash()) << "\n";
   if (writer)
     os << "  trajectories: " << sc.output.path << " ("
-       << (sc.output.format == OutputSpec::Format::csv ? "csv" : "sqlite, JuPedSim format v3") << ")\n";
+       << (sc.output.format == OutputSpec::Format::csv ? "csv" : "sqlite, JuPedSim format v3")
+       << ")\n";
   std::cout << os.str();
   if (o.analyze) std::cout << sim.explain() << sim.explain_analyze();
   return 0;
@@ -156,15 +165,18 @@ void add_run_command(CLI::App& app, Action& action) {
   static RunOptions o;
   auto* sub = app.add_subcommand("run", "simulate a scenario file (see docs/scenario-format.md)");
   sub->add_option("scenario", o.scenario, "scenario JSON file")->required();
-  sub->add_option("--ticks", o.ticks, "number of ticks (overrides the file)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--ticks", o.ticks, "number of ticks (overrides the file)")
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--out", o.out, "trajectory output: FILE.sqlite (JuPedSim format) or FILE.csv");
   sub->add_option("--format", o.format, "output format when the extension does not say")
       ->check(CLI::IsMember({"sqlite", "csv"}));
   sub->add_flag("--no-output", o.no_output, "write no trajectories");
   sub->add_option("--every", o.every, "write every n-th frame")->check(CLI::PositiveNumber);
   sub->add_flag("--explain", o.explain, "print the tick's query plan and exit");
-  sub->add_flag("--explain-analyze", o.analyze, "run, then print the plan with rows and time per operator");
-  sub->add_option("--threads", o.threads, "threads (results do not depend on it)")->check(CLI::Range(1, 256));
+  sub->add_flag("--explain-analyze", o.analyze,
+                "run, then print the plan with rows and time per operator");
+  sub->add_option("--threads", o.threads, "threads (results do not depend on it)")
+      ->check(CLI::Range(1, 256));
   sub->add_flag("--no-backoff", o.no_backoff, "switch the backoff freeze loop off");
   sub->add_flag("--no-navigation", o.no_navigation,
                 "switch the path service off (agents steer straight at their goals)");
@@ -186,9 +198,9 @@ void add_validate_command(CLI::App& app, Action& action) {
       const std::size_t agents = sc.world.agents().size(), goals = sc.world.goals().size();
       const std::size_t circles = sc.world.circles().size(), polygons = sc.world.polygons().size();
       Simulation sim(std::move(sc.world), sc.config);  // also checks the access-path choices
-      std::cout << file << ": ok: " << (sc.name.empty() ? "(unnamed)" : sc.name) << ", " << agents << " agents, "
-                << goals << " goals, " << circles << " circles, " << polygons << " polygons, " << sc.ticks
-                << " ticks\n";
+      std::cout << file << ": ok: " << (sc.name.empty() ? "(unnamed)" : sc.name) << ", " << agents
+                << " agents, " << goals << " goals, " << circles << " circles, " << polygons
+                << " polygons, " << sc.ticks << " ticks\n";
       return 0;
     };
   });

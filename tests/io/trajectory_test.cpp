@@ -1,0 +1,120 @@
+#include "io/trajectory.hpp"
+
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <algorithm>
+
+#include "support/cli.hpp"
+
+namespace crowddb {
+namespace {
+
+// Runs a query on an SQLite file and returns the first column of every row as text.
+std::vector<std::string> query(const std::filesystem::path& db, const std::string& sql) {
+  sqlite3* h = nullptr;
+  EXPECT_EQ(sqlite3_open_v2(db.c_str(), &h, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  std::vector<std::string> out;
+  sqlite3_exec(
+      h, sql.c_str(),
+      [](void* p, int, char** v, char**) {
+        static_cast<std::vector<std::string>*>(p)->push_back(v[0] ? v[0] : "NULL");
+        return 0;
+      },
+      &out, nullptr);
+  sqlite3_close(h);
+  return out;
+}
+
+const char* kScenario = R"({"name": "two", "bounds": [0, 0, 100, 50], "dt": 0.5, "ticks": 10,
+  "goals": [{"name": "g", "x": 90, "y": 25, "arrival_radius": 2}],
+  "obstacles": [{"type": "circle", "x": 50, "y": 40, "radius": 3}],
+  "agents": [{"x": 10, "y": 25, "goal": "g"}, {"x": 10, "y": 30, "goal": "g"}]})";
+
+void run_to(const std::filesystem::path& out, OutputSpec::Format format, uint32_t every = 1) {
+  Scenario sc = parse_scenario(kScenario, "two.json");
+  sc.output = {out.string(), format, every};
+  Simulation sim(std::move(sc.world), sc.config);
+  auto w = io::make_writer(sc.output);
+  w->begin(sc, sim.world());
+  w->frame(0, sim.world());
+  for (uint64_t t = 1; t <= sc.ticks; ++t) {
+    w->metrics(sim.step());
+    w->frame(t, sim.world());
+  }
+  w->finish({});
+}
+
+TEST(TrajectorySqlite, JuPedSimSchemaVersion3WithOwnTables) {
+  test::TempDir dir;
+  const auto db = dir / "run.sqlite";
+  run_to(db, OutputSpec::Format::sqlite);
+  EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.partial"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite-wal"));
+  EXPECT_EQ(query(db, "SELECT value FROM metadata WHERE key = 'version'"),
+            std::vector<std::string>{"3"});
+  EXPECT_EQ(std::stod(query(db, "SELECT value FROM metadata WHERE key = 'fps'").at(0)),
+            2.0);  // dt = 0.5
+  EXPECT_EQ(query(db, "SELECT count(DISTINCT frame) FROM trajectory_data"),
+            std::vector<std::string>{"11"});
+  EXPECT_EQ(query(db, "SELECT count(*) FROM frame_data"), std::vector<std::string>{"11"});
+  EXPECT_EQ(
+      query(db, "SELECT count(*) FROM frame_data f JOIN geometry g ON f.geometry_hash = g.hash"),
+      std::vector<std::string>{"11"});
+  const std::string wkt = query(db, "SELECT wkt FROM geometry").at(0);
+  EXPECT_EQ(wkt.rfind("POLYGON((", 0), 0u) << wkt;
+  EXPECT_NE(wkt.find("),("), std::string::npos) << "the obstacle should be a hole: " << wkt;
+  EXPECT_EQ(query(db, "SELECT count(*) FROM trajectory_data WHERE frame = 0"),
+            std::vector<std::string>{"2"});
+  EXPECT_EQ(query(db, "SELECT pos_x FROM trajectory_data WHERE frame = 0 AND id = 0"),
+            std::vector<std::string>{"10.0"});
+  EXPECT_EQ(query(db, "SELECT count(*) FROM crowddb_tick_metrics"), std::vector<std::string>{"10"});
+  EXPECT_EQ(query(db, "SELECT count(*) FROM crowddb_agent_state"),
+            query(db, "SELECT count(*) FROM trajectory_data"));
+  EXPECT_EQ(query(db, "SELECT value FROM crowddb_run WHERE key = 'scenario_name'"),
+            std::vector<std::string>{"two"});
+  EXPECT_EQ(query(db, "PRAGMA journal_mode"), std::vector<std::string>{"delete"});
+}
+
+TEST(TrajectorySqlite, EveryNthFrameAndFps) {
+  test::TempDir dir;
+  const auto db = dir / "run.sqlite";
+  run_to(db, OutputSpec::Format::sqlite, 5);
+  EXPECT_EQ(query(db,
+                  "SELECT group_concat(frame) FROM (SELECT DISTINCT frame FROM trajectory_data "
+                  "ORDER BY frame)"),
+            std::vector<std::string>{"0,1,2"});
+  EXPECT_EQ(std::stod(query(db, "SELECT value FROM metadata WHERE key = 'fps'").at(0)), 0.4);
+}
+
+TEST(TrajectorySqlite, AbortLeavesNothingBehind) {
+  test::TempDir dir;
+  Scenario sc = parse_scenario(kScenario, "two.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
+  w->begin(sc, sim.world());
+  w->frame(0, sim.world());
+  w->abort();
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+}
+
+TEST(TrajectorySqlite, UnwritablePathFailsAtBegin) {
+  Scenario sc = parse_scenario(kScenario, "two.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  auto w = io::make_sqlite_writer("/nonexistent-dir/run.sqlite", 1);
+  EXPECT_THROW(w->begin(sc, sim.world()), Error);
+}
+
+TEST(TrajectoryCsv, RoundTripsExactly) {
+  test::TempDir dir;
+  run_to(dir / "run.csv", OutputSpec::Format::csv);
+  const std::string text = test::slurp(dir / "run.csv");
+  EXPECT_EQ(text.rfind("frame,id,x,y,vx,vy,radius,state,goal\n0,0,10,25,0,0,1,active,0\n", 0), 0u)
+      << text.substr(0, 120);
+  const std::string metrics = test::slurp(dir / "run.metrics.csv");
+  EXPECT_EQ(std::count(metrics.begin(), metrics.end(), '\n'), 11);
+  EXPECT_FALSE(std::filesystem::exists(dir / "run.csv.partial"));
+}
+
+}  // namespace
+}  // namespace crowddb

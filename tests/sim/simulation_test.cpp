@@ -1,0 +1,207 @@
+#include "crowddb/simulation.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "crowddb/scenario.hpp"
+#include "support/cli.hpp"
+#include "world/geometry.hpp"
+
+namespace crowddb {
+namespace {
+
+// A small, dense airport: 250 travellers in a 160 x 160 hall with 6 pillars and 4 gates.
+std::string small_airport(uint64_t seed, int threads = 1, const char* arrival = "retarget") {
+  return std::string(R"({"bounds": [0, 0, 160, 160], "seed": )") + std::to_string(seed) +
+         R"(, "threads": )" + std::to_string(threads) + R"(, "arrival": ")" + arrival + R"(",
+    "goals": [{"name": "S", "x": 80, "y": 4, "arrival_radius": 8}, {"name": "N", "x": 80, "y": 156, "arrival_radius": 8},
+              {"name": "W", "x": 4, "y": 80, "arrival_radius": 8}, {"name": "E", "x": 156, "y": 80, "arrival_radius": 8}],
+    "obstacles": [{"type": "circle", "x": 40, "y": 50, "radius": 8}, {"type": "circle", "x": 80, "y": 50, "radius": 10},
+                  {"type": "circle", "x": 120, "y": 50, "radius": 8}, {"type": "circle", "x": 40, "y": 110, "radius": 9},
+                  {"type": "polygon", "vertices": [[70, 100], [90, 100], [90, 120], [70, 120]]},
+                  {"type": "circle", "x": 120, "y": 110, "radius": 8}],
+    "groups": [{"count": 250, "radius": [1, 3], "speed": [0, 5], "max_speed": 5, "max_accel": 1,
+                "placement": {"type": "uniform", "region": [5, 5, 155, 155], "gap": 0.5},
+                "goals": {"assign": "round_robin"}}],
+    "steering": {"w_apf": 30, "w_ftc": 3}})";
+}
+
+std::vector<uint64_t> hashes(const std::string& text, int ticks) {
+  Scenario sc = parse_scenario(text, "t.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  std::vector<uint64_t> h{sim.state_hash()};
+  for (int t = 0; t < ticks; ++t) h.push_back(sim.step().state_hash);
+  return h;
+}
+
+TEST(Determinism, SameSeedTwiceGivesTheSameHashEveryTick) {
+  EXPECT_EQ(hashes(small_airport(5), 40), hashes(small_airport(5), 40));
+  EXPECT_NE(hashes(small_airport(5), 2), hashes(small_airport(6), 2));
+}
+
+TEST(Determinism, OneAndTwoThreadsGiveTheSameHashEveryTick) {
+  EXPECT_EQ(hashes(small_airport(5, 1), 40), hashes(small_airport(5, 2), 40));
+}
+
+TEST(Simulation, BackoffKeepsAnOverlapFreeWorldOverlapFree) {
+  Scenario sc = parse_scenario(small_airport(3), "t.json");
+  ASSERT_TRUE(sc.warnings.empty());
+  Simulation sim(std::move(sc.world), sc.config);
+  std::size_t frozen = 0;
+  for (int t = 0; t < 150; ++t) {
+    const TickMetrics& m = sim.step();
+    ASSERT_EQ(m.overlapping_pairs, 0u) << "tick " << m.tick;
+    ASSERT_EQ(m.obstacle_overlaps, 0u) << "tick " << m.tick;
+    frozen += m.frozen;
+  }
+  EXPECT_GT(frozen, 0u);  // the loop had work to do: the invariant is not vacuous
+  EXPECT_GT(sim.arrived_total(), 0u);
+}
+
+TEST(Simulation, WithoutBackoffOverlapsHappen) {
+  std::string text = small_airport(3);
+  text.insert(text.rfind('}'), R"(, "backoff": false)");
+  Scenario sc = parse_scenario(text, "t.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  std::size_t worst = 0;
+  for (int t = 0; t < 60; ++t) worst = std::max(worst, sim.step().overlapping_pairs);
+  EXPECT_GT(worst, 0u);
+}
+
+World corridor_world() {
+  World w(Bounds{0, 0, 100, 20});
+  w.add_goal({"east", 90, 10, 1, 2});
+  w.add_goal({"west", 10, 10, 1, 2});
+  return w;
+}
+
+AgentSpec walker(double x, uint32_t goal, double vx = 0) {
+  AgentSpec s;
+  s.x = x;
+  s.y = 10;
+  s.vx = vx;
+  s.radius = 1;
+  s.max_speed = 1;
+  s.goal = goal;
+  return s;
+}
+
+TEST(Simulation, ALoneAgentWalksStraightToItsGoalAndLeaves) {
+  World w = corridor_world();
+  const AgentId a = w.insert(walker(10, 0));
+  Simulation sim(std::move(w), SimConfig{});
+  int ticks = 0;
+  while (sim.world().contains(a) && ticks < 200) {
+    const double y = sim.world().agents().y[*sim.world().row_of(a)];
+    ASSERT_NEAR(y, 10, 1e-9);
+    sim.step();
+    ++ticks;
+  }
+  EXPECT_FALSE(sim.world().contains(a));
+  EXPECT_EQ(sim.arrived_total(), 1u);
+  // 78 units to go at max speed 1 after accelerating from rest (tau = 2): a little over 78 ticks.
+  EXPECT_GE(ticks, 78);
+  EXPECT_LE(ticks, 90);
+}
+
+TEST(Simulation, ArrivalPoliciesIdleAndRetarget) {
+  for (ArrivalPolicy policy : {ArrivalPolicy::idle, ArrivalPolicy::retarget}) {
+    World w = corridor_world();
+    const AgentId a = w.insert(walker(85, 0));
+    SimConfig cfg;
+    cfg.arrival = policy;
+    Simulation sim(std::move(w), cfg);
+    for (int t = 0; t < 10; ++t) sim.step();
+    ASSERT_TRUE(sim.world().contains(a));
+    const std::size_t row = *sim.world().row_of(a);
+    EXPECT_GE(sim.arrived_total(), 1u);
+    if (policy == ArrivalPolicy::idle) {
+      EXPECT_EQ(sim.world().agents().state[row], AgentState::arrived);
+      EXPECT_EQ(sim.world().agents().vx[row], 0.0);
+    } else {
+      EXPECT_EQ(sim.world().agents().goal[row], 1u);  // the only other goal
+    }
+  }
+}
+
+TEST(Simulation, ChangesMadeBetweenTicksApplyAtTheNextTickAsOneBatch) {
+  World w = corridor_world();
+  const AgentId a = w.insert(walker(20, 0));
+  Simulation sim(std::move(w), SimConfig{});
+  sim.step();
+  const AgentId b = sim.world().insert(walker(60, 1));
+  sim.world().retarget(a, 1);
+  EXPECT_FALSE(sim.world().contains(b));
+  EXPECT_EQ(sim.world().agents().goal[*sim.world().row_of(a)], 0u);
+  sim.step();
+  ASSERT_TRUE(sim.world().contains(b));
+  EXPECT_EQ(sim.world().agents().goal[*sim.world().row_of(a)], 1u);
+  sim.world().erase(a);
+  sim.step();
+  EXPECT_FALSE(sim.world().contains(a));
+  EXPECT_TRUE(sim.world().contains(b));
+  sim.world().validate();
+}
+
+TEST(Simulation, PreExistingOverlapsNeverDeepen) {
+  World w = corridor_world();
+  // Spawned overlapping (centres 1.5 apart, radii 1), both pulled towards each other's side.
+  const AgentId a = w.insert(walker(49, 0, 1));
+  const AgentId b = w.insert(walker(50.5, 1, -1));
+  SimConfig cfg;
+  cfg.steering.w_apf = 0;  // no repulsion: only backoff stops them
+  cfg.steering.w_ftc = 0;
+  Simulation sim(std::move(w), cfg);
+  double gap = 1.5;
+  for (int t = 0; t < 30; ++t) {
+    sim.step();
+    const AgentTable& tab = sim.world().agents();
+    const std::size_t i = *sim.world().row_of(a), j = *sim.world().row_of(b);
+    const double d = std::hypot(tab.x[i] - tab.x[j], tab.y[i] - tab.y[j]);
+    ASSERT_GE(d, gap) << "tick " << t;
+    gap = d;
+  }
+}
+
+TEST(Simulation, WallsKeepAgentsInside) {
+  World w(Bounds{0, 0, 50, 50});
+  w.add_goal({"outside", 200, 25, 1, 1});
+  for (int i = 0; i < 5; ++i) {
+    AgentSpec s = walker(30 + 3 * i, 0, 2);
+    s.y = 10 + 7 * i;
+    s.max_speed = 3;
+    w.insert(s);
+  }
+  Simulation sim(std::move(w), SimConfig{});
+  for (int t = 0; t < 50; ++t) {
+    sim.step();
+    const AgentTable& tab = sim.world().agents();
+    for (std::size_t i = 0; i < tab.size(); ++i) {
+      ASSERT_LE(tab.x[i] + tab.radius[i], 50.0);
+      ASSERT_GE(tab.x[i] - tab.radius[i], 0.0);
+    }
+  }
+}
+
+TEST(Simulation, ExplainNamesEveryOperatorAndAccessPath) {
+  Scenario sc = parse_scenario(small_airport(1), "t.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  const std::string plan = sim.explain();
+  for (const char* s : {"Q1 attraction", "Q2 inner avoidance", "Q3 outer avoidance", "backoff",
+                        "commit", "access path: naive", "exp-l1"})
+    EXPECT_NE(plan.find(s), std::string::npos) << s << "\n" << plan;
+  for (int t = 0; t < 3; ++t) sim.step();
+  const std::string analyze = sim.explain_analyze();
+  EXPECT_NE(analyze.find("EXPLAIN ANALYZE  3 ticks"), std::string::npos) << analyze;
+  EXPECT_NE(analyze.find("pair tests"), std::string::npos) << analyze;
+}
+
+TEST(Simulation, UnknownAccessPathIsRejectedBeforeTheRun) {
+  Scenario sc = parse_scenario(small_airport(1), "t.json");
+  sc.config.access.ftc = "quantum";
+  EXPECT_THROW(Simulation(std::move(sc.world), sc.config), Error);
+}
+
+}  // namespace
+}  // namespace crowddb
