@@ -329,7 +329,12 @@ struct Loader {
   // "walkable": a WKT POLYGON / MULTIPOLYGON (or {"wkt": ..., "charge": ...}). Its complement
   // within the bounds becomes polygon obstacles, so every query sees it as solid.
   void read_walkable(Node& root, const io::WalkableArea& area, double charge) {
-    const auto pieces = area.blocked_pieces(sc.world.bounds());
+    std::vector<std::vector<Vec2>> pieces;
+    try {
+      pieces = area.blocked_pieces(sc.world.bounds());
+    } catch (const Error& e) {
+      root.fail("walkable", e.what());
+    }
     for (const auto& ring : pieces) {
       try {
         sc.world.add_obstacle(PolygonObstacle{ring, charge});

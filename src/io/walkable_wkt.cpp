@@ -189,6 +189,8 @@ WalkableArea WalkableArea::parse(std::string_view wkt) {
     std::string what = e.what();
     std::replace(what.begin(), what.end(), '\n', ' ');
     invalid("malformed WKT: " + what);
+  } catch (const std::exception& e) {  // e.g. a coordinate Boost cannot convert
+    invalid(std::string("malformed WKT: ") + e.what());
   }
   if (m.empty()) invalid("the walkable area is empty");
   for (std::size_t i = 0; i < m.size(); ++i) {
@@ -206,7 +208,8 @@ WalkableArea WalkableArea::parse(std::string_view wkt) {
         if (v.empty() || v.back().x != r[k].x() || v.back().y != r[k].y())
           v.push_back({r[k].x(), r[k].y()});
       if (v.size() >= 3 && v.front().x == v.back().x && v.front().y == v.back().y) v.pop_back();
-      if (v.size() < 3) return;
+      // The exact check is quadratic; very long rings are left to Boost's validity check below.
+      if (v.size() < 3 || v.size() > 5000) return;
       if (auto bad = first_self_intersection(v)) {
         auto edge = [&](std::size_t e) {
           const Vec2 &a = v[e], &b = v[(e + 1) % v.size()];
@@ -220,19 +223,27 @@ WalkableArea WalkableArea::parse(std::string_view wkt) {
     for (std::size_t k = 0; k < m[i].inners().size(); ++k)
       crossing(m[i].inners()[k], poly + "hole " + std::to_string(k + 1));
   }
-  bg::correct(m);  // either orientation is fine
-  bg::validity_failure_type failure = bg::no_failure;
-  if (!bg::is_valid(m, failure)) {
-    if (failure == bg::failure_self_intersections && m.size() > 1)
-      invalid("invalid walkable area: polygons of the MULTIPOLYGON overlap or cross each other");
-    std::string msg;
-    bg::is_valid(m, msg);
-    // Boost's message names the point of a self-intersection; keep its first sentence(s).
-    const auto cut = msg.find("; method");
-    if (cut != std::string::npos) msg.resize(cut);
-    invalid(std::string("invalid walkable area: ") + failure_text(failure) + " (" + msg + ")");
+  try {
+    bg::correct(m);  // either orientation is fine
+    bg::validity_failure_type failure = bg::no_failure;
+    if (!bg::is_valid(m, failure)) {
+      if (failure == bg::failure_self_intersections && m.size() > 1)
+        invalid("invalid walkable area: polygons of the MULTIPOLYGON overlap or cross each other");
+      if (failure == bg::failure_wrong_orientation)  // still, after correct(): a figure of eight
+        invalid("invalid walkable area: it is self-intersecting (a ring crosses itself)");
+      std::string msg;
+      bg::is_valid(m, msg);
+      // Boost's message names the point of a self-intersection; keep its first sentence(s).
+      const auto cut = msg.find("; method");
+      if (cut != std::string::npos) msg.resize(cut);
+      invalid(std::string("invalid walkable area: ") + failure_text(failure) + " (" + msg + ")");
+    }
+    if (!(bg::area(m) > 0)) invalid("invalid walkable area: it has zero area");
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {  // Boost.Geometry on extreme coordinates
+    invalid(std::string("invalid walkable area: ") + e.what());
   }
-  if (!(bg::area(m) > 0)) invalid("invalid walkable area: it has zero area");
   return WalkableArea(std::move(impl));
 }
 
@@ -255,6 +266,16 @@ bool WalkableArea::within(const Bounds& b) const {
 }
 
 std::vector<std::vector<Vec2>> WalkableArea::blocked_pieces(const Bounds& b) const {
+  try {
+    return split_blocked(b);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {  // Boost.Geometry's overlay on extreme coordinates
+    invalid(std::string("walkable area: could not compute the blocked area: ") + e.what());
+  }
+}
+
+std::vector<std::vector<Vec2>> WalkableArea::split_blocked(const Bounds& b) const {
   Multi rest;
   bg::difference(box_polygon(b.xmin, b.ymin, b.xmax, b.ymax), impl_->area, rest);
   std::vector<Polygon> work(rest.begin(), rest.end());
@@ -262,7 +283,7 @@ std::vector<std::vector<Vec2>> WalkableArea::blocked_pieces(const Bounds& b) con
   const double tiny = 1e-12 * b.width() * b.height();
   std::size_t guard = 0;
   while (!work.empty()) {
-    if (++guard > 1'000'000)
+    if (++guard > 100'000)
       invalid("walkable area: could not split the blocked area into simple polygons");
     Polygon p = std::move(work.back());
     work.pop_back();

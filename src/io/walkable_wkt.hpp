@@ -39,6 +39,7 @@ class WalkableArea {
  private:
   struct Impl;
   explicit WalkableArea(std::unique_ptr<Impl> impl);
+  std::vector<std::vector<Vec2>> split_blocked(const Bounds& b) const;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -1,5 +1,6 @@
 #include "path/navigation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -38,7 +39,10 @@ const NavMesh& Navigation::mesh_for(double radius) {
   if (!slot) {
     NavMeshParams p;
     p.radius = k * params_.radius_step + params_.clearance;
-    p.cell_size = params_.cell_size > 0 ? params_.cell_size : k * params_.radius_step / 4;
+    // Auto: a quarter of the class radius, but at most 4096 cells along the world's longer side
+    // (a 1 km world at 0.25: 16 M cells, seconds to build).
+    const double side = std::max(geometry_.bounds.width(), geometry_.bounds.height());
+    p.cell_size = params_.cell_size > 0 ? params_.cell_size : std::max(k * params_.radius_step / 4, side / 4096);
     p.tile_size = static_cast<int>(params_.tile_size);
     slot = NavMesh::build(geometry_, p, &ex_);
   }
