@@ -20,12 +20,13 @@
 #include "sim/stages.hpp"
 #include "util/executor.hpp"
 #include "util/rng.hpp"
+#include "util/stopwatch.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb {
 namespace {
 
-constexpr double kSide = 1000;  // the world: 1 km x 1 km (1 length unit = 1 m)
+constexpr double kSide = 1000;   // the world: 1 km x 1 km (1 length unit = 1 m)
 constexpr double kRadius = 0.5;  // agents (and the mesh's radius class)
 
 // 1,000 obstacles: rectangles (walls and boxes), circles (pillars) and non-convex L-shapes,
@@ -45,7 +46,8 @@ path::NavGeometry city(uint64_t seed = 42) {
         break;
       default: {  // an L: counter-clockwise, non-convex
         const double t = std::min(w, h) / 3;
-        g.polygons.push_back({{{x, y}, {x + w, y}, {x + w, y + t}, {x + t, y + t}, {x + t, y + h}, {x, y + h}}, 1});
+        g.polygons.push_back(
+            {{{x, y}, {x + w, y}, {x + w, y + t}, {x + t, y + t}, {x + t, y + h}, {x, y + h}}, 1});
       }
     }
   }
@@ -174,7 +176,8 @@ BENCHMARK(BM_SightLine)->Unit(benchmark::kMicrosecond);
 // goal (World::retarget, applied as the tick's batch): each must re-plan. Per tick the service's
 // operators run exactly as in Simulation::step — path results, Q1 attraction with waypoint
 // skipping, path requests — and the agents stand still (no steering), so only the service's
-// own cost is timed. Arg 0: navigation off (Q1 only, the baseline) or on; arg 1: budget.
+// own cost is timed. Args: navigation off (Q1 only, the baseline) or on; budget; threads;
+// sight_interval (ticks between an agent's line-of-sight checks).
 struct Crowd {
   World world;
   std::vector<AgentId> ids;
@@ -212,9 +215,10 @@ void BM_ServiceOverhead(benchmark::State& state) {
   SimConfig cfg;
   cfg.navigation.enabled = nav_on;
   cfg.navigation.latency = 2;
-  cfg.navigation.budget = static_cast<uint32_t>(state.range(1));
+  cfg.navigation.budget = static_cast<uint32_t>(std::max<int64_t>(1, state.range(1)));
   cfg.navigation.cell_size = 0.25;
   cfg.navigation.replan_after = 0;
+  cfg.navigation.sight_interval = static_cast<uint32_t>(state.range(3));
   Executor ex(static_cast<int>(state.range(2)));
   std::unique_ptr<path::Navigation> nav;
   if (nav_on) {
@@ -224,6 +228,7 @@ void BM_ServiceOverhead(benchmark::State& state) {
   sim::Effects fx;
   Rng rng(5);
   uint64_t tick = 0;
+  double apply_s = 0, q1_s = 0, request_s = 0;
   for (auto _ : state) {
     ++tick;
     state.PauseTiming();
@@ -232,34 +237,79 @@ void BM_ServiceOverhead(benchmark::State& state) {
     c.world.apply_pending();
     fx.reset(n);
     state.ResumeTiming();
+    Stopwatch sw;
     if (nav) nav->apply_results(c.world, tick);
+    apply_s += sw.seconds();
+    sw.restart();
     sim::attraction(c.world.agents(), c.world.goals(), cfg, tick, fx, ex, nav.get());
+    q1_s += sw.seconds();
+    sw.restart();
     if (nav) nav->request_paths(c.world, tick);
+    request_s += sw.seconds();
   }
+  const double per_tick = 1e3 / static_cast<double>(tick);
+  state.counters["q1_ms"] = q1_s * per_tick;  // attraction, with the line-of-sight checks
   if (nav) {
     const auto s = nav->stats();
     const auto w = nav->service_stats();
+    state.counters["apply_ms"] = (apply_s - w.wait_seconds) * per_tick;
+    state.counters["wait_ms"] = w.wait_seconds * per_tick;  // the tick waiting for the worker
+    state.counters["request_ms"] = request_s * per_tick;
     state.counters["requests"] = static_cast<double>(s.requests);
-    state.counters["applied"] = static_cast<double>(s.applied);  // checksum-ish
+    state.counters["applied"] = static_cast<double>(s.applied);
     state.counters["queued_end"] = static_cast<double>(s.queued);
-    state.counters["waits"] = static_cast<double>(w.waits);
-    state.counters["wait_ms_per_tick"] = w.wait_seconds * 1e3 / static_cast<double>(tick);
-    state.counters["worker_search_us"] =
+    state.counters["search_us"] =
         w.jobs_done ? w.work_seconds * 1e6 / static_cast<double>(w.jobs_done) : 0;
   }
-  double skipped = 0;
-  for (uint8_t s : fx.skip) skipped += s;
-  state.counters["skips_last_tick"] = skipped;
 }
 BENCHMARK(BM_ServiceOverhead)
-    ->ArgNames({"nav", "budget", "threads"})
-    ->Args({0, 0, 1})
-    ->Args({1, 500, 1})
-    ->Args({1, 2000, 1})
-    ->Args({1, 10000, 1})
-    ->Args({1, 2000, 2})
+    ->ArgNames({"nav", "budget", "threads", "sight"})
+    ->Args({0, 0, 1, 1})
+    ->Args({1, 500, 1, 1})
+    ->Args({1, 2000, 1, 1})
+    ->Args({1, 2000, 2, 1})
+    ->Args({1, 2000, 1, 4})
     ->Unit(benchmark::kMillisecond)
-    ->Iterations(200)
+    ->Iterations(100)
+    ->UseRealTime();
+
+// The whole tick (Simulation::step) with 10^4 walking agents, navigation off and on, so the
+// worker's searches overlap the tick's other work as they do in a run. The steering queries are
+// off (w_apf = w_ftc = 0, backoff off): with only naive access paths they would cost seconds at
+// this size; what remains is Q1, integrate, the naive overlap count and commit. Every 20 ticks
+// all agents get new goals (arrivals re-target too). Args: navigation, budget.
+void BM_TickOverhead(benchmark::State& state) {
+  static const path::NavGeometry g = city();
+  Crowd c = crowd(g, 10'000);
+  SimConfig cfg;
+  cfg.steering.w_apf = 0;
+  cfg.steering.w_ftc = 0;
+  cfg.backoff = false;
+  cfg.arrival = ArrivalPolicy::retarget;
+  cfg.navigation.enabled = state.range(0) != 0;
+  cfg.navigation.budget = static_cast<uint32_t>(std::max<int64_t>(1, state.range(1)));
+  cfg.navigation.cell_size = 0.25;
+  Simulation sim(std::move(c.world), cfg);
+  Rng rng(5);
+  uint64_t tick = 0;
+  for (auto _ : state) {
+    if (++tick % 20 == 0) {
+      state.PauseTiming();
+      for (const AgentId& id : c.ids)
+        sim.world().retarget(id, static_cast<uint32_t>(rng.below(50)));
+      state.ResumeTiming();
+    }
+    sim.step();
+  }
+  state.counters["arrived"] = static_cast<double>(sim.arrived_total());
+  state.counters["hash_lo"] = static_cast<double>(sim.state_hash() & 0xffff);  // checksum
+}
+BENCHMARK(BM_TickOverhead)
+    ->ArgNames({"nav", "budget"})
+    ->Args({0, 0})
+    ->Args({1, 2000})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(40)
     ->UseRealTime();
 
 }  // namespace

@@ -750,6 +750,9 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
     nav.tile_size = static_cast<uint32_t>(n.integer("tile_size", nav.tile_size, 4096));
     if (nav.tile_size < 16) n.fail("tile_size", "must be in 16..4096");
     nav.skip_visible = n.boolean("skip_visible", nav.skip_visible);
+    nav.sight_interval =
+        static_cast<uint32_t>(n.integer("sight_interval", nav.sight_interval, 1u << 20));
+    if (nav.sight_interval < 1) n.fail("sight_interval", "must be >= 1");
     n.finish();
   }
   if (root.has("access")) {

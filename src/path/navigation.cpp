@@ -42,7 +42,8 @@ const NavMesh& Navigation::mesh_for(double radius) {
     // Auto: a quarter of the class radius, but at most 4096 cells along the world's longer side
     // (a 1 km world at 0.25: 16 M cells, seconds to build).
     const double side = std::max(geometry_.bounds.width(), geometry_.bounds.height());
-    p.cell_size = params_.cell_size > 0 ? params_.cell_size : std::max(k * params_.radius_step / 4, side / 4096);
+    p.cell_size = params_.cell_size > 0 ? params_.cell_size
+                                        : std::max(k * params_.radius_step / 4, side / 4096);
     p.tile_size = static_cast<int>(params_.tile_size);
     slot = NavMesh::build(geometry_, p, &ex_);
   }

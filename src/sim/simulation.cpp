@@ -57,6 +57,7 @@ void SimConfig::validate() const {
   require(std::isfinite(n.cell_size) && n.cell_size >= 0, "navigation/cell_size", "must be >= 0");
   require(std::isfinite(n.clearance) && n.clearance >= 0, "navigation/clearance", "must be >= 0");
   require(n.tile_size >= 16 && n.tile_size <= 4096, "navigation/tile_size", "must be in 16..4096");
+  require(n.sight_interval >= 1, "navigation/sight_interval", "must be >= 1");
 }
 
 // Per-operator EXPLAIN ANALYZE counters.
@@ -333,7 +334,13 @@ std::string Simulation::explain() const {
     os << "       waypoints: advance when within "
        << (config_.waypoint_radius > 0 ? num(config_.waypoint_radius)
                                        : std::string("the agent's radius"))
-       << (nv.skip_visible ? " or when the next one is in sight (Detour raycast)" : "") << "\n";
+       << (nv.skip_visible ? " or when the next one is in sight (Detour raycast" +
+                                 (nv.sight_interval > 1
+                                      ? ", every " + std::to_string(nv.sight_interval) + " ticks"
+                                      : std::string()) +
+                                 ")"
+                           : std::string())
+       << "\n";
   if (p.field)
     os << "  2 Q2 inner avoidance potential field " << kernel_name(s.potential.kernel) << "-"
        << metric_name(s.potential.metric) << " A=" << num(s.potential.A)

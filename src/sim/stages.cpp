@@ -47,7 +47,7 @@ void attraction(const AgentTable& t, std::span<const Goal> goals, const SimConfi
     for (std::size_t i = b; i < e; ++i) {
       if (idle(t, i)) continue;
       double tx = t.target_x[i], ty = t.target_y[i];
-      if (sight && !t.route[i].empty()) {
+      if (sight && !t.route[i].empty() && (tick + t.id[i]) % cfg.navigation.sight_interval == 0) {
         // The waypoint after the current one: the next route point, or the goal.
         const auto& route = t.route[i];
         const Goal& g = goals[t.goal[i]];

@@ -37,9 +37,10 @@ struct NextState {
 // Q1: preferred velocity towards the current waypoint, (v_pref - v) / tau, times the goal's
 // charge; turned aside for agents frozen cfg.nudge_after ticks in a row. Idle (arrived) agents
 // get no effect. `tick` is the tick being computed (it seeds the sidesteps).
-// Waypoint following: with `nav` (and cfg.navigation.skip_visible), an agent whose waypoint
-// after the current one is in sight (a disc of its radius class can walk straight there) steers
-// at that one instead and records the skipped waypoint in fx.skip; commit pops it.
+// Waypoint following: with `nav` (and cfg.navigation.skip_visible, every sight_interval ticks
+// per agent), an agent whose waypoint after the current one is in sight (a disc of its radius class
+// can walk straight there) steers at that one instead and records the skipped waypoint in fx.skip;
+// commit pops it.
 void attraction(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,
                 uint64_t tick, Effects& fx, Executor& ex, const path::Navigation* nav = nullptr);
 

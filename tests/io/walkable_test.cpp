@@ -2,17 +2,14 @@
 // (src/io/scenario_json.cpp): valid areas become obstacles that cover exactly the complement;
 // invalid geometry gives a one-line error naming the file and the JSON pointer.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 
 #include "crowddb/scenario.hpp"
 #include "io/walkable_wkt.hpp"
+#include "support/cli.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb {
@@ -198,7 +195,7 @@ TEST(ScenarioGeometry, NavigationBlockSwitchesTheServiceOn) {
       scenario(
           "'bounds': [0, 0, 40, 40], 'navigation': {'latency': 4, 'budget': 9, 'replan_after': 0, "
           "'radius_step': 0.5, 'cell_size': 0.2, 'clearance': 0.1, 'tile_size': 64, "
-          "'skip_visible': false}"),
+          "'skip_visible': false, 'sight_interval': 3}"),
       "t.json");
   const NavigationParams& n = on.config.navigation;
   EXPECT_TRUE(n.enabled);
@@ -210,6 +207,7 @@ TEST(ScenarioGeometry, NavigationBlockSwitchesTheServiceOn) {
   EXPECT_EQ(n.clearance, 0.1);
   EXPECT_EQ(n.tile_size, 64u);
   EXPECT_FALSE(n.skip_visible);
+  EXPECT_EQ(n.sight_interval, 3u);
   EXPECT_FALSE(parse_scenario(
                    scenario("'bounds': [0, 0, 40, 40], 'navigation': {'enabled': false}"), "t.json")
                    .config.navigation.enabled);
@@ -228,25 +226,28 @@ TEST(ScenarioGeometry, EveryShippedScenarioLoads) {
 
 // The CLI turns a geometry error into one line on stderr and a non-zero exit status.
 TEST(ScenarioGeometry, CliReportsBadGeometryOnOneLine) {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("crowddb_walkable_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const auto file = dir / "bowtie.json";
-  std::ofstream(file) << scenario("'walkable': 'POLYGON((0 0, 10 10, 10 0, 0 10, 0 0))'");
-  const std::string cmd =
-      std::string(CROWDDB_CLI) + " validate " + file.string() + " 2>&1; echo \"exit=$?\"";
-  FILE* p = popen(cmd.c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  std::string out;
-  char buf[512];
-  while (fgets(buf, sizeof buf, p)) out += buf;
-  pclose(p);
-  std::filesystem::remove_all(dir);
-  EXPECT_NE(out.find("bowtie.json: /walkable: invalid walkable area: it is self-intersecting"),
+  test::TempDir dir;
+  dir.write("bowtie.json", scenario("'walkable': 'POLYGON((0 0, 10 10, 10 0, 0 10, 0 0))'"));
+  const test::CliResult r = test::run_cli("validate " + (dir / "bowtie.json").string(), dir);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_NE(r.err.find("bowtie.json: /walkable: invalid walkable area: it is self-intersecting"),
             std::string::npos)
-      << out;
-  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 2) << out;  // the message and exit=...
-  EXPECT_EQ(out.find("exit=0"), std::string::npos) << out;
+      << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+// `crowddb run --explain` shows the path service; `--no-navigation` switches it off.
+TEST(ScenarioGeometry, CliExplainShowsThePathService) {
+  test::TempDir dir;
+  const std::string file = std::string(CROWDDB_SOURCE_DIR) + "/scenarios/two_rooms.json";
+  const test::CliResult on = test::run_cli("run " + file + " --explain", dir);
+  EXPECT_EQ(on.status, 0) << on.err;
+  EXPECT_NE(on.out.find("path service: Recast/Detour"), std::string::npos) << on.out;
+  EXPECT_NE(on.out.find("7 path requests"), std::string::npos) << on.out;
+  const test::CliResult off = test::run_cli("run " + file + " --explain --no-navigation", dir);
+  EXPECT_EQ(off.status, 0) << off.err;
+  EXPECT_EQ(off.out.find("path service"), std::string::npos) << off.out;
 }
 
 }  // namespace
