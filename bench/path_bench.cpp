@@ -302,12 +302,19 @@ void BM_TickOverhead(benchmark::State& state) {
     sim.step();
   }
   state.counters["arrived"] = static_cast<double>(sim.arrived_total());
+  // The path service's own rows of EXPLAIN ANALYZE: waits and the queue left at the end.
+  const std::string ea = sim.explain_analyze();
+  if (const auto at = ea.find("the tick waited for it "); at != std::string::npos)
+    state.counters["waits"] = std::stod(ea.substr(at + 23));
+  if (const auto at = ea.find(" superseded, "); at != std::string::npos)
+    state.counters["queued_end"] = std::stod(ea.substr(at + 13));
   state.counters["hash_lo"] = static_cast<double>(sim.state_hash() & 0xffff);  // checksum
 }
 BENCHMARK(BM_TickOverhead)
     ->ArgNames({"nav", "budget"})
     ->Args({0, 0})
     ->Args({1, 2000})
+    ->Args({1, 200})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(40)
     ->UseRealTime();
