@@ -1,0 +1,128 @@
+// Synchronous Data-Flow graphs: actors and channels, the typed errors of the sdf library, and
+// the compact adjacency every algorithm walks.
+//
+// A channel carries tokens from `src` to `dst`: each firing of src appends `prd` tokens, each
+// firing of dst removes `cns`; `delay` tokens sit on it initially. Rates are positive, delays
+// non-negative, all 64-bit. Channel names are the SDF3 name when read from SDF3 XML, otherwise
+// `src->dst#k` with k counting the channels from src to dst in order (0, 1, ...).
+//
+// Thread-safety: a Graph is a plain value; concurrent const use is safe, mutation is not.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sdf {
+
+using ActorId = uint32_t;
+using ChannelId = uint32_t;
+
+// Every failure the library reports by exception. what() is one line naming the file, line,
+// element or field; the CLI prints it and exits with exit_code() (2 usage, 1 otherwise).
+class Error : public std::runtime_error {
+ public:
+  enum class Kind {
+    usage,     // bad command-line use
+    input,     // malformed or invalid graph file or parameter
+    io,        // the operating system refused (missing file, unwritable path)
+    overflow,  // a count does not fit in 64 bits; never reported as a wrong number instead
+  };
+  Error(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
+  Kind kind() const { return kind_; }
+  int exit_code() const { return kind_ == Kind::usage ? 2 : 1; }
+
+ private:
+  Kind kind_;
+};
+
+struct Channel {
+  ActorId src = 0;
+  ActorId dst = 0;
+  uint64_t prd = 1;    // tokens produced per firing of src (> 0)
+  uint64_t cns = 1;    // tokens consumed per firing of dst (> 0)
+  uint64_t delay = 0;  // initial tokens
+  std::string name;
+  // SDF3 port names, kept so that a file read and written again keeps them; empty when the
+  // channel came from elsewhere (the writer then invents unique ones).
+  std::string src_port;
+  std::string dst_port;
+};
+
+class Graph {
+ public:
+  // Throws Error(input) on an empty or duplicate name.
+  ActorId add_actor(std::string name);
+  // Throws Error(input) on an unknown actor id, a zero rate or a duplicate channel name. An empty
+  // name becomes `src->dst#k`.
+  ChannelId add_channel(ActorId src, ActorId dst, uint64_t prd, uint64_t cns, uint64_t delay,
+                        std::string name = {});
+
+  size_t actor_count() const { return actor_names_.size(); }
+  size_t channel_count() const { return channels_.size(); }
+  const std::string& actor_name(ActorId a) const { return actor_names_[a]; }
+  const Channel& channel(ChannelId c) const { return channels_[c]; }
+  std::span<const Channel> channels() const { return channels_; }
+  // Changes the rates of an existing channel (dynamic rate changes). Rates must be positive.
+  void set_rates(ChannelId c, uint64_t prd, uint64_t cns);
+  void set_port_names(ChannelId c, std::string src_port, std::string dst_port);
+
+  std::optional<ActorId> find_actor(std::string_view name) const;
+  std::optional<ChannelId> find_channel(std::string_view name) const;
+
+  // Initial token vector (the delays), indexed by channel.
+  std::vector<uint64_t> delays() const;
+
+  std::string name;  // the graph's name (SDF3 `sdf name=`), may be empty
+
+ private:
+  std::vector<std::string> actor_names_;
+  std::vector<Channel> channels_;
+  // Flat open-addressing tables of ids (the names live in actor_names_ / channels_): no node
+  // per entry, so a 10^6-actor graph loads without millions of small allocations.
+  struct FlatIndex {
+    std::vector<uint32_t> slots;  // id + 1, 0 = empty
+    size_t size = 0;
+  };
+  template <class KeyOf>
+  static int64_t flat_find(const FlatIndex& t, std::string_view key, KeyOf&& key_of);
+  template <class KeyOf>
+  static void flat_insert(FlatIndex& t, uint32_t id, KeyOf&& key_of);
+  FlatIndex actor_index_, channel_index_;
+  // (src, dst) -> number of channels so far, for the default names `src->dst#k`.
+  std::vector<uint64_t> pair_keys_;
+  std::vector<uint32_t> pair_counts_;
+  size_t pair_size_ = 0;
+  uint32_t next_parallel_index(uint64_t pair);
+};
+
+// Compressed incidence lists: for actor a, inputs(a) / outputs(a) are channel ids in channel
+// order. A self-loop appears in both lists. Built in O(V + E); immutable.
+class Adjacency {
+ public:
+  explicit Adjacency(const Graph& g);
+  std::span<const ChannelId> inputs(ActorId a) const {
+    return {in_.data() + in_off_[a], in_.data() + in_off_[a + 1]};
+  }
+  std::span<const ChannelId> outputs(ActorId a) const {
+    return {out_.data() + out_off_[a], out_.data() + out_off_[a + 1]};
+  }
+
+ private:
+  std::vector<uint32_t> in_off_, out_off_;
+  std::vector<ChannelId> in_, out_;
+};
+
+// Connected components of the underlying undirected graph: component id per actor, numbered
+// in order of each component's lowest actor id.
+struct Components {
+  std::vector<uint32_t> of_actor;
+  uint32_t count = 0;
+};
+Components connected_components(const Graph& g, const Adjacency& adj);
+
+}  // namespace sdf

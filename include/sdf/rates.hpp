@@ -1,0 +1,61 @@
+// Dynamic rate changes (thesis 5.4): an actor's rates change after a given number of firings,
+// mid-period. Every output channel of the actor then produces `prd` per firing and every input
+// channel consumes `cns`. The thesis notes the result is the new graph with different initial
+// delays (the tokens at the change).
+//
+// The static path recomputes the repetitions vector and builds a new ready-queue schedule from
+// the tokens at the change: it is periodic at once (or deadlocks). The online path just
+// continues from its scheduler state (keys and eligibility of the actor updated); the bounded
+// path continues with the new repetitions vector and a new iteration. For the online paths the
+// run is then driven to an outcome as in run_online and the firings until the state is periodic
+// again are the transient's.
+//
+// Thread-safety: pure function.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "sdf/graph.hpp"
+#include "sdf/online.hpp"
+#include "sdf/repetitions.hpp"
+
+namespace sdf {
+
+enum class Policy { static_order, online, online_bounded };
+const char* policy_name(Policy p);
+
+struct RateChange {
+  ActorId actor = 0;
+  uint64_t prd = 1, cns = 1;
+  uint64_t at_firing = 0;  // the change happens after this many firings
+};
+
+struct RateChangeResult {
+  std::vector<uint64_t> q_before, q_after;  // q_after empty when the new graph is inconsistent
+  Repetitions after;                        // consistency verdict of the changed graph
+  Graph changed;                            // the graph with the new rates
+  std::vector<uint64_t> tokens_at_change;
+  // Static: `returns` or `deadlock`; online paths: run_online's outcome after the change.
+  Outcome outcome = Outcome::returns;
+  std::vector<ActorId> stuck;           // deadlock after the change (static path)
+  std::optional<ChannelId> channel;     // unbounded after the change
+  uint64_t firings_until_periodic = 0;  // after the change
+  uint64_t period_firings = 0;          // firings in one period / cycle after the change
+  uint64_t period_decisions = 0;
+  // The post-change period (the cycle, from the state where it starts) passed the checker;
+  // period_checked is false when the cycle was too long to list (max_listed_runs).
+  bool period_checked = false;
+  bool period_valid = false;
+  std::vector<uint64_t> buffers_before;  // over one period of the original graph
+  std::vector<uint64_t> buffers_after;   // over one period / cycle after the change
+};
+
+// The original graph must be consistent and live (throws Error(input) naming the problem
+// otherwise); the change's actor and rates must be valid. max_decisions in options bounds
+// the run before the change as well.
+RateChangeResult simulate_rate_change(const Graph& g, Policy policy, const RateChange& change,
+                                      const OnlineRunOptions& options);
+
+}  // namespace sdf

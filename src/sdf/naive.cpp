@@ -1,0 +1,163 @@
+#include "sdf/naive.hpp"
+
+#include <algorithm>
+#include <map>
+
+namespace sdf::naive {
+
+namespace {
+
+__extension__ using u128 = unsigned __int128;
+
+bool can_fire(const Graph& g, const std::vector<uint64_t>& tokens, ActorId a) {
+  for (ChannelId c = 0; c < g.channel_count(); ++c)
+    if (g.channel(c).dst == a && tokens[c] < g.channel(c).cns) return false;
+  return true;
+}
+
+// One firing, exactly as the definition says: consume from every input, then produce.
+void fire_once(const Graph& g, std::vector<uint64_t>& tokens, ActorId a) {
+  for (ChannelId c = 0; c < g.channel_count(); ++c)
+    if (g.channel(c).dst == a) tokens[c] -= g.channel(c).cns;
+  for (ChannelId c = 0; c < g.channel_count(); ++c)
+    if (g.channel(c).src == a) tokens[c] += g.channel(c).prd;
+}
+
+}  // namespace
+
+std::vector<uint64_t> max_run(const Graph& g, std::span<const uint64_t> q, crowddb::Rng& rng) {
+  std::vector<uint64_t> tokens = g.delays(), count(g.actor_count(), 0);
+  for (;;) {
+    std::vector<ActorId> ready;
+    for (ActorId a = 0; a < g.actor_count(); ++a)
+      if (count[a] < q[a] && can_fire(g, tokens, a)) ready.push_back(a);
+    if (ready.empty()) return count;
+    const ActorId a = ready[rng.below(ready.size())];
+    fire_once(g, tokens, a);
+    ++count[a];
+  }
+}
+
+NaiveOnline online(const Graph& g, std::span<const uint64_t> q, const OnlineRunOptions& options) {
+  const size_t n = g.actor_count();
+  const bool bounded = options.scheduler.bounded;
+  std::vector<uint64_t> tokens = g.delays(), count(n, 0), stamp(n, 0);
+  const std::vector<uint64_t> tokens0 = tokens;
+  std::vector<uint64_t> cap(g.channel_count());
+  for (ChannelId c = 0; c < g.channel_count(); ++c)
+    cap[c] = tokens0[c] + options.growth_periods * q[g.channel(c).src] * g.channel(c).prd;
+  auto eligible = [&](ActorId a) {
+    return (!bounded || count[a] < q[a]) && can_fire(g, tokens, a);
+  };
+  // key as a fraction: min over inputs of tokens/cns, 1/1 without inputs.
+  auto key = [&](ActorId a) {
+    std::pair<uint64_t, uint64_t> k{1, 1};
+    bool any = false;
+    for (ChannelId c = 0; c < g.channel_count(); ++c) {
+      if (g.channel(c).dst != a) continue;
+      const std::pair<uint64_t, uint64_t> f{tokens[c], g.channel(c).cns};
+      if (!any || static_cast<u128>(f.first) * k.second < static_cast<u128>(k.first) * f.second)
+        k = f;
+      any = true;
+    }
+    return k;
+  };
+  std::vector<char> was(n);
+  for (ActorId a = 0; a < n; ++a) was[a] = eligible(a);
+  auto state = [&]() {
+    std::vector<uint64_t> s = tokens;
+    s.insert(s.end(), count.begin(), count.end());
+    std::vector<ActorId> order;
+    for (ActorId a = 0; a < n; ++a)
+      if (was[a]) order.push_back(a);
+    std::sort(order.begin(), order.end(), [&](ActorId x, ActorId y) {
+      return stamp[x] != stamp[y] ? stamp[x] < stamp[y] : x < y;
+    });
+    s.push_back(UINT64_MAX);
+    s.insert(s.end(), order.begin(), order.end());
+    return s;
+  };
+  std::map<std::vector<uint64_t>, uint64_t> seen;
+  seen[state()] = 0;
+  std::vector<char> fired(n, 0);
+  NaiveOnline out;
+  uint64_t extra = 0;  // after a repeat: decisions left to look for a return
+  bool periodic = false;
+  for (uint64_t t = 0;; ++t) {
+    if (!periodic && t >= options.max_decisions) {
+      out.outcome = Outcome::limit;
+      return out;
+    }
+    int64_t best = -1;
+    std::pair<uint64_t, uint64_t> bk;
+    for (ActorId a = 0; a < n; ++a) {
+      if (!was[a]) continue;
+      const auto k = key(a);
+      const u128 l = static_cast<u128>(k.first) * bk.second;
+      const u128 r = static_cast<u128>(bk.first) * k.second;
+      if (best < 0 || l > r || (l == r && stamp[a] < stamp[best])) {
+        best = a;
+        bk = k;
+      }
+    }
+    if (best < 0) {
+      out.outcome = Outcome::deadlock;
+      return out;
+    }
+    const auto a = static_cast<ActorId>(best);
+    uint64_t k = options.scheduler.firings == FiringRule::one ? 1 : bk.first / bk.second;
+    if (bounded) k = std::min(k, q[a] - count[a]);
+    out.runs.push_back({a, k});
+    out.waits.push_back(t - stamp[a]);
+    for (uint64_t i = 0; i < k; ++i) fire_once(g, tokens, a);
+    fired[a] = 1;
+    if (bounded) {
+      count[a] += k;
+      bool all = true;
+      for (ActorId b = 0; b < n; ++b) all = all && count[b] >= q[b];
+      if (all) std::fill(count.begin(), count.end(), 0);
+    }
+    for (ActorId b = 0; b < n; ++b) {
+      const bool now = eligible(b);
+      if (now && (!was[b] || b == a)) stamp[b] = t + 1;
+      was[b] = now;
+    }
+    if (periodic) {
+      if (--extra == 0) {  // no return within one more cycle
+        out.runs.resize(out.transient + out.cycle);
+        out.waits.resize(out.transient + out.cycle);
+        return out;
+      }
+    } else {
+      for (ChannelId c = 0; c < g.channel_count(); ++c) {
+        if (tokens[c] > cap[c]) {
+          out.outcome = Outcome::unbounded;
+          out.channel = c;
+          return out;
+        }
+      }
+    }
+    const bool all_fired = std::all_of(fired.begin(), fired.end(), [](char f) { return f; });
+    bool zero_counts = std::all_of(count.begin(), count.end(), [](uint64_t c) { return c == 0; });
+    if (all_fired && zero_counts && tokens == tokens0) {
+      out.outcome = Outcome::returns;
+      out.transient = 0;
+      out.cycle = t + 1;
+      out.runs.resize(t + 1);
+      out.waits.resize(t + 1);
+      return out;
+    }
+    if (!periodic) {
+      auto [it, inserted] = seen.try_emplace(state(), t + 1);
+      if (!inserted) {
+        periodic = true;
+        out.outcome = Outcome::periodic;
+        out.transient = it->second;
+        out.cycle = t + 1 - it->second;
+        extra = out.cycle;
+      }
+    }
+  }
+}
+
+}  // namespace sdf::naive

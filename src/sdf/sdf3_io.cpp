@@ -1,0 +1,249 @@
+// SDF3 XML reading and writing (pugixml). Two passes over <sdf>: actors and their ports first,
+// then channels, so element order does not matter. Ports are found by binary search in a list
+// sorted by (actor, name): O(P log P) for P ports, never the quadratic scan that makes SDF3's
+// own loader take minutes on 10^5 actors.
+#include <algorithm>
+#include <charconv>
+#include <pugixml.hpp>
+#include <sstream>
+#include <unordered_set>
+
+#include "sdf/io.hpp"
+#include "sdf/text.hpp"
+
+namespace sdf {
+
+namespace {
+
+struct Port {
+  ActorId actor;
+  std::string_view name;
+  bool out;
+  uint64_t rate;
+  size_t line;
+  int64_t channel = -1;
+};
+
+class Sdf3Reader {
+ public:
+  Sdf3Reader(std::string_view text, const std::string& source) : lines_(text), source_(source) {}
+
+  Graph read(std::string_view text) {
+    const pugi::xml_parse_result res =
+        doc_.load_buffer(text.data(), text.size(), pugi::parse_default, pugi::encoding_utf8);
+    if (!res) fail(static_cast<size_t>(res.offset), std::string("XML: ") + res.description());
+    const pugi::xml_node root = doc_.child("sdf3");
+    if (!root) fail(0, "no <sdf3> root element");
+    const std::string_view type = root.attribute("type").value();
+    if (!type.empty() && type != "sdf")
+      fail(root, "graph type '" + std::string(type) + "' is not supported (only type=\"sdf\")");
+    const pugi::xml_node app = root.child("applicationGraph");
+    if (!app) fail(root, "<sdf3> has no <applicationGraph>");
+    const pugi::xml_node sdf = app.child("sdf");
+    if (!sdf) fail(app, "<applicationGraph> has no <sdf>");
+    Graph g;
+    g.name = sdf.attribute("name").value();
+    if (!valid_utf8(g.name)) fail(sdf, "attribute 'name' is not valid UTF-8");
+    for (pugi::xml_node actor : sdf.children("actor")) read_actor(g, actor);
+    std::sort(ports_.begin(), ports_.end(), [](const Port& a, const Port& b) {
+      return a.actor != b.actor ? a.actor < b.actor : a.name < b.name;
+    });
+    for (size_t i = 1; i < ports_.size(); ++i)
+      if (ports_[i].actor == ports_[i - 1].actor && ports_[i].name == ports_[i - 1].name)
+        fail_line(std::max(ports_[i].line, ports_[i - 1].line),
+                  "duplicate port '" + std::string(ports_[i].name) + "' on actor '" +
+                      g.actor_name(ports_[i].actor) + "'");
+    for (pugi::xml_node ch : sdf.children("channel")) read_channel(g, ch);
+    for (const Port& p : ports_)
+      if (p.channel < 0)
+        fail_line(p.line, "port '" + std::string(p.name) + "' of actor '" + g.actor_name(p.actor) +
+                              "' is not connected to a channel");
+    return g;
+  }
+
+ private:
+  [[noreturn]] void fail_line(size_t line, const std::string& msg) const {
+    throw Error(Error::Kind::input, source_ + ":" + std::to_string(line) + ": " + msg);
+  }
+  [[noreturn]] void fail(size_t offset, const std::string& msg) const {
+    fail_line(lines_.line_of(offset), msg);
+  }
+  [[noreturn]] void fail(pugi::xml_node node, const std::string& msg) const {
+    fail(static_cast<size_t>(std::max<ptrdiff_t>(0, node.offset_debug())), msg);
+  }
+
+  std::string_view required(pugi::xml_node node, const char* attr) const {
+    const pugi::xml_attribute a = node.attribute(attr);
+    if (!a) fail(node, "<" + std::string(node.name()) + "> lacks the attribute '" + attr + "'");
+    const std::string_view v = trim(a.value());
+    if (v.empty()) fail(node, "attribute '" + std::string(attr) + "' is empty");
+    if (!valid_utf8(v)) fail(node, "attribute '" + std::string(attr) + "' is not valid UTF-8");
+    return v;
+  }
+
+  uint64_t number(pugi::xml_node node, const char* attr, std::string_view text,
+                  bool positive) const {
+    uint64_t v = 0;
+    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec != std::errc() || ptr != text.data() + text.size() || (positive && v == 0)) {
+      std::string msg = "attribute " + std::string(attr) + "='" + std::string(text) +
+                        "' is not a " + (positive ? "positive" : "non-negative") +
+                        " 64-bit integer";
+      if (text.find(',') != std::string_view::npos) msg += " (CSDF rate lists are not supported)";
+      fail(node, msg);
+    }
+    return v;
+  }
+
+  void read_actor(Graph& g, pugi::xml_node actor) {
+    const std::string_view name = required(actor, "name");
+    if (g.find_actor(name)) fail(actor, "duplicate actor name '" + std::string(name) + "'");
+    const ActorId id = g.add_actor(std::string(name));
+    for (pugi::xml_node port : actor.children("port")) {
+      Port p;
+      p.actor = id;
+      p.name = required(port, "name");
+      const std::string_view type = required(port, "type");
+      if (type != "in" && type != "out")
+        fail(port, "port type '" + std::string(type) + "' is neither 'in' nor 'out'");
+      p.out = type == "out";
+      p.rate = number(port, "rate", required(port, "rate"), true);
+      p.line = lines_.line_of(static_cast<size_t>(std::max<ptrdiff_t>(0, port.offset_debug())));
+      ports_.push_back(p);
+    }
+  }
+
+  Port& find_port(const Graph& g, pugi::xml_node ch, ActorId actor, std::string_view name) {
+    auto it = std::lower_bound(ports_.begin(), ports_.end(), std::pair{actor, name},
+                               [](const Port& p, const std::pair<ActorId, std::string_view>& k) {
+                                 return p.actor != k.first ? p.actor < k.first : p.name < k.second;
+                               });
+    if (it == ports_.end() || it->actor != actor || it->name != name)
+      fail(ch, "actor '" + g.actor_name(actor) + "' has no port '" + std::string(name) + "'");
+    return *it;
+  }
+
+  void read_channel(Graph& g, pugi::xml_node ch) {
+    const pugi::xml_attribute name_attr = ch.attribute("name");
+    const std::string name(trim(name_attr.value()));
+    if (name_attr && name.empty()) fail(ch, "attribute 'name' is empty");
+    if (!valid_utf8(name)) fail(ch, "attribute 'name' is not valid UTF-8");
+    auto actor = [&](const char* attr) {
+      const std::string_view v = required(ch, attr);
+      const auto a = g.find_actor(v);
+      if (!a) fail(ch, "channel refers to an unknown actor '" + std::string(v) + "'");
+      return *a;
+    };
+    const ActorId src = actor("srcActor");
+    const ActorId dst = actor("dstActor");
+    Port& sp = find_port(g, ch, src, required(ch, "srcPort"));
+    Port& dp = find_port(g, ch, dst, required(ch, "dstPort"));
+    if (!sp.out) fail(ch, "srcPort '" + std::string(sp.name) + "' is an input port");
+    if (dp.out) fail(ch, "dstPort '" + std::string(dp.name) + "' is an output port");
+    for (Port* p : {&sp, &dp})
+      if (p->channel >= 0)
+        fail(ch, "port '" + std::string(p->name) + "' of actor '" + g.actor_name(p->actor) +
+                     "' is already connected to channel '" +
+                     g.channel(static_cast<ChannelId>(p->channel)).name + "'");
+    uint64_t delay = 0;
+    if (const pugi::xml_attribute t = ch.attribute("initialTokens"))
+      delay = number(ch, "initialTokens", trim(t.value()), false);
+    if (!name.empty() && g.find_channel(name)) fail(ch, "duplicate channel name '" + name + "'");
+    ChannelId c;
+    try {
+      c = g.add_channel(src, dst, sp.rate, dp.rate, delay, name);
+    } catch (const Error& e) {
+      fail(ch, e.what());
+    }
+    g.set_port_names(c, std::string(sp.name), std::string(dp.name));
+    sp.channel = dp.channel = c;
+  }
+
+  LineIndex lines_;
+  const std::string& source_;
+  pugi::xml_document doc_;
+  std::vector<Port> ports_;
+};
+
+// Port names for writing: the ones read, else "in<k>"/"out<k>" avoiding names already taken.
+std::vector<std::pair<std::string, std::string>> port_names(const Graph& g) {
+  std::vector<std::unordered_set<std::string>> taken(g.actor_count());
+  bool any_named = false;
+  for (const Channel& c : g.channels()) {
+    if (!c.src_port.empty()) taken[c.src].insert(c.src_port), any_named = true;
+    if (!c.dst_port.empty()) taken[c.dst].insert(c.dst_port), any_named = true;
+  }
+  std::vector<uint32_t> next(g.actor_count(), 0);
+  auto invent = [&](ActorId a, const char* prefix) {
+    for (;;) {
+      std::string p = prefix + std::to_string(next[a]++);
+      if (!any_named || taken[a].insert(p).second) return p;
+    }
+  };
+  std::vector<std::pair<std::string, std::string>> names(g.channel_count());
+  for (ChannelId c = 0; c < g.channel_count(); ++c) {
+    const Channel& ch = g.channel(c);
+    names[c].first = ch.src_port.empty() ? invent(ch.src, "out") : ch.src_port;
+    names[c].second = ch.dst_port.empty() ? invent(ch.dst, "in") : ch.dst_port;
+  }
+  return names;
+}
+
+}  // namespace
+
+Graph read_sdf3(std::string_view text, const std::string& source) {
+  Sdf3Reader reader(text, source);
+  return reader.read(text);
+}
+
+std::string write_sdf3(const Graph& g) {
+  const auto ports = port_names(g);
+  const Adjacency adj(g);
+  pugi::xml_document doc;
+  pugi::xml_node decl = doc.append_child(pugi::node_declaration);
+  decl.append_attribute("version") = "1.0";
+  decl.append_attribute("encoding") = "UTF-8";
+  pugi::xml_node root = doc.append_child("sdf3");
+  root.append_attribute("type") = "sdf";
+  root.append_attribute("version") = "1.0";
+  pugi::xml_node app = root.append_child("applicationGraph");
+  const std::string name = g.name.empty() ? "graph" : g.name;
+  app.append_attribute("name") = name.c_str();
+  pugi::xml_node sdf = app.append_child("sdf");
+  sdf.append_attribute("name") = name.c_str();
+  sdf.append_attribute("type") = name.c_str();
+  for (ActorId a = 0; a < g.actor_count(); ++a) {
+    pugi::xml_node actor = sdf.append_child("actor");
+    actor.append_attribute("name") = g.actor_name(a).c_str();
+    actor.append_attribute("type") = g.actor_name(a).c_str();
+    for (ChannelId c : adj.inputs(a)) {
+      pugi::xml_node p = actor.append_child("port");
+      p.append_attribute("name") = ports[c].second.c_str();
+      p.append_attribute("type") = "in";
+      p.append_attribute("rate") = static_cast<unsigned long long>(g.channel(c).cns);
+    }
+    for (ChannelId c : adj.outputs(a)) {
+      pugi::xml_node p = actor.append_child("port");
+      p.append_attribute("name") = ports[c].first.c_str();
+      p.append_attribute("type") = "out";
+      p.append_attribute("rate") = static_cast<unsigned long long>(g.channel(c).prd);
+    }
+  }
+  for (ChannelId c = 0; c < g.channel_count(); ++c) {
+    const Channel& ch = g.channel(c);
+    pugi::xml_node e = sdf.append_child("channel");
+    e.append_attribute("name") = ch.name.c_str();
+    e.append_attribute("srcActor") = g.actor_name(ch.src).c_str();
+    e.append_attribute("srcPort") = ports[c].first.c_str();
+    e.append_attribute("dstActor") = g.actor_name(ch.dst).c_str();
+    e.append_attribute("dstPort") = ports[c].second.c_str();
+    if (ch.delay != 0)
+      e.append_attribute("initialTokens") = static_cast<unsigned long long>(ch.delay);
+  }
+  app.append_child("sdfProperties");
+  std::ostringstream out;
+  doc.save(out, "  ", pugi::format_default, pugi::encoding_utf8);
+  return out.str();
+}
+
+}  // namespace sdf

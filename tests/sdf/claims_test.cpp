@@ -1,0 +1,97 @@
+// The thesis's claims (DESIGN §8, docs/sdf.md "The thesis's claims, tested"): a quick random
+// sample here, thousands of graphs in claims_slow_test.cpp, and the smallest counter-example of
+// each failed claim pinned as a data file.
+#include "sdf/claims.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "helpers.hpp"
+#include "sdf/checker.hpp"
+#include "sdf/io.hpp"
+#include "sdf/online.hpp"
+#include "sdf/repetitions.hpp"
+
+namespace sdf {
+namespace {
+
+TEST(Claims, RandomSampleBoundedAlwaysValidAndEveryScheduleChecks) {
+  claims::Options o;
+  o.graphs_per_class = 25;  // 20 classes: 500 graphs, each run by three policies
+  o.seed = 7;
+  const claims::Report r = claims::run(o);
+  ASSERT_EQ(r.classes.size(), 20u);
+  uint64_t graphs = 0, returns = 0, periodic = 0, unbounded = 0;
+  for (const claims::ClassStats& c : r.classes) {
+    graphs += c.graphs;
+    EXPECT_EQ(c.graphs, 25u) << c.name;  // the generator's graphs are consistent and live
+    EXPECT_EQ(c.bounded.returns, c.graphs) << c.name;
+    for (const claims::PolicyStats* s : {&c.online, &c.online_one, &c.bounded}) {
+      EXPECT_EQ(s->checker_failures, 0u) << c.name;
+      EXPECT_EQ(s->limit + s->deadlock, 0u) << c.name;
+    }
+    returns += c.online.returns;
+    periodic += c.online.periodic;
+    unbounded += c.online.unbounded;
+  }
+  EXPECT_EQ(graphs, 500u);
+  EXPECT_EQ(r.counterexamples.count("generator-q"), 0u);
+  EXPECT_EQ(r.counterexamples.count("generator-live"), 0u);
+  EXPECT_EQ(r.counterexamples.count("bounded-invalid"), 0u);
+  // Measured, not assumed: the sample shows all three outcomes of `online`.
+  EXPECT_GT(returns, 0u);
+  EXPECT_GT(periodic, 0u);
+  EXPECT_GT(unbounded, 0u);
+}
+
+// Each pinned counter-example still fails its claim. The file name says which:
+// <policy>-<claim>.json with policy online | online-one | bounded.
+TEST(Claims, PinnedCounterExamplesStillFail) {
+  const std::filesystem::path dir = test::data("counterexamples");
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string name = entry.path().stem().string();
+    SCOPED_TRACE(name);
+    ++files;
+    const Graph g = read_graph_file(entry.path().string());
+    const Repetitions rep = compute_repetitions(g);
+    ASSERT_TRUE(rep.consistent);
+    OnlineRunOptions o;
+    std::string claim;
+    if (name.rfind("online-one-", 0) == 0) {
+      o.scheduler.firings = FiringRule::one;
+      claim = name.substr(11);
+    } else if (name.rfind("online-", 0) == 0) {
+      claim = name.substr(7);
+    } else if (name.rfind("bounded-", 0) == 0) {
+      o.scheduler.bounded = true;
+      claim = name.substr(8);
+    } else {
+      FAIL() << "unknown counter-example file";
+    }
+    const OnlineRun run = run_online(g, rep.q, o);
+    const uint64_t n = g.actor_count();
+    if (claim == "periodic") {
+      EXPECT_EQ(run.outcome, Outcome::periodic);
+    } else if (claim.rfind("unbounded", 0) == 0) {
+      EXPECT_EQ(run.outcome, Outcome::unbounded);
+      o.growth_periods = 4096;
+      EXPECT_EQ(run_online(g, rep.q, o).outcome, Outcome::unbounded);
+    } else if (claim == "fairness") {
+      EXPECT_GE(run.metrics.fairness.max, n - 1);
+    } else if (claim == "fairness-weak") {
+      EXPECT_GT(run.metrics.fairness.max, n - 1);
+    } else {
+      FAIL() << "unknown claim " << claim;
+    }
+    if (o.scheduler.bounded) {
+      ASSERT_EQ(run.outcome, Outcome::returns);
+      EXPECT_TRUE(check_period(g, rep.q, run.runs).valid);
+    }
+  }
+  EXPECT_GE(files, 10);
+}
+
+}  // namespace
+}  // namespace sdf

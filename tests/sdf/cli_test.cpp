@@ -1,0 +1,184 @@
+// The sdfsched binary: exit codes, the JSON shapes of DESIGN §9, one-line errors.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "helpers.hpp"
+
+namespace sdf {
+namespace {
+
+using nlohmann::json;
+
+std::string graph(const std::string& name) {
+  return "'" + test::data(name) + "'";
+}
+
+bool one_line(const std::string& s) {
+  return !s.empty() && s.back() == '\n' && s.find('\n') == s.size() - 1;
+}
+
+TEST(SdfschedCli, RepetitionsJson) {
+  const test::Cli r = test::sdfsched("repetitions " + graph("cd2dat.xml") + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["consistent"], true);
+  EXPECT_EQ(j["repetitions"].dump(), R"({"A":147,"B":147,"C":98,"D":28,"E":32,"F":160})");
+  const test::Cli big = test::sdfsched("repetitions " + graph("chain65537.json") + " --json");
+  EXPECT_EQ(json::parse(big.out)["repetitions"]["C"].get<uint64_t>(), 4295098369ull);
+  const test::Cli text = test::sdfsched("repetitions " + graph("cd2dat.json"));
+  EXPECT_EQ(text.out, "A 147\nB 147\nC 98\nD 28\nE 32\nF 160\n");
+}
+
+TEST(SdfschedCli, InconsistentAndOverflow) {
+  const test::Cli r = test::sdfsched("repetitions " + graph("inconsistent.json") + " --json");
+  EXPECT_EQ(r.status, 1);
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["consistent"], false);
+  EXPECT_TRUE(j["channel"].is_string());
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  const test::Cli o = test::sdfsched("repetitions " + graph("overflow.json"));
+  EXPECT_EQ(o.status, 1);
+  EXPECT_EQ(o.out, "");
+  EXPECT_NE(o.err.find("does not fit in 64 bits"), std::string::npos);
+  EXPECT_TRUE(one_line(o.err));
+}
+
+TEST(SdfschedCli, ScheduleStaticJson) {
+  const test::Cli r =
+      test::sdfsched("schedule " + graph("cd2dat.json") + " --policy static --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["outcome"], "returns");
+  EXPECT_EQ(j["valid"], true);
+  ASSERT_EQ(j["firings"].size(), 612u);
+  EXPECT_EQ(j["firings"][0], "A");
+  EXPECT_EQ(j["firings"][611], "F");
+  EXPECT_EQ(j["buffers"]["B->C#0"], 294);
+  EXPECT_EQ(j["fairness"]["max"], 0);
+  EXPECT_TRUE(j["fairness"]["mean"].is_number());
+}
+
+TEST(SdfschedCli, ScheduleOnlineOutcomesAndExitStatus) {
+  const test::Cli p =
+      test::sdfsched("schedule " + graph("cd2dat.json") + " --policy online --json");
+  EXPECT_EQ(p.status, 3);
+  const json j = json::parse(p.out);
+  EXPECT_EQ(j["outcome"], "periodic");
+  EXPECT_EQ(j["valid"], false);
+  EXPECT_EQ(j["transient"].size(), 1u);
+  EXPECT_EQ(j["cycle"].size(), 1224u);
+  EXPECT_EQ(j["cycle_repetitions"]["F"], 320);
+  EXPECT_FALSE(j.contains("firings"));
+  const test::Cli u =
+      test::sdfsched("schedule " + graph("starved_cycle.json") + " --policy online --json");
+  EXPECT_EQ(u.status, 3);
+  const json k = json::parse(u.out);
+  EXPECT_EQ(k["outcome"], "unbounded");
+  EXPECT_EQ(k["channel"], "S->X#0");
+  const test::Cli b =
+      test::sdfsched("schedule " + graph("cd2dat.json") + " --policy online-bounded --json");
+  EXPECT_EQ(b.status, 0);
+  const json l = json::parse(b.out);
+  EXPECT_EQ(l["outcome"], "returns");
+  EXPECT_EQ(l["valid"], true);
+  EXPECT_EQ(l["firings"].size(), 612u);
+  const test::Cli lim = test::sdfsched("schedule " + graph("cd2dat.json") +
+                                       " --policy online --max-decisions 10 --json");
+  EXPECT_EQ(lim.status, 3);
+  EXPECT_EQ(json::parse(lim.out)["outcome"], "limit");
+  const test::Cli one = test::sdfsched("schedule " + graph("chain65537.json") +
+                                       " --policy online --firings one --max-decisions 1000");
+  EXPECT_EQ(one.status, 3);
+  EXPECT_NE(one.out.find("outcome: limit"), std::string::npos);
+}
+
+TEST(SdfschedCli, HugePeriodsAreNotListedButStillChecked) {
+  const test::Cli r = test::sdfsched("schedule " + graph("chain65537.json") + " --json");
+  ASSERT_EQ(r.status, 0);
+  const json j = json::parse(r.out);
+  EXPECT_TRUE(j["firings"].is_null());
+  EXPECT_EQ(j["period_firings"].get<uint64_t>(), 4295163907ull);
+  EXPECT_EQ(j["runs"].dump(), R"([["A",1],["B",65537],["C",4295098369]])");
+  EXPECT_EQ(j["valid"], true);
+}
+
+TEST(SdfschedCli, Deadlock) {
+  for (const char* policy : {"static", "online", "online-bounded"}) {
+    const test::Cli r =
+        test::sdfsched("schedule " + graph("deadlock.json") + " --policy " + policy + " --json");
+    EXPECT_EQ(r.status, 1);
+    const json j = json::parse(r.out);
+    EXPECT_EQ(j["deadlock"], true);
+    EXPECT_EQ(j["stuck"].dump(), R"(["P","Q","R"])");
+    EXPECT_TRUE(one_line(r.err));
+  }
+}
+
+TEST(SdfschedCli, SimulateRateChange) {
+  const test::Cli r = test::sdfsched("simulate " + graph("cd2dat.json") +
+                                     " --rate-change C:4/3@100 --policy online-bounded --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["change"]["actor"], "C");
+  EXPECT_EQ(j["consistent_after"], true);
+  EXPECT_TRUE(j["firings_until_periodic"].is_number());
+  EXPECT_EQ(j["period_valid"], true);
+  EXPECT_EQ(j["buffers_before"].size(), 5u);
+  EXPECT_EQ(j["buffers_after"].size(), 5u);
+  EXPECT_EQ(j["repetitions_after"]["C"].get<uint64_t>() * 4,
+            j["repetitions_after"]["D"].get<uint64_t>() * 7);
+  const test::Cli s =
+      test::sdfsched("simulate " + graph("cd2dat.json") + " --rate-change C:4/3@100 --json");
+  EXPECT_EQ(s.status, 0);
+  EXPECT_EQ(json::parse(s.out)["firings_until_periodic"], 0);
+  const test::Cli inc =
+      test::sdfsched("simulate " + graph("crlf_loop.xml") + " --rate-change X:2/1@1 --json");
+  EXPECT_EQ(inc.status, 1);
+  EXPECT_EQ(json::parse(inc.out)["consistent_after"], false);
+}
+
+TEST(SdfschedCli, ConvertRoundTrips) {
+  const std::string out = test::temp_path("g.xml");
+  const test::Cli x =
+      test::sdfsched("convert " + graph("cd2dat.json") + " --to sdf3 -o '" + out + "'");
+  ASSERT_EQ(x.status, 0) << x.err;
+  const test::Cli back = test::sdfsched("repetitions '" + out + "' --json");
+  std::remove(out.c_str());
+  EXPECT_EQ(json::parse(back.out)["repetitions"]["F"], 160);
+  const test::Cli j = test::sdfsched("convert " + graph("cd2dat.xml") + " --to json");
+  EXPECT_EQ(json::parse(j.out)["channels"][0]["name"], "ab");
+  const test::Cli d = test::sdfsched("convert " + graph("cd2dat.xml") + " --to dot");
+  EXPECT_NE(d.out.find("\"A\" -> \"B\""), std::string::npos);
+}
+
+TEST(SdfschedCli, BadInputAndUsage) {
+  struct Case {
+    std::string args;
+    int status;
+    std::string in_err;
+  };
+  const Case cases[] = {
+      {"repetitions " + graph("unconnected_port_crlf.xml"), 1,
+       "unconnected_port_crlf.xml:12: port 'spare'"},
+      {"repetitions /nonexistent.json", 1, "/nonexistent.json: cannot open"},
+      {"schedule " + graph("cd2dat.json") + " --policy fastest", 2, "--policy"},
+      {"schedule", 2, "graph"},
+      {"frobnicate", 2, ""},
+      {"simulate " + graph("cd2dat.json") + " --rate-change C43@1", 2,
+       "expected ACTOR:PRD/CNS@FIRING"},
+      {"simulate " + graph("cd2dat.json") + " --rate-change C:0/3@1", 2, "not a positive integer"},
+      {"simulate " + graph("cd2dat.json") + " --rate-change Z:1/3@1", 1, "unknown actor 'Z'"},
+      {"convert " + graph("cd2dat.json") + " --to png", 2, "--to"},
+  };
+  for (const Case& c : cases) {
+    const test::Cli r = test::sdfsched(c.args);
+    EXPECT_EQ(r.status, c.status) << c.args << ": " << r.err;
+    EXPECT_TRUE(one_line(r.err)) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.in_err), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_EQ(r.out, "") << c.args;
+  }
+}
+
+}  // namespace
+}  // namespace sdf

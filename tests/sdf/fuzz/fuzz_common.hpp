@@ -1,0 +1,56 @@
+// Shared body of the libFuzzer targets for the graph readers: any input either reads or fails
+// with sdf::Error; what reads must survive the analyses (bounded in size) and a write/read
+// round trip through both formats. Anything else (another exception, a sanitizer report, a
+// round-trip mismatch) is a finding.
+#pragma once
+
+#include <cstdint>
+#include <cstdlib>
+#include <string_view>
+
+#include "sdf/io.hpp"
+#include "sdf/online.hpp"
+#include "sdf/repetitions.hpp"
+#include "sdf/schedule.hpp"
+
+namespace sdf::fuzz {
+
+inline bool same(const Graph& a, const Graph& b) {
+  if (a.actor_count() != b.actor_count() || a.channel_count() != b.channel_count()) return false;
+  for (ActorId x = 0; x < a.actor_count(); ++x)
+    if (a.actor_name(x) != b.actor_name(x)) return false;
+  for (ChannelId c = 0; c < a.channel_count(); ++c) {
+    const Channel &p = a.channel(c), &q = b.channel(c);
+    if (p.src != q.src || p.dst != q.dst || p.prd != q.prd || p.cns != q.cns ||
+        p.delay != q.delay || p.name != q.name)
+      return false;
+  }
+  return true;
+}
+
+inline void exercise(Graph (*read)(std::string_view, const std::string&), std::string_view text) {
+  Graph g;
+  try {
+    g = read(text, "fuzz");
+  } catch (const Error&) {
+    return;
+  }
+  // Round trips: what was read must be written so that it reads back the same.
+  if (!same(g, read_json(write_json(g), "json")) || !same(g, read_sdf3(write_sdf3(g), "sdf3")))
+    std::abort();
+  (void)write_dot(g);
+  try {
+    const Repetitions r = compute_repetitions(g);
+    if (!r.consistent || g.actor_count() > 64) return;
+    const StaticSchedule s = static_schedule(g, r.q);
+    if (!s.complete) return;
+    OnlineRunOptions o;
+    o.max_decisions = 2000;
+    o.max_listed_runs = 2000;
+    (void)run_online(g, r.q, o);
+  } catch (const Error& e) {
+    if (e.kind() != Error::Kind::overflow) std::abort();
+  }
+}
+
+}  // namespace sdf::fuzz

@@ -1,0 +1,53 @@
+#include "sdf/graph.hpp"
+
+#include <gtest/gtest.h>
+
+#include "helpers.hpp"
+
+namespace sdf {
+namespace {
+
+TEST(Graph, DefaultChannelNamesCountParallelChannels) {
+  const Graph g =
+      test::make({"A", "B"}, {{"A", "B", 1, 1, 0}, {"A", "B", 2, 2, 0}, {"B", "A", 1, 1, 1}});
+  EXPECT_EQ(g.channel(0).name, "A->B#0");
+  EXPECT_EQ(g.channel(1).name, "A->B#1");
+  EXPECT_EQ(g.channel(2).name, "B->A#0");
+  EXPECT_EQ(g.find_channel("A->B#1"), 1u);
+  EXPECT_FALSE(g.find_channel("A->B#2"));
+}
+
+TEST(Graph, RejectsDuplicatesAndZeroRates) {
+  Graph g;
+  g.add_actor("A");
+  EXPECT_THROW(g.add_actor("A"), Error);
+  EXPECT_THROW(g.add_actor(""), Error);
+  EXPECT_THROW(g.add_channel(0, 0, 0, 1, 0), Error);
+  EXPECT_THROW(g.add_channel(0, 5, 1, 1, 0), Error);
+  g.add_channel(0, 0, 1, 1, 1, "self");
+  EXPECT_THROW(g.add_channel(0, 0, 1, 1, 1, "self"), Error);
+}
+
+TEST(Graph, AdjacencyListsChannelsInOrderAndSelfLoopsTwice) {
+  const Graph g = test::make(
+      {"A", "B", "C"},
+      {{"A", "B", 1, 1, 0}, {"B", "B", 1, 1, 1}, {"A", "C", 1, 1, 0}, {"C", "B", 1, 1, 0}});
+  const Adjacency adj(g);
+  EXPECT_EQ(std::vector<ChannelId>(adj.outputs(0).begin(), adj.outputs(0).end()),
+            (std::vector<ChannelId>{0, 2}));
+  EXPECT_EQ(std::vector<ChannelId>(adj.inputs(1).begin(), adj.inputs(1).end()),
+            (std::vector<ChannelId>{0, 1, 3}));
+  EXPECT_EQ(std::vector<ChannelId>(adj.outputs(1).begin(), adj.outputs(1).end()),
+            (std::vector<ChannelId>{1}));
+}
+
+TEST(Graph, ConnectedComponentsIgnoreDirection) {
+  const Graph g = test::make({"A", "B", "C", "D", "E"}, {{"B", "A", 1, 1, 0}, {"D", "C", 1, 1, 0}});
+  const Adjacency adj(g);
+  const Components c = connected_components(g, adj);
+  EXPECT_EQ(c.count, 3u);
+  EXPECT_EQ(c.of_actor, (std::vector<uint32_t>{0, 0, 1, 1, 2}));
+}
+
+}  // namespace
+}  // namespace sdf

@@ -1,0 +1,251 @@
+#include "sdf/io.hpp"
+
+#include <gtest/gtest.h>
+
+#include "helpers.hpp"
+#include "sdf/generate.hpp"
+
+namespace sdf {
+namespace {
+
+std::string sdf3(const std::string& body) {
+  return "<?xml version='1.0'?>\n<sdf3 type='sdf' version='1.0'>\n<applicationGraph name='g'>\n"
+         "<sdf name='g' type='g'>\n" +
+         body + "</sdf>\n</applicationGraph>\n</sdf3>\n";
+}
+
+const char* kTwo =
+    "<actor name='A' type='a'><port name='o' type='out' rate='2'/></actor>\n"
+    "<actor name='B' type='b'><port name='i' type='in' rate='3'/></actor>\n";
+
+// The error message of reading `text`, or "" if it reads.
+std::string sdf3_error(const std::string& text) {
+  try {
+    read_sdf3(text, "f.xml");
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::input);
+    return e.what();
+  }
+  return "";
+}
+
+std::string json_error(const std::string& text) {
+  try {
+    read_json(text, "f.json");
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::input);
+    return e.what();
+  }
+  return "";
+}
+
+bool same_graph(const Graph& a, const Graph& b) {
+  if (a.actor_count() != b.actor_count() || a.channel_count() != b.channel_count()) return false;
+  for (ActorId x = 0; x < a.actor_count(); ++x)
+    if (a.actor_name(x) != b.actor_name(x)) return false;
+  for (ChannelId c = 0; c < a.channel_count(); ++c) {
+    const Channel &p = a.channel(c), &q = b.channel(c);
+    if (p.src != q.src || p.dst != q.dst || p.prd != q.prd || p.cns != q.cns ||
+        p.delay != q.delay || p.name != q.name)
+      return false;
+  }
+  return true;
+}
+
+TEST(Sdf3Reader, ReadsSingleQuotedSdf3WithProperties) {
+  const Graph g = read_graph_file(test::data("cd2dat.xml"));
+  ASSERT_EQ(g.actor_count(), 6u);
+  ASSERT_EQ(g.channel_count(), 5u);
+  EXPECT_EQ(g.name, "cd2dat");
+  EXPECT_EQ(g.channel(1).name, "bc");
+  EXPECT_EQ(g.channel(1).prd, 2u);
+  EXPECT_EQ(g.channel(1).cns, 3u);
+  EXPECT_EQ(g.channel(1).src_port, "o");
+}
+
+TEST(Sdf3Reader, ReadsCrlfFilesAndCountsTheirLines) {
+  const Graph g = read_graph_file(test::data("crlf_loop.xml"));
+  ASSERT_EQ(g.channel_count(), 2u);
+  EXPECT_EQ(g.channel(1).delay, 2u);
+  EXPECT_EQ(g.channel(0).prd, 3u);
+  try {
+    read_graph_file(test::data("unconnected_port_crlf.xml"));
+    FAIL() << "an unconnected port must be rejected";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("unconnected_port_crlf.xml:12: port 'spare' of actor 'Y' "
+                                         "is not connected"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Sdf3Reader, RejectsNamesThatAreNotUtf8) {
+  // Found by fuzzing: such a name was read, and writing the graph as JSON then threw.
+  EXPECT_NE(sdf3_error(sdf3("<actor name='\xff\xfe'/>\n"))
+                .find("f.xml:5: attribute 'name' is not valid UTF-8"),
+            std::string::npos);
+  EXPECT_NE(sdf3_error(sdf3("<actor name='\xed\xa0\x80'/>\n")).find("not valid UTF-8"),
+            std::string::npos);  // a UTF-16 surrogate
+  EXPECT_NE(sdf3_error(sdf3("<actor name='\xc0\x80'/>\n")).find("not valid UTF-8"),
+            std::string::npos);                                            // overlong
+  EXPECT_EQ(sdf3_error(sdf3("<actor name='\xc3\xa9t\xc3\xa9'/>\n")), "");  // "été"
+}
+
+TEST(Sdf3Reader, ElementOrderDoesNotMatter) {
+  const Graph g =
+      read_sdf3(sdf3("<channel name='c' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n" +
+                     std::string(kTwo)));
+  EXPECT_EQ(g.channel(0).name, "c");
+}
+
+TEST(Sdf3Reader, NamesTheLineOfEachMistake) {
+  const std::string ch = "<channel name='c' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n";
+  // Line 5 is the first body line (after the xml declaration, sdf3, applicationGraph, sdf).
+  EXPECT_EQ(sdf3_error(sdf3(std::string(kTwo) + ch)), "");
+  EXPECT_NE(sdf3_error(sdf3(kTwo)).find("f.xml:5: port 'o' of actor 'A' is not connected"),
+            std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3(std::string(kTwo) +
+                      "<channel name='c' srcActor='A' srcPort='o' dstActor='Z' dstPort='i'/>\n"))
+          .find("f.xml:7: channel refers to an unknown actor 'Z'"),
+      std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3(std::string(kTwo) +
+                      "<channel name='c' srcActor='A' srcPort='x' dstActor='B' dstPort='i'/>\n"))
+          .find("f.xml:7: actor 'A' has no port 'x'"),
+      std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3(std::string(kTwo) +
+                      "<channel name='c' srcActor='B' srcPort='i' dstActor='A' dstPort='o'/>\n"))
+          .find("is an input port"),
+      std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3(std::string(kTwo) + ch +
+                      "<channel name='d' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n"))
+          .find("f.xml:8: port 'o' of actor 'A' is already connected to channel 'c'"),
+      std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3("<actor name='A' type='a'><port name='o' type='out' rate='1,2'/></actor>\n"))
+          .find("f.xml:5: attribute rate='1,2' is not a positive 64-bit integer (CSDF"),
+      std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3("<actor name='A' type='a'><port name='o' type='out' rate='0'/></actor>\n"))
+          .find("f.xml:5: attribute rate='0'"),
+      std::string::npos);
+  EXPECT_NE(sdf3_error(sdf3("<actor name='A' type='a'><port name='o' type='out' "
+                            "rate='99999999999999999999'/></actor>\n"))
+                .find("not a positive 64-bit integer"),
+            std::string::npos);
+  EXPECT_NE(sdf3_error(sdf3("<actor name='A'/>\n<actor name='A'/>\n"))
+                .find("f.xml:6: duplicate actor name 'A'"),
+            std::string::npos);
+  EXPECT_NE(
+      sdf3_error(sdf3("<actor type='a'/>\n")).find("f.xml:5: <actor> lacks the attribute 'name'"),
+      std::string::npos);
+  EXPECT_NE(sdf3_error(std::string(kTwo) + ch).find("f.xml:"), std::string::npos);  // no root
+  EXPECT_NE(sdf3_error("<sdf3 type='csdf'><applicationGraph/></sdf3>").find("not supported"),
+            std::string::npos);
+  EXPECT_NE(sdf3_error(sdf3(kTwo).substr(0, 120)).find("f.xml:"), std::string::npos);  // truncated
+  EXPECT_NE(sdf3_error("<sdf3 type=\"sdf\">\r\n<applicationGraph>\r\n<sdf>\r\n<actor name='A' "
+                       "x='1\"/>\r\n</sdf></applicationGraph></sdf3>")
+                .find("f.xml:4: XML"),
+            std::string::npos);
+}
+
+TEST(JsonReader, ReadsTheDesignForm) {
+  const Graph g = read_graph_file(test::data("cd2dat.json"));
+  EXPECT_EQ(g.actor_count(), 6u);
+  EXPECT_EQ(g.channel(4).name, "E->F#0");
+  EXPECT_EQ(g.channel(4).prd, 5u);
+  const Graph d =
+      read_json(R"({"channels":[{"src":"A","dst":"A","prd":1,"cns":1}],"actors":[{"name":"A"}]})");
+  EXPECT_EQ(d.channel(0).delay, 0u);  // delay defaults to 0; channels may precede actors
+}
+
+TEST(JsonReader, NamesTheFieldOfEachMistake) {
+  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"}],"channels":[]})"), "");
+  EXPECT_EQ(json_error(R"({"channels":[]})"), "f.json: top level: missing field 'actors'");
+  EXPECT_EQ(
+      json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":0,"cns":1}]})"),
+      "f.json: channels[0].prd: must be positive");
+  EXPECT_EQ(json_error(
+                R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1,"cns":-1}]})"),
+            "f.json: channels[0].cns: must not be negative");
+  EXPECT_EQ(
+      json_error(
+          R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1.5,"cns":1}]})"),
+      "f.json: channels[0].prd: '1.5' is not an integer below 2^64");
+  EXPECT_EQ(
+      json_error(
+          R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1,"cns":1,"dely":1}]})"),
+      "f.json: channels[0]: unknown field 'dely'");
+  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","cns":1}]})"),
+            "f.json: channels[0]: missing field 'prd'");
+  EXPECT_EQ(
+      json_error(R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"B","prd":1,"cns":1}]})"),
+      "f.json: channels[0].dst: unknown actor 'B'");
+  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"},{"name":"A"}]})"),
+            "f.json: actors[1].name: duplicate actor name 'A'");
+  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"},{}]})"),
+            "f.json: actors[1]: missing field 'name'");
+  EXPECT_EQ(json_error(R"({"actors":[{"name":["A"]}]})"),
+            "f.json: actors[0].name: unexpected an array");
+  EXPECT_EQ(
+      json_error(
+          R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":"1","cns":1}]})"),
+      "f.json: channels[0].prd: unexpected a string");
+  EXPECT_EQ(
+      json_error(
+          R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1,"cns":99999999999999999999}]})"),
+      "f.json: channels[0].cns: '99999999999999999999' is not an integer below 2^64");
+  EXPECT_EQ(json_error("[]"), "f.json: top level: unexpected an array");
+  EXPECT_NE(json_error("{\r\n\"actors\": [\r\n{\"name\": \"A\"},\r\n]}")
+                .find("f.json: parse error at line 4"),
+            std::string::npos);
+  EXPECT_NE(json_error("").find("f.json: parse error"), std::string::npos);
+}
+
+TEST(Writers, RoundTripRandomGraphsThroughBothFormats) {
+  crowddb::Rng rng(7);
+  for (int i = 0; i < 60; ++i) {
+    gen::Spec spec;
+    spec.shape = static_cast<gen::Shape>(i % 6);
+    spec.actors = 1 + static_cast<uint32_t>(rng.below(12));
+    spec.self_loops = i % 4 == 0;
+    const Graph g = gen::generate(spec, rng).graph;
+    const Graph j = read_json(write_json(g));
+    EXPECT_TRUE(same_graph(g, j)) << i;
+    const Graph x = read_sdf3(write_sdf3(g));
+    EXPECT_TRUE(same_graph(g, x)) << i;
+    // Port names invented on the first write are kept by the second.
+    EXPECT_EQ(write_sdf3(x), write_sdf3(read_sdf3(write_sdf3(x)))) << i;
+  }
+}
+
+TEST(Writers, KeepsSdf3NamesAndWritesDot) {
+  const Graph g = read_graph_file(test::data("cd2dat.xml"));
+  const Graph j = read_json(write_json(g));
+  EXPECT_EQ(j.channel(0).name, "ab");  // a non-default name travels as "name"
+  const std::string x = write_sdf3(g);
+  EXPECT_NE(x.find("srcPort=\"o\""), std::string::npos);
+  const std::string dot = write_dot(test::make({"a\"b", "c"}, {{"a\"b", "c", 2, 3, 1}}));
+  EXPECT_NE(dot.find("\"a\\\"b\" -> \"c\" [label=\"2:3 (1)\""), std::string::npos) << dot;
+}
+
+TEST(GraphFile, ReportsMissingFilesAndUnknownContent) {
+  try {
+    read_graph_file("/nonexistent/g.json");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::io);
+  }
+  const std::string path = test::temp_path("graph.txt");
+  std::ofstream(path) << "  {\"actors\":[{\"name\":\"A\"}]}";
+  EXPECT_EQ(read_graph_file(path).actor_count(), 1u);  // sniffed as JSON
+  std::ofstream(path) << "hello";
+  EXPECT_THROW(read_graph_file(path), Error);
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace sdf

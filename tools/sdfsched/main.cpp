@@ -1,0 +1,561 @@
+// sdfsched: SDF scheduling from the command line (DESIGN §9, docs/sdf.md).
+// Exit status: 0 ok; 1 inconsistent graph, deadlock or bad input; 2 usage; 3 an online outcome
+// other than `returns` (simulate: other than `returns` or `periodic`).
+#include <CLI/CLI.hpp>
+#include <charconv>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "sdf/checker.hpp"
+#include "sdf/claims.hpp"
+#include "sdf/graph.hpp"
+#include "sdf/io.hpp"
+#include "sdf/metrics.hpp"
+#include "sdf/online.hpp"
+#include "sdf/rates.hpp"
+#include "sdf/repetitions.hpp"
+#include "sdf/schedule.hpp"
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+using sdf::Error;
+
+void print_json(const Json& j) {
+  std::cout << j.dump() << "\n";
+}
+
+Json per_actor(const sdf::Graph& g, std::span<const uint64_t> v) {
+  Json j = Json::object();
+  for (sdf::ActorId a = 0; a < g.actor_count(); ++a) j[g.actor_name(a)] = v[a];
+  return j;
+}
+
+Json per_channel(const sdf::Graph& g, std::span<const uint64_t> v) {
+  Json j = Json::object();
+  for (sdf::ChannelId c = 0; c < g.channel_count(); ++c) j[g.channel(c).name] = v[c];
+  return j;
+}
+
+Json actor_list(const sdf::Graph& g, std::span<const sdf::ActorId> actors) {
+  Json j = Json::array();
+  for (sdf::ActorId a : actors) j.push_back(g.actor_name(a));
+  return j;
+}
+
+// Expanded firings, or null when there are more than `max` of them.
+Json firings(const sdf::Graph& g, std::span<const sdf::Run> runs, uint64_t max) {
+  if (sdf::total_firings(runs) > max) return nullptr;
+  Json j = Json::array();
+  for (const sdf::Run& r : runs)
+    for (uint64_t i = 0; i < r.count; ++i) j.push_back(g.actor_name(r.actor));
+  return j;
+}
+
+Json run_list(const sdf::Graph& g, std::span<const sdf::Run> runs) {
+  Json j = Json::array();
+  for (const sdf::Run& r : runs) j.push_back(Json::array({g.actor_name(r.actor), r.count}));
+  return j;
+}
+
+std::string describe_channel(const sdf::Graph& g, sdf::ChannelId c) {
+  const sdf::Channel& ch = g.channel(c);
+  std::string s = "'" + ch.name + "' (";
+  s += g.actor_name(ch.src);
+  s += " -> ";
+  s += g.actor_name(ch.dst);
+  s += ", prd " + std::to_string(ch.prd) + ", cns " + std::to_string(ch.cns) + ")";
+  return s;
+}
+
+// Repetitions or the inconsistency report (exit 1).
+struct Consistency {
+  sdf::Repetitions rep;
+  int status = 0;
+};
+
+Consistency consistency(const sdf::Graph& g, bool json) {
+  Consistency c{sdf::compute_repetitions(g), 0};
+  if (c.rep.consistent) return c;
+  const sdf::Channel& ch = g.channel(c.rep.channel);
+  if (json) {
+    print_json({{"consistent", false},
+                {"channel", ch.name},
+                {"src", g.actor_name(ch.src)},
+                {"dst", g.actor_name(ch.dst)},
+                {"prd", ch.prd},
+                {"cns", ch.cns},
+                {"q_src", c.rep.q_src},
+                {"q_dst", c.rep.q_dst}});
+  }
+  std::cerr << "sdfsched: inconsistent graph: the balance equation of channel "
+            << describe_channel(g, c.rep.channel) << " fails (" << c.rep.q_src << "*" << ch.prd
+            << " != " << c.rep.q_dst << "*" << ch.cns << ")\n";
+  c.status = 1;
+  return c;
+}
+
+int report_deadlock(const sdf::Graph& g, const sdf::StaticSchedule& s, bool json) {
+  if (json) {
+    Json cycle = Json::array();
+    for (sdf::ChannelId c : s.starved_cycle) cycle.push_back(g.channel(c).name);
+    print_json({{"deadlock", true},
+                {"stuck", actor_list(g, s.stuck)},
+                {"starved_cycle", cycle},
+                {"fired", per_actor(g, s.fired)}});
+  }
+  std::string stuck;
+  for (sdf::ActorId a : s.stuck) stuck += (stuck.empty() ? "" : ", ") + g.actor_name(a);
+  std::string cycle;
+  for (sdf::ChannelId c : s.starved_cycle) cycle += (cycle.empty() ? "" : ", ") + g.channel(c).name;
+  std::cerr << "sdfsched: deadlock: stuck actors: " << stuck << "; cycle lacking tokens: " << cycle
+            << "\n";
+  return 1;
+}
+
+sdf::Policy parse_policy(const std::string& p) {
+  if (p == "static") return sdf::Policy::static_order;
+  if (p == "online") return sdf::Policy::online;
+  return sdf::Policy::online_bounded;
+}
+
+struct RunFlags {
+  std::string firings = "floor";
+  uint64_t max_decisions = 100'000'000;
+  uint64_t growth_periods = 16;
+  uint64_t max_list = 1'000'000;
+  void add(CLI::App* cmd) {
+    cmd->add_option("--firings", firings,
+                    "firings per online decision: floor (⌊key⌋, the thesis) or one")
+        ->check(CLI::IsMember({"floor", "one"}));
+    cmd->add_option("--max-decisions", max_decisions,
+                    "online: stop with outcome `limit` after this many decisions")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--growth-periods", growth_periods,
+                    "online: a channel holding more than its delay plus this many periods' tokens "
+                    "is `unbounded`")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--max-list", max_list, "list firings/runs only up to this many");
+  }
+  sdf::OnlineRunOptions options(bool bounded) const {
+    sdf::OnlineRunOptions o;
+    o.scheduler.firings = firings == "one" ? sdf::FiringRule::one : sdf::FiringRule::floor_key;
+    o.scheduler.bounded = bounded;
+    o.max_decisions = max_decisions;
+    o.growth_periods = growth_periods;
+    o.max_listed_runs = max_list;
+    return o;
+  }
+};
+
+void print_text_metrics(const sdf::Graph& g, const sdf::Metrics& m) {
+  std::cout << "buffers:";
+  for (sdf::ChannelId c = 0; c < g.channel_count(); ++c)
+    std::cout << " " << g.channel(c).name << "=" << m.buffers[c];
+  std::cout << "\nfairness: max " << m.fairness.max << ", mean " << m.fairness.mean << " over "
+            << m.fairness.decisions << " decisions\n";
+}
+
+int cmd_repetitions(const std::string& path, bool json) {
+  const sdf::Graph g = sdf::read_graph_file(path);
+  const Consistency c = consistency(g, json);
+  if (c.status) return c.status;
+  if (json) {
+    print_json({{"consistent", true}, {"repetitions", per_actor(g, c.rep.q)}});
+  } else {
+    for (sdf::ActorId a = 0; a < g.actor_count(); ++a)
+      std::cout << g.actor_name(a) << " " << c.rep.q[a] << "\n";
+  }
+  return 0;
+}
+
+int cmd_schedule(const std::string& path, const std::string& policy_text, bool json,
+                 const RunFlags& flags) {
+  const sdf::Graph g = sdf::read_graph_file(path);
+  const Consistency c = consistency(g, json);
+  if (c.status) return c.status;
+  const std::vector<uint64_t>& q = c.rep.q;
+  const sdf::StaticSchedule st = sdf::static_schedule(g, q);
+  if (!st.complete) return report_deadlock(g, st, json);
+  const sdf::Policy policy = parse_policy(policy_text);
+  Json j;
+  j["policy"] = sdf::policy_name(policy);
+  if (policy == sdf::Policy::static_order) {
+    const sdf::CheckResult check = sdf::check_period(g, q, st.runs);
+    const sdf::Metrics m = sdf::measure(g, q, sdf::Eligibility::owing, st.runs);
+    if (!json) {
+      std::cout << "outcome: returns ("
+                << (check.valid ? "valid period" : "INVALID: " + check.reason)
+                << ")\nperiod: " << sdf::total_firings(st.runs) << " firings in " << st.runs.size()
+                << " decisions\nschedule: " << sdf::run_length_form(g, st.runs) << "\n";
+      print_text_metrics(g, m);
+      return check.valid ? 0 : 1;
+    }
+    j["outcome"] = "returns";
+    j["valid"] = check.valid;
+    j["repetitions"] = per_actor(g, q);
+    j["decisions"] = st.runs.size();
+    j["period_firings"] = sdf::total_firings(st.runs);
+    j["firings"] = firings(g, st.runs, flags.max_list);
+    j["runs"] = st.runs.size() <= flags.max_list ? run_list(g, st.runs) : Json(nullptr);
+    j["buffers"] = per_channel(g, m.buffers);
+    j["fairness"] = {{"max", m.fairness.max}, {"mean", m.fairness.mean}};
+    print_json(j);
+    return check.valid ? 0 : 1;
+  }
+  const sdf::OnlineRunOptions opt = flags.options(policy == sdf::Policy::online_bounded);
+  const sdf::OnlineRun run = sdf::run_online(g, q, opt);
+  const std::span<const sdf::Run> runs(run.runs);
+  bool valid = false;
+  std::string why;
+  if (run.outcome == sdf::Outcome::returns && run.runs_listed) {
+    const sdf::CheckResult check = sdf::check_period(g, q, runs);
+    valid = check.valid;
+    why = check.reason;
+  } else if (run.outcome == sdf::Outcome::returns) {
+    why = "period too long to list and check (raise --max-list)";
+  }
+  // A periodic cycle is checked too: from the state where it starts, it must be admissible
+  // and return to that state (a valid period from there, though not from the initial state).
+  Json cycle_check = nullptr;
+  if (run.outcome == sdf::Outcome::periodic && run.runs_listed) {
+    const sdf::CheckResult pre = sdf::check_admissible(g, runs.first(run.transient_decisions));
+    const sdf::CheckResult cyc =
+        sdf::check_period(g, q, runs.subspan(run.transient_decisions), pre.tokens);
+    cycle_check = cyc.valid ? Json("valid period from the cycle's start state") : Json(cyc.reason);
+  }
+  const int status = run.outcome == sdf::Outcome::returns ? (valid ? 0 : 1) : 3;
+  if (!json) {
+    std::cout << "outcome: " << sdf::outcome_name(run.outcome);
+    if (run.outcome == sdf::Outcome::returns)
+      std::cout << " (" << (valid ? "valid period" : "NOT CHECKED/INVALID: " + why) << ")";
+    if (run.channel)
+      std::cout << ": channel " << describe_channel(g, *run.channel) << " keeps growing";
+    std::cout << "\n";
+    if (run.outcome == sdf::Outcome::periodic) {
+      std::cout << "transient: " << run.transient_firings << " firings in "
+                << run.transient_decisions << " decisions\ncycle: " << run.cycle_firings
+                << " firings in " << run.cycle_decisions << " decisions";
+      if (!cycle_check.is_null()) std::cout << " (" << cycle_check.get<std::string>() << ")";
+      std::cout << "\n";
+      if (run.runs_listed) {
+        std::cout << "transient schedule: "
+                  << sdf::run_length_form(g, runs.first(run.transient_decisions))
+                  << "\ncycle schedule: "
+                  << sdf::run_length_form(g, runs.subspan(run.transient_decisions)) << "\n";
+      }
+    } else if (run.outcome == sdf::Outcome::returns) {
+      std::cout << "period: " << run.cycle_firings << " firings in " << run.cycle_decisions
+                << " decisions\n";
+      if (run.runs_listed) std::cout << "schedule: " << sdf::run_length_form(g, runs) << "\n";
+    } else {
+      std::cout << "stopped after " << run.decisions_explored << " decisions\n";
+    }
+    print_text_metrics(g, run.metrics);
+    return status;
+  }
+  j["outcome"] = sdf::outcome_name(run.outcome);
+  j["valid"] = valid;
+  j["repetitions"] = per_actor(g, q);
+  j["decisions"] = run.transient_decisions + run.cycle_decisions;
+  if (run.outcome == sdf::Outcome::returns) {
+    j["period_firings"] = run.cycle_firings;
+    j["firings"] = run.runs_listed ? firings(g, runs, flags.max_list) : Json(nullptr);
+    j["runs"] = run.runs_listed ? run_list(g, runs) : Json(nullptr);
+  } else if (run.outcome == sdf::Outcome::periodic) {
+    j["transient"] = run.runs_listed
+                         ? firings(g, runs.first(run.transient_decisions), flags.max_list)
+                         : Json(nullptr);
+    j["cycle"] = run.runs_listed ? firings(g, runs.subspan(run.transient_decisions), flags.max_list)
+                                 : Json(nullptr);
+    j["transient_firings"] = run.transient_firings;
+    j["cycle_firings"] = run.cycle_firings;
+    j["cycle_repetitions"] = per_actor(g, run.cycle_fired);
+    j["cycle_check"] = cycle_check;
+  } else {
+    if (run.channel) j["channel"] = g.channel(*run.channel).name;
+    j["decisions_explored"] = run.decisions_explored;
+  }
+  j["buffers"] = per_channel(g, run.metrics.buffers);
+  j["fairness"] = {{"max", run.metrics.fairness.max}, {"mean", run.metrics.fairness.mean}};
+  print_json(j);
+  return status;
+}
+
+sdf::RateChange parse_rate_change(const sdf::Graph& g, const std::string& spec) {
+  // ACTOR:PRD/CNS@FIRING, parsed from the right so actor names may contain ':'.
+  const auto at = spec.rfind('@');
+  const auto colon = spec.rfind(':', at);
+  const auto slash = spec.find('/', colon == std::string::npos ? 0 : colon);
+  if (at == std::string::npos || colon == std::string::npos || slash == std::string::npos ||
+      !(colon < slash && slash < at))
+    throw Error(Error::Kind::usage, "--rate-change '" + spec + "': expected ACTOR:PRD/CNS@FIRING");
+  auto number = [&](size_t from, size_t to, bool positive) {
+    const std::string s = spec.substr(from, to - from);
+    uint64_t v = 0;
+    const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (s.empty() || ec != std::errc() || p != s.data() + s.size() || (positive && v == 0))
+      throw Error(Error::Kind::usage, "--rate-change '" + spec + "': '" + s + "' is not a " +
+                                          (positive ? "positive" : "non-negative") + " integer");
+    return v;
+  };
+  sdf::RateChange rc;
+  const std::string actor = spec.substr(0, colon);
+  const auto a = g.find_actor(actor);
+  if (!a) throw Error(Error::Kind::input, "--rate-change: unknown actor '" + actor + "'");
+  rc.actor = *a;
+  rc.prd = number(colon + 1, slash, true);
+  rc.cns = number(slash + 1, at, true);
+  rc.at_firing = number(at + 1, spec.size(), false);
+  return rc;
+}
+
+int cmd_simulate(const std::string& path, const std::string& policy_text,
+                 const std::string& change_text, bool json, const RunFlags& flags) {
+  const sdf::Graph g = sdf::read_graph_file(path);
+  const Consistency c = consistency(g, json);
+  if (c.status) return c.status;
+  const sdf::StaticSchedule st = sdf::static_schedule(g, c.rep.q);
+  if (!st.complete) return report_deadlock(g, st, json);
+  const sdf::RateChange rc = parse_rate_change(g, change_text);
+  const sdf::Policy policy = parse_policy(policy_text);
+  const sdf::RateChangeResult r = sdf::simulate_rate_change(
+      g, policy, rc, flags.options(policy == sdf::Policy::online_bounded));
+  const sdf::Graph& g2 = r.changed;
+  int status = 0;
+  if (!r.after.consistent) {
+    status = 1;
+  } else if (r.outcome == sdf::Outcome::deadlock) {
+    status = 1;
+  } else if (r.outcome != sdf::Outcome::returns && r.outcome != sdf::Outcome::periodic) {
+    status = 3;
+  }
+  if (!json) {
+    std::cout << "policy: " << sdf::policy_name(policy) << "\nchange: " << g.actor_name(rc.actor)
+              << " to prd " << rc.prd << ", cns " << rc.cns << " after firing " << rc.at_firing
+              << "\n";
+    if (!r.after.consistent) {
+      std::cerr << "sdfsched: the changed graph is inconsistent: channel "
+                << describe_channel(g2, r.after.channel) << "\n";
+      return status;
+    }
+    std::cout << "outcome after the change: " << sdf::outcome_name(r.outcome) << "\n";
+    if (r.outcome == sdf::Outcome::deadlock) {
+      std::string stuck;
+      for (sdf::ActorId a : r.stuck) stuck += " " + g2.actor_name(a);
+      std::cout << "stuck:" << stuck << "\n";
+    }
+    if (r.channel) std::cout << "growing channel: " << describe_channel(g2, *r.channel) << "\n";
+    std::cout << "firings until periodic again: " << r.firings_until_periodic
+              << "\nperiod after: " << r.period_firings << " firings ("
+              << (r.period_valid ? "valid" : "not valid or not checked") << ")\nbuffers:";
+    for (sdf::ChannelId ch = 0; ch < g.channel_count(); ++ch) {
+      std::cout << " " << g.channel(ch).name << "=" << r.buffers_before[ch] << "->";
+      std::cout << (r.buffers_after.empty() ? std::string("?")
+                                            : std::to_string(r.buffers_after[ch]));
+    }
+    std::cout << "\n";
+    return status;
+  }
+  Json j;
+  j["policy"] = sdf::policy_name(policy);
+  j["change"] = {{"actor", g.actor_name(rc.actor)},
+                 {"prd", rc.prd},
+                 {"cns", rc.cns},
+                 {"at_firing", rc.at_firing}};
+  j["repetitions_before"] = per_actor(g, r.q_before);
+  j["tokens_at_change"] = per_channel(g, r.tokens_at_change);
+  j["buffers_before"] = per_channel(g, r.buffers_before);
+  j["consistent_after"] = r.after.consistent;
+  if (!r.after.consistent) {
+    j["channel"] = g2.channel(r.after.channel).name;
+    print_json(j);
+    std::cerr << "sdfsched: the changed graph is inconsistent: channel "
+              << describe_channel(g2, r.after.channel) << "\n";
+    return status;
+  }
+  j["repetitions_after"] = per_actor(g2, r.q_after);
+  j["outcome"] = sdf::outcome_name(r.outcome);
+  if (r.outcome == sdf::Outcome::deadlock) j["stuck"] = actor_list(g2, r.stuck);
+  if (r.channel) j["channel"] = g2.channel(*r.channel).name;
+  const bool periodic = r.outcome == sdf::Outcome::returns || r.outcome == sdf::Outcome::periodic;
+  j["firings_until_periodic"] = periodic ? Json(r.firings_until_periodic) : Json(nullptr);
+  j["period_firings"] = periodic ? Json(r.period_firings) : Json(nullptr);
+  j["period_valid"] = r.period_checked ? Json(r.period_valid) : Json(nullptr);
+  j["buffers_after"] = r.buffers_after.empty() ? Json(nullptr) : per_channel(g2, r.buffers_after);
+  print_json(j);
+  return status;
+}
+
+int cmd_convert(const std::string& path, const std::string& to, const std::string& out) {
+  const sdf::Graph g = sdf::read_graph_file(path);
+  const std::string text =
+      to == "json" ? sdf::write_json(g) : (to == "dot" ? sdf::write_dot(g) : sdf::write_sdf3(g));
+  if (out.empty() || out == "-") {
+    std::cout << text;
+    return 0;
+  }
+  // Written beside the target and renamed, so a failed run never leaves half a file.
+  const std::string tmp = out + ".partial";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    if (!f) throw Error(Error::Kind::io, out + ": cannot write");
+    f << text;
+    if (!f.flush()) throw Error(Error::Kind::io, out + ": write error");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, out, ec);
+  if (ec) throw Error(Error::Kind::io, out + ": " + ec.message());
+  return 0;
+}
+
+int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& save_dir) {
+  sdf::claims::Options opts;
+  opts.graphs_per_class = graphs;
+  opts.seed = seed;
+  const sdf::claims::Report r = sdf::claims::run(opts);
+  auto stats = [](const sdf::claims::PolicyStats& s) {
+    return Json{{"returns", s.returns},
+                {"periodic", s.periodic},
+                {"unbounded", s.unbounded},
+                {"unbounded_confirmed", s.unbounded_confirmed},
+                {"deadlock", s.deadlock},
+                {"limit", s.limit},
+                {"fairness_violations", s.fairness_violations},
+                {"fairness_violations_weak", s.fairness_violations_weak},
+                {"max_wait", s.max_wait},
+                {"checker_failures", s.checker_failures}};
+  };
+  if (!save_dir.empty()) {
+    std::filesystem::create_directories(save_dir);
+    for (const auto& [claim, g] : r.counterexamples) {
+      std::ofstream f(save_dir + "/" + claim + ".json");
+      f << sdf::write_json(g);
+    }
+  }
+  if (json) {
+    Json j = Json::array();
+    for (const auto& c : r.classes)
+      j.push_back({{"class", c.name},
+                   {"graphs", c.graphs},
+                   {"online", stats(c.online)},
+                   {"online_one", stats(c.online_one)},
+                   {"bounded", stats(c.bounded)},
+                   {"buffers_on_common_graphs",
+                    {{"graphs", c.common},
+                     {"static", c.buffers_static},
+                     {"online", c.buffers_online},
+                     {"bounded", c.buffers_bounded}}}});
+    Json ce = Json::object();
+    for (const auto& [claim, g] : r.counterexamples) ce[claim] = Json::parse(sdf::write_json(g));
+    print_json({{"classes", j}, {"counterexamples", ce}});
+    return 0;
+  }
+  auto outcomes = [](const sdf::claims::PolicyStats& s) {
+    std::string t = std::to_string(s.returns) + " / " + std::to_string(s.periodic) + " / " +
+                    std::to_string(s.unbounded);
+    if (s.unbounded) t += " (" + std::to_string(s.unbounded_confirmed) + " confirmed)";
+    if (s.limit + s.deadlock) t += " +" + std::to_string(s.limit + s.deadlock) + " other";
+    return t;
+  };
+  std::cout << "| class | graphs | online: returns / periodic / unbounded | max wait >= n-1 | "
+               "max wait > n-1 | max wait | --firings one: returns / periodic / unbounded | "
+               "bounded valid | checker failures | buffers static : online : bounded (graphs) |\n"
+               "|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& c : r.classes) {
+    const auto& o = c.online;
+    std::cout << "| " << c.name << " | " << c.graphs << " | " << outcomes(o) << " | "
+              << o.fairness_violations << " | " << o.fairness_violations_weak << " | " << o.max_wait
+              << " | " << outcomes(c.online_one) << " | " << c.bounded.returns << " | "
+              << o.checker_failures + c.online_one.checker_failures + c.bounded.checker_failures
+              << " | " << c.buffers_static << " : " << c.buffers_online << " : "
+              << c.buffers_bounded << " (" << c.common << ") |\n";
+  }
+  std::cout << "\nsmallest counter-examples:";
+  for (const auto& [claim, g] : r.counterexamples)
+    std::cout << " " << claim << " (" << g.actor_count() << " actors, " << g.channel_count()
+              << " channels)";
+  std::cout << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"sdfsched: Synchronous Data-Flow scheduling (see docs/sdf.md)", "sdfsched"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "sdfsched 0.1.0");
+  std::function<int()> action;
+  std::string graph, policy = "static", to, out, change;
+  bool json = false;
+  RunFlags flags;
+
+  auto* rep = app.add_subcommand("repetitions", "the repetitions vector (or the failing channel)");
+  rep->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
+  rep->add_flag("--json", json, "JSON output");
+  rep->callback([&] { action = [&] { return cmd_repetitions(graph, json); }; });
+
+  auto* sch = app.add_subcommand("schedule", "one period by the static or an online scheduler");
+  sch->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
+  sch->add_option("--policy", policy, "static, online or online-bounded")
+      ->check(CLI::IsMember({"static", "online", "online-bounded"}));
+  sch->add_flag("--json", json, "JSON output");
+  flags.add(sch);
+  sch->callback([&] { action = [&] { return cmd_schedule(graph, policy, json, flags); }; });
+
+  auto* sim = app.add_subcommand("simulate", "change an actor's rates mid-period and continue");
+  sim->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
+  sim->add_option("--rate-change", change, "ACTOR:PRD/CNS@FIRING")->required();
+  sim->add_option("--policy", policy, "static, online or online-bounded")
+      ->check(CLI::IsMember({"static", "online", "online-bounded"}));
+  sim->add_flag("--json", json, "JSON output");
+  flags.add(sim);
+  sim->callback([&] { action = [&] { return cmd_simulate(graph, policy, change, json, flags); }; });
+
+  auto* conv = app.add_subcommand("convert", "write the graph as SDF3 XML, JSON or DOT");
+  conv->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
+  conv->add_option("--to", to, "sdf3, json or dot")
+      ->required()
+      ->check(CLI::IsMember({"sdf3", "json", "dot"}));
+  conv->add_option("-o,--output", out, "output file (default: standard output)");
+  conv->callback([&] { action = [&] { return cmd_convert(graph, to, out); }; });
+
+  uint64_t graphs = 100, seed = 1;
+  std::string save;
+  auto* cl = app.add_subcommand("claims", "test the thesis's claims on random consistent graphs");
+  cl->add_option("--graphs", graphs, "graphs per class")->check(CLI::PositiveNumber);
+  cl->add_option("--seed", seed, "random seed");
+  cl->add_option("--save-counterexamples", save, "directory for the smallest counter-examples");
+  cl->add_flag("--json", json, "JSON output");
+  cl->callback([&] { action = [&] { return cmd_claims(graphs, seed, json, save); }; });
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string msg = e.what();
+    while (!msg.empty() && msg.back() == '\n') msg.pop_back();
+    std::cerr << "sdfsched: " << msg << " (see --help)\n";
+    return 2;
+  }
+  try {
+    return action ? action() : 0;
+  } catch (const Error& e) {
+    std::cerr << "sdfsched: " << e.what() << "\n";
+    return e.exit_code();
+  } catch (const std::bad_alloc&) {
+    std::cerr << "sdfsched: out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "sdfsched: internal error: " << e.what() << "\n";
+    return 1;
+  }
+}
