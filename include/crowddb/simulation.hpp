@@ -44,6 +44,27 @@ struct AccessChoice {
   std::string collisions = "auto";
 };
 
+// The path service (DESIGN.md §6): a Recast/Detour navigation mesh per agent-radius class, path
+// requests served asynchronously on a worker thread, and waypoint following in Q1. Off unless
+// the scenario has a "navigation" block (docs/scenario-format.md, "Navigation").
+struct NavigationParams {
+  bool enabled = false;
+  // A request dispatched at tick t is applied at the start of tick t + latency (>= 1), whatever
+  // the worker's timing: the tick waits for a due result that is not ready yet.
+  uint32_t latency = 2;
+  uint32_t budget = 64;        // path searches dispatched per tick (>= 1); the rest wait, FIFO
+  uint32_t replan_after = 40;  // re-plan after this many ticks without progress; 0: never
+  double radius_step = 0.25;   // radius classes: an agent's radius rounded up to a multiple (> 0)
+  double cell_size = 0;        // navmesh cell [length]; 0: auto (a quarter of the class radius,
+                               // at most 4096 cells along the world's longer side)
+  double clearance = 0;        // extra distance kept from obstacles beyond the class radius (>= 0)
+  uint32_t tile_size = 256;    // navmesh tile side [cells] (16..4096)
+  bool skip_visible = true;    // skip a waypoint when the one after it is in sight (Detour raycast)
+  // Ticks between an agent's line-of-sight checks (>= 1), staggered by agent id: each check is a
+  // mesh query, about a microsecond, and at 10^4 agents they add up.
+  uint32_t sight_interval = 1;
+};
+
 struct SimConfig {
   double dt = 1;  // [ticks per step] (> 0)
   uint64_t seed = 1;
@@ -60,6 +81,7 @@ struct SimConfig {
   uint32_t nudge_after = 2;
   double waypoint_radius =
       0;  // advance to the next waypoint within this distance; 0: the agent's radius
+  NavigationParams navigation;
   // Throws Error(input) naming the field when a value is out of range.
   void validate() const;
 };

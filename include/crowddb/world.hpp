@@ -97,6 +97,12 @@ struct AgentTable {
   // cold: bookkeeping
   std::vector<uint64_t> id;              // AgentId::value()
   std::vector<std::vector<Vec2>> route;  // intermediate waypoints still ahead of the goal
+  // path service (DESIGN.md §6); only read when navigation is on
+  static constexpr uint32_t kNoPath = std::numeric_limits<uint32_t>::max();
+  std::vector<uint32_t> path_goal;    // goal row the route is planned for; kNoPath: none
+  std::vector<uint64_t> path_ticket;  // the path request in flight (0: none)
+  std::vector<double> path_best;      // closest distance to the current waypoint since it was set
+  std::vector<uint32_t> path_stall;   // ticks without progress towards the current waypoint
 
   std::size_t size() const { return x.size(); }
   bool empty() const { return x.empty(); }
@@ -141,7 +147,8 @@ class World {
   AgentTable& agents_for_tick() { return agents_; }
   // Removes a row by swapping the last row into it; the handle of the removed agent dies.
   void remove_row(std::size_t row);
-  // The current waypoint of a row: next route point, else its goal.
+  // The current waypoint of a row: next route point, else its goal. Restarts the row's progress
+  // watch (path_best, path_stall) because the waypoint may have changed.
   void refresh_target(std::size_t row);
 
   static void validate_spec(const AgentSpec& spec, std::size_t goal_count);

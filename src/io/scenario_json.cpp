@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "crowddb/scenario.hpp"
+#include "io/walkable_wkt.hpp"
 #include "util/rng.hpp"
 #include "world/geometry.hpp"
 
@@ -268,9 +269,35 @@ class DiscGrid {
 struct Loader {
   Scenario& sc;
   std::map<std::string, uint32_t> goal_rows;
-  std::vector<AgentSpec> agents;          // in insertion order
-  std::vector<std::vector<Vec2>> routes;  // per agent (via points)
-  std::unique_ptr<DiscGrid> placed;       // every agent placed so far
+  std::vector<AgentSpec> agents;               // in insertion order
+  std::vector<std::vector<Vec2>> routes;       // per agent (via points)
+  std::unique_ptr<DiscGrid> placed;            // every agent placed so far
+  const io::WalkableArea* walkable = nullptr;  // the "walkable" WKT, if given
+  std::size_t walkable_pieces = 0;             // polygons [0, walkable_pieces) are its blocked area
+  std::vector<std::size_t> circle_src,
+      polygon_src;  // /obstacles index of each circle / polygon row
+
+  // Why a point is not walkable (a goal or an agent's centre), or empty when it is: outside the
+  // walkable WKT area or the walled bounds, or strictly inside an obstacle.
+  std::string outside_walkable(double x, double y) const {
+    if (walkable && !walkable->covers(x, y)) return "lies outside the walkable area";
+    const Bounds& b = sc.world.bounds();
+    if (sc.config.walls && (x < b.xmin || x > b.xmax || y < b.ymin || y > b.ymax))
+      return "lies outside the bounds (the walls)";
+    for (std::size_t k = 0; k < sc.world.circles().size(); ++k) {
+      const CircleObstacle& c = sc.world.circles()[k];
+      if (std::hypot(c.x - x, c.y - y) < c.radius)
+        return "lies inside obstacle /obstacles/" + std::to_string(circle_src[k]) +
+               ", outside the walkable area";
+    }
+    for (std::size_t k = walkable_pieces; k < sc.world.polygons().size(); ++k) {
+      const auto& ring = sc.world.polygons()[k].vertices;
+      if (point_in_polygon(ring, x, y) && dist2_to_boundary(ring, x, y) > 0)
+        return "lies inside obstacle /obstacles/" +
+               std::to_string(polygon_src[k - walkable_pieces]) + ", outside the walkable area";
+    }
+    return {};
+  }
 
   bool blocked_by_obstacle(double x, double y, double r, double gap) const {
     for (const CircleObstacle& c : sc.world.circles())
@@ -284,6 +311,40 @@ struct Loader {
     auto it = goal_rows.find(name);
     if (it == goal_rows.end()) n.fail(key, "unknown goal '" + name + "'");
     return it->second;
+  }
+
+  // Explicit goals (rows 0.. of the goals table) must be walkable.
+  void check_goals(Node& root) {
+    if (!root.has("goals")) return;
+    const json& arr = root.raw("goals");
+    for (std::size_t i = 0; i < arr.size(); ++i) {
+      const Goal& goal = sc.world.goals()[i];
+      if (const std::string why = outside_walkable(goal.x, goal.y); !why.empty())
+        root.element(arr, "goals", i)
+            .fail("", "goal '" + goal.name + "' at (" + Node::fmt(goal.x) + ", " +
+                          Node::fmt(goal.y) + ") " + why);
+    }
+  }
+
+  // "walkable": a WKT POLYGON / MULTIPOLYGON (or {"wkt": ..., "charge": ...}). Its complement
+  // within the bounds becomes polygon obstacles, so every query sees it as solid.
+  void read_walkable(Node& root, const io::WalkableArea& area, double charge) {
+    std::vector<std::vector<Vec2>> pieces;
+    try {
+      pieces = area.blocked_pieces(sc.world.bounds());
+    } catch (const Error& e) {
+      root.fail("walkable", e.what());
+    }
+    for (const auto& ring : pieces) {
+      try {
+        sc.world.add_obstacle(PolygonObstacle{ring, charge});
+      } catch (const InvalidRow& e) {
+        root.fail("walkable",
+                  std::string("could not turn the blocked area into obstacles: ") + e.what());
+      }
+    }
+    walkable = &area;
+    walkable_pieces = sc.world.polygons().size();
   }
 
   void read_goals(Node& root) {
@@ -318,12 +379,14 @@ struct Loader {
           c.charge = o.number("charge", 1.0);
           o.finish();
           sc.world.add_obstacle(c);
+          circle_src.push_back(i);
         } else {
           PolygonObstacle p;
           p.vertices = o.points("vertices");
           p.charge = o.number("charge", 1.0);
           o.finish();
           sc.world.add_obstacle(std::move(p));
+          polygon_src.push_back(i);
         }
       } catch (const InvalidRow& e) {
         o.fail(e.field(), e.what());
@@ -331,12 +394,16 @@ struct Loader {
     }
   }
 
-  void add_agent(Node& n, AgentSpec spec, std::vector<Vec2> via) {
+  // `label`: which agent of a group (empty for an explicit agent).
+  void add_agent(Node& n, AgentSpec spec, std::vector<Vec2> via, const std::string& label = {}) {
     try {
       World::validate_spec(spec, sc.world.goals().size());
     } catch (const InvalidRow& e) {
       n.fail(e.field(), e.what());
     }
+    if (const std::string why = outside_walkable(spec.x, spec.y); !why.empty())
+      n.fail("", (label.empty() ? "agent" : label) + " at (" + Node::fmt(spec.x) + ", " +
+                     Node::fmt(spec.y) + ") " + why);
     agents.push_back(spec);
     routes.push_back(std::move(via));
     placed->add(spec.x, spec.y, spec.radius);
@@ -496,6 +563,9 @@ struct Loader {
           goal.y = 2 * centre.y - s.y;
           goal.arrival_radius = antipodal_radius;
           goal.charge = antipodal_charge;
+          if (const std::string why = outside_walkable(goal.x, goal.y); !why.empty())
+            g.fail("goals", "the antipodal goal of agent " + std::to_string(i + 1) + " at (" +
+                                Node::fmt(goal.x) + ", " + Node::fmt(goal.y) + ") " + why);
           s.goal = sc.world.add_goal(goal);
         } else if (assign == "single" || assign == "round_robin") {
           s.goal = pool[i % pool.size()];
@@ -522,7 +592,7 @@ struct Loader {
         }
         s.vx = v * std::cos(angle);
         s.vy = v * std::sin(angle);
-        add_agent(g, s, via);
+        add_agent(g, s, via, "agent " + std::to_string(i + 1) + " of " + std::to_string(count));
       }
     }
   }
@@ -612,9 +682,40 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
   Node root(doc, "", &source);
   sc.name = root.string("name", std::string());
   root.string("description", std::string());
+  // The walkable area (WKT), if any: it may stand in for the bounds.
+  std::optional<io::WalkableArea> walkable;
+  double walkable_charge = 1;
+  if (root.has("walkable")) {
+    std::string wkt;
+    std::string key = "walkable";
+    if (root.raw("walkable").is_object()) {
+      Node w = root.child("walkable");
+      wkt = w.string("wkt");
+      walkable_charge = w.number("charge", 1.0);
+      w.finish();
+      key = "walkable/wkt";
+    } else {
+      wkt = root.string("walkable");
+    }
+    try {
+      walkable = io::WalkableArea::parse(wkt);
+    } catch (const Error& e) {
+      root.fail(key, e.what());
+    }
+  }
   try {
-    const auto b = root.numbers("bounds", 4);
-    sc.world.set_bounds({b[0], b[1], b[2], b[3]});
+    if (root.has("bounds")) {
+      const auto b = root.numbers("bounds", 4);
+      sc.world.set_bounds({b[0], b[1], b[2], b[3]});
+      if (walkable && !walkable->within(sc.world.bounds()))
+        root.fail("walkable", "the walkable area extends outside the bounds");
+    } else if (walkable) {
+      sc.world.set_bounds(walkable->envelope());
+    } else {
+      root.fail(
+          "bounds",
+          "missing ([xmin, ymin, xmax, ymax] is required unless a \"walkable\" area is given)");
+    }
   } catch (const InvalidRow& e) {
     root.fail("bounds", e.what());
   }
@@ -634,6 +735,26 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
   cfg.waypoint_radius = root.non_negative("waypoint_radius", 0.0);
   cfg.nudge_after = static_cast<uint32_t>(root.integer("nudge_after", cfg.nudge_after, 1u << 30));
   read_steering(root, cfg);
+  if (root.has("navigation")) {
+    Node n = root.child("navigation");
+    NavigationParams& nav = cfg.navigation;
+    nav.enabled = n.boolean("enabled", true);
+    nav.latency = static_cast<uint32_t>(n.integer("latency", nav.latency, 100000));
+    if (nav.latency < 1) n.fail("latency", "must be >= 1");
+    nav.budget = static_cast<uint32_t>(n.integer("budget", nav.budget, 1u << 30));
+    if (nav.budget < 1) n.fail("budget", "must be >= 1");
+    nav.replan_after = static_cast<uint32_t>(n.integer("replan_after", nav.replan_after, 1u << 30));
+    nav.radius_step = n.positive("radius_step", nav.radius_step);
+    nav.cell_size = n.non_negative("cell_size", nav.cell_size);
+    nav.clearance = n.non_negative("clearance", nav.clearance);
+    nav.tile_size = static_cast<uint32_t>(n.integer("tile_size", nav.tile_size, 4096));
+    if (nav.tile_size < 16) n.fail("tile_size", "must be in 16..4096");
+    nav.skip_visible = n.boolean("skip_visible", nav.skip_visible);
+    nav.sight_interval =
+        static_cast<uint32_t>(n.integer("sight_interval", nav.sight_interval, 1u << 20));
+    if (nav.sight_interval < 1) n.fail("sight_interval", "must be >= 1");
+    n.finish();
+  }
   if (root.has("access")) {
     Node a = root.child("access");
     cfg.access.ftc = a.string("ftc", "auto");
@@ -652,9 +773,11 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
     o.finish();
   }
 
-  Loader loader{sc, {}, {}, {}, nullptr};
+  Loader loader{sc, {}, {}, {}, nullptr, nullptr, 0, {}, {}};
+  if (walkable) loader.read_walkable(root, *walkable, walkable_charge);
   loader.read_goals(root);
   loader.read_obstacles(root);
+  loader.check_goals(root);
   double rmax = 1;
   loader.placed = std::make_unique<DiscGrid>(2 * rmax);
   // Cell size for the placement grid: twice the largest radius any agent may have.
@@ -672,6 +795,11 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
   root.finish();
   if (!loader.agents.empty() && sc.world.goals().empty())
     root.fail("goals", "agents need at least one goal");
+  if (cfg.navigation.enabled)
+    for (const auto& via : loader.routes)
+      if (!via.empty())
+        root.fail("navigation",
+                  "cannot be combined with \"via\" waypoints: the path service plans every route");
   loader.warn_overlaps();
 
   try {

@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include "path/navigation.hpp"
 #include "sim/stages.hpp"
 #include "util/rng.hpp"
 #include "util/stopwatch.hpp"
@@ -48,6 +49,15 @@ void SimConfig::validate() const {
   require(threads >= 1 && threads <= 256, "threads", "must be in 1..256");
   require(std::isfinite(waypoint_radius) && waypoint_radius >= 0, "waypoint_radius",
           "must be >= 0");
+  const NavigationParams& n = navigation;
+  require(n.latency >= 1, "navigation/latency", "must be >= 1");
+  require(n.budget >= 1, "navigation/budget", "must be >= 1");
+  require(std::isfinite(n.radius_step) && n.radius_step > 0, "navigation/radius_step",
+          "must be > 0");
+  require(std::isfinite(n.cell_size) && n.cell_size >= 0, "navigation/cell_size", "must be >= 0");
+  require(std::isfinite(n.clearance) && n.clearance >= 0, "navigation/clearance", "must be >= 0");
+  require(n.tile_size >= 16 && n.tile_size <= 4096, "navigation/tile_size", "must be in 16..4096");
+  require(n.sight_interval >= 1, "navigation/sight_interval", "must be >= 1");
 }
 
 // Per-operator EXPLAIN ANALYZE counters.
@@ -80,8 +90,20 @@ struct Simulation::Engine {
   std::map<std::string, std::unique_ptr<FtcPath>> ftc_paths;
   std::map<std::string, std::unique_ptr<FieldPath>> field_paths;
   std::map<std::string, std::unique_ptr<CollisionPath>> collision_paths;
+  std::unique_ptr<path::Navigation> nav;  // null: navigation off
   // EXPLAIN ANALYZE, in operator order.
-  enum Op { kApply, kAttraction, kInner, kOuter, kIntegrate, kBackoff, kCommit, kOpCount };
+  enum Op {
+    kApply,
+    kPathApply,
+    kAttraction,
+    kInner,
+    kOuter,
+    kIntegrate,
+    kBackoff,
+    kCommit,
+    kPathRequest,
+    kOpCount
+  };
   OperatorStats ops[kOpCount];
   std::map<std::string, uint64_t> method_ticks;  // "field=naive" -> ticks it was chosen
   // The agents are known to overlap nowhere at the start of the next tick: the last tick ended
@@ -165,6 +187,11 @@ Simulation::Simulation(World world, SimConfig config)
   world_.apply_pending();
   engine_->refresh_scene(world_, config_);
   engine_->plan(world_, config_, true);  // reject unknown or unsupported methods now, not mid-run
+  if (config_.navigation.enabled) {
+    // Meshes for the radius classes present, and the first requests (tick 0: due at `latency`).
+    engine_->nav = std::make_unique<path::Navigation>(world_, config_, engine_->ex);
+    engine_->nav->request_paths(world_, 0);
+  }
   last_.agents = world_.agents().size();
   last_.state_hash = sim::state_hash(world_.agents(), 0);
 }
@@ -196,6 +223,11 @@ const TickMetrics& Simulation::step() {
   timed(Engine::kApply, world_.pending_changes(), [&] { applied = world_.apply_pending(); });
   if (applied)
     e.start_clean = false;  // an insert may overlap (erases and re-targets cannot, but are rare)
+  if (e.nav) {
+    std::size_t routes = 0;
+    timed(Engine::kPathApply, 0, [&] { routes = e.nav->apply_results(world_, m.tick); });
+    e.ops[Engine::kPathApply].rows += routes;
+  }
   e.refresh_scene(world_, cfg);
   const TickPlan plan = e.plan(world_, cfg);
   AgentTable& t = world_.agents_for_tick();
@@ -209,7 +241,7 @@ const TickMetrics& Simulation::step() {
     for (std::size_t i = 0; i < n; ++i)
       m.nudged += t.state[i] != AgentState::arrived && t.frozen_ticks[i] >= cfg.nudge_after;
   timed(Engine::kAttraction, n,
-        [&] { sim::attraction(t, world_.goals(), cfg, m.tick, e.fx, e.ex); });
+        [&] { sim::attraction(t, world_.goals(), cfg, m.tick, e.fx, e.ex, e.nav.get()); });
   if (plan.field) {
     ++e.method_ticks["field=" + plan.field->info.name];
     timed(Engine::kInner, n, [&] {
@@ -267,6 +299,12 @@ const TickMetrics& Simulation::step() {
         t.frozen_ticks[i] = 0;
       }
       if (t.frozen_ticks[i] >= cfg.gridlock_ticks) ++m.gridlocked;
+      if (e.fx.skip[i] && !t.route[i].empty()) {  // Q1 saw the waypoint after the current one
+        t.route[i].erase(
+            t.route[i].begin(),
+            t.route[i].begin() + std::min<std::size_t>(e.fx.skip[i], t.route[i].size()));
+        world_.refresh_target(i);
+      }
       const double reach = cfg.waypoint_radius > 0 ? cfg.waypoint_radius : t.radius[i];
       while (!t.route[i].empty() &&
              std::hypot(t.route[i].front().x - t.x[i], t.route[i].front().y - t.y[i]) <= reach) {
@@ -285,6 +323,7 @@ const TickMetrics& Simulation::step() {
           const auto pick = static_cast<uint32_t>(rng.below(others));
           t.goal[i] = pick >= t.goal[i] ? pick + 1 : pick;
           t.route[i].clear();
+          t.path_goal[i] = AgentTable::kNoPath;  // a new goal: re-plan
           world_.refresh_target(i);
         } else {
           t.state[i] = AgentState::arrived;
@@ -295,6 +334,12 @@ const TickMetrics& Simulation::step() {
     // Descending rows: each swap-remove moves in a row that is staying (or already handled).
     for (auto it = leaving.rbegin(); it != leaving.rend(); ++it) world_.remove_row(*it);
   });
+  // 7. path requests: progress watch, new requests, dispatch to the worker within the budget
+  if (e.nav) {
+    std::size_t made = 0;
+    timed(Engine::kPathRequest, 0, [&] { made = e.nav->request_paths(world_, m.tick); });
+    e.ops[Engine::kPathRequest].rows += made;
+  }
   m.agents = world_.agents().size();
   m.state_hash = sim::state_hash(world_.agents(), m.tick);
   arrived_total_ += m.arrived;
@@ -314,10 +359,30 @@ std::string Simulation::explain() const {
      << " goals; threads=" << config_.threads << "\n";
   os << "  0 apply_batch        buffered inserts, deletes, re-targets (" << world_.pending_changes()
      << " pending)\n";
+  const NavigationParams& nv = config_.navigation;
+  if (e.nav) {
+    os << "  P path results       apply the routes due this tick (requested " << nv.latency
+       << " tick" << (nv.latency == 1 ? "" : "s") << " earlier; waits only for a late worker)\n"
+       << "       path service: Recast/Detour navigation mesh per radius class (radius rounded up "
+          "to a multiple of "
+       << num(nv.radius_step) << "), findPath + findStraightPath on a worker thread\n"
+       << e.nav->describe_meshes();
+  }
   os << "  1 Q1 attraction      per row: v_pref towards waypoint, (v_pref - v)/tau, tau="
      << num(s.tau);
   if (config_.nudge_after) os << "; sidestep after " << config_.nudge_after << " frozen ticks";
   os << "\n";
+  if (e.nav)
+    os << "       waypoints: advance when within "
+       << (config_.waypoint_radius > 0 ? num(config_.waypoint_radius)
+                                       : std::string("the agent's radius"))
+       << (nv.skip_visible ? " or when the next one is in sight (Detour raycast" +
+                                 (nv.sight_interval > 1
+                                      ? ", every " + std::to_string(nv.sight_interval) + " ticks"
+                                      : std::string()) +
+                                 ")"
+                           : std::string())
+       << "\n";
   if (p.field)
     os << "  2 Q2 inner avoidance potential field " << kernel_name(s.potential.kernel) << "-"
        << metric_name(s.potential.metric) << " A=" << num(s.potential.A)
@@ -356,18 +421,24 @@ std::string Simulation::explain() const {
          : config_.arrival == ArrivalPolicy::idle ? "idle"
                                                   : "retarget")
      << "), state hash\n";
+  if (e.nav)
+    os << "  7 path requests      new goal or no progress for " << nv.replan_after
+       << " ticks -> FIFO queue; <= " << nv.budget << " dispatched per tick, due " << nv.latency
+       << " tick" << (nv.latency == 1 ? "" : "s") << " later\n";
   return os.str();
 }
 
 std::string Simulation::explain_analyze() const {
   const Engine& e = *engine_;
   static const char* names[] = {"apply_batch",
+                                "path results",
                                 "Q1 attraction",
                                 "Q2 inner avoidance",
                                 "Q3 outer avoidance",
                                 "combine+integrate",
                                 config_.backoff ? "backoff" : "overlap count",
-                                "commit"};
+                                "commit",
+                                "path requests"};
   std::ostringstream os;
   char line[256];
   std::snprintf(line, sizeof line, "EXPLAIN ANALYZE  %llu ticks\n",
@@ -402,7 +473,30 @@ std::string Simulation::explain_analyze() const {
     }
   }
   std::snprintf(line, sizeof line, "  %-20s %8s %12s %12.3f\n", "total", "", "", total * 1e3);
-  os << line << "  access paths used (ticks):";
+  os << line;
+  if (e.nav) {
+    const path::NavigationStats ns = e.nav->stats();
+    const path::PathService::Stats ss = e.nav->service_stats();
+    std::snprintf(
+        line, sizeof line,
+        "  path service: %llu requests (%llu re-plans), %llu dispatched, %llu superseded, %llu "
+        "queued; "
+        "%llu routes applied (%llu partial, %llu without a path)\n",
+        static_cast<unsigned long long>(ns.requests), static_cast<unsigned long long>(ns.replans),
+        static_cast<unsigned long long>(ns.dispatched),
+        static_cast<unsigned long long>(ns.superseded), static_cast<unsigned long long>(ns.queued),
+        static_cast<unsigned long long>(ns.applied), static_cast<unsigned long long>(ns.partial),
+        static_cast<unsigned long long>(ns.failed));
+    os << line;
+    std::snprintf(line, sizeof line,
+                  "  worker: %llu searches in %.3f ms; the tick waited for it %llu times, %.3f ms; "
+                  "meshes built in %.3f ms\n",
+                  static_cast<unsigned long long>(ss.jobs_done), ss.work_seconds * 1e3,
+                  static_cast<unsigned long long>(ss.waits), ss.wait_seconds * 1e3,
+                  e.nav->mesh_build_seconds() * 1e3);
+    os << line;
+  }
+  os << "  access paths used (ticks):";
   for (const auto& [k, v] : e.method_ticks) os << " " << k << " x" << v;
   os << "\n";
   return os.str();

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "path/navigation.hpp"
 #include "util/hash.hpp"
 #include "util/rng.hpp"
 #include "world/geometry.hpp"
@@ -21,6 +22,7 @@ bool idle(const AgentTable& t, std::size_t i) {
 
 void Effects::reset(std::size_t n) {
   for (auto* c : {&attract_x, &attract_y, &apf_x, &apf_y, &ftc_x, &ftc_y}) c->assign(n, 0.0);
+  skip.assign(n, 0);
 }
 
 void NextState::resize(std::size_t n) {
@@ -32,12 +34,25 @@ void NextState::resize(std::size_t n) {
 }
 
 void attraction(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,
-                uint64_t tick, Effects& fx, Executor& ex) {
+                uint64_t tick, Effects& fx, Executor& ex, const path::Navigation* nav) {
   const double tau = cfg.steering.tau, dt = cfg.dt;
+  const bool sight = nav && cfg.navigation.skip_visible;
   ex.for_each_chunk(t.size(), kGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       if (idle(t, i)) continue;
-      const double dx = t.target_x[i] - t.x[i], dy = t.target_y[i] - t.y[i];
+      double tx = t.target_x[i], ty = t.target_y[i];
+      if (sight && !t.route[i].empty() && (tick + t.id[i]) % cfg.navigation.sight_interval == 0) {
+        // The waypoint after the current one: the next route point, or the goal.
+        const auto& route = t.route[i];
+        const Goal& g = goals[t.goal[i]];
+        const Vec2 next = route.size() > 1 ? route[1] : Vec2{g.x, g.y};
+        if (nav->visible(t.radius[i], {t.x[i], t.y[i]}, next)) {
+          fx.skip[i] = 1;
+          tx = next.x;
+          ty = next.y;
+        }
+      }
+      const double dx = tx - t.x[i], dy = ty - t.y[i];
       const double dist = std::sqrt(dx * dx + dy * dy);
       double px = 0, py = 0;  // preferred velocity
       if (dist > 0) {

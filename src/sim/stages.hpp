@@ -11,6 +11,10 @@
 #include "plan/access_path.hpp"
 #include "util/executor.hpp"
 
+namespace crowddb::path {
+class Navigation;
+}
+
 namespace crowddb::sim {
 
 // The effects table: at most one row per agent, one column pair per steering query.
@@ -19,6 +23,7 @@ struct Effects {
   std::vector<double> attract_x, attract_y;  // Q1 [length/tick^2]
   std::vector<double> apf_x, apf_y;          // Q2
   std::vector<double> ftc_x, ftc_y;          // Q3
+  std::vector<uint8_t> skip;  // Q1: route waypoints passed by line of sight (popped at commit)
   void reset(std::size_t n);
 };
 
@@ -32,8 +37,12 @@ struct NextState {
 // Q1: preferred velocity towards the current waypoint, (v_pref - v) / tau, times the goal's
 // charge; turned aside for agents frozen cfg.nudge_after ticks in a row. Idle (arrived) agents
 // get no effect. `tick` is the tick being computed (it seeds the sidesteps).
+// Waypoint following: with `nav` (and cfg.navigation.skip_visible, every sight_interval ticks
+// per agent), an agent whose waypoint after the current one is in sight (a disc of its radius class
+// can walk straight there) steers at that one instead and records the skipped waypoint in fx.skip;
+// commit pops it.
 void attraction(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,
-                uint64_t tick, Effects& fx, Executor& ex);
+                uint64_t tick, Effects& fx, Executor& ex, const path::Navigation* nav = nullptr);
 
 // Q2: -w_apf * gradient of the potential field at each agent.
 void inner_avoidance(const FieldColumns& field, const SimConfig& cfg, Effects& fx, Executor& ex);

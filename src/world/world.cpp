@@ -166,6 +166,10 @@ void World::push_row(AgentId id, const AgentSpec& s) {
   t.frozen_ticks.push_back(0);
   t.id.push_back(id.value());
   t.route.emplace_back();
+  t.path_goal.push_back(AgentTable::kNoPath);
+  t.path_ticket.push_back(0);
+  t.path_best.push_back(INFINITY);
+  t.path_stall.push_back(0);
   slots_[id.index].row = static_cast<uint32_t>(t.size() - 1);
   slots_[id.index].pending = false;
 }
@@ -193,6 +197,10 @@ void World::remove_row(std::size_t row) {
   move_last(t.frozen_ticks);
   move_last(t.id);
   move_last(t.route);
+  move_last(t.path_goal);
+  move_last(t.path_ticket);
+  move_last(t.path_best);
+  move_last(t.path_stall);
   if (row != last) slots_[AgentId::from_value(t.id[row]).index].row = static_cast<uint32_t>(row);
   Slot& s = slots_[dead.index];
   s.row = kNoRow;
@@ -212,6 +220,8 @@ void World::refresh_target(std::size_t row) {
     t.target_x[row] = g.x;
     t.target_y[row] = g.y;
   }
+  t.path_best[row] = INFINITY;
+  t.path_stall[row] = 0;
 }
 
 std::size_t World::apply_pending() {
@@ -238,6 +248,7 @@ std::size_t World::apply_pending() {
         if (!row) break;  // erased earlier in this batch
         agents_.goal[*row] = c.goal;
         agents_.route[*row].clear();
+        agents_.path_goal[*row] = AgentTable::kNoPath;  // re-plan, even for the same goal
         if (agents_.state[*row] == AgentState::arrived) agents_.state[*row] = AgentState::active;
         refresh_target(*row);
         break;
@@ -268,6 +279,10 @@ void World::validate() const {
   same(t.frozen_ticks.size(), "frozen_ticks");
   same(t.id.size(), "id");
   same(t.route.size(), "route");
+  same(t.path_goal.size(), "path_goal");
+  same(t.path_ticket.size(), "path_ticket");
+  same(t.path_best.size(), "path_best");
+  same(t.path_stall.size(), "path_stall");
   std::size_t live = 0;
   for (std::size_t r = 0; r < n; ++r) {
     const AgentId id = AgentId::from_value(t.id[r]);

@@ -28,7 +28,7 @@ struct RunOptions {
   int64_t ticks = -1;
   std::string out, format;
   bool no_output = false;
-  bool explain = false, analyze = false, quiet = false, no_backoff = false;
+  bool explain = false, analyze = false, quiet = false, no_backoff = false, no_navigation = false;
   int threads = 0;
   int64_t every = 0;
   int64_t nudge_after = -1;
@@ -52,6 +52,7 @@ void apply_overrides(Scenario& sc, const RunOptions& o) {
   if (o.threads > 0) sc.config.threads = o.threads;
   if (o.no_backoff) sc.config.backoff = false;
   if (o.nudge_after >= 0) sc.config.nudge_after = static_cast<uint32_t>(o.nudge_after);
+  if (o.no_navigation) sc.config.navigation.enabled = false;
   if (!o.ftc.empty()) sc.config.access.ftc = o.ftc;
   if (!o.field.empty()) sc.config.access.field = o.field;
   if (!o.collisions.empty()) sc.config.access.collisions = o.collisions;
@@ -208,6 +209,8 @@ void add_run_command(CLI::App& app, Action& action) {
                   "sidestep agents frozen this many ticks in a row; 0 = never (overrides the "
                   "file's nudge_after)")
       ->check(CLI::Range(int64_t{0}, int64_t{1} << 30));
+  sub->add_flag("--no-navigation", o.no_navigation,
+                "switch the path service off (agents steer straight at their goals)");
   sub->add_option("--ftc", o.ftc, "first-to-collide access path (auto, naive, ...)");
   sub->add_option("--field", o.field, "potential-field access path (auto, naive, ...)");
   sub->add_option("--collisions", o.collisions, "collision-set access path (auto, naive, ...)");

@@ -1,0 +1,90 @@
+// The tick's side of path planning (DESIGN.md §3 "path requests", §6): one navigation mesh per
+// agent-radius class, the path service, and the operators the tick runs around the steering
+// queries:
+//
+//   start of tick t:  apply_results  — results due at t become the agents' routes
+//   Q1 attraction:    visible        — skip a waypoint when the one after it is in sight
+//   after commit:     request_paths  — progress watch, new requests, dispatch within the budget
+//
+// Requests: an agent asks for a path when its route was not planned for its current goal (a
+// new agent, a changed goal) or when it made no progress towards its current waypoint for
+// `replan_after` ticks. Requests wait in FIFO order; each tick at most `budget` of them are
+// dispatched to the worker, with the agent's position at that moment, due `latency` ticks later.
+// A newer request for the same agent supersedes an older one (tickets). Everything here is
+// decided from simulation state only, so runs are bit-identical whatever the worker's timing.
+//
+// Thread-safety: apply_results/request_paths on the tick's thread; visible() from any thread
+// during the steering queries (the meshes are read-only then).
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "crowddb/simulation.hpp"
+#include "path/navmesh.hpp"
+#include "path/path_service.hpp"
+#include "util/executor.hpp"
+
+namespace crowddb::path {
+
+struct NavigationStats {
+  uint64_t requests = 0;    // requests made (new goals + re-plans)
+  uint64_t replans = 0;     // of which for lack of progress
+  uint64_t dispatched = 0;  // sent to the worker
+  uint64_t superseded =
+      0;                 // dropped before dispatch or on return: a newer request or the agent left
+  uint64_t applied = 0;  // results that became routes
+  uint64_t failed = 0;   // of which with no path (the agent keeps steering straight)
+  uint64_t partial = 0;  // of which towards an unreachable goal
+  uint64_t queued = 0;   // requests waiting for dispatch now
+  uint64_t sight_checks = 0;  // line-of-sight checks when applying results
+};
+
+class Navigation {
+ public:
+  // Builds the meshes for the radius classes present; `threads` parallelise the tile builds.
+  Navigation(const World& world, const SimConfig& cfg, Executor& ex);
+  ~Navigation();
+
+  // Applies the results due at `tick` (waits for the worker if one is late). Returns the
+  // number of routes set.
+  std::size_t apply_results(World& world, uint64_t tick);
+  // After the commit of `tick`: progress watch, requests, dispatch. Returns requests made.
+  std::size_t request_paths(World& world, uint64_t tick);
+
+  // Line of sight for a disc of `radius` (its class mesh). False when the class has no mesh yet.
+  bool visible(double radius, Vec2 from, Vec2 to) const;
+
+  double class_radius(double radius) const;
+  const NavigationParams& params() const { return params_; }
+  NavigationStats stats() const;
+  PathService::Stats service_stats() const { return service_->stats(); }
+  // One line per mesh: class radius, cell, tiles, polygons, build time.
+  std::string describe_meshes() const;
+  std::size_t mesh_count() const { return meshes_.size(); }
+  double mesh_build_seconds() const;
+
+ private:
+  int class_of(double radius) const;
+  const NavMesh& mesh_for(double radius);  // builds on first use
+  // Drops the leading waypoints the agent has already passed (the one after is in sight).
+  void trim_passed(World& world, std::size_t row);
+
+  struct Queued {
+    uint64_t ticket;
+    uint64_t agent;
+  };
+  NavigationParams params_;
+  NavGeometry geometry_;
+  Executor& ex_;
+  std::map<int, std::unique_ptr<NavMesh>> meshes_;  // by class (radius = class * radius_step)
+  std::deque<Queued> queue_;
+  uint64_t next_ticket_ = 0;
+  NavigationStats stats_;
+  std::unique_ptr<PathService> service_;  // declared last: stopped before the meshes go
+};
+
+}  // namespace crowddb::path

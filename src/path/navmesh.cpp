@@ -1,0 +1,467 @@
+#include "path/navmesh.hpp"
+
+#include <DetourNavMesh.h>
+#include <DetourNavMeshBuilder.h>
+#include <DetourNavMeshQuery.h>
+#include <Recast.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdarg>
+#include <cstring>
+#include <string>
+
+#include "util/executor.hpp"
+#include "util/stopwatch.hpp"
+#include "world/geometry.hpp"
+
+namespace crowddb::path {
+namespace {
+
+// Heights: the floor is the plane y = 0; nothing stands above it, so any positive clearance
+// and climb will do. One cell of height is enough.
+constexpr float kCellHeight = 0.5f;
+constexpr float kFloorBelow = -1.0f, kFloorAbove = 2.0f;
+constexpr int kWalkableHeight = 2, kWalkableClimb = 1;  // [cells]
+// Extra erosion beyond ceil(radius / cell): the chamfer distance transform and contour
+// simplification may each bring the mesh edge up to about a cell closer to an obstacle.
+constexpr int kErodeMargin = 1;
+constexpr unsigned short kWalkFlag = 1;
+constexpr int kMaxPathPolys = 4096;
+constexpr int kMaxStraight = 512;
+
+// Recast reports failures through its context's log; keep the first error for the message.
+class Context : public rcContext {
+ public:
+  Context() : rcContext(true) {}
+  std::string error;
+
+ protected:
+  void doLog(const rcLogCategory category, const char* msg, const int len) override {
+    if (category == RC_LOG_ERROR && error.empty())
+      error.assign(msg, static_cast<std::size_t>(std::max(0, len)));
+  }
+};
+
+template <class T, void (*Free)(T*)>
+struct RcPtr {
+  T* p;
+  explicit RcPtr(T* q) : p(q) {}
+  ~RcPtr() { Free(p); }
+  RcPtr(const RcPtr&) = delete;
+  RcPtr& operator=(const RcPtr&) = delete;
+  T* operator->() const { return p; }
+  T& operator*() const { return *p; }
+};
+using Heightfield = RcPtr<rcHeightfield, rcFreeHeightField>;
+using CompactHeightfield = RcPtr<rcCompactHeightfield, rcFreeCompactHeightfield>;
+using ContourSet = RcPtr<rcContourSet, rcFreeContourSet>;
+using PolyMesh = RcPtr<rcPolyMesh, rcFreePolyMesh>;
+
+struct Box {
+  double xmin, ymin, xmax, ymax;
+  bool overlaps(const Box& o) const {
+    return xmin <= o.xmax && o.xmin <= xmax && ymin <= o.ymax && o.ymin <= ymax;
+  }
+};
+
+// Obstacles in mesh-local coordinates with their bounding boxes.
+struct LocalObstacles {
+  std::vector<CircleObstacle> circles;
+  std::vector<std::vector<Vec2>> rings;
+  std::vector<Box> circle_boxes, ring_boxes;
+};
+
+LocalObstacles localise(const NavGeometry& g, Vec2 o) {
+  LocalObstacles L;
+  for (const CircleObstacle& c : g.circles) {
+    CircleObstacle l = c;
+    l.x -= o.x;
+    l.y -= o.y;
+    L.circles.push_back(l);
+    L.circle_boxes.push_back({l.x - l.radius, l.y - l.radius, l.x + l.radius, l.y + l.radius});
+  }
+  for (const PolygonObstacle& p : g.polygons) {
+    std::vector<Vec2> ring;
+    Box b{INFINITY, INFINITY, -INFINITY, -INFINITY};
+    for (const Vec2& v : p.vertices) {
+      ring.push_back({v.x - o.x, v.y - o.y});
+      b = {std::min(b.xmin, ring.back().x), std::min(b.ymin, ring.back().y),
+           std::max(b.xmax, ring.back().x), std::max(b.ymax, ring.back().y)};
+    }
+    L.rings.push_back(std::move(ring));
+    L.ring_boxes.push_back(b);
+  }
+  return L;
+}
+
+// Marks every compact-heightfield cell whose square touches an obstacle as unwalkable: a cell
+// centre within half a cell diagonal of the obstacle. Exact geometry (no triangulation), so
+// non-convex polygons need no decomposition.
+void mark_obstacles(rcCompactHeightfield& chf, const LocalObstacles& L) {
+  const double cs = chf.cs, half_diag = cs * std::sqrt(0.5);
+  const double bx = chf.bmin[0], bz = chf.bmin[2];
+  auto block = [&](const Box& box, auto&& touches) {
+    const int x0 = std::max(0, static_cast<int>(std::floor((box.xmin - half_diag - bx) / cs)));
+    const int x1 =
+        std::min(chf.width - 1, static_cast<int>(std::floor((box.xmax + half_diag - bx) / cs)));
+    const int z0 = std::max(0, static_cast<int>(std::floor((box.ymin - half_diag - bz) / cs)));
+    const int z1 =
+        std::min(chf.height - 1, static_cast<int>(std::floor((box.ymax + half_diag - bz) / cs)));
+    for (int z = z0; z <= z1; ++z)
+      for (int x = x0; x <= x1; ++x) {
+        const rcCompactCell& c = chf.cells[x + z * chf.width];
+        if (c.count == 0) continue;
+        if (!touches(bx + (x + 0.5) * cs, bz + (z + 0.5) * cs)) continue;
+        for (unsigned i = c.index, e = c.index + c.count; i < e; ++i) chf.areas[i] = RC_NULL_AREA;
+      }
+  };
+  const Box tile{bx, bz, bx + chf.width * cs, bz + chf.height * cs};
+  for (std::size_t k = 0; k < L.circles.size(); ++k) {
+    if (!L.circle_boxes[k].overlaps({tile.xmin - half_diag, tile.ymin - half_diag,
+                                     tile.xmax + half_diag, tile.ymax + half_diag}))
+      continue;
+    const CircleObstacle& c = L.circles[k];
+    block(L.circle_boxes[k], [&](double x, double y) {
+      return discs_overlap(x - c.x, y - c.y, c.radius + half_diag);
+    });
+  }
+  for (std::size_t k = 0; k < L.rings.size(); ++k) {
+    if (!L.ring_boxes[k].overlaps({tile.xmin - half_diag, tile.ymin - half_diag,
+                                   tile.xmax + half_diag, tile.ymax + half_diag}))
+      continue;
+    const auto& ring = L.rings[k];
+    block(L.ring_boxes[k],
+          [&](double x, double y) { return disc_overlaps_polygon(ring, x, y, half_diag); });
+  }
+}
+
+struct TileData {
+  unsigned char* data = nullptr;
+  int size = 0;
+  int polygons = 0, vertices = 0;
+  std::string error;
+};
+
+struct TileJob {
+  int tx, ty;
+  int tile_cells, border, erode;
+  float cs;
+  float world_w, world_h;  // local floor extent
+  const LocalObstacles* obstacles;
+};
+
+TileData build_tile(const TileJob& j) {
+  TileData out;
+  Context ctx;
+  auto fail = [&](const char* step) {
+    out.error = std::string(step) + (ctx.error.empty() ? "" : ": " + ctx.error);
+    return out;
+  };
+  const float tile_w = static_cast<float>(j.tile_cells) * j.cs;
+  const float pad = static_cast<float>(j.border) * j.cs;
+  float bmin[3] = {static_cast<float>(j.tx) * tile_w - pad, kFloorBelow,
+                   static_cast<float>(j.ty) * tile_w - pad};
+  float bmax[3] = {static_cast<float>(j.tx + 1) * tile_w + pad, kFloorAbove,
+                   static_cast<float>(j.ty + 1) * tile_w + pad};
+  const int side = j.tile_cells + 2 * j.border;
+
+  Heightfield hf(rcAllocHeightfield());
+  if (!hf.p || !rcCreateHeightfield(&ctx, *hf, side, side, bmin, bmax, j.cs, kCellHeight))
+    return fail("heightfield");
+  // The floor: the bounds rectangle as two triangles (Recast clips them to the tile).
+  const float verts[12] = {0, 0, 0, j.world_w, 0, 0, j.world_w, 0, j.world_h, 0, 0, j.world_h};
+  const int tris[6] = {0, 2, 1, 0, 3, 2};
+  const unsigned char areas[2] = {RC_WALKABLE_AREA, RC_WALKABLE_AREA};
+  if (!rcRasterizeTriangles(&ctx, verts, 4, tris, areas, 2, *hf, kWalkableClimb))
+    return fail("rasterize");
+
+  CompactHeightfield chf(rcAllocCompactHeightfield());
+  if (!chf.p || !rcBuildCompactHeightfield(&ctx, kWalkableHeight, kWalkableClimb, *hf, *chf))
+    return fail("compact heightfield");
+  mark_obstacles(*chf, *j.obstacles);
+  if (!rcErodeWalkableArea(&ctx, j.erode, *chf)) return fail("erode");
+  // Watershed partitioning: the most regular polygons, hence the best A* corridors. Layer and
+  // monotone partitioning built the 1 km benchmark world twice as fast but, in a single large
+  // tile, led A* into a corridor 10% longer (tests/path/navmesh_test.cpp, TilesJoinSeamlessly).
+  if (!rcBuildDistanceField(&ctx, *chf)) return fail("distance field");
+  if (!rcBuildRegions(&ctx, *chf, j.border, /*minRegionArea=*/8, /*mergeRegionArea=*/64))
+    return fail("regions");
+  ContourSet cset(rcAllocContourSet());
+  if (!cset.p || !rcBuildContours(&ctx, *chf, /*maxError=*/1.0f, /*maxEdgeLen=*/64, *cset))
+    return fail("contours");
+  if (cset->nconts == 0) return out;  // nothing walkable in this tile
+  PolyMesh pmesh(rcAllocPolyMesh());
+  if (!pmesh.p || !rcBuildPolyMesh(&ctx, *cset, DT_VERTS_PER_POLYGON, *pmesh))
+    return fail("polygon mesh");
+  if (pmesh->npolys == 0) return out;
+  for (int i = 0; i < pmesh->npolys; ++i)
+    pmesh->flags[i] = pmesh->areas[i] == RC_WALKABLE_AREA ? kWalkFlag : 0;
+
+  dtNavMeshCreateParams p;
+  std::memset(&p, 0, sizeof p);
+  p.verts = pmesh->verts;
+  p.vertCount = pmesh->nverts;
+  p.polys = pmesh->polys;
+  p.polyAreas = pmesh->areas;
+  p.polyFlags = pmesh->flags;
+  p.polyCount = pmesh->npolys;
+  p.nvp = pmesh->nvp;
+  p.walkableHeight = kWalkableHeight * kCellHeight;
+  p.walkableRadius = static_cast<float>(j.erode) * j.cs;
+  p.walkableClimb = kWalkableClimb * kCellHeight;
+  p.tileX = j.tx;
+  p.tileY = j.ty;
+  p.tileLayer = 0;
+  rcVcopy(p.bmin, pmesh->bmin);
+  rcVcopy(p.bmax, pmesh->bmax);
+  p.cs = j.cs;
+  p.ch = kCellHeight;
+  p.buildBvTree = true;
+  if (!dtCreateNavMeshData(&p, &out.data, &out.size)) return fail("Detour tile data");
+  out.polygons = pmesh->npolys;
+  out.vertices = pmesh->nverts;
+  return out;
+}
+
+int bits_for(int n) {
+  int b = 0;
+  while ((1 << b) < n) ++b;
+  return b;
+}
+
+[[noreturn]] void bad(const std::string& what) {
+  throw Error(Error::Kind::input, "navigation mesh: " + what);
+}
+
+}  // namespace
+
+const char* to_string(PathStatus s) {
+  switch (s) {
+    case PathStatus::ok:
+      return "ok";
+    case PathStatus::partial:
+      return "partial";
+    case PathStatus::no_start:
+      return "no_start";
+    case PathStatus::no_goal:
+    default:
+      return "no_goal";
+  }
+}
+
+NavGeometry NavGeometry::of(const World& w) {
+  return {w.bounds(),
+          {w.circles().begin(), w.circles().end()},
+          {w.polygons().begin(), w.polygons().end()}};
+}
+
+NavMesh::~NavMesh() {
+  dtFreeNavMeshQuery(shared_query_);
+  dtFreeNavMesh(mesh_);
+}
+
+double NavMesh::clearance() const {
+  return stats_.erode_cells * params_.cell_size;
+}
+
+std::unique_ptr<NavMesh> NavMesh::build(const NavGeometry& g, const NavMeshParams& params,
+                                        Executor* ex) {
+  Stopwatch clock;
+  const double cs = params.cell_size;
+  if (!(std::isfinite(params.radius) && params.radius > 0)) bad("radius must be > 0");
+  if (!(std::isfinite(cs) && cs > 0)) bad("cell_size must be > 0");
+  if (params.tile_size < 16 || params.tile_size > 4096) bad("tile_size must be in 16..4096");
+  const Bounds& b = g.bounds;
+  if (!(b.width() > 0 && b.height() > 0)) bad("the bounds are empty");
+  const int erode = static_cast<int>(std::ceil(params.radius / cs)) + kErodeMargin;
+  if (erode > 120)
+    bad("cell_size " + std::to_string(cs) + " is too small for radius " +
+        std::to_string(params.radius) + " (erosion over 120 cells): raise cell_size");
+  const double gw = std::ceil(b.width() / cs), gh = std::ceil(b.height() / cs);
+  const double tx = std::ceil(gw / params.tile_size), ty = std::ceil(gh / params.tile_size);
+  if (tx * ty > 16384)
+    bad("the world needs " + std::to_string(static_cast<long long>(tx * ty)) +
+        " tiles at cell_size " + std::to_string(cs) +
+        " (at most 16384): raise cell_size or tile_size");
+  const int tiles_x = static_cast<int>(tx), tiles_y = static_cast<int>(ty);
+
+  auto nm = std::unique_ptr<NavMesh>(new NavMesh());
+  nm->params_ = params;
+  nm->origin_ = {b.xmin, b.ymin};
+  nm->stats_.erode_cells = erode;
+  nm->stats_.tiles_x = tiles_x;
+  nm->stats_.tiles_y = tiles_y;
+  nm->reach_ = static_cast<float>((erode + 1) * cs);
+  const LocalObstacles local = localise(g, nm->origin_);
+
+  nm->mesh_ = dtAllocNavMesh();
+  if (!nm->mesh_) bad("out of memory");
+  dtNavMeshParams np;
+  std::memset(&np, 0, sizeof np);
+  np.tileWidth = np.tileHeight = static_cast<float>(params.tile_size * cs);
+  np.maxTiles = tiles_x * tiles_y;
+  const int tile_bits = std::max(1, bits_for(np.maxTiles));
+  np.maxPolys = 1 << (22 - tile_bits);
+  if (dtStatusFailed(nm->mesh_->init(&np))) bad("Detour could not initialise the mesh");
+
+  const int n = tiles_x * tiles_y;
+  std::vector<TileData> tiles(static_cast<std::size_t>(n));
+  auto build_range = [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t k = lo; k < hi; ++k) {
+      TileJob j{static_cast<int>(k) % tiles_x,
+                static_cast<int>(k) / tiles_x,
+                params.tile_size,
+                erode + 3,
+                erode,
+                static_cast<float>(cs),
+                static_cast<float>(b.width()),
+                static_cast<float>(b.height()),
+                &local};
+      tiles[k] = build_tile(j);
+    }
+  };
+  if (ex)
+    ex->for_each_chunk(tiles.size(), 1, build_range);
+  else
+    build_range(0, tiles.size());
+  // Tiles join the mesh in index order, so the mesh (and its polygon refs) never depends on
+  // which thread built which tile.
+  std::string first_error;
+  for (std::size_t k = 0; k < tiles.size(); ++k) {
+    TileData& t = tiles[k];
+    if (!t.error.empty() && first_error.empty())
+      first_error = "tile " + std::to_string(k) + ": " + t.error;
+    if (!t.data) continue;
+    if (!first_error.empty() || t.polygons > np.maxPolys ||
+        dtStatusFailed(nm->mesh_->addTile(t.data, t.size, DT_TILE_FREE_DATA, 0, nullptr))) {
+      if (first_error.empty()) first_error = "tile " + std::to_string(k) + " could not be added";
+      dtFree(t.data);
+      continue;
+    }
+    ++nm->stats_.tiles;
+    nm->stats_.polygons += t.polygons;
+    nm->stats_.vertices += t.vertices;
+  }
+  if (!first_error.empty()) bad("Recast failed: " + first_error);
+  nm->shared_query_ = dtAllocNavMeshQuery();
+  if (!nm->shared_query_ || dtStatusFailed(nm->shared_query_->init(nm->mesh_, 16)))
+    bad("out of memory");
+  nm->filter_ = std::make_unique<dtQueryFilter>();
+  nm->stats_.seconds = clock.seconds();
+  return nm;
+}
+
+unsigned int NavMesh::locate(const dtNavMeshQuery& q, const float* p, float* snapped) const {
+  for (float reach = reach_; reach <= reach_ * 16; reach *= 4) {
+    const float ext[3] = {reach, 2 * kFloorAbove, reach};
+    dtPolyRef ref = 0;
+    if (dtStatusSucceed(q.findNearestPoly(p, ext, filter_.get(), &ref, snapped)) && ref) return ref;
+  }
+  return 0;
+}
+
+std::optional<Vec2> NavMesh::nearest(Vec2 p, double reach) const {
+  const float c[3] = {lx(p.x), 0, ly(p.y)};
+  const float ext[3] = {static_cast<float>(reach), 2 * kFloorAbove, static_cast<float>(reach)};
+  dtPolyRef ref = 0;
+  float s[3];
+  if (dtStatusFailed(shared_query_->findNearestPoly(c, ext, filter_.get(), &ref, s)) || !ref)
+    return std::nullopt;
+  return world(s);
+}
+
+bool NavMesh::visible(Vec2 from, Vec2 to) const {
+  const float a[3] = {lx(from.x), 0, ly(from.y)};
+  float s[3];
+  const dtPolyRef ref = locate(*shared_query_, a, s);
+  if (!ref) return false;
+  const float e[3] = {lx(to.x), s[1], ly(to.y)};
+  dtRaycastHit hit;
+  std::memset(&hit, 0, sizeof hit);
+  if (dtStatusFailed(shared_query_->raycast(ref, s, e, filter_.get(), 0, &hit))) return false;
+  return hit.t == FLT_MAX;
+}
+
+std::vector<std::vector<Vec2>> NavMesh::polygons() const {
+  std::vector<std::vector<Vec2>> out;
+  const dtNavMesh& m = *mesh_;
+  for (int i = 0; i < m.getMaxTiles(); ++i) {
+    const dtMeshTile* t = m.getTile(i);
+    if (!t || !t->header) continue;
+    for (int k = 0; k < t->header->polyCount; ++k) {
+      const dtPoly& p = t->polys[k];
+      if (p.getType() != DT_POLYTYPE_GROUND) continue;
+      std::vector<Vec2> ring;
+      for (int v = 0; v < p.vertCount; ++v) ring.push_back(world(&t->verts[p.verts[v] * 3]));
+      out.push_back(std::move(ring));
+    }
+  }
+  return out;
+}
+
+PathFinder::PathFinder(const NavMesh& mesh, int max_nodes) : mesh_(mesh), polys_(kMaxPathPolys) {
+  query_ = dtAllocNavMeshQuery();
+  if (!query_ || dtStatusFailed(query_->init(mesh.mesh_, std::clamp(max_nodes, 64, 65535))))
+    throw Error(Error::Kind::input, "navigation mesh: out of memory for the path search");
+}
+
+PathFinder::~PathFinder() {
+  dtFreeNavMeshQuery(query_);
+}
+
+PathResult PathFinder::find(Vec2 start, Vec2 goal) {
+  PathResult r;
+  const dtQueryFilter* filter = mesh_.filter_.get();
+  const float sp[3] = {mesh_.lx(start.x), 0, mesh_.ly(start.y)};
+  const float gp[3] = {mesh_.lx(goal.x), 0, mesh_.ly(goal.y)};
+  float s[3], g[3];
+  const dtPolyRef sref = mesh_.locate(*query_, sp, s);
+  if (!sref) {
+    r.status = PathStatus::no_start;
+    return r;
+  }
+  const dtPolyRef gref = mesh_.locate(*query_, gp, g);
+  if (!gref) {
+    r.status = PathStatus::no_goal;
+    return r;
+  }
+  int npolys = 0;
+  const dtStatus st =
+      query_->findPath(sref, gref, s, g, filter, polys_.data(), &npolys, kMaxPathPolys);
+  if (dtStatusFailed(st) || npolys == 0) {
+    r.status = PathStatus::no_goal;
+    return r;
+  }
+  r.status = PathStatus::ok;
+  float end[3] = {g[0], g[1], g[2]};
+  if (polys_[static_cast<std::size_t>(npolys - 1)] != gref ||
+      dtStatusDetail(st, DT_PARTIAL_RESULT)) {
+    r.status = PathStatus::partial;
+    query_->closestPointOnPoly(polys_[static_cast<std::size_t>(npolys - 1)], g, end, nullptr);
+  }
+  float straight[kMaxStraight * 3];
+  unsigned char flags[kMaxStraight];
+  dtPolyRef refs[kMaxStraight];
+  int ns = 0;
+  if (dtStatusFailed(query_->findStraightPath(s, end, polys_.data(), npolys, straight, flags, refs,
+                                              &ns, kMaxStraight)) ||
+      ns == 0) {
+    r.status = PathStatus::no_goal;
+    return r;
+  }
+  if (!(flags[ns - 1] & DT_STRAIGHTPATH_END)) r.status = PathStatus::partial;  // truncated
+  r.start = mesh_.world(&straight[0]);
+  r.end = mesh_.world(&straight[(ns - 1) * 3]);
+  Vec2 prev = r.start;
+  for (int i = 1; i < ns; ++i) {
+    const Vec2 p = mesh_.world(&straight[i * 3]);
+    r.length += std::hypot(p.x - prev.x, p.y - prev.y);
+    prev = p;
+    if (i < ns - 1) r.corners.push_back(p);
+  }
+  return r;
+}
+
+}  // namespace crowddb::path

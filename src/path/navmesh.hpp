@@ -1,0 +1,141 @@
+// A navigation mesh for one agent-radius class (DESIGN.md §6), built with Recast and queried
+// with Detour.
+//
+// Build: the world's bounds are the floor; every cell whose square touches an obstacle (circle
+// or polygon, exact geometry) is marked unwalkable; Recast erodes the walkable cells by the
+// class radius plus a safety margin (its distance transform overestimates diagonal distances
+// by up to 12% and contour simplification moves edges by up to a cell), then partitions the
+// rest into regions, contours and convex polygons. Large worlds are split into square tiles
+// built independently (in parallel when an executor is given) and joined by Detour.
+//
+// Queries: PathFinder (A* over polygons, then the funnel algorithm for the corner points) and
+// NavMesh::visible (Detour raycast: is the straight segment inside the eroded walkable area,
+// i.e. can a disc of the class radius walk it?).
+//
+// Coordinates: Recast works in floats; the mesh stores positions relative to the bounds'
+// minimum corner so that large world coordinates keep their precision.
+//
+// Thread-safety: a built NavMesh is immutable. visible() and nearest() may be called from many
+// threads at once (they use only Detour's read-only queries). A PathFinder owns Detour's search
+// state: one per thread.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "crowddb/world.hpp"
+
+class dtNavMesh;
+class dtNavMeshQuery;
+class dtQueryFilter;
+
+namespace crowddb {
+class Executor;
+}
+
+namespace crowddb::path {
+
+// The static geometry a mesh is built from: the floor (bounds) and the obstacles.
+struct NavGeometry {
+  Bounds bounds;
+  std::vector<CircleObstacle> circles;
+  std::vector<PolygonObstacle> polygons;  // simple, counter-clockwise (as World stores them)
+
+  static NavGeometry of(const World& world);
+};
+
+struct NavMeshParams {
+  double radius = 1;            // clearance kept from obstacles and bounds [length] (> 0)
+  double cell_size = 0.25;      // Recast cell side [length] (> 0)
+  int tile_size = 256;          // cells per tile side (16..4096)
+  double max_edge_error = 1.0;  // contour simplification tolerance [cells]
+};
+
+struct NavMeshStats {
+  int tiles = 0;  // tiles holding polygons
+  int tiles_x = 0, tiles_y = 0;
+  int polygons = 0;
+  int vertices = 0;
+  int erode_cells = 0;  // erosion radius [cells]
+  double seconds = 0;   // build wall time
+};
+
+enum class PathStatus : uint8_t {
+  ok,        // a path to the goal
+  partial,   // the goal is unreachable (or the search ran out of nodes): a path towards it
+  no_start,  // no mesh polygon near the start
+  no_goal,   // no mesh polygon near the goal
+};
+
+const char* to_string(PathStatus s);
+
+struct PathResult {
+  PathStatus status = PathStatus::no_start;
+  std::vector<Vec2> corners;  // intermediate corners, start and end excluded
+  Vec2 start{}, end{};        // the start and end points on the mesh
+  double length = 0;          // start -> corners -> end
+};
+
+class NavMesh {
+ public:
+  // Throws Error(input) when the parameters are out of range or Recast fails (out of memory, a
+  // world too large for the cell size).
+  static std::unique_ptr<NavMesh> build(const NavGeometry& geometry, const NavMeshParams& params,
+                                        Executor* ex = nullptr);
+  ~NavMesh();
+  NavMesh(const NavMesh&) = delete;
+  NavMesh& operator=(const NavMesh&) = delete;
+
+  const NavMeshParams& params() const { return params_; }
+  const NavMeshStats& stats() const { return stats_; }
+  // The eroded clearance [length]: erode_cells * cell_size.
+  double clearance() const;
+
+  // The closest point on the mesh within `reach` of p (searching a square of half-side reach).
+  std::optional<Vec2> nearest(Vec2 p, double reach) const;
+  // Line of sight for a disc of the mesh's radius: from the mesh point nearest `from` to `to`
+  // without leaving the walkable polygons. False when `from` is off the mesh.
+  bool visible(Vec2 from, Vec2 to) const;
+
+  // Every mesh polygon as world-coordinate vertices (for tests and debugging).
+  std::vector<std::vector<Vec2>> polygons() const;
+
+ private:
+  friend class PathFinder;
+  NavMesh() = default;
+  float lx(double x) const { return static_cast<float>(x - origin_.x); }
+  float ly(double y) const { return static_cast<float>(y - origin_.y); }
+  Vec2 world(const float* p) const { return {origin_.x + p[0], origin_.y + p[2]}; }
+  // Nearest polygon to a local point, searching squares of growing half-side.
+  unsigned int locate(const dtNavMeshQuery& q, const float* p, float* snapped) const;
+
+  NavMeshParams params_;
+  NavMeshStats stats_;
+  Vec2 origin_{};
+  float reach_ = 1;  // first search half-side for locate()
+  dtNavMesh* mesh_ = nullptr;
+  dtNavMeshQuery* shared_query_ = nullptr;  // read-only queries only
+  std::unique_ptr<dtQueryFilter> filter_;
+};
+
+// A path search context over one mesh (Detour's node pool and open list). One per thread.
+class PathFinder {
+ public:
+  explicit PathFinder(const NavMesh& mesh, int max_nodes = 16384);
+  ~PathFinder();
+  PathFinder(const PathFinder&) = delete;
+  PathFinder& operator=(const PathFinder&) = delete;
+
+  // The shortest corridor of polygons from start to goal, and its corner points (Detour's
+  // findPath + findStraightPath). Deterministic: the same mesh and inputs give the same result.
+  PathResult find(Vec2 start, Vec2 goal);
+
+ private:
+  const NavMesh& mesh_;
+  dtNavMeshQuery* query_ = nullptr;
+  std::vector<unsigned int> polys_;
+};
+
+}  // namespace crowddb::path

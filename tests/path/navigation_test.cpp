@@ -1,0 +1,190 @@
+// The path service inside the tick (src/path/navigation.cpp through Simulation): results applied
+// exactly `latency` ticks after dispatch, straight steering until then, the per-tick budget,
+// re-planning on a new goal and on lack of progress, and waypoint skipping by line of sight.
+#include "path/navigation.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "crowddb/simulation.hpp"
+
+namespace crowddb {
+namespace {
+
+// A 60 x 40 room split by a wall with a gap at its north end; goal 0 behind the wall, goal 1
+// on the start side.
+World walled_world() {
+  World w(Bounds{0, 0, 60, 40});
+  w.add_goal({"east", 50, 10, 1, 2});
+  w.add_goal({"west", 5, 35, 1, 2});
+  w.add_obstacle(PolygonObstacle{{{29, 0}, {31, 0}, {31, 30}, {29, 30}}, 0.1});
+  return w;
+}
+
+SimConfig nav_config(uint32_t latency, uint32_t budget = 64) {
+  SimConfig c;
+  c.navigation.enabled = true;
+  c.navigation.latency = latency;
+  c.navigation.budget = budget;
+  c.steering.w_apf = 1;
+  c.steering.w_ftc = 2;
+  return c;
+}
+
+AgentSpec walker(double x, double y, uint32_t goal = 0) {
+  AgentSpec s;
+  s.x = x;
+  s.y = y;
+  s.radius = 0.8;
+  s.max_speed = 1;
+  s.max_accel = 0.5;
+  s.goal = goal;
+  return s;
+}
+
+TEST(Navigation, ResultIsAppliedExactlyLatencyTicksAfterTheRequest) {
+  for (uint32_t latency : {1u, 3u, 7u}) {
+    World w = walled_world();
+    w.insert(walker(10, 10));
+    Simulation sim(std::move(w), nav_config(latency));
+    const AgentTable& t = sim.world().agents();
+    EXPECT_NE(t.path_ticket[0], 0u);  // requested at tick 0
+    for (uint32_t k = 1; k < latency; ++k) {
+      sim.step();
+      EXPECT_NE(t.path_ticket[0], 0u) << "latency " << latency << " tick " << k;
+      EXPECT_TRUE(t.route[0].empty());
+      EXPECT_EQ(t.target_x[0], 50);  // steering straight at the goal meanwhile
+      EXPECT_EQ(t.target_y[0], 10);
+    }
+    sim.step();  // tick `latency`: the result is applied before the steering queries
+    EXPECT_EQ(t.path_ticket[0], 0u) << "latency " << latency;
+    EXPECT_GT(t.target_y[0], 30) << "the waypoint at the wall's open end";
+  }
+}
+
+TEST(Navigation, BudgetLimitsDispatchesPerTickInRequestOrder) {
+  World w = walled_world();
+  for (int i = 0; i < 10; ++i) w.insert(walker(3 + 2.5 * i, 5));
+  Simulation sim(std::move(w), nav_config(2, 3));
+  // Ticket order is row order; dispatches: 3 at tick 0, 3 at 1, 3 at 2, 1 at 3.
+  auto applied = [&] {
+    std::size_t n = 0;
+    for (uint64_t tk : sim.world().agents().path_ticket) n += tk == 0;
+    return n;
+  };
+  EXPECT_EQ(applied(), 0u);
+  sim.step();  // tick 1: nothing due yet
+  EXPECT_EQ(applied(), 0u);
+  for (std::size_t expect : {3u, 6u, 9u, 10u, 10u}) {
+    sim.step();
+    EXPECT_EQ(applied(), expect);
+  }
+  for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(sim.world().agents().path_ticket[i], 0u);
+}
+
+TEST(Navigation, ANewGoalIsReplanned) {
+  World w = walled_world();
+  const AgentId a = w.insert(walker(10, 10));
+  Simulation sim(std::move(w), nav_config(2));
+  for (int k = 0; k < 5; ++k) sim.step();
+  const AgentTable& t = sim.world().agents();
+  ASSERT_EQ(t.path_goal[0], 0u);
+  ASSERT_FALSE(t.route[0].empty());
+  sim.world().retarget(a, 1);
+  sim.step();  // the re-target clears the route; a new request goes out at the end of the tick
+  EXPECT_TRUE(t.route[0].empty());
+  EXPECT_EQ(t.path_goal[0], 1u);
+  EXPECT_NE(t.path_ticket[0], 0u);
+  EXPECT_EQ(t.target_x[0], 5);  // straight at the new goal until its path arrives
+  sim.step();
+  sim.step();
+  EXPECT_EQ(t.path_ticket[0], 0u);
+}
+
+TEST(Navigation, NoProgressTriggersReplanning) {
+  // The goal sits in a closed box: the path is partial and the agent stalls at the box.
+  World w(Bounds{0, 0, 60, 40});
+  w.add_goal({"boxed", 45, 20, 1, 1});
+  w.add_obstacle(PolygonObstacle{{{38, 13}, {52, 13}, {52, 15}, {38, 15}}, 0.1});
+  w.add_obstacle(PolygonObstacle{{{38, 25}, {52, 25}, {52, 27}, {38, 27}}, 0.1});
+  w.add_obstacle(PolygonObstacle{{{38, 15}, {40, 15}, {40, 25}, {38, 25}}, 0.1});
+  w.add_obstacle(PolygonObstacle{{{50, 15}, {52, 15}, {52, 25}, {50, 25}}, 0.1});
+  w.insert(walker(10, 20));
+  SimConfig c = nav_config(1);
+  c.navigation.replan_after = 10;
+  Simulation sim(std::move(w), c);
+  for (int k = 0; k < 300; ++k) sim.step();
+  // EXPLAIN ANALYZE: "path service: N requests (M re-plans), ..."
+  const std::string ea = sim.explain_analyze();
+  const auto pos = ea.find("path service: ");
+  ASSERT_NE(pos, std::string::npos) << ea;
+  const unsigned long requests = std::stoul(ea.substr(pos + 14));
+  const unsigned long replans = std::stoul(ea.substr(ea.find('(', pos) + 1));
+  EXPECT_EQ(requests, replans + 1) << ea;  // the goal never changes
+  // The agent walks ~100 ticks to the far side of the box, then stands: one re-plan per 10
+  // ticks, never more often.
+  EXPECT_GE(replans, 10u) << ea;
+  EXPECT_LE(replans, 30u) << ea;
+  EXPECT_NE(ea.find("partial"), std::string::npos);
+}
+
+TEST(Navigation, WaypointsAreSkippedWhenTheNextOneIsInSight) {
+  for (bool skip : {false, true}) {
+    World w = walled_world();
+    w.insert(walker(10, 10));
+    SimConfig c = nav_config(1);
+    c.navigation.skip_visible = skip;
+    Simulation sim(std::move(w), c);
+    const AgentTable& t = sim.world().agents();
+    double farthest_pop = 0;
+    std::size_t arrived = 0;
+    for (int k = 0; k < 300 && !t.empty(); ++k) {
+      const std::vector<Vec2> before = t.route[0];
+      arrived += sim.step().arrived;
+      if (t.empty()) break;
+      if (!before.empty() && t.route[0].size() < before.size())
+        farthest_pop = std::max(farthest_pop,
+                                std::hypot(before.front().x - t.x[0], before.front().y - t.y[0]));
+    }
+    EXPECT_EQ(arrived, 1u) << "skip " << skip;
+    if (skip) {
+      EXPECT_GT(farthest_pop, 0.8) << "a corner was passed by sight, before the agent reached it";
+    } else {
+      EXPECT_LE(farthest_pop, 0.8 + 1e-9) << "without sight, only reaching a corner advances";
+    }
+  }
+}
+
+TEST(Navigation, ExplainShowsThePathService) {
+  World w = walled_world();
+  w.insert(walker(10, 10));
+  Simulation sim(std::move(w), nav_config(2));
+  const std::string plan = sim.explain();
+  EXPECT_NE(plan.find("path results"), std::string::npos) << plan;
+  EXPECT_NE(plan.find("Recast/Detour"), std::string::npos) << plan;
+  EXPECT_NE(plan.find("path requests"), std::string::npos) << plan;
+  EXPECT_NE(plan.find("in sight"), std::string::npos) << plan;
+  World plain = walled_world();
+  plain.insert(walker(10, 10));
+  Simulation off(std::move(plain), SimConfig{});
+  EXPECT_EQ(off.explain().find("path results"), std::string::npos);
+  EXPECT_EQ(off.explain().find("path requests"), std::string::npos);
+}
+
+TEST(Navigation, RadiusClassesRoundUp) {
+  World w = walled_world();
+  w.insert(walker(10, 10));
+  SimConfig c = nav_config(1);
+  c.navigation.radius_step = 0.25;
+  Executor ex(1);
+  path::Navigation nav(w, c, ex);  // the pending insert is not applied yet: no agents, no mesh
+  EXPECT_EQ(nav.mesh_count(), 0u);
+  EXPECT_DOUBLE_EQ(nav.class_radius(0.8), 1.0);
+  EXPECT_DOUBLE_EQ(nav.class_radius(1.0), 1.0);
+  EXPECT_DOUBLE_EQ(nav.class_radius(1.01), 1.25);
+  EXPECT_DOUBLE_EQ(nav.class_radius(0.01), 0.25);
+}
+
+}  // namespace
+}  // namespace crowddb

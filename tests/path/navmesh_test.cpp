@@ -1,0 +1,269 @@
+// The navigation mesh against an independent oracle: shortest paths of a disc over a visibility
+// graph (tests/path/visibility_graph.hpp) on fixed and random worlds, the clearance of every
+// returned path, line of sight, tiling and determinism.
+#include "path/navmesh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "path/visibility_graph.hpp"
+#include "util/executor.hpp"
+#include "util/rng.hpp"
+
+namespace crowddb::path {
+namespace {
+
+PolygonObstacle rect(double x0, double y0, double x1, double y1) {
+  return {{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, 1};
+}
+
+testing::DiscWorld disc_world(const NavGeometry& g) {
+  testing::DiscWorld d;
+  d.bounds = g.bounds;
+  d.circles = g.circles;
+  for (const auto& p : g.polygons) d.polygons.push_back(p.vertices);
+  return d;
+}
+
+// Every point of the path (sampled every 0.02) keeps at least `need` from obstacles and walls.
+double min_clearance(const testing::DiscWorld& w, const PathResult& r) {
+  std::vector<Vec2> pts{r.start};
+  pts.insert(pts.end(), r.corners.begin(), r.corners.end());
+  pts.push_back(r.end);
+  double worst = INFINITY;
+  for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+    const double len = std::hypot(pts[i + 1].x - pts[i].x, pts[i + 1].y - pts[i].y);
+    const int n = std::max(1, static_cast<int>(len / 0.02));
+    for (int k = 0; k <= n; ++k) {
+      const double t = static_cast<double>(k) / n;
+      worst = std::min(worst, testing::clearance_at(w, {pts[i].x + t * (pts[i + 1].x - pts[i].x),
+                                                        pts[i].y + t * (pts[i + 1].y - pts[i].y)}));
+    }
+  }
+  return worst;
+}
+
+double polyline_length(const PathResult& r) {
+  double len = 0;
+  Vec2 prev = r.start;
+  for (const Vec2& c : r.corners) {
+    len += std::hypot(c.x - prev.x, c.y - prev.y);
+    prev = c;
+  }
+  return len + std::hypot(r.end.x - prev.x, r.end.y - prev.y);
+}
+
+TEST(NavMesh, OpenFloorGivesTheStraightLine) {
+  NavGeometry g{{0, 0, 50, 30}, {}, {}};
+  auto mesh = NavMesh::build(g, {1.0, 0.25});
+  PathFinder f(*mesh);
+  const PathResult r = f.find({5, 5}, {45, 25});
+  ASSERT_EQ(r.status, PathStatus::ok);
+  EXPECT_TRUE(r.corners.empty());
+  EXPECT_NEAR(r.length, std::hypot(40, 20), 1e-3);
+  EXPECT_NEAR(polyline_length(r), r.length, 1e-9);
+  EXPECT_TRUE(mesh->visible({5, 5}, {45, 25}));
+}
+
+TEST(NavMesh, WallWithAGapMatchesTheVisibilityGraph) {
+  // A wall across the world with a gap near its north end.
+  NavGeometry g{{0, 0, 60, 40}, {}, {rect(29, 0, 31, 30)}};
+  const NavMeshParams p{1.0, 0.25};
+  auto mesh = NavMesh::build(g, p);
+  PathFinder f(*mesh);
+  const PathResult r = f.find({10, 10}, {50, 10});
+  ASSERT_EQ(r.status, PathStatus::ok);
+  EXPECT_GE(r.corners.size(), 1u);
+  for (const Vec2& c : r.corners) EXPECT_GT(c.y, 30);  // around the wall's end
+  const auto dw = disc_world(g);
+  const double exact = testing::shortest_path(dw, p.radius, {10, 10}, {50, 10});
+  const double inflated =
+      testing::shortest_path(dw, mesh->clearance() + 2 * p.cell_size, {10, 10}, {50, 10});
+  // Never shorter than the true shortest path of the disc, about that of a disc as wide as the
+  // mesh's clearance (plus two cells: the grid rounds the eroded boundary outwards).
+  EXPECT_GE(r.length, exact * (1 - 1e-4));
+  EXPECT_LE(r.length, inflated * 1.02);
+  EXPECT_GE(min_clearance(dw, r), p.radius);
+  EXPECT_FALSE(mesh->visible({10, 10}, {50, 10}));
+  EXPECT_TRUE(mesh->visible({10, 10}, {10, 35}));
+}
+
+TEST(NavMesh, UnreachableGoalGivesAPartialPathTowardsIt) {
+  NavGeometry g{{0, 0, 60, 40}, {}, {rect(29, 0, 31, 40)}};  // the wall closes the world
+  auto mesh = NavMesh::build(g, {1.0, 0.25});
+  PathFinder f(*mesh);
+  const PathResult r = f.find({10, 10}, {50, 10});
+  EXPECT_EQ(r.status, PathStatus::partial);
+  EXPECT_LT(r.end.x, 29);  // as close as the start's side gets
+  EXPECT_GT(r.end.x, 26);
+}
+
+TEST(NavMesh, NarrowDoorPassesSmallDiscsOnly) {
+  // A door 3 wide: open for a disc of radius 0.5 (clearance 1.0), closed for radius 1.5.
+  NavGeometry g{{0, 0, 40, 30}, {}, {rect(19, 0, 21, 13.5), rect(19, 16.5, 21, 30)}};
+  auto small = NavMesh::build(g, {0.5, 0.125});
+  auto large = NavMesh::build(g, {1.5, 0.25});
+  PathFinder fs(*small), fl(*large);
+  EXPECT_EQ(fs.find({5, 15}, {35, 15}).status, PathStatus::ok);
+  EXPECT_EQ(fl.find({5, 15}, {35, 15}).status, PathStatus::partial);
+}
+
+TEST(NavMesh, NonConvexPolygonsAndCirclesAreRespected) {
+  // A U opening west with the goal behind its closed side, and a pillar.
+  PolygonObstacle u{
+      {{40, 18}, {64, 18}, {64, 62}, {40, 62}, {40, 60}, {62, 60}, {62, 20}, {40, 20}}, 1};
+  NavGeometry g{{0, 0, 100, 80}, {{80, 55, 3, 1}}, {u}};
+  const NavMeshParams p{0.8, 0.2};
+  auto mesh = NavMesh::build(g, p);
+  PathFinder f(*mesh);
+  const PathResult r = f.find({20, 40}, {86, 40});
+  ASSERT_EQ(r.status, PathStatus::ok);
+  const auto dw = disc_world(g);
+  EXPECT_GE(min_clearance(dw, r), p.radius);
+  EXPECT_GE(r.length, testing::shortest_path(dw, p.radius, {20, 40}, {86, 40}) * (1 - 1e-4));
+  EXPECT_LE(
+      r.length,
+      testing::shortest_path(dw, mesh->clearance() + 2 * p.cell_size, {20, 40}, {86, 40}) * 1.02);
+  EXPECT_FALSE(mesh->visible({50, 40}, {86, 40}));  // from inside the U
+}
+
+// Random worlds: rectangles, triangles and circles; random start/goal pairs. Against the exact
+// oracle, the mesh's path (plus any snap from the query points onto the mesh) is never shorter
+// than the shortest path of its disc; it keeps the disc's radius from every obstacle; it exists
+// whenever a disc as wide as the mesh's clearance plus two cells (the grid's rounding) can pass,
+// and it is then at most 10% longer than that disc's shortest path: Detour's A* runs over
+// polygons (costs between edge midpoints), so the corridor it picks is not always the one of
+// the shortest path; the funnel then straightens within that corridor only.
+TEST(NavMesh, RandomWorldsAgreeWithTheVisibilityGraphOracle) {
+  Rng rng(20240611);
+  int compared = 0;
+  double worst_clearance = INFINITY, worst_excess = 0;
+  for (int world = 0; world < 6; ++world) {
+    NavGeometry g{{0, 0, 60, 45}, {}, {}};
+    for (int k = 0; k < 7; ++k) {
+      const double x = rng.uniform(5, 55), y = rng.uniform(5, 40), w = rng.uniform(1, 8),
+                   h = rng.uniform(1, 8);
+      if (rng.below(3) == 0) {
+        g.circles.push_back({x, y, rng.uniform(0.5, 3), 1});
+      } else if (rng.below(2) == 0) {
+        g.polygons.push_back(rect(x, y, x + w, y + h));
+      } else {
+        g.polygons.push_back(
+            {{{x, y}, {x + w, y + rng.uniform(-2, 2)}, {x + rng.uniform(0, w), y + h}}, 1});
+      }
+    }
+    // Triangles may come out clockwise: store them as World does (counter-clockwise).
+    for (auto& p : g.polygons) {
+      double a = 0;
+      for (std::size_t i = 0; i < p.vertices.size(); ++i) {
+        const Vec2 &u = p.vertices[i], &v = p.vertices[(i + 1) % p.vertices.size()];
+        a += u.x * v.y - v.x * u.y;
+      }
+      if (a < 0) std::reverse(p.vertices.begin(), p.vertices.end());
+    }
+    const double radius = world % 2 ? 0.5 : 1.0;
+    const NavMeshParams params{radius, radius / 4, 64};
+    auto mesh = NavMesh::build(g, params);
+    PathFinder f(*mesh);
+    const auto dw = disc_world(g);
+    const double wide_radius = mesh->clearance() + 2 * params.cell_size;
+    for (int q = 0; q < 8; ++q) {
+      const Vec2 a{rng.uniform(2, 58), rng.uniform(2, 43)},
+          b{rng.uniform(2, 58), rng.uniform(2, 43)};
+      const double wide = testing::shortest_path(dw, wide_radius, a, b);
+      if (!std::isfinite(wide)) continue;  // start or goal too close to an obstacle, or no passage
+      const PathResult r = f.find(a, b);
+      ASSERT_EQ(r.status, PathStatus::ok) << "world " << world << " query " << q;
+      const double total = r.length + std::hypot(r.start.x - a.x, r.start.y - a.y) +
+                           std::hypot(r.end.x - b.x, r.end.y - b.y);
+      const double exact = testing::shortest_path(dw, radius, a, b);
+      EXPECT_GE(total, exact * (1 - 1e-4)) << "world " << world << " query " << q;
+      EXPECT_LE(total, wide * 1.10) << "world " << world << " query " << q;
+      const double c = min_clearance(dw, r);
+      EXPECT_GE(c, radius) << "world " << world << " query " << q;
+      worst_clearance = std::min(worst_clearance, c / radius);
+      worst_excess = std::max(worst_excess, total / wide);
+      ++compared;
+    }
+  }
+  EXPECT_GE(compared, 20);
+  std::printf(
+      "[ navmesh  ] %d random paths compared; smallest clearance %.3f x radius; longest %.3f x the "
+      "wider disc's\n",
+      compared, worst_clearance, worst_excess);
+}
+
+TEST(NavMesh, TilesJoinSeamlessly) {
+  NavGeometry g{{0, 0, 80, 60}, {{40, 30, 6, 1}}, {rect(20, 10, 24, 50), rect(56, 10, 60, 50)}};
+  auto one = NavMesh::build(g, {1.0, 0.25, 512});
+  auto many = NavMesh::build(g, {1.0, 0.25, 32});
+  EXPECT_EQ(one->stats().tiles, 1);
+  EXPECT_GT(many->stats().tiles, 50);
+  PathFinder f1(*one), fm(*many);
+  for (const auto& [a, b] : std::vector<std::pair<Vec2, Vec2>>{
+           {{5, 30}, {75, 30}}, {{5, 5}, {75, 55}}, {{30, 55}, {50, 5}}}) {
+    const PathResult r1 = f1.find(a, b), rm = fm.find(a, b);
+    ASSERT_EQ(r1.status, PathStatus::ok);
+    ASSERT_EQ(rm.status, PathStatus::ok);
+    EXPECT_NEAR(rm.length, r1.length, 0.02 * r1.length);
+    EXPECT_TRUE(many->visible(a, {a.x + 3, a.y}));  // a ray across a tile edge
+  }
+}
+
+TEST(NavMesh, BuildAndQueriesAreDeterministicOnAnyThreadCount) {
+  NavGeometry g{{0, 0, 80, 60}, {{40, 30, 6, 1}}, {rect(20, 10, 24, 50), rect(56, 10, 60, 50)}};
+  Executor two(2);
+  auto a = NavMesh::build(g, {1.0, 0.25, 32});
+  auto b = NavMesh::build(g, {1.0, 0.25, 32}, &two);
+  const auto pa = a->polygons(), pb = b->polygons();
+  ASSERT_EQ(pa.size(), pb.size());
+  for (std::size_t i = 0; i < pa.size(); ++i) {
+    ASSERT_EQ(pa[i].size(), pb[i].size());
+    for (std::size_t k = 0; k < pa[i].size(); ++k) {
+      EXPECT_EQ(pa[i][k].x, pb[i][k].x);
+      EXPECT_EQ(pa[i][k].y, pb[i][k].y);
+    }
+  }
+  PathFinder fa(*a), fb(*b);
+  const PathResult ra = fa.find({5, 5}, {75, 55});
+  fa.find({70, 5}, {5, 50});  // the search state must not leak into the next query
+  const PathResult ra2 = fa.find({5, 5}, {75, 55}), rb = fb.find({5, 5}, {75, 55});
+  ASSERT_EQ(ra.corners.size(), rb.corners.size());
+  for (std::size_t i = 0; i < ra.corners.size(); ++i) {
+    EXPECT_EQ(ra.corners[i].x, rb.corners[i].x);
+    EXPECT_EQ(ra.corners[i].y, ra2.corners[i].y);
+  }
+  EXPECT_EQ(ra.length, rb.length);
+  EXPECT_EQ(ra.length, ra2.length);
+}
+
+TEST(NavMesh, StartOffTheMeshSnapsOrFails) {
+  NavGeometry g{{0, 0, 40, 30}, {}, {rect(10, 10, 30, 20)}};
+  auto mesh = NavMesh::build(g, {1.0, 0.25});
+  PathFinder f(*mesh);
+  // Inside the obstacle, near its edge: snapped to the mesh just outside.
+  const PathResult near = f.find({20, 10.5}, {35, 25});
+  EXPECT_NE(near.status, PathStatus::no_start);
+  EXPECT_LT(near.start.y, 10);
+  // Deep inside a large obstacle: nothing within reach.
+  NavGeometry big{{0, 0, 200, 200}, {}, {rect(10, 10, 190, 190)}};
+  auto bm = NavMesh::build(big, {1.0, 0.25, 128});
+  PathFinder fb(*bm);
+  EXPECT_EQ(fb.find({100, 100}, {5, 5}).status, PathStatus::no_start);
+  EXPECT_FALSE(bm->visible({100, 100}, {5, 5}));
+}
+
+TEST(NavMesh, RejectsBadParameters) {
+  NavGeometry g{{0, 0, 40, 30}, {}, {}};
+  EXPECT_THROW(NavMesh::build(g, {0, 0.25}), Error);
+  EXPECT_THROW(NavMesh::build(g, {1, 0}), Error);
+  EXPECT_THROW(NavMesh::build(g, {1, 0.25, 8}), Error);
+  EXPECT_THROW(NavMesh::build(g, {100, 0.25}), Error);  // erosion beyond Recast's limit
+  NavGeometry huge{{0, 0, 1e6, 1e6}, {}, {}};
+  EXPECT_THROW(NavMesh::build(huge, {1, 0.25}), Error);  // too many tiles
+}
+
+}  // namespace
+}  // namespace crowddb::path
