@@ -189,8 +189,14 @@ TEST(Simulation, ExplainNamesEveryOperatorAndAccessPath) {
   Simulation sim(std::move(sc.world), sc.config);
   const std::string plan = sim.explain();
   for (const char* s : {"Q1 attraction", "Q2 inner avoidance", "Q3 outer avoidance", "backoff",
-                        "commit", "access path: naive", "exp-l1"})
+                        "commit", "exp-l1"})
     EXPECT_NE(plan.find(s), std::string::npos) << s << "\n" << plan;
+  // One access path per indexed query: Q2, Q3 and the backoff's collision set.
+  std::size_t paths = 0;
+  for (auto at = plan.find("access path: "); at != std::string::npos;
+       at = plan.find("access path: ", at + 1))
+    ++paths;
+  EXPECT_EQ(paths, 3u) << plan;
   for (int t = 0; t < 3; ++t) sim.step();
   const std::string analyze = sim.explain_analyze();
   EXPECT_NE(analyze.find("EXPLAIN ANALYZE  3 ticks"), std::string::npos) << analyze;
