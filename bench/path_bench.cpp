@@ -275,8 +275,8 @@ BENCHMARK(BM_ServiceOverhead)
 
 // The whole tick (Simulation::step) with 10^4 walking agents, navigation off and on, so the
 // worker's searches overlap the tick's other work as they do in a run. The steering queries are
-// off (w_apf = w_ftc = 0, backoff off): with only naive access paths they would cost seconds at
-// this size; what remains is Q1, integrate, the naive overlap count and commit. Every 20 ticks
+// off (w_apf = w_ftc = 0, backoff off) so that the service's share is not hidden behind them; what
+// remains is Q1, integrate, the overlap count and commit. Every 20 ticks
 // all agents get new goals (arrivals re-target too). Args: navigation, budget.
 void BM_TickOverhead(benchmark::State& state) {
   static const path::NavGeometry g = city();
