@@ -63,16 +63,37 @@ FtcIndexOptions options_for(int variant) {
   using O = FtcIndexOptions;
   O o;
   switch (variant) {
-    case 1: o.bound = O::Bound::frustum; break;
-    case 2: o.order = O::Order::best_first; break;
-    case 3: o.slices = 1; break;
-    case 4: o.slices = 2; break;
-    case 5: o.order = O::Order::nearer_first; break;
-    case 6: o.order = O::Order::bottom_up; break;
-    case 7: o.overlaps_first = false; break;
-    case 8:  // the thesis's search made exact
-      o = {.leaf_size = 1, .bound = O::Bound::frustum, .slices = 1, .order = O::Order::best_first,
-           .seed_own_leaf = false, .overlaps_first = false};
+    case 1:
+      o.bound = O::Bound::frustum;
+      break;
+    case 2:
+      o.order = O::Order::best_first;
+      break;
+    case 3:
+      o.slices = 1;
+      break;
+    case 4:
+      o.slices = 2;
+      break;
+    case 5:
+      o.order = O::Order::nearer_first;
+      break;
+    case 6:
+      o.order = O::Order::bottom_up;
+      break;
+    case 7:
+      o.overlaps_first = false;
+      break;
+    case 9:
+      o.overlap_join = false;
+      break;  // overlaps by the tree search (before the join)
+    case 8:   // the thesis's search made exact
+      o = {.leaf_size = 1,
+           .bound = O::Bound::frustum,
+           .slices = 1,
+           .order = O::Order::best_first,
+           .seed_own_leaf = false,
+           .overlaps_first = false};
       break;
     default:
       if (variant >= 100) o.leaf_size = static_cast<std::size_t>(variant - 100);  // leaf sweeps
@@ -159,11 +180,12 @@ void BM_Naive(benchmark::State& state) {
 // fixed 640 x 480 plane), variant (0 default: chord K = 4, leaf_queue, leaf 16; 1 frustum bound;
 // 2 best-first order from the root; 3 K = 1; 4 K = 2; 5 nearer-first from the root; 6 bottom-up;
 // 7 no overlap-first phase; 8 the thesis's search (frustum, best-first, one agent per leaf);
+// 9 the overlap phase by the tree search instead of the leaf join;
 // 100 + L: leaf size L).
 void sizes(benchmark::internal::Benchmark* b) {
   for (int w : {uniform_w, crunch_w, perturbed_w})
     for (int64_t n : {1000, 15000, 100000, 1000000}) b->Args({n, w, 0});
-  for (int v : {1, 2, 3, 4, 5, 6, 7, 8})
+  for (int v : {1, 2, 3, 4, 5, 6, 7, 8, 9})
     for (int w : {uniform_w, crunch_w, perturbed_w}) b->Args({15000, w, v});
   b->Unit(benchmark::kMillisecond);
 }

@@ -67,6 +67,7 @@ inline FtcIndexOptions thesis() {
   o.slices = 1;
   o.order = FtcIndexOptions::Order::best_first;
   o.seed_own_leaf = false;
+  o.overlap_join = false;  // its overlap phase searches the tree as well
   return o;
 }
 

@@ -98,10 +98,6 @@ struct Later {
   }
 };
 
-struct Scratch {
-  std::vector<Entry> heap;
-};
-
 // The bound on one slice: the first t in [t0, t0 + span] at which the box comes within
 // Chebyshev distance R of the probe's centre, or +inf. (qx, qy): the probe's centre at t0. The
 // four edges are lines in t in the probe's frame; an edge outside reach must close its gap within
@@ -144,6 +140,27 @@ inline double node_bound(const Slice* s, std::size_t stride, const Frame& f, con
 
 // ------------------------------------------------------------------- member sources
 
+// A member of a tree: its columns copied from the source in tree order, so a leaf's members lie
+// together in memory (scans and queries run in tree order). The values are the source's own,
+// untouched, so pair times computed from them are bit-identical to the naive path's.
+struct Member {
+  double x, y, vx, vy, r;
+  uint64_t key;
+  uint32_t row;
+};
+
+struct Scratch {
+  std::vector<Entry> heap;
+  // The overlap phase of one leaf of the agent tree (see leaf_overlaps()): its candidates'
+  // columns, a per-candidate buffer, and each member's answer (a row, or kNone).
+  std::vector<double> cx, cy, cr, cc;
+  std::vector<uint64_t> ckey;
+  std::vector<uint32_t> crow, pick, hit;
+  uint32_t leaf = kNone;
+  std::size_t ncand = 0;      // candidates of that leaf (the member itself included)
+  uint64_t join_visited = 0;  // nodes its walk visited
+};
+
 struct AgentSource {
   static constexpr Kind kind = Kind::agent;
   const DiscView* d = nullptr;
@@ -154,23 +171,14 @@ struct AgentSource {
   double vy(uint32_t i) const { return d->vy[i]; }
   double r(uint32_t i) const { return d->radius[i]; }
   uint64_t key(uint32_t i) const { return d->id[i]; }
-  void prefetch(uint32_t i) const {
-    __builtin_prefetch(d->x + i);
-    __builtin_prefetch(d->y + i);
-    __builtin_prefetch(d->vx + i);
-    __builtin_prefetch(d->vy + i);
-    __builtin_prefetch(d->radius + i);
-    __builtin_prefetch(d->id + i);
-  }
   // Exactly the naive path's expressions (ftc_naive.cpp, ray_disc_time), so times are
   // bit-identical: overlaps() is ray_disc_time's own test for time 0.
-  bool overlaps(const Probe& a, uint32_t b) const {
-    const double dx = d->x[b] - a.ax, dy = d->y[b] - a.ay, R = a.ar + d->radius[b];
+  static bool overlaps(const Probe& a, const Member& b) {
+    const double dx = b.x - a.ax, dy = b.y - a.ay, R = a.ar + b.r;
     return dx * dx + dy * dy - R * R < 0;
   }
-  double time(const Probe& a, uint32_t b, double horizon) const {
-    return ray_disc_time(d->x[b] - a.ax, d->y[b] - a.ay, d->vx[b] - a.avx, d->vy[b] - a.avy,
-                         a.ar + d->radius[b], horizon);
+  static double time(const Probe& a, const Member& b, double horizon) {
+    return ray_disc_time(b.x - a.ax, b.y - a.ay, b.vx - a.avx, b.vy - a.avy, a.ar + b.r, horizon);
   }
 };
 
@@ -184,15 +192,29 @@ struct CircleSource {
   double vy(uint32_t) const { return 0; }
   double r(uint32_t i) const { return c[i].radius; }
   uint64_t key(uint32_t i) const { return i; }
-  void prefetch(uint32_t i) const { __builtin_prefetch(c.data() + i); }
-  bool overlaps(const Probe& a, uint32_t b) const {
-    const double dx = c[b].x - a.ax, dy = c[b].y - a.ay, R = a.ar + c[b].radius;
+  static bool overlaps(const Probe& a, const Member& b) {
+    const double dx = b.x - a.ax, dy = b.y - a.ay, R = a.ar + b.r;
     return dx * dx + dy * dy - R * R < 0;
   }
-  double time(const Probe& a, uint32_t b, double horizon) const {
-    return ray_disc_time(c[b].x - a.ax, c[b].y - a.ay, -a.avx, -a.avy, a.ar + c[b].radius, horizon);
+  static double time(const Probe& a, const Member& b, double horizon) {
+    return ray_disc_time(b.x - a.ax, b.y - a.ay, -a.avx, -a.avy, a.ar + b.r, horizon);
   }
 };
+
+// c[j] = ray_disc_time's overlap term for the query (ax, ay, ar) against candidate j, exactly
+// the naive path's expression, in a loop the compiler vectorizes (IEEE operations lane by lane
+// give the same bits; -ffp-contract=off keeps them unfused). Returns how many are < 0.
+double overlap_terms(const double* __restrict x, const double* __restrict y,
+                     const double* __restrict r, double* __restrict c, std::size_t n, double ax,
+                     double ay, double ar) {
+  double hits = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const double dx = x[j] - ax, dy = y[j] - ay, R = ar + r[j];
+    c[j] = dx * dx + dy * dy - R * R;
+    hits += c[j] < 0 ? 1.0 : 0.0;
+  }
+  return hits;
+}
 
 // ------------------------------------------------------------------- the tree
 
@@ -209,28 +231,22 @@ class KineticTree {
   void search(const Probe& q, double horizon, Best& best, Scratch& sc, Counters& c, Order order,
               uint32_t self_pos, bool seed) const;
   std::string validate(const Frame& f) const;
+  // The overlap phase for all members of `leaf` at once: sc.hit[i] is the row of the smallest
+  // (key, row) member overlapping member begin + i at t = 0, or kNone. The candidates are the
+  // members of every leaf whose t = 0 box comes within reach of `leaf`'s (Chebyshev gap <= the
+  // two leaves' largest radii summed): every member that can overlap is among them.
+  void leaf_overlaps(uint32_t leaf, Scratch& sc) const;
 
   bool empty() const { return nodes_.empty(); }
   std::size_t node_count() const { return nodes_.size(); }
   const std::vector<uint32_t>& perm() const { return perm_; }
   uint32_t pos_of(uint32_t row) const { return pos_of_[row]; }
   uint32_t leaf_at(uint32_t pos) const { return leaf_at_[pos]; }
-  bool leaf_begins_at(uint32_t leaf, uint32_t pos) const { return nodes_[leaf].begin == pos; }
-  // Asks the cache for the rows of node k if it is a leaf (a hint only; no effect on results).
-  void prefetch_leaf(uint32_t k) const {
-    if (k >= nodes_.size() || !nodes_[k].leaf()) return;
-    for (uint32_t i = nodes_[k].begin; i < nodes_[k].end; ++i) src_->prefetch(perm_[i]);
-  }
+  const Member& member(uint32_t pos) const { return items_[pos]; }
+  uint32_t leaf_begin(uint32_t leaf) const { return nodes_[leaf].begin; }
 
  private:
-  // A member during the build, with the columns the bounds need: read once in row order, so
-  // the build never gathers columns at random (the index keeps none of this afterwards).
-  struct Item {
-    double x, y;  // frame coordinates at t = 0
-    double vx, vy, r;
-    uint64_t key;
-    uint32_t row;
-  };
+  using Item = Member;
   // Raw (uninflated) bounds during the build: K + 1 knot boxes, or box + velocity bounds.
   struct Raw {
     double lo_x, lo_y, hi_x, hi_y;
@@ -260,8 +276,16 @@ class KineticTree {
   std::vector<Cell> cells_;        // per node
   // Reach of any member: largest radius and speeds per axis (for the bottom-up walk's stop).
   double reach_r_ = 0, reach_vx_ = 0, reach_vy_ = 0;
-  // build scratch
-  std::vector<Item> items_;
+  std::vector<Item> items_;  // the members in tree order (read once in row order by the build)
+  // build scratch: the positions the median splits partition (small, so they move cheaply)
+  struct Pt {
+    double x, y;  // the source's values (x - ox is monotone in x: raw order is frame order)
+    uint32_t row;
+  };
+  std::vector<Pt> pts_, lohi_, middle_;
+  // Rearranges pts_[b, e) as std::nth_element does at position k, by coordinate C.
+  template <double Pt::*C>
+  void select_median(uint32_t b, uint32_t e, uint32_t k);
   std::vector<Raw> raw_;  // (K + 1) per node (chord) or 2 per node (frustum: box, velocity box)
 };
 
@@ -280,14 +304,20 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
   cells_.clear();
   if (n == 0) return;
   items_.resize(n);
+  pts_.resize(n);
   double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   for (uint32_t i = 0; i < n; ++i) {
-    items_[i] = {src.x(i) - f.ox, src.y(i) - f.oy, src.vx(i), src.vy(i), src.r(i), src.key(i), i};
-    x0 = std::min(x0, items_[i].x);
-    x1 = std::max(x1, items_[i].x);
-    y0 = std::min(y0, items_[i].y);
-    y1 = std::max(y1, items_[i].y);
+    pts_[i] = {src.x(i), src.y(i), i};
+    x0 = std::min(x0, pts_[i].x);
+    x1 = std::max(x1, pts_[i].x);
+    y0 = std::min(y0, pts_[i].y);
+    y1 = std::max(y1, pts_[i].y);
   }
+  // Frame coordinates (x - ox is monotone in x, so orders by raw x are orders by frame x).
+  x0 -= f.ox;
+  x1 -= f.ox;
+  y0 -= f.oy;
+  y1 -= f.oy;
   // Median splits leave at least leaf_size / 2 members per leaf: at most 4n / leaf + 2 nodes.
   const std::size_t most = 4 * n / leaf_size_ + 2;
   nodes_.reserve(most);
@@ -307,7 +337,6 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
     reach_vx_ = std::max(reach_vx_, std::fabs(src.vx(i)));
     reach_vy_ = std::max(reach_vy_, std::fabs(src.vy(i)));
   }
-  items_.clear();
   raw_.clear();
 }
 
@@ -319,7 +348,13 @@ uint32_t KineticTree<Src>::build_node(uint32_t b, uint32_t e, uint32_t parent, C
   const std::size_t per = f_->chord ? f_->knots.size() : 2;
   raw_.resize(raw_.size() + per);
   if (e - b <= leaf_size_) {
-    // Members by key, so a scan can stop at the first key that can no longer win.
+    // The leaf's members, copied from the source, by key: a scan can stop at the first key
+    // that can no longer win.
+    const Src& src = *src_;
+    for (uint32_t i = b; i < e; ++i) {
+      const uint32_t row = pts_[i].row;
+      items_[i] = {src.x(row), src.y(row), src.vx(row), src.vy(row), src.r(row), src.key(row), row};
+    }
     std::sort(items_.begin() + b, items_.begin() + e, [](const Item& p, const Item& q) {
       return p.key != q.key ? p.key < q.key : p.row < q.row;
     });
@@ -329,13 +364,12 @@ uint32_t KineticTree<Src>::build_node(uint32_t b, uint32_t e, uint32_t parent, C
     const bool by_x = cell.x1 - cell.x0 >= cell.y1 - cell.y0;
     const uint32_t mid = b + (e - b) / 2;
     if (by_x)
-      std::nth_element(items_.begin() + b, items_.begin() + mid, items_.begin() + e,
-                       [](const Item& p, const Item& q) { return p.x < q.x; });
+      select_median<&Pt::x>(b, e, mid);
     else
-      std::nth_element(items_.begin() + b, items_.begin() + mid, items_.begin() + e,
-                       [](const Item& p, const Item& q) { return p.y < q.y; });
+      select_median<&Pt::y>(b, e, mid);
     // Left members have coordinate <= cut, right ones >= cut (ties may fall either side).
-    const double cut = by_x ? items_[mid].x : items_[mid].y;
+    // (x - ox rounds monotonically: raw order is frame order, and the cut bounds both sides.)
+    const double cut = by_x ? pts_[mid].x - f_->ox : pts_[mid].y - f_->oy;
     Cell lc = cell, rc = cell;
     (by_x ? lc.x1 : lc.y1) = cut;
     (by_x ? rc.x0 : rc.y0) = cut;
@@ -346,6 +380,53 @@ uint32_t KineticTree<Src>::build_node(uint32_t b, uint32_t e, uint32_t parent, C
   }
   finish_bounds(idx);
   return idx;
+}
+
+// nth_element's comparisons are unpredictable branches, a pass per level of the tree. Large
+// ranges are cut first: two order statistics of a sample bracket the median, one branch-free pass
+// sorts the range into below / between / above (out of place), and only the between part is left
+// to nth_element. If the bracket misses the median (adversarial orders), nth_element does it all.
+template <class Src>
+template <double KineticTree<Src>::Pt::*C>
+void KineticTree<Src>::select_median(uint32_t b, uint32_t e, uint32_t k) {
+  Pt* a = pts_.data() + b;
+  const std::size_t n = e - b, kk = k - b;
+  const auto less = [](const Pt& p, const Pt& q) { return p.*C < q.*C; };
+  if (n <= 256) {
+    std::nth_element(a, a + kk, a + n, less);
+    return;
+  }
+  double s[31];
+  for (std::size_t i = 0; i < 31; ++i) s[i] = a[(2 * i + 1) * n / 62].*C;
+  std::sort(s, s + 31);
+  const double p1 = s[11], p2 = s[19];
+  if (lohi_.size() < n) {
+    lohi_.resize(n);
+    middle_.resize(n);
+  }
+  Pt* t = lohi_.data();  // below p1 from the front, above p2 from the back
+  Pt* m = middle_.data();
+  std::size_t lo = 0, hi = 0, mi = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    // Every slot written to is either kept (its counter advances) or unused: the front and the
+    // back never meet before the last element.
+    const Pt x = a[i];
+    const bool l = x.*C<p1, h = x.*C> p2;
+    t[lo] = x;
+    t[n - 1 - hi] = x;
+    m[mi] = x;
+    lo += l;
+    hi += h;
+    mi += !(l | h);
+  }
+  if (kk < lo || kk >= lo + mi) {
+    std::nth_element(a, a + kk, a + n, less);
+    return;
+  }
+  std::copy(t, t + lo, a);
+  std::copy(m, m + mi, a + lo);
+  std::copy(t + n - hi, t + n, a + lo + mi);
+  std::nth_element(a + lo, a + kk, a + lo + mi, less);
 }
 
 template <class Src>
@@ -359,7 +440,7 @@ void KineticTree<Src>::leaf_bounds(uint32_t node) {
   nd.min_key = std::numeric_limits<uint64_t>::max();
   for (uint32_t i = nd.begin; i < nd.end; ++i) {
     const Item& it = items_[i];
-    const double x = it.x, y = it.y, vx = it.vx, vy = it.vy;
+    const double x = it.x - f.ox, y = it.y - f.oy, vx = it.vx, vy = it.vy;
     nd.rmax = std::max(nd.rmax, it.r);
     nd.min_key = std::min(nd.min_key, it.key);
     if (f.chord) {
@@ -432,16 +513,15 @@ void KineticTree<Src>::scan(uint32_t node, const Probe& q, double horizon, Best&
                             Counters& c) const {
   const Node& nd = nodes_[node];
   for (uint32_t i = nd.begin; i < nd.end; ++i) {
-    const uint32_t row = perm_[i];
-    const uint64_t key = src_->key(row);
+    const Member& m = items_[i];
     // Leaves are sorted by key: once the answer beats (t = 0, key), it beats the rest too.
-    if (best.beats(0, Src::kind, key)) break;
-    if (row == q.self) continue;
+    if (best.beats(0, Src::kind, m.key)) break;
+    if (m.row == q.self) continue;
     ++c.pair_tests;
     if constexpr (OverlapOnly) {
-      if (src_->overlaps(q, row)) best.offer(0.0, Src::kind, key, row);
+      if (Src::overlaps(q, m)) best.offer(0.0, Src::kind, m.key, m.row);
     } else {
-      best.offer(src_->time(q, row, horizon), Src::kind, key, row);
+      best.offer(Src::time(q, m, horizon), Src::kind, m.key, m.row);
     }
   }
 }
@@ -560,6 +640,85 @@ void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratc
   }
   const double b0 = bound_of(0);
   if (!pruned(b0, nodes_[0].min_key)) explore(0, b0, leaf);
+}
+
+template <class Src>
+void KineticTree<Src>::leaf_overlaps(uint32_t leaf, Scratch& sc) const {
+  std::size_t n = 0;  // candidates so far, in sc.cx[0, n) etc.
+  sc.join_visited = 0;
+  // Slice 0 of every node starts with its inflated box at t = 0 (chord and frustum alike).
+  const Slice& L = slices_[leaf];
+  const double rl = nodes_[leaf].rmax;
+  // A depth-first walk; the heap's storage serves as the stack (it is empty between searches).
+  std::vector<Entry>& stack = sc.heap;
+  stack.clear();
+  stack.push_back({0, 0, 0});
+  while (!stack.empty()) {
+    const uint32_t k = stack.back().node;
+    stack.pop_back();
+    const Slice& b = slices_[k];
+    const double R = rl + nodes_[k].rmax;
+    ++sc.join_visited;
+    if (b.lo_x - L.hi_x > R || L.lo_x - b.hi_x > R || b.lo_y - L.hi_y > R || L.lo_y - b.hi_y > R)
+      continue;
+    const Node& nd = nodes_[k];
+    if (!nd.leaf()) {
+      stack.push_back({0, 0, nd.right});
+      stack.push_back({0, 0, k + 1});
+      continue;
+    }
+    // Only the members within reach of the leaf's box (Chebyshev, frame coordinates): the box is
+    // inflated by delta0, far more than the rounding of the overlap test. Branch-free: each
+    // member is written, and kept by advancing n.
+    if (sc.cx.size() < n + (nd.end - nd.begin)) {
+      const std::size_t cap = 2 * (n + (nd.end - nd.begin));
+      sc.cx.resize(cap);
+      sc.cy.resize(cap);
+      sc.cr.resize(cap);
+      sc.ckey.resize(cap);
+      sc.crow.resize(cap);
+    }
+    for (uint32_t i = nd.begin; i < nd.end; ++i) {
+      const Member& m = items_[i];
+      const double fx = m.x - f_->ox, fy = m.y - f_->oy, reach = rl + m.r;
+      sc.cx[n] = m.x;
+      sc.cy[n] = m.y;
+      sc.cr[n] = m.r;
+      sc.ckey[n] = m.key;
+      sc.crow[n] = m.row;
+      n += (fx >= L.lo_x - reach) & (fx <= L.hi_x + reach) & (fy >= L.lo_y - reach) &
+           (fy <= L.hi_y + reach);
+    }
+  }
+  sc.ncand = n;
+  sc.cc.resize(std::max(sc.cc.size(), n));
+  sc.pick.resize(std::max(sc.pick.size(), n));
+  const Node& nl = nodes_[leaf];
+  sc.hit.assign(nl.end - nl.begin, kNone);
+  const double* cx = sc.cx.data();  // (the member itself is among the candidates)
+  const double* cy = sc.cy.data();
+  const double* cr = sc.cr.data();
+  double* cc = sc.cc.data();
+  for (uint32_t i = nl.begin; i < nl.end; ++i) {
+    const Member& a = items_[i];
+    if (overlap_terms(cx, cy, cr, cc, n, a.x, a.y, a.r) < 2) continue;  // only itself
+    // The few overlapping candidates, gathered without branches, then the smallest (key, row).
+    uint32_t* pick = sc.pick.data();
+    std::size_t m = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      pick[m] = static_cast<uint32_t>(j);
+      m += cc[j] < 0;
+    }
+    uint32_t best = kNone;
+    for (std::size_t h = 0; h < m; ++h) {
+      const uint32_t j = pick[h];
+      if (sc.crow[j] == a.row) continue;
+      if (best == kNone || sc.ckey[j] < sc.ckey[best] ||
+          (sc.ckey[j] == sc.ckey[best] && sc.crow[j] < sc.crow[best]))
+        best = j;
+    }
+    if (best != kNone) sc.hit[i - nl.begin] = sc.crow[best];
+  }
 }
 
 template <class Src>
@@ -689,19 +848,27 @@ void FtcIndex::Impl::make_frame() {
 }
 
 FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, Scratch& sc, Counters& c) const {
-  const DiscView& d = discs;
-  Probe q{d.x[row],
-          d.y[row],
-          d.vx[row],
-          d.vy[row],
-          d.radius[row],
-          d.x[row] - frame.ox,
-          d.y[row] - frame.oy,
-          row};
+  const Member& a = agent_tree.member(pos);  // the row's own values, in tree order
+  Probe q{a.x, a.y, a.vx, a.vy, a.r, a.x - frame.ox, a.y - frame.oy, row};
   Best best;
-  if (opt.overlaps_first) {
+  if (opt.overlaps_first && opt.overlap_join) {
     // An agent overlapping the query now wins outright (time 0, agents before obstacles); only
-    // the smallest such id is wanted, and only t = 0 checks are needed to find it.
+    // the smallest (id, row) is wanted, and only t = 0 checks are needed to find it. The join
+    // answers the whole leaf at once (queries run in tree order, so once per leaf). Counters:
+    // each member its own pair tests, the leaf's first member the walk's nodes, so the sums do
+    // not depend on how the rows are split between threads.
+    const uint32_t leaf = agent_tree.leaf_at(pos);
+    if (sc.leaf != leaf) {
+      agent_tree.leaf_overlaps(leaf, sc);
+      sc.leaf = leaf;
+    }
+    const uint32_t begin = agent_tree.leaf_begin(leaf);
+    if (pos == begin) c.visited += sc.join_visited;
+    c.pair_tests += sc.ncand - 1;
+    const uint32_t hit = sc.hit[pos - begin];
+    if (hit != kNone) return {{Kind::agent, hit}, 0.0};
+  } else if (opt.overlaps_first) {
+    // The same answer through the tree search in the chosen order, t = 0 checks only.
     agent_tree.search<true>(q, horizon, best, sc, c, opt.order, pos, opt.seed_own_leaf);
     if (best.kind != Kind::none) return {{best.kind, best.row}, best.t};
   }
@@ -756,6 +923,7 @@ void FtcIndex::build(const DiscView& discs, const StaticScene& scene, double hor
     throw Error(Error::Kind::input, "first-to-collide index: horizon is NaN");
   m.discs = discs;
   m.scene = &scene;
+  m.scratch.leaf = kNone;
   m.horizon = horizon;
   m.make_frame();
   m.agents.d = &m.discs;
@@ -779,10 +947,7 @@ void FtcIndex::query_all(std::span<FtcHit> out, Executor& ex, QueryStats& stats)
     Scratch sc;
     Counters c;
     for (std::size_t i = begin; i < end; ++i) {
-      // Queries run leaf by leaf in tree order; fetch the next leaf's rows while this one runs.
       const auto pos = static_cast<uint32_t>(i);
-      const uint32_t leaf = m.agent_tree.leaf_at(pos);
-      if (m.agent_tree.leaf_begins_at(leaf, pos)) m.agent_tree.prefetch_leaf(leaf + 1);
       out[order[i]] = m.probe(order[i], pos, sc, c);
     }
     std::lock_guard lock(mu);  // integer sums: the total does not depend on the order

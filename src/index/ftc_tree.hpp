@@ -115,6 +115,9 @@ struct FtcIndexOptions {
   Order order = Order::leaf_queue;
   bool seed_own_leaf = true;   // top-down orders: scan the query's own leaf first
   bool overlaps_first = true;  // first look only for agents overlapping the query now (t = 0)
+  // overlaps_first: find them leaf by leaf, all members of a leaf against the members of the
+  // leaves within reach (set-at-a-time); false: by the tree search in `order` (t = 0 bounds).
+  bool overlap_join = true;
 };
 
 // Thread-safety: build() and query() change the index (one caller at a time); query_all() may

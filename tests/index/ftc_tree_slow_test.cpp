@@ -51,6 +51,10 @@ std::vector<Opt> options() {
           o.slices = slices;
           o.leaf_size = leaf;
           v.push_back(o);
+          if (leaf == 16) {  // the overlap phase by the tree search instead of the join
+            o.overlap_join = false;
+            v.push_back(o);
+          }
           o.overlaps_first = false;
           v.push_back(o);
         }

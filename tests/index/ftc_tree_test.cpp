@@ -102,7 +102,9 @@ std::vector<Opt> all_options() {
             o.leaf_size = leaf;
             o.seed_own_leaf = seed;
             v.push_back(o);
-            if (slices == 1) {  // and without the overlap-first phase
+            if (slices == 1) {  // the overlap phase by the tree search, and none at all
+              o.overlap_join = false;
+              v.push_back(o);
               o.overlaps_first = false;
               v.push_back(o);
             }
@@ -118,9 +120,12 @@ std::vector<Opt> some_options() {
   thesis.leaf_size = 1;
   thesis.seed_own_leaf = false;
   thesis.overlaps_first = false;
-  return {Opt{}, Opt{.bound = Opt::Bound::frustum},
+  return {Opt{},
+          Opt{.bound = Opt::Bound::frustum},
           Opt{.slices = 1, .order = Opt::Order::bottom_up},
-          Opt{.leaf_size = 3, .slices = 7, .order = Opt::Order::nearer_first}, thesis};
+          Opt{.leaf_size = 3, .slices = 7, .order = Opt::Order::nearer_first},
+          Opt{.slices = 2, .overlap_join = false},
+          thesis};
 }
 
 const StaticScene kNoScene;
@@ -318,8 +323,8 @@ TEST(FtcIndex, StatisticsAddUp) {
   EXPECT_EQ(one.pair_tests, all.pair_tests);
   EXPECT_GT(all.nodes_visited, 0u);
   EXPECT_LE(all.queue_pops, all.queue_pushes);
-  // Best-first sends every visited node through the queue.
-  FtcIndex bf({.order = Opt::Order::best_first});
+  // Best-first sends every visited node through the queue (the join's walk does not use it).
+  FtcIndex bf({.order = Opt::Order::best_first, .overlap_join = false});
   bf.build(t.view(), kNoScene, 30);
   QueryStats b;
   bf.query_all(out, ex, b);
