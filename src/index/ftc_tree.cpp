@@ -154,8 +154,7 @@ struct Scratch {
   // The overlap phase of one leaf of the agent tree (see leaf_overlaps()): its candidates'
   // columns, a per-candidate buffer, and each member's answer (a row, or kNone).
   std::vector<double> cx, cy, cr, cc;
-  std::vector<uint64_t> ckey;
-  std::vector<uint32_t> crow, pick, hit;
+  std::vector<uint32_t> cpos, pick, hit;  // candidates' positions in tree order
   uint32_t leaf = kNone;
   std::size_t ncand = 0;      // candidates of that leaf (the member itself included)
   uint64_t join_visited = 0;  // nodes its walk visited
@@ -276,7 +275,7 @@ class KineticTree {
   std::vector<Cell> cells_;        // per node
   // Reach of any member: largest radius and speeds per axis (for the bottom-up walk's stop).
   double reach_r_ = 0, reach_vx_ = 0, reach_vy_ = 0;
-  std::vector<Item> items_;  // the members in tree order (read once in row order by the build)
+  std::vector<Item> items_;  // the members in tree order (copied from the source at the leaves)
   // build scratch: the positions the median splits partition (small, so they move cheaply)
   struct Pt {
     double x, y;  // the source's values (x - ox is monotone in x: raw order is frame order)
@@ -649,6 +648,8 @@ void KineticTree<Src>::leaf_overlaps(uint32_t leaf, Scratch& sc) const {
   // Slice 0 of every node starts with its inflated box at t = 0 (chord and frustum alike).
   const Slice& L = slices_[leaf];
   const double rl = nodes_[leaf].rmax;
+  const double ox = f_->ox, oy = f_->oy;
+  const double lx0 = L.lo_x - rl, lx1 = L.hi_x + rl, ly0 = L.lo_y - rl, ly1 = L.hi_y + rl;
   // A depth-first walk; the heap's storage serves as the stack (it is empty between searches).
   std::vector<Entry>& stack = sc.heap;
   stack.clear();
@@ -669,30 +670,30 @@ void KineticTree<Src>::leaf_overlaps(uint32_t leaf, Scratch& sc) const {
     }
     // Only the members within reach of the leaf's box (Chebyshev, frame coordinates): the box is
     // inflated by delta0, far more than the rounding of the overlap test. Branch-free: each
-    // member is written, and kept by advancing n.
-    if (sc.cx.size() < n + (nd.end - nd.begin)) {
-      const std::size_t cap = 2 * (n + (nd.end - nd.begin));
-      sc.cx.resize(cap);
-      sc.cy.resize(cap);
-      sc.cr.resize(cap);
-      sc.ckey.resize(cap);
-      sc.crow.resize(cap);
-    }
+    // member's position is written, and kept by advancing n.
+    if (sc.cpos.size() < n + (nd.end - nd.begin)) sc.cpos.resize(2 * (n + (nd.end - nd.begin)));
+    uint32_t* cpos = sc.cpos.data();
     for (uint32_t i = nd.begin; i < nd.end; ++i) {
       const Member& m = items_[i];
-      const double fx = m.x - f_->ox, fy = m.y - f_->oy, reach = rl + m.r;
-      sc.cx[n] = m.x;
-      sc.cy[n] = m.y;
-      sc.cr[n] = m.r;
-      sc.ckey[n] = m.key;
-      sc.crow[n] = m.row;
-      n += (fx >= L.lo_x - reach) & (fx <= L.hi_x + reach) & (fy >= L.lo_y - reach) &
-           (fy <= L.hi_y + reach);
+      const double fx = m.x - ox, fy = m.y - oy, rb = m.r;
+      cpos[n] = i;
+      n += (fx >= lx0 - rb) & (fx <= lx1 + rb) & (fy >= ly0 - rb) & (fy <= ly1 + rb);
     }
   }
   sc.ncand = n;
-  sc.cc.resize(std::max(sc.cc.size(), n));
-  sc.pick.resize(std::max(sc.pick.size(), n));
+  if (sc.cx.size() < n) {
+    sc.cx.resize(n);
+    sc.cy.resize(n);
+    sc.cr.resize(n);
+    sc.cc.resize(n);
+    sc.pick.resize(n);
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    const Member& m = items_[sc.cpos[j]];
+    sc.cx[j] = m.x;
+    sc.cy[j] = m.y;
+    sc.cr[j] = m.r;
+  }
   const Node& nl = nodes_[leaf];
   sc.hit.assign(nl.end - nl.begin, kNone);
   const double* cx = sc.cx.data();  // (the member itself is among the candidates)
@@ -711,13 +712,13 @@ void KineticTree<Src>::leaf_overlaps(uint32_t leaf, Scratch& sc) const {
     }
     uint32_t best = kNone;
     for (std::size_t h = 0; h < m; ++h) {
-      const uint32_t j = pick[h];
-      if (sc.crow[j] == a.row) continue;
-      if (best == kNone || sc.ckey[j] < sc.ckey[best] ||
-          (sc.ckey[j] == sc.ckey[best] && sc.crow[j] < sc.crow[best]))
+      const uint32_t j = sc.cpos[pick[h]];  // a position in tree order
+      if (j == i) continue;                 // the member itself
+      if (best == kNone || items_[j].key < items_[best].key ||
+          (items_[j].key == items_[best].key && items_[j].row < items_[best].row))
         best = j;
     }
-    if (best != kNone) sc.hit[i - nl.begin] = sc.crow[best];
+    if (best != kNone) sc.hit[i - nl.begin] = items_[best].row;
   }
 }
 

@@ -9,9 +9,12 @@
 //
 // STRUCTURE. A k-d tree over the positions at t = 0: median split of the wider side of the cell,
 // leaves of at most leaf_size members, members of a leaf sorted by key (id). The index reads the
-// rows only through the DiscView and keeps orderings (tree order, row -> position, position ->
-// leaf) and per-node aggregates: kinetic bounds (below), the largest radius, the smallest key,
-// the node's cell (its ancestors' split half-planes) and its parent. Rebuilt every tick.
+// rows through the DiscView and keeps a copy of each member's columns (x, y, v, r, id, row) in
+// tree order, so a leaf's members lie together in memory and queries, run in tree order, read
+// memory in order; the copies are the rows' own values, so pair times are unchanged. It also
+// keeps orderings (tree order, row -> position, position -> leaf) and per-node aggregates:
+// kinetic bounds (below), the largest radius, the smallest key, the node's cell (its ancestors'
+// split half-planes) and its parent. Rebuilt every tick.
 // Static circles get a tree of their own (zero velocities); polygons (few) are tested one by one
 // through their boxes (the naive path's box filter, then the box bound, then ray_polygon_time).
 //
@@ -47,19 +50,31 @@
 // the best time may still hold an equal-time member with a smaller id. The queue is ordered by
 // (bound, min_key) and the search stops when its smallest entry is skipped (nothing later can
 // win). Order (leaf_queue, default): (1) overlaps first: an agent overlapping a now wins outright
-// (time 0, agents first), and finding the smallest such id needs only the t = 0 box test and
-// ray_disc_time's own overlap test (c < 0): at the E1 density ~90% of agents end here;
-// (2) otherwise a's own leaf is scanned (its neighbours give an early best time), then the path
-// is walked up to the root: each sibling's bound goes into the queue; the walk stops once every
-// position from which a member could still reach a before the best time (a's centre
+// (time 0, agents first), and finding the smallest such (id, row) needs only t = 0 tests: at the
+// E1 density ~90% of agents end here. It runs set-at-a-time, leaf by leaf (overlap_join): a walk
+// from the root collects the members of every leaf whose t = 0 box lies within Chebyshev
+// distance r_max(leaf) + r_max(other) of the leaf's box, keeping those within r_max(leaf) + r_b
+// of it (the boxes carry the delta0 inflation, so rounding cannot drop an overlapping member);
+// then every member of the leaf is tested against all of them with ray_disc_time's own overlap
+// term (c = |d|^2 - R^2 < 0, the same expression, so the same bits) in a loop the compiler
+// vectorizes, and the overlapping ones (a few) are compared by (id, row). Queries run in tree
+// order, so the join runs once per leaf (~37 tests per agent at the E1 density, no queue, no
+// unpredictable branches). With overlap_join off, the same answer comes from the tree search
+// below with t = 0 bounds. (2) otherwise a's own leaf is scanned (its neighbours give an early best
+// time), then the path is walked up to the root: each sibling's bound goes into the queue; the walk
+// stops once every position from which a member could still reach a before the best time (a's
+// centre
 // +- R_max + (|v_a| + v_max) cap per axis) lies strictly inside the cell below: all other members
 // lie outside that cell. (3) The queue is searched in bound order, descending into the child with
 // the smaller bound and queueing the other. Any visiting order is exact; the order only changes
 // the work. Leaves stop scanning at the first key that cannot win any more.
 //
-// COMPLEXITY. Build O(n log n) (nth_element per level) plus O(n K) for the kinetic bounds;
-// memory O(n / leaf * K) aggregates and three arrays of n ints. A query costs O(log n) node
-// visits when a collision is found nearby (the usual case); in the worst case (no collision
+// COMPLEXITY. Build O(n log n): a median split per level; large ranges are first cut by two
+// sample quantiles bracketing the median in one branch-free pass, and only the middle part goes to
+// nth_element (whose comparisons are unpredictable branches); plus O(n K) for the kinetic
+// bounds. Memory O(n / leaf * K) aggregates, the members' copy (56 bytes each) and three arrays
+// of n ints. The overlap join costs O(leaf) tests per agent at a fixed density. A query costs O(log
+// n) node visits when a collision is found nearby (the usual case); in the worst case (no collision
 // within the horizon and bounds that cannot prune, e.g. sparse worlds with fast random
 // velocities, whose nodes all carry the full velocity spread) it is O(n), as the naive loop.
 // Splitting velocities as well as positions (a 4-d tree) was tried and measured, and dropped:
