@@ -157,6 +157,7 @@ struct Scratch {
   std::vector<uint32_t> cpos, pick, hit;  // candidates' positions in tree order
   uint32_t leaf = kNone;
   std::size_t ncand = 0;      // candidates of that leaf (the member itself included)
+  bool crowded = false;       // more than the join's cap: that leaf uses the tree search
   uint64_t join_visited = 0;  // nodes its walk visited
 };
 
@@ -645,6 +646,10 @@ template <class Src>
 void KineticTree<Src>::leaf_overlaps(uint32_t leaf, Scratch& sc) const {
   std::size_t n = 0;  // candidates so far, in sc.cx[0, n) etc.
   sc.join_visited = 0;
+  sc.crowded = false;
+  // In a crowd (everyone within reach of everyone) the join would cost O(n) per agent, while the
+  // tree search, pruning by smallest key, stays cheap: past the cap, the leaf falls back to it.
+  const std::size_t cap = std::max<std::size_t>(256, 16 * leaf_size_);
   // Slice 0 of every node starts with its inflated box at t = 0 (chord and frustum alike).
   const Slice& L = slices_[leaf];
   const double rl = nodes_[leaf].rmax;
@@ -678,6 +683,11 @@ void KineticTree<Src>::leaf_overlaps(uint32_t leaf, Scratch& sc) const {
       const double fx = m.x - ox, fy = m.y - oy, rb = m.r;
       cpos[n] = i;
       n += (fx >= lx0 - rb) & (fx <= lx1 + rb) & (fy >= ly0 - rb) & (fy <= ly1 + rb);
+    }
+    if (n > cap) {
+      sc.crowded = true;
+      sc.ncand = 0;
+      return;
     }
   }
   sc.ncand = n;
@@ -865,9 +875,14 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, Scratch& sc, Counters& 
     }
     const uint32_t begin = agent_tree.leaf_begin(leaf);
     if (pos == begin) c.visited += sc.join_visited;
-    c.pair_tests += sc.ncand - 1;
-    const uint32_t hit = sc.hit[pos - begin];
-    if (hit != kNone) return {{Kind::agent, hit}, 0.0};
+    if (sc.crowded) {  // a crowd: the tree search below instead
+      agent_tree.search<true>(q, horizon, best, sc, c, opt.order, pos, opt.seed_own_leaf);
+      if (best.kind != Kind::none) return {{best.kind, best.row}, best.t};
+    } else {
+      c.pair_tests += sc.ncand - 1;
+      const uint32_t hit = sc.hit[pos - begin];
+      if (hit != kNone) return {{Kind::agent, hit}, 0.0};
+    }
   } else if (opt.overlaps_first) {
     // The same answer through the tree search in the chosen order, t = 0 checks only.
     agent_tree.search<true>(q, horizon, best, sc, c, opt.order, pos, opt.seed_own_leaf);

@@ -145,6 +145,18 @@ TEST(FtcIndex, EmptyAndTinyTables) {
   for (const Opt& o : all_options()) EXPECT_EQ(compare(t, kNoScene, 30, o), 0);
 }
 
+// Everyone within reach of everyone: the overlap join gives up (its cap) and the tree search
+// answers; both must agree with the naive loop, with and without the join.
+TEST(FtcIndex, CrowdFallsBackFromTheJoin) {
+  const DiscTable t = build::uniform(1500, {0, 0, 4, 4}, 5, 1, 3, 7);
+  for (bool join : {true, false}) {
+    QueryStats st;
+    EXPECT_EQ(compare(t, kNoScene, 30, {.overlap_join = join}, 1, &st), 0) << join;
+    // The join would test every pair (n^2 = 2.25e6); the fallback prunes by smallest id.
+    EXPECT_LT(st.pair_tests, 1500u * 1499u / 4) << join;
+  }
+}
+
 TEST(FtcIndex, UniformE1Setup) {
   for (uint64_t seed : {1, 2, 3}) {
     const DiscTable t = build::uniform(2000, {}, 50, 1, 3, seed);
