@@ -191,9 +191,8 @@ void sizes(benchmark::internal::Benchmark* b, std::initializer_list<int64_t> ns,
 BENCHMARK(BM_Repetitions)->Apply([](auto* b) {
                            sizes(b, {1000, 10000, 100000, 1000000});
                          }) -> Unit(benchmark::kMillisecond);
-BENCHMARK(BM_RepetitionsPlainWalk)->Apply([](auto* b) {
-                                    sizes(b, {1000000});
-                                  }) -> Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RepetitionsPlainWalk)
+    ->Apply([](auto* b) { sizes(b, {1000000}); }) -> Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadAndRepetitions)
     ->Apply([](auto* b) {
       for (int64_t shape : {0, 2})

@@ -114,8 +114,7 @@ class Graph {
   template <class KeyOf>
   static int64_t flat_find(const FlatIndex& t, std::string_view key, KeyOf&& key_of);
   template <class KeyOf>
-  static int64_t flat_find(const FlatIndex& t, std::string_view key, uint64_t hash,
-                           KeyOf&& key_of);
+  static int64_t flat_find(const FlatIndex& t, std::string_view key, uint64_t hash, KeyOf&& key_of);
   template <class KeyOf>
   static void flat_insert(FlatIndex& t, uint32_t id, uint64_t hash, KeyOf&& key_of);
   template <class KeyOf>

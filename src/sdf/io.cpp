@@ -1,14 +1,14 @@
 #include "sdf/io.hpp"
 
-#include <cerrno>
-#include <cstring>
-#include <fstream>
-#include <sstream>
-
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
 
 namespace sdf {
 
@@ -73,7 +73,6 @@ Graph read_graph_file(const std::string& path) {
   if (in.bad()) throw Error(Error::Kind::io, path + ": read error");
   return parse_graph_text(std::move(buf).str(), path);
 }
-
 
 std::string write_dot(const Graph& g) {
   std::string out = "digraph " + quoted(g.name.empty() ? "sdf" : g.name) + " {\n";

@@ -8,12 +8,11 @@
 // accepts (tests/sdf/io_test.cpp compares them on random and mutated texts), so the graph and
 // its errors do not depend on which reader ran. Channels are kept as names until the end
 // because the "channels" array may come before "actors".
-#include "sdf/json_detail.hpp"
-
 #include <nlohmann/json.hpp>
 #include <set>
 
 #include "sdf/io.hpp"
+#include "sdf/json_detail.hpp"
 
 namespace sdf {
 
@@ -208,9 +207,7 @@ struct Parsed {
 // The graph from parsed names; the errors found only once everything is read (duplicate
 // actors, unknown actors, duplicate channel names).
 Graph build(Parsed& p, const std::string& source) {
-  auto fail = [&](const std::string& msg) {
-    throw Error(Error::Kind::input, source + ": " + msg);
-  };
+  auto fail = [&](const std::string& msg) { throw Error(Error::Kind::input, source + ": " + msg); };
   Graph g;
   g.name = std::move(p.graph_name);
   g.reserve(p.actors.size(), p.channels.size());
@@ -351,8 +348,8 @@ class Scanner {
     if (peek_is(']')) return true;
     do {
       std::string_view k, v;
-      if (!skip_to('{') || !string(k) || k != "name" || !skip_to(':') || !string(v) ||
-          v.empty() || !skip_to('}'))
+      if (!skip_to('{') || !string(k) || k != "name" || !skip_to(':') || !string(v) || v.empty() ||
+          !skip_to('}'))
         return false;
       out.actors.push_back(v);
     } while (peek_is(','));

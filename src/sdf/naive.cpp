@@ -107,7 +107,6 @@ Repetitions repetitions(const Graph& g) {
   return r;
 }
 
-
 std::vector<uint64_t> max_run(const Graph& g, std::span<const uint64_t> q, crowddb::Rng& rng) {
   std::vector<uint64_t> tokens = g.delays(), count(g.actor_count(), 0);
   for (;;) {

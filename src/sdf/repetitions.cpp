@@ -37,7 +37,6 @@ struct Visit {
   Fraction f;
 };
 
-
 // Non-throwing twin of scale(): false when a product does not fit.
 bool scale_to(Fraction f, uint64_t a, uint64_t b, Fraction& out) {
   const uint64_t g = std::gcd(a, b);
@@ -138,7 +137,8 @@ std::optional<std::vector<uint64_t>> union_find_vector(const Graph& g) {
     Fraction x;
     if (!uf.find(v, r, x)) return std::nullopt;
     uint64_t& l = lcm[r];
-    if (x.den != 1 && __builtin_mul_overflow(l / std::gcd(l, x.den), x.den, &l)) return std::nullopt;
+    if (x.den != 1 && __builtin_mul_overflow(l / std::gcd(l, x.den), x.den, &l))
+      return std::nullopt;
   }
   for (uint32_t v = 0; v < n; ++v) {
     const UnionFind::Node& node = uf.nodes[v];  // the root itself: parent v, rel 1/1
