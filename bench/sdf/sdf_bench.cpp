@@ -15,6 +15,7 @@
 
 #include "sdf/generate.hpp"
 #include "sdf/io.hpp"
+#include "sdf/naive.hpp"
 #include "sdf/online.hpp"
 #include "sdf/repetitions.hpp"
 #include "sdf/schedule.hpp"
@@ -62,6 +63,22 @@ void BM_Repetitions(benchmark::State& state) {
   uint64_t sum = 0;
   for (auto _ : state) {
     const sdf::Repetitions r = sdf::compute_repetitions(gg.graph);
+    if (!r.consistent || r.q != gg.q) state.SkipWithError("wrong repetitions vector");
+    sum = checksum(r.q);
+    benchmark::DoNotOptimize(sum);
+  }
+  state.counters["checksum"] = static_cast<double>(sum % 1000000);
+  state.SetItemsProcessed(state.iterations() * state.range(1));
+  set_label(state, shape);
+}
+
+// The plain walk (naive::repetitions, the first implementation), for the ratio in one run.
+void BM_RepetitionsPlainWalk(benchmark::State& state) {
+  const int shape = static_cast<int>(state.range(0));
+  const auto& gg = graph(shape, static_cast<uint32_t>(state.range(1)));
+  uint64_t sum = 0;
+  for (auto _ : state) {
+    const sdf::Repetitions r = sdf::naive::repetitions(gg.graph);
     if (!r.consistent || r.q != gg.q) state.SkipWithError("wrong repetitions vector");
     sum = checksum(r.q);
     benchmark::DoNotOptimize(sum);
@@ -174,6 +191,8 @@ void sizes(benchmark::internal::Benchmark* b, std::initializer_list<int64_t> ns,
 BENCHMARK(BM_Repetitions)->Apply([](auto* b) {
                            sizes(b, {1000, 10000, 100000, 1000000});
                          }) -> Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RepetitionsPlainWalk)
+    ->Apply([](auto* b) { sizes(b, {1000000}); }) -> Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadAndRepetitions)
     ->Apply([](auto* b) {
       for (int64_t shape : {0, 2})

@@ -104,6 +104,7 @@ class OnlineScheduler {
   void recompute_key(ActorId a);
   Entry entry(ActorId a) const;
   bool better(const Entry& x, const Entry& y) const;
+  bool better_exact(const Entry& x, const Entry& y) const;
   void heap_push(ActorId a);
   void list_insert(ActorId a);
   void list_remove(ActorId a);

@@ -1,11 +1,15 @@
 // The repetitions vector: the smallest positive integers q with q[src]·prd = q[dst]·cns on every
 // channel, per connected component (thesis 5.2.1, the Ptolemy algorithm).
 //
-// Rational propagation: a depth-first walk gives each actor a reduced fraction relative to the
-// component's first actor, the fractions are scaled by the lcm of their denominators, then every
-// channel's balance equation is checked. O(V + E) per component with 64-bit checked arithmetic:
-// every intermediate numerator and denominator is bounded by the largest entry of the result, so
-// an overflow means the answer itself does not fit and is reported as Error(overflow).
+// Rational propagation: a union-find over the channels in file order keeps each actor's
+// q / q_root as a reduced fraction; when the graph is consistent and every count fits, the
+// fractions scaled by the lcm of their denominators are the answer (unique, whatever forest
+// found it). Otherwise a depth-first walk from each component's lowest actor gives each actor a
+// fraction relative to that actor, the fractions are scaled, then every channel's balance
+// equation is checked: the walk's spanning tree defines the failing channel and its two sides.
+// O(V + E) per component with 64-bit checked arithmetic: every intermediate numerator and
+// denominator is bounded by the largest entry of the result, so an overflow means the answer
+// itself does not fit and is reported as Error(overflow).
 //
 // Thread-safety: pure function.
 #pragma once

@@ -1,15 +1,11 @@
 #include "sdf/graph.hpp"
 
 #include <algorithm>
-#include <functional>
+#include <cstring>
 
 namespace sdf {
 
 namespace {
-
-size_t hash_of(std::string_view s) {
-  return std::hash<std::string_view>{}(s);
-}
 
 uint64_t mix64(uint64_t z) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -17,62 +13,138 @@ uint64_t mix64(uint64_t z) {
   return z ^ (z >> 31);
 }
 
+// Names are short: eight bytes at a time, then the tail, then a full mix (low bits index the
+// table, high bits are the slot's tag).
+uint64_t hash_of(std::string_view s) {
+  uint64_t h = 0x9e3779b97f4a7c15ull ^ s.size();
+  size_t i = 0;
+  for (; i + 8 <= s.size(); i += 8) {
+    uint64_t w;
+    std::memcpy(&w, s.data() + i, 8);
+    h = (h ^ w) * 0xff51afd7ed558ccdull;
+    h ^= h >> 32;
+  }
+  uint64_t w = 0;
+  if (i < s.size()) std::memcpy(&w, s.data() + i, s.size() - i);
+  return mix64(h ^ w);
+}
+
+constexpr uint64_t tag_of(uint64_t hash) {
+  return hash & 0xffffffff00000000ull;
+}
+
+// A prefetch hint. On x86-64 as inline assembly: GCC 12 silently dropped __builtin_prefetch
+// from some of the loops below (seen in the disassembly).
+inline void prefetch(const void* p) {
+#if defined(__x86_64__)
+  asm volatile("prefetcht0 (%0)" : : "r"(p));
+#else
+  __builtin_prefetch(p);  // NOLINT
+#endif
+}
+
+size_t table_size_for(size_t entries) {
+  size_t cap = 16;
+  while (cap < 2 * entries) cap *= 2;  // load factor at most 1/2
+  return cap;
+}
+
 }  // namespace
 
 template <class KeyOf>
 int64_t Graph::flat_find(const FlatIndex& t, std::string_view key, KeyOf&& key_of) {
+  return flat_find(t, key, hash_of(key), key_of);
+}
+
+template <class KeyOf>
+int64_t Graph::flat_find(const FlatIndex& t, std::string_view key, uint64_t h, KeyOf&& key_of) {
   if (t.slots.empty()) return -1;
   const size_t mask = t.slots.size() - 1;
-  for (size_t i = hash_of(key) & mask;; i = (i + 1) & mask) {
-    const uint32_t v = t.slots[i];
+  const uint64_t tag = tag_of(h);
+  for (size_t i = h & mask;; i = (i + 1) & mask) {
+    const uint64_t v = t.slots[i];
     if (v == 0) return -1;
-    if (key_of(v - 1) == key) return v - 1;
+    const auto id = static_cast<uint32_t>(v) - 1;
+    if (tag_of(v) == tag && key_of(id) == key) return id;
   }
 }
 
 template <class KeyOf>
-void Graph::flat_insert(FlatIndex& t, uint32_t id, KeyOf&& key_of) {
-  if (2 * (t.size + 1) > t.slots.size()) {  // load factor at most 1/2
-    std::vector<uint32_t> old = std::move(t.slots);
-    t.slots.assign(std::max<size_t>(16, old.size() * 2), 0);
-    const size_t mask = t.slots.size() - 1;
-    for (uint32_t v : old) {
-      if (v == 0) continue;
-      size_t i = hash_of(key_of(v - 1)) & mask;
-      while (t.slots[i] != 0) i = (i + 1) & mask;
-      t.slots[i] = v;
-    }
+void Graph::flat_rehash(FlatIndex& t, size_t capacity, KeyOf&& key_of) {
+  std::vector<uint64_t> old = std::move(t.slots);
+  t.slots.assign(capacity, 0);
+  const size_t mask = capacity - 1;
+  for (uint64_t v : old) {
+    if (v == 0) continue;
+    size_t i = hash_of(key_of(static_cast<uint32_t>(v) - 1)) & mask;
+    while (t.slots[i] != 0) i = (i + 1) & mask;
+    t.slots[i] = v;
   }
+}
+
+template <class KeyOf>
+void Graph::flat_insert(FlatIndex& t, uint32_t id, uint64_t hash, KeyOf&& key_of) {
+  if (2 * (t.size + 1) > t.slots.size())
+    flat_rehash(t, std::max<size_t>(16, t.slots.size() * 2), key_of);
   const size_t mask = t.slots.size() - 1;
-  size_t i = hash_of(key_of(id)) & mask;
+  size_t i = hash & mask;
   while (t.slots[i] != 0) i = (i + 1) & mask;
-  t.slots[i] = id + 1;
+  t.slots[i] = tag_of(hash) | (static_cast<uint64_t>(id) + 1);
   ++t.size;
 }
 
-uint32_t Graph::next_parallel_index(uint64_t pair) {
-  if (2 * (pair_size_ + 1) > pair_keys_.size()) {
-    std::vector<uint64_t> keys = std::move(pair_keys_);
-    std::vector<uint32_t> counts = std::move(pair_counts_);
-    const size_t cap = std::max<size_t>(16, keys.size() * 2);
-    pair_keys_.assign(cap, UINT64_MAX);  // (src, dst) never both 2^32 - 1: a free marker
-    pair_counts_.assign(cap, 0);
-    for (size_t j = 0; j < keys.size(); ++j) {
-      if (keys[j] == UINT64_MAX) continue;
-      size_t i = mix64(keys[j]) & (cap - 1);
-      while (pair_keys_[i] != UINT64_MAX) i = (i + 1) & (cap - 1);
-      pair_keys_[i] = keys[j];
-      pair_counts_[i] = counts[j];
-    }
+void Graph::pair_rehash(size_t capacity) {
+  std::vector<PairCount> old = std::move(pairs_);
+  pairs_.assign(capacity, PairCount{UINT64_MAX, 0});
+  for (const PairCount& p : old) {
+    if (p.key == UINT64_MAX) continue;
+    size_t i = mix64(p.key) & (capacity - 1);
+    while (pairs_[i].key != UINT64_MAX) i = (i + 1) & (capacity - 1);
+    pairs_[i] = p;
   }
-  const size_t mask = pair_keys_.size() - 1;
+}
+
+size_t Graph::pair_slot(uint64_t pair) {
+  if (2 * (pair_size_ + 1) > pairs_.size()) pair_rehash(std::max<size_t>(16, pairs_.size() * 2));
+  const size_t mask = pairs_.size() - 1;
   size_t i = mix64(pair) & mask;
-  while (pair_keys_[i] != UINT64_MAX && pair_keys_[i] != pair) i = (i + 1) & mask;
-  if (pair_keys_[i] == UINT64_MAX) {
-    pair_keys_[i] = pair;
+  while (pairs_[i].key != UINT64_MAX && pairs_[i].key != pair) i = (i + 1) & mask;
+  if (pairs_[i].key == UINT64_MAX) {
+    pairs_[i].key = pair;
     ++pair_size_;
   }
-  return pair_counts_[i]++;
+  return i;
+}
+
+uint32_t Graph::next_parallel_index(uint64_t pair) {
+  return static_cast<uint32_t>(pairs_[pair_slot(pair)].count++);
+}
+
+std::string Graph::default_name(ActorId src, ActorId dst, uint64_t k) const {
+  std::string s;
+  s.reserve(actor_names_[src].size() + actor_names_[dst].size() + 8);
+  s += actor_names_[src];
+  s += "->";
+  s += actor_names_[dst];
+  s += '#';
+  s += std::to_string(k);
+  return s;
+}
+
+void Graph::reserve(size_t actors, size_t channels) {
+  actor_names_.reserve(actors);
+  channels_.reserve(channels);
+  reserve_tables(actors, channels);
+}
+
+void Graph::reserve_tables(size_t actors, size_t channels) {
+  auto actor_name = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
+  auto channel_name = [this](uint32_t c) -> std::string_view { return channels_[c].name; };
+  if (table_size_for(actors) > actor_index_.slots.size())
+    flat_rehash(actor_index_, table_size_for(actors), actor_name);
+  if (table_size_for(channels) > channel_index_.slots.size())
+    flat_rehash(channel_index_, table_size_for(channels), channel_name);
+  if (table_size_for(channels) > pairs_.size()) pair_rehash(table_size_for(channels));
 }
 
 ActorId Graph::add_actor(std::string actor_name) {
@@ -80,11 +152,36 @@ ActorId Graph::add_actor(std::string actor_name) {
   if (actor_names_.size() >= UINT32_MAX) throw Error(Error::Kind::input, "too many actors");
   const auto id = static_cast<ActorId>(actor_names_.size());
   auto name_of = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
-  if (flat_find(actor_index_, actor_name, name_of) >= 0)
+  const uint64_t h = hash_of(actor_name);
+  if (flat_find(actor_index_, actor_name, h, name_of) >= 0)
     throw Error(Error::Kind::input, "duplicate actor name '" + actor_name + "'");
   actor_names_.push_back(std::move(actor_name));
-  flat_insert(actor_index_, id, name_of);
+  flat_insert(actor_index_, id, h, name_of);
   return id;
+}
+
+size_t Graph::add_actors(std::span<const std::string_view> names) {
+  reserve_tables(actor_names_.size() + names.size(), channels_.size());  // no rehash below
+  auto name_of = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
+  constexpr size_t kAhead = 8;
+  uint64_t hashes[kAhead];
+  const size_t mask = actor_index_.slots.size() - 1;
+  auto ahead = [&](size_t i) {
+    hashes[i % kAhead] = hash_of(names[i]);
+    prefetch(&actor_index_.slots[hashes[i % kAhead] & mask]);
+  };
+  for (size_t i = 0; i < std::min(names.size(), kAhead); ++i) ahead(i);
+  for (size_t i = 0; i < names.size(); ++i) {
+    const uint64_t h = hashes[i % kAhead];
+    if (i + kAhead < names.size()) ahead(i + kAhead);
+    if (names[i].empty() || actor_names_.size() >= UINT32_MAX ||
+        flat_find(actor_index_, names[i], h, name_of) >= 0)
+      return i;
+    const auto id = static_cast<ActorId>(actor_names_.size());
+    actor_names_.emplace_back(names[i]);
+    flat_insert(actor_index_, id, h, name_of);
+  }
+  return names.size();
 }
 
 ChannelId Graph::add_channel(ActorId src, ActorId dst, uint64_t prd, uint64_t cns, uint64_t delay,
@@ -95,17 +192,11 @@ ChannelId Graph::add_channel(ActorId src, ActorId dst, uint64_t prd, uint64_t cn
   if (channels_.size() >= UINT32_MAX) throw Error(Error::Kind::input, "too many channels");
   const uint64_t pair = (static_cast<uint64_t>(src) << 32) | dst;
   const uint32_t k = next_parallel_index(pair);
-  if (channel_name.empty()) {
-    channel_name.reserve(actor_names_[src].size() + actor_names_[dst].size() + 8);
-    channel_name += actor_names_[src];
-    channel_name += "->";
-    channel_name += actor_names_[dst];
-    channel_name += '#';
-    channel_name += std::to_string(k);
-  }
+  if (channel_name.empty()) channel_name = default_name(src, dst, k);
   const auto id = static_cast<ChannelId>(channels_.size());
   auto name_of = [this](uint32_t c) -> std::string_view { return channels_[c].name; };
-  if (flat_find(channel_index_, channel_name, name_of) >= 0)
+  const uint64_t h = hash_of(channel_name);
+  if (flat_find(channel_index_, channel_name, h, name_of) >= 0)
     throw Error(Error::Kind::input, "duplicate channel name '" + channel_name + "'");
   Channel c;
   c.src = src;
@@ -115,8 +206,84 @@ ChannelId Graph::add_channel(ActorId src, ActorId dst, uint64_t prd, uint64_t cn
   c.delay = delay;
   c.name = std::move(channel_name);
   channels_.push_back(std::move(c));
-  flat_insert(channel_index_, id, name_of);
+  flat_insert(channel_index_, id, h, name_of);
   return id;
+}
+
+size_t Graph::add_channels(std::span<const NewChannel> cs) {
+  reserve_tables(actor_names_.size(), channels_.size() + cs.size());  // no rehash below
+  auto name_of = [this](uint32_t c) -> std::string_view { return channels_[c].name; };
+  // Three stages kAhead channels apart, each in channel order: prefetch the (src, dst) slot;
+  // take the parallel index k from it (so the name is known), hash the name and prefetch its
+  // slot; insert. A channel that fails is reached by the last stage after the middle stage has
+  // counted up to kAhead later channels: those counts are taken back.
+  constexpr size_t kAhead = 8, kRing = 2 * kAhead;
+  struct Pending {
+    std::string name;
+    uint64_t hash = 0;
+    size_t pair_slot = 0;
+  };
+  Pending ring[kRing];
+  const size_t n = cs.size();
+  auto valid = [&](const NewChannel& c) {
+    return c.src < actor_count() && c.dst < actor_count() && c.prd != 0 && c.cns != 0;
+  };
+  auto pair_of = [](const NewChannel& c) { return (static_cast<uint64_t>(c.src) << 32) | c.dst; };
+  auto stage1 = [&](size_t i) {
+    if (!valid(cs[i])) return;
+    prefetch(pairs_.data() + (mix64(pair_of(cs[i])) & (pairs_.size() - 1)));
+    if (cs[i].name.empty()) {  // the default name is made of the two actor names
+      prefetch(&actor_names_[cs[i].src]);
+      prefetch(&actor_names_[cs[i].dst]);
+    }
+  };
+  size_t counted = 0;  // channels [0, counted) went through stage 2
+  auto stage2 = [&](size_t i) {
+    // Stops at an invalid channel: stage 3 returns there, and nothing after it is counted.
+    if (!valid(cs[i])) return false;
+    Pending& p = ring[i % kRing];
+    p.pair_slot = pair_slot(pair_of(cs[i]));
+    const uint64_t k = pairs_[p.pair_slot].count++;
+    counted = i + 1;
+    if (cs[i].name.empty()) {
+      p.name = default_name(cs[i].src, cs[i].dst, k);
+    } else {
+      p.name.assign(cs[i].name);
+    }
+    p.hash = hash_of(p.name);
+    prefetch(&channel_index_.slots[p.hash & (channel_index_.slots.size() - 1)]);
+    return true;
+  };
+  auto undo = [&](size_t from) {
+    for (size_t j = from; j < counted; ++j) --pairs_[ring[j % kRing].pair_slot].count;
+  };
+  for (size_t i = 0; i < std::min(n, 2 * kAhead); ++i) stage1(i);
+  bool stage2_open = true;
+  for (size_t i = 0; i < std::min(n, kAhead) && stage2_open; ++i) stage2_open = stage2(i);
+  for (size_t i = 0; i < n; ++i) {
+    if (i >= counted || channels_.size() >= UINT32_MAX) {  // invalid: left to add_channel
+      undo(i);
+      return i;
+    }
+    Pending& p = ring[i % kRing];
+    if (flat_find(channel_index_, p.name, p.hash, name_of) >= 0) {
+      undo(i);
+      return i;
+    }
+    const auto id = static_cast<ChannelId>(channels_.size());
+    Channel c;
+    c.src = cs[i].src;
+    c.dst = cs[i].dst;
+    c.prd = cs[i].prd;
+    c.cns = cs[i].cns;
+    c.delay = cs[i].delay;
+    c.name = std::move(p.name);
+    channels_.push_back(std::move(c));
+    flat_insert(channel_index_, id, p.hash, name_of);
+    if (i + 2 * kAhead < n) stage1(i + 2 * kAhead);
+    if (stage2_open && i + kAhead < n) stage2_open = stage2(i + kAhead);
+  }
+  return n;
 }
 
 void Graph::set_rates(ChannelId c, uint64_t prd, uint64_t cns) {
@@ -135,6 +302,34 @@ std::optional<ActorId> Graph::find_actor(std::string_view actor) const {
                               [this](uint32_t i) -> std::string_view { return actor_names_[i]; });
   if (a < 0) return std::nullopt;
   return static_cast<ActorId>(a);
+}
+
+void Graph::find_actors(std::span<const std::string_view> names, std::span<int64_t> ids) const {
+  auto name_of = [this](uint32_t i) -> std::string_view { return actor_names_[i]; };
+  if (actor_index_.slots.empty()) {
+    std::fill(ids.begin(), ids.end(), -1);
+    return;
+  }
+  // Three stages, kAhead names apart: hash and prefetch the slot; read the slot and prefetch the
+  // name it points to; probe (now mostly from cache).
+  constexpr size_t kAhead = 8, kRing = 32;
+  uint64_t hashes[kRing];
+  const size_t n = names.size(), mask = actor_index_.slots.size() - 1;
+  auto stage1 = [&](size_t i) {
+    hashes[i % kRing] = hash_of(names[i]);
+    prefetch(&actor_index_.slots[hashes[i % kRing] & mask]);
+  };
+  auto stage2 = [&](size_t i) {
+    const uint64_t v = actor_index_.slots[hashes[i % kRing] & mask];
+    if (v != 0) prefetch(&actor_names_[static_cast<uint32_t>(v) - 1]);
+  };
+  for (size_t i = 0; i < std::min(n, 2 * kAhead); ++i) stage1(i);
+  for (size_t i = 0; i < std::min(n, kAhead); ++i) stage2(i);
+  for (size_t i = 0; i < n; ++i) {
+    if (i + 2 * kAhead < n) stage1(i + 2 * kAhead);
+    if (i + kAhead < n) stage2(i + kAhead);
+    ids[i] = flat_find(actor_index_, names[i], hashes[i % kRing], name_of);
+  }
 }
 
 std::optional<ChannelId> Graph::find_channel(std::string_view channel_name) const {

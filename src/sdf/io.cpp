@@ -1,5 +1,10 @@
 #include "sdf/io.hpp"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -27,15 +32,7 @@ std::string quoted(const std::string& s) {
   return out + "\"";
 }
 
-}  // namespace
-
-Graph read_graph_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(Error::Kind::io, path + ": cannot open (" + std::strerror(errno) + ")");
-  std::ostringstream buf;
-  buf << in.rdbuf();
-  if (in.bad()) throw Error(Error::Kind::io, path + ": read error");
-  const std::string text = std::move(buf).str();
+Graph parse_graph_text(std::string_view text, const std::string& path) {
   if (ends_with(path, ".xml")) return read_sdf3(text, path);
   if (ends_with(path, ".json")) return read_json(text, path);
   for (char c : text) {
@@ -45,6 +42,36 @@ Graph read_graph_file(const std::string& path) {
   }
   throw Error(Error::Kind::input,
               path + ":1: not a graph file (expected SDF3 XML or the JSON form, .xml or .json)");
+}
+
+}  // namespace
+
+Graph read_graph_file(const std::string& path) {
+  // A regular file is mapped rather than copied into a string (a 100 MB file costs a copy and
+  // the page faults of a fresh buffer otherwise); anything else (a pipe, an empty file) is read.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw Error(Error::Kind::io, path + ": cannot open (" + std::strerror(errno) + ")");
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+    const auto size = static_cast<size_t>(st.st_size);
+    void* p = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    ::close(fd);
+    if (p == MAP_FAILED)
+      throw Error(Error::Kind::io, path + ": cannot map (" + std::strerror(errno) + ")");
+    struct Unmap {
+      void* p;
+      size_t size;
+      ~Unmap() { ::munmap(p, size); }
+    } unmap{p, size};
+    return parse_graph_text(std::string_view(static_cast<const char*>(p), size), path);
+  }
+  ::close(fd);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(Error::Kind::io, path + ": cannot open (" + std::strerror(errno) + ")");
+  std::ostringstream buf;
+  buf << in.rdbuf();
+  if (in.bad()) throw Error(Error::Kind::io, path + ": read error");
+  return parse_graph_text(std::move(buf).str(), path);
 }
 
 std::string write_dot(const Graph& g) {

@@ -1,10 +1,18 @@
-// The JSON form, read with nlohmann's SAX interface straight into the graph: no document tree,
-// so a 10^6-actor file loads in one pass. Channels are kept as names until the end because the
-// "channels" array may come before "actors".
+// The JSON form. Two readers feed the same graph-building step:
+//  - a direct scanner for the plain form (ASCII strings without escapes, non-negative integers,
+//    the known fields each at most once, nothing missing): one pass over the bytes, names kept as
+//    views into the text. It does not report errors: on anything else it gives up, and
+//  - nlohmann's SAX interface (no document tree) reads the text again, accepting what JSON
+//    allows and producing every error message (line and column, field).
+// Both produce the same actor names and channels in the same order for every text the scanner
+// accepts (tests/sdf/io_test.cpp compares them on random and mutated texts), so the graph and
+// its errors do not depend on which reader ran. Channels are kept as names until the end
+// because the "channels" array may come before "actors".
 #include <nlohmann/json.hpp>
 #include <set>
 
 #include "sdf/io.hpp"
+#include "sdf/json_detail.hpp"
 
 namespace sdf {
 
@@ -183,31 +191,242 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
 
 }  // namespace
 
-Graph read_json(std::string_view text, const std::string& source) {
+namespace {
+
+struct ChannelView {
+  std::string_view src, dst, name;
+  uint64_t prd = 0, cns = 0, delay = 0;
+};
+
+struct Parsed {
+  std::string graph_name;
+  std::vector<std::string_view> actors;
+  std::vector<ChannelView> channels;
+};
+
+// The graph from parsed names; the errors found only once everything is read (duplicate
+// actors, unknown actors, duplicate channel names).
+Graph build(Parsed& p, const std::string& source) {
+  auto fail = [&](const std::string& msg) { throw Error(Error::Kind::input, source + ": " + msg); };
+  Graph g;
+  g.name = std::move(p.graph_name);
+  g.reserve(p.actors.size(), p.channels.size());
+  if (const size_t i = g.add_actors(p.actors); i < p.actors.size())
+    fail("actors[" + std::to_string(i) + "].name: duplicate actor name '" +
+         std::string(p.actors[i]) + "'");
+  // A block at a time: resolve the names (Graph::find_actors overlaps the probes), add the
+  // channels before the first unknown name, then report the first failure in file order.
+  constexpr size_t kBlock = 4096;
+  std::vector<std::string_view> names;
+  std::vector<int64_t> ids(2 * kBlock);
+  std::vector<Graph::NewChannel> batch;
+  names.reserve(2 * kBlock);
+  batch.reserve(kBlock);
+  for (size_t b = 0; b < p.channels.size(); b += kBlock) {
+    const size_t end = std::min(p.channels.size(), b + kBlock);
+    names.clear();
+    for (size_t i = b; i < end; ++i) {
+      names.push_back(p.channels[i].src);
+      names.push_back(p.channels[i].dst);
+    }
+    g.find_actors(names, std::span(ids).first(names.size()));
+    batch.clear();
+    for (size_t i = b; i < end && ids[2 * (i - b)] >= 0 && ids[2 * (i - b) + 1] >= 0; ++i) {
+      const ChannelView& c = p.channels[i];
+      batch.push_back({static_cast<ActorId>(ids[2 * (i - b)]),
+                       static_cast<ActorId>(ids[2 * (i - b) + 1]), c.prd, c.cns, c.delay, c.name});
+    }
+    const size_t added = g.add_channels(batch);
+    const size_t i = b + added;
+    if (i == end) continue;
+    const ChannelView& c = p.channels[i];
+    if (added < batch.size()) {  // rejected by the graph: add_channel says why
+      try {
+        g.add_channel(batch[added].src, batch[added].dst, c.prd, c.cns, c.delay,
+                      std::string(c.name));
+      } catch (const Error& e) {
+        fail("channels[" + std::to_string(i) + "]: " + e.what());
+      }
+    }
+    if (ids[2 * (i - b)] < 0)
+      fail("channels[" + std::to_string(i) + "].src: unknown actor '" + std::string(c.src) + "'");
+    fail("channels[" + std::to_string(i) + "].dst: unknown actor '" + std::string(c.dst) + "'");
+  }
+  return g;
+}
+
+// The direct scanner of the plain form; false as soon as the text leaves it.
+class Scanner {
+ public:
+  explicit Scanner(std::string_view text) : p_(text.data()), end_(text.data() + text.size()) {}
+
+  bool parse(Parsed& out) {
+    bool seen_actors = false, seen_channels = false, seen_name = false;
+    if (!skip_to('{')) return false;
+    if (!peek_is('}')) {
+      for (;;) {
+        std::string_view k;
+        if (!string(k) || !skip_to(':')) return false;
+        if (k == "actors") {
+          if (seen_actors) return false;
+          seen_actors = true;
+          if (!actors(out)) return false;
+        } else if (k == "channels") {
+          if (seen_channels) return false;
+          seen_channels = true;
+          if (!channels(out)) return false;
+        } else if (k == "name") {
+          std::string_view v;
+          if (seen_name || !string(v)) return false;
+          seen_name = true;
+          out.graph_name = v;
+        } else {
+          return false;
+        }
+        if (peek_is(',')) continue;
+        break;
+      }
+    }
+    if (!skip_to('}')) return false;
+    skip_space();
+    return p_ == end_ && seen_actors;
+  }
+
+ private:
+  void skip_space() {
+    while (p_ != end_ && (*p_ == ' ' || *p_ == '\n' || *p_ == '\r' || *p_ == '\t')) ++p_;
+  }
+  // Skips blanks and the character c.
+  bool skip_to(char c) {
+    skip_space();
+    if (p_ == end_ || *p_ != c) return false;
+    ++p_;
+    return true;
+  }
+  // Skips blanks, then c if it is next.
+  bool peek_is(char c) {
+    skip_space();
+    if (p_ != end_ && *p_ == c) {
+      ++p_;
+      return true;
+    }
+    return false;
+  }
+  // A string of printable ASCII without escapes.
+  bool string(std::string_view& out) {
+    if (!skip_to('"')) return false;
+    const char* start = p_;
+    while (p_ != end_ && *p_ != '"') {
+      const auto c = static_cast<unsigned char>(*p_);
+      if (c < 0x20 || c >= 0x80 || c == '\\') return false;
+      ++p_;
+    }
+    if (p_ == end_) return false;
+    out = std::string_view(start, static_cast<size_t>(p_ - start));
+    ++p_;
+    return true;
+  }
+  // A non-negative integer below 2^64 in JSON's form (no leading zeros, no fraction, no exponent).
+  bool number(uint64_t& out) {
+    skip_space();
+    if (p_ == end_ || *p_ < '0' || *p_ > '9') return false;
+    uint64_t v = 0;
+    const char* start = p_;
+    while (p_ != end_ && *p_ >= '0' && *p_ <= '9') {
+      if (__builtin_mul_overflow(v, uint64_t{10}, &v) ||
+          __builtin_add_overflow(v, static_cast<uint64_t>(*p_ - '0'), &v))
+        return false;
+      ++p_;
+    }
+    if (*start == '0' && p_ - start > 1) return false;
+    if (p_ != end_ && (*p_ == '.' || *p_ == 'e' || *p_ == 'E')) return false;
+    out = v;
+    return true;
+  }
+  bool actors(Parsed& out) {
+    if (!skip_to('[')) return false;
+    if (peek_is(']')) return true;
+    do {
+      std::string_view k, v;
+      if (!skip_to('{') || !string(k) || k != "name" || !skip_to(':') || !string(v) || v.empty() ||
+          !skip_to('}'))
+        return false;
+      out.actors.push_back(v);
+    } while (peek_is(','));
+    return skip_to(']');
+  }
+  bool channels(Parsed& out) {
+    if (!skip_to('[')) return false;
+    if (peek_is(']')) return true;
+    do {
+      if (!skip_to('{')) return false;
+      ChannelView c;
+      unsigned seen = 0;
+      do {
+        std::string_view k;
+        if (!string(k) || !skip_to(':')) return false;
+        unsigned bit;
+        bool ok;
+        if (k == "src") {
+          bit = 1, ok = string(c.src);
+        } else if (k == "dst") {
+          bit = 2, ok = string(c.dst);
+        } else if (k == "prd") {
+          bit = 4, ok = number(c.prd) && c.prd != 0;
+        } else if (k == "cns") {
+          bit = 8, ok = number(c.cns) && c.cns != 0;
+        } else if (k == "delay") {
+          bit = 16, ok = number(c.delay);
+        } else if (k == "name") {
+          bit = 32, ok = string(c.name) && !c.name.empty();
+        } else {
+          return false;
+        }
+        if (!ok || (seen & bit)) return false;
+        seen |= bit;
+      } while (peek_is(','));
+      if ((seen & 15) != 15 || !skip_to('}')) return false;
+      out.channels.push_back(c);
+    } while (peek_is(','));
+    return skip_to(']');
+  }
+
+  const char* p_;
+  const char* end_;
+};
+
+}  // namespace
+
+namespace detail {
+
+Graph read_json_sax(std::string_view text, const std::string& source) {
   JsonReader r(source);
   nlohmann::json::sax_parse(text.begin(), text.end(), &r);
   if (!r.saw_actors()) r.fail("top level: missing field 'actors'");
-  Graph& g = r.graph;
-  for (size_t i = 0; i < r.actor_names.size(); ++i) {
-    if (g.find_actor(r.actor_names[i]))
-      r.fail("actors[" + std::to_string(i) + "].name: duplicate actor name '" + r.actor_names[i] +
-             "'");
-    g.add_actor(std::move(r.actor_names[i]));
-  }
-  for (size_t i = 0; i < r.channels.size(); ++i) {
-    const PendingChannel& c = r.channels[i];
-    const std::string at = "channels[" + std::to_string(i) + "]";
-    const auto src = g.find_actor(c.src);
-    if (!src) r.fail(at + ".src: unknown actor '" + c.src + "'");
-    const auto dst = g.find_actor(c.dst);
-    if (!dst) r.fail(at + ".dst: unknown actor '" + c.dst + "'");
-    try {
-      g.add_channel(*src, *dst, c.prd, c.cns, c.delay, c.name);
-    } catch (const Error& e) {
-      r.fail(at + ": " + e.what());
-    }
-  }
-  return std::move(r.graph);
+  Parsed p;
+  p.graph_name = std::move(r.graph.name);
+  p.actors.assign(r.actor_names.begin(), r.actor_names.end());
+  p.channels.reserve(r.channels.size());
+  for (const PendingChannel& c : r.channels)
+    p.channels.push_back({c.src, c.dst, c.name, c.prd, c.cns, c.delay});
+  return build(p, source);
+}
+
+std::optional<Graph> read_json_plain(std::string_view text, const std::string& source) {
+  Parsed p;
+  // Rough sizes from the file length, so the vectors do not grow in steps (a written actor
+  // takes at least ~20 bytes, a channel ~70).
+  p.actors.reserve(text.size() / 64);
+  p.channels.reserve(text.size() / 128);
+  if (!Scanner(text).parse(p)) return std::nullopt;
+  return build(p, source);
+}
+
+}  // namespace detail
+
+Graph read_json(std::string_view text, const std::string& source) {
+  if (auto g = detail::read_json_plain(text, source)) return std::move(*g);
+  return detail::read_json_sax(text, source);
 }
 
 std::string write_json(const Graph& g) {

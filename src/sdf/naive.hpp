@@ -16,10 +16,16 @@
 
 #include "sdf/graph.hpp"
 #include "sdf/online.hpp"
+#include "sdf/repetitions.hpp"
 #include "sdf/schedule.hpp"
 #include "util/rng.hpp"
 
 namespace sdf::naive {
+
+// The repetitions vector by the plain walk over Adjacency with a fraction per actor (the first
+// implementation of compute_repetitions): same spanning tree, so the same vector, the same
+// failing channel and q_src / q_dst, and the same overflow errors.
+Repetitions repetitions(const Graph& g);
 
 std::vector<uint64_t> max_run(const Graph& g, std::span<const uint64_t> q, crowddb::Rng& rng);
 

@@ -8,9 +8,11 @@ namespace sdf {
 
 struct OnlineScheduler::Topology {
   std::vector<ActorId> src, dst;
-  std::vector<char> self;  // per channel: a self-loop
+  std::vector<char> self;      // per channel: a self-loop
+  std::vector<char> has_loop;  // per actor: one of its channels is a self-loop
   std::vector<uint32_t> in_off, out_off;
   std::vector<ChannelId> in, out;
+  std::vector<ActorId> out_dst;  // dst of out[i], beside it
 };
 
 namespace {
@@ -22,6 +24,18 @@ inline uint64_t salt_of(uint64_t slot) {
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
   return (z ^ (z >> 31)) | 1;
 }
+// ⌊num / den⌋ (den > 0). A 64-bit integer division has a long latency on the critical path of
+// a decision; below 2^52 a double division gives the quotient or one off, corrected exactly.
+inline uint64_t floor_div(uint64_t num, uint64_t den) {
+  if (den == 1) return num;
+  constexpr uint64_t kExact = uint64_t{1} << 52;
+  if (num >= kExact || den >= kExact) return num / den;
+  auto k = static_cast<uint64_t>(static_cast<double>(num) / static_cast<double>(den));
+  if (k * den > num) --k;
+  if ((k + 1) * den <= num) ++k;
+  return k;
+}
+
 constexpr uint64_t kCountSalt = 0x632be59bd9b4e019ull;
 constexpr uint64_t kSmall = uint64_t{1} << 21;
 
@@ -36,6 +50,7 @@ OnlineScheduler::OnlineScheduler(const Graph& g, std::span<const uint64_t> q, On
   topo->src.resize(e);
   topo->dst.resize(e);
   topo->self.resize(e);
+  topo->has_loop.assign(n_, 0);
   prd_.resize(e);
   cns_.resize(e);
   for (ChannelId c = 0; c < e; ++c) {
@@ -43,6 +58,7 @@ OnlineScheduler::OnlineScheduler(const Graph& g, std::span<const uint64_t> q, On
     topo->src[c] = ch.src;
     topo->dst[c] = ch.dst;
     topo->self[c] = ch.src == ch.dst;
+    if (ch.src == ch.dst) topo->has_loop[ch.src] = 1;
     prd_[c] = ch.prd;
     cns_[c] = ch.cns;
   }
@@ -54,6 +70,8 @@ OnlineScheduler::OnlineScheduler(const Graph& g, std::span<const uint64_t> q, On
     topo->in.insert(topo->in.end(), adj.inputs(a).begin(), adj.inputs(a).end());
     topo->out.insert(topo->out.end(), adj.outputs(a).begin(), adj.outputs(a).end());
   }
+  topo->out_dst.resize(topo->out.size());
+  for (size_t i = 0; i < topo->out.size(); ++i) topo->out_dst[i] = topo->dst[topo->out[i]];
   topo_ = std::move(topo);
   tokens_ = tokens.empty() ? g.delays() : std::vector<uint64_t>(tokens.begin(), tokens.end());
   if (tokens_.size() != e) throw Error(Error::Kind::input, "token state has the wrong size");
@@ -130,18 +148,23 @@ OnlineScheduler::Entry OnlineScheduler::entry(ActorId a) const {
           num < kSmall && den < kSmall};
 }
 
-// Larger key first; then earlier eligibility; then lower id.
-bool OnlineScheduler::better(const Entry& x, const Entry& y) const {
-  if (x.small && y.small) {
-    if (x.key != y.key) return x.key > y.key;
-  } else {
-    const double gap = (x.key > y.key ? x.key : y.key) * 1e-12;
-    if (x.key - y.key > gap) return true;
-    if (y.key - x.key > gap) return false;
-    const int c = detail::compare_fractions(key_num_[x.actor], key_den_[x.actor], key_num_[y.actor],
-                                            key_den_[y.actor]);
-    if (c != 0) return c > 0;
-  }
+// Larger key first; then earlier eligibility; then lower id. With both keys small the doubles
+// decide exactly and the whole comparison is computed without branches (in the heap's sifts
+// it is a coin toss, and mispredicted branches dominated a decision's cost).
+inline bool OnlineScheduler::better(const Entry& x, const Entry& y) const {
+  if (__builtin_expect(x.small & y.small, 1))
+    return (x.key > y.key) | ((x.key == y.key) &
+                              ((x.stamp < y.stamp) | ((x.stamp == y.stamp) & (x.actor < y.actor))));
+  return better_exact(x, y);
+}
+
+bool OnlineScheduler::better_exact(const Entry& x, const Entry& y) const {
+  const double gap = (x.key > y.key ? x.key : y.key) * 1e-12;
+  if (x.key - y.key > gap) return true;
+  if (y.key - x.key > gap) return false;
+  const int c = detail::compare_fractions(key_num_[x.actor], key_den_[x.actor], key_num_[y.actor],
+                                          key_den_[y.actor]);
+  if (c != 0) return c > 0;
   if (x.stamp != y.stamp) return x.stamp < y.stamp;
   return x.actor < y.actor;
 }
@@ -165,7 +188,7 @@ void OnlineScheduler::sift_down(uint32_t i) {
   for (;;) {
     uint32_t child = 2 * i + 1;
     if (child >= size) break;
-    if (child + 1 < size && better(heap_[child + 1], heap_[child])) ++child;
+    if (child + 1 < size) child += better(heap_[child + 1], heap_[child]);
     if (!better(heap_[child], e)) break;
     heap_[i] = heap_[child];
     pos_[heap_[i].actor] = i;
@@ -192,7 +215,7 @@ void OnlineScheduler::heap_remove(ActorId a) {
   for (;;) {
     uint32_t child = 2 * i + 1;
     if (child >= size) break;
-    if (child + 1 < size && better(heap_[child + 1], heap_[child])) ++child;
+    if (child + 1 < size) child += better(heap_[child + 1], heap_[child]);
     heap_[i] = heap_[child];
     pos_[heap_[i].actor] = i;
     i = child;
@@ -276,7 +299,7 @@ std::optional<Run> OnlineScheduler::step(uint64_t max_firings) {
   const bool from_heap = !heap_.empty();
   const ActorId a = from_heap ? heap_[0].actor : head_;
   uint64_t k = 1;
-  if (opt_.firings == FiringRule::floor_key) k = key_num_[a] / key_den_[a];
+  if (opt_.firings == FiringRule::floor_key) k = floor_div(key_num_[a], key_den_[a]);
   if (opt_.bounded) k = std::min(k, q_[a] - count_[a]);
   k = std::min(k, max_firings);
   // Fire k times. ⌊key⌋ firings are admissible in a row: on a plain input k·cns <= tokens; on
@@ -307,8 +330,16 @@ std::optional<Run> OnlineScheduler::step(uint64_t max_firings) {
     set_count(a, count_[a] + k);
     if (count_[a] == q_[a]) --owing_;
   }
-  // The winner: still eligible counts as newly eligible.
-  recompute_key(a);
+  // The winner's key. Every input that is not a self-loop lost exactly k·cns tokens, so each
+  // tokens/cns dropped by exactly k and the minimising input (the first of the least) is still
+  // the same one: its new tokens/cns is the key, as recompute_key would find. A self-loop input
+  // changes by another amount, and an actor without inputs keeps 1/1.
+  if (t.has_loop[a]) {
+    recompute_key(a);
+  } else if (key_arg_[a] != kNone) {
+    key_num_[a] = tokens_[key_arg_[a]];
+  }
+  // Still eligible counts as newly eligible.
   if (eligible(a)) {
     stamp_[a] = decisions_;
     if (from_heap && key_num_[a] != key_den_[a]) {
@@ -325,7 +356,7 @@ std::optional<Run> OnlineScheduler::step(uint64_t max_firings) {
   // setting the key (the first input with the least tokens/cns): otherwise nothing changes.
   for (uint32_t i = t.out_off[a]; i < t.out_off[a + 1]; ++i) {
     const ChannelId c = t.out[i];
-    const ActorId b = t.dst[c];
+    const ActorId b = t.out_dst[i];
     if (b == a || key_arg_[b] != c) continue;
     recompute_key(b);
     if (pos_[b] != UINT32_MAX) {

@@ -1,7 +1,8 @@
 // SDF3 XML reading and writing (pugixml). Two passes over <sdf>: actors and their ports first,
-// then channels, so element order does not matter. Ports are found by binary search in a list
-// sorted by (actor, name): O(P log P) for P ports, never the quadratic scan that makes SDF3's
-// own loader take minutes on 10^5 actors.
+// then channels, so element order does not matter. Ports are sorted by (actor, name) and found
+// by binary search among their actor's own: O(P log P) for P ports, never the quadratic scan
+// that makes SDF3's own loader take minutes on 10^5 actors. Line numbers are computed only for
+// an error message.
 #include <algorithm>
 #include <charconv>
 #include <pugixml.hpp>
@@ -20,13 +21,13 @@ struct Port {
   std::string_view name;
   bool out;
   uint64_t rate;
-  size_t line;
+  size_t offset;  // of the <port> element; its line is computed only for an error message
   int64_t channel = -1;
 };
 
 class Sdf3Reader {
  public:
-  Sdf3Reader(std::string_view text, const std::string& source) : lines_(text), source_(source) {}
+  Sdf3Reader(std::string_view text, const std::string& source) : text_(text), source_(source) {}
 
   Graph read(std::string_view text) {
     const pugi::xml_parse_result res =
@@ -50,14 +51,17 @@ class Sdf3Reader {
     });
     for (size_t i = 1; i < ports_.size(); ++i)
       if (ports_[i].actor == ports_[i - 1].actor && ports_[i].name == ports_[i - 1].name)
-        fail_line(std::max(ports_[i].line, ports_[i - 1].line),
-                  "duplicate port '" + std::string(ports_[i].name) + "' on actor '" +
-                      g.actor_name(ports_[i].actor) + "'");
+        fail(std::max(ports_[i].offset, ports_[i - 1].offset),
+             "duplicate port '" + std::string(ports_[i].name) + "' on actor '" +
+                 g.actor_name(ports_[i].actor) + "'");
+    port_begin_.assign(g.actor_count() + 1, 0);
+    for (const Port& p : ports_) ++port_begin_[p.actor + 1];
+    for (size_t a = 0; a < g.actor_count(); ++a) port_begin_[a + 1] += port_begin_[a];
     for (pugi::xml_node ch : sdf.children("channel")) read_channel(g, ch);
     for (const Port& p : ports_)
       if (p.channel < 0)
-        fail_line(p.line, "port '" + std::string(p.name) + "' of actor '" + g.actor_name(p.actor) +
-                              "' is not connected to a channel");
+        fail(p.offset, "port '" + std::string(p.name) + "' of actor '" + g.actor_name(p.actor) +
+                           "' is not connected to a channel");
     return g;
   }
 
@@ -66,7 +70,7 @@ class Sdf3Reader {
     throw Error(Error::Kind::input, source_ + ":" + std::to_string(line) + ": " + msg);
   }
   [[noreturn]] void fail(size_t offset, const std::string& msg) const {
-    fail_line(lines_.line_of(offset), msg);
+    fail_line(LineIndex(text_).line_of(offset), msg);  // built only for the one error
   }
   [[noreturn]] void fail(pugi::xml_node node, const std::string& msg) const {
     fail(static_cast<size_t>(std::max<ptrdiff_t>(0, node.offset_debug())), msg);
@@ -97,8 +101,12 @@ class Sdf3Reader {
 
   void read_actor(Graph& g, pugi::xml_node actor) {
     const std::string_view name = required(actor, "name");
-    if (g.find_actor(name)) fail(actor, "duplicate actor name '" + std::string(name) + "'");
-    const ActorId id = g.add_actor(std::string(name));
+    ActorId id;
+    try {
+      id = g.add_actor(std::string(name));  // "duplicate actor name '...'"
+    } catch (const Error& e) {
+      fail(actor, e.what());
+    }
     for (pugi::xml_node port : actor.children("port")) {
       Port p;
       p.actor = id;
@@ -108,17 +116,18 @@ class Sdf3Reader {
         fail(port, "port type '" + std::string(type) + "' is neither 'in' nor 'out'");
       p.out = type == "out";
       p.rate = number(port, "rate", required(port, "rate"), true);
-      p.line = lines_.line_of(static_cast<size_t>(std::max<ptrdiff_t>(0, port.offset_debug())));
+      p.offset = static_cast<size_t>(std::max<ptrdiff_t>(0, port.offset_debug()));
       ports_.push_back(p);
     }
   }
 
   Port& find_port(const Graph& g, pugi::xml_node ch, ActorId actor, std::string_view name) {
-    auto it = std::lower_bound(ports_.begin(), ports_.end(), std::pair{actor, name},
-                               [](const Port& p, const std::pair<ActorId, std::string_view>& k) {
-                                 return p.actor != k.first ? p.actor < k.first : p.name < k.second;
-                               });
-    if (it == ports_.end() || it->actor != actor || it->name != name)
+    // The actor's ports are ports_[port_begin_[actor], port_begin_[actor + 1]), sorted by name.
+    const auto first = ports_.begin() + static_cast<ptrdiff_t>(port_begin_[actor]);
+    const auto last = ports_.begin() + static_cast<ptrdiff_t>(port_begin_[actor + 1]);
+    auto it = std::lower_bound(first, last, name,
+                               [](const Port& p, std::string_view k) { return p.name < k; });
+    if (it == last || it->name != name)
       fail(ch, "actor '" + g.actor_name(actor) + "' has no port '" + std::string(name) + "'");
     return *it;
   }
@@ -148,10 +157,9 @@ class Sdf3Reader {
     uint64_t delay = 0;
     if (const pugi::xml_attribute t = ch.attribute("initialTokens"))
       delay = number(ch, "initialTokens", trim(t.value()), false);
-    if (!name.empty() && g.find_channel(name)) fail(ch, "duplicate channel name '" + name + "'");
     ChannelId c;
     try {
-      c = g.add_channel(src, dst, sp.rate, dp.rate, delay, name);
+      c = g.add_channel(src, dst, sp.rate, dp.rate, delay, name);  // "duplicate channel name"
     } catch (const Error& e) {
       fail(ch, e.what());
     }
@@ -159,10 +167,11 @@ class Sdf3Reader {
     sp.channel = dp.channel = c;
   }
 
-  LineIndex lines_;
+  std::string_view text_;
   const std::string& source_;
   pugi::xml_document doc_;
   std::vector<Port> ports_;
+  std::vector<size_t> port_begin_;  // per actor, into ports_ (sorted by actor, then name)
 };
 
 // Port names for writing: the ones read, else "in<k>"/"out<k>" avoiding names already taken.

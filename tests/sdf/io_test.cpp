@@ -2,8 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+
 #include "helpers.hpp"
 #include "sdf/generate.hpp"
+#include "sdf/json_detail.hpp"
 
 namespace sdf {
 namespace {
@@ -139,6 +144,13 @@ TEST(Sdf3Reader, NamesTheLineOfEachMistake) {
   EXPECT_NE(sdf3_error(sdf3("<actor name='A'/>\n<actor name='A'/>\n"))
                 .find("f.xml:6: duplicate actor name 'A'"),
             std::string::npos);
+  EXPECT_EQ(sdf3_error(sdf3(
+                "<actor name='A' type='a'><port name='o' type='out' rate='1'/>"
+                "<port name='p' type='out' rate='1'/></actor>\n"
+                "<actor name='B' type='b'><port name='i' type='in' rate='1'/>"
+                "<port name='j' type='in' rate='1'/></actor>\n" +
+                ch + "<channel name='c' srcActor='A' srcPort='p' dstActor='B' dstPort='j'/>\n")),
+            "f.xml:8: duplicate channel name 'c'");
   EXPECT_NE(
       sdf3_error(sdf3("<actor type='a'/>\n")).find("f.xml:5: <actor> lacks the attribute 'name'"),
       std::string::npos);
@@ -203,6 +215,83 @@ TEST(JsonReader, NamesTheFieldOfEachMistake) {
                 .find("f.json: parse error at line 4"),
             std::string::npos);
   EXPECT_NE(json_error("").find("f.json: parse error"), std::string::npos);
+}
+
+// What a reader made of a text: the graph written out (names, rates, delays, channel names) or
+// the error message.
+std::string outcome(const std::function<Graph()>& read) {
+  try {
+    const Graph g = read();
+    std::string out = "graph '" + g.name + "':";
+    for (ActorId a = 0; a < g.actor_count(); ++a) out += " " + g.actor_name(a);
+    for (const Channel& c : g.channels())
+      out += " [" + std::to_string(c.src) + ">" + std::to_string(c.dst) + " " +
+             std::to_string(c.prd) + "/" + std::to_string(c.cns) + "+" + std::to_string(c.delay) +
+             " " + c.name + "]";
+    return out;
+  } catch (const Error& e) {
+    return std::string("error: ") + e.what();
+  }
+}
+
+// The direct scanner against nlohmann's SAX reader: on every text the scanner accepts, the same
+// graph or the same error (duplicate or unknown names are found after parsing); read_json, which
+// tries the scanner first, always agrees with the SAX reader. Texts: written random graphs in
+// three layouts, with channel names and a graph name, then random byte-level mutations.
+TEST(JsonReader, DirectScannerAgreesWithTheSaxReader) {
+  crowddb::Rng rng(71);
+  const std::string alphabet = "{}[],:\" \n\r\t0123456789-+.eE\\/aAbz#>\x7f\xc3\xa9";
+  int accepted = 0, scanned_errors = 0, rejected = 0;
+  for (int i = 0; i < 1500; ++i) {
+    gen::Spec spec;
+    spec.shape = static_cast<gen::Shape>(rng.below(6));
+    spec.actors = 1 + static_cast<uint32_t>(rng.below(8));
+    Graph g = gen::generate(spec, rng).graph;
+    if (rng.below(3) == 0) g.name = "g" + std::to_string(i);
+    std::string text = write_json(g);
+    if (rng.below(3) == 0) {  // explicit channel names, duplicates possible (an error later)
+      nlohmann::ordered_json j = nlohmann::ordered_json::parse(text);
+      for (auto& c : j["channels"]) c["name"] = "c" + std::to_string(rng.below(5));
+      text = j.dump(1);
+    }
+    if (rng.below(2) == 0)
+      text = nlohmann::ordered_json::parse(text).dump(static_cast<int>(rng.below(3)) - 1);
+    const int mutations = i % 4 == 0 ? 0 : 1 + static_cast<int>(rng.below(3));
+    for (int m = 0; m < mutations && !text.empty(); ++m) {
+      const size_t at = rng.below(text.size());
+      switch (rng.below(4)) {
+        case 0:
+          text.erase(at, 1);
+          break;
+        case 1:
+          text.insert(at, 1, alphabet[rng.below(alphabet.size())]);
+          break;
+        case 2:
+          text[at] = alphabet[rng.below(alphabet.size())];
+          break;
+        default:
+          text.insert(at, text.substr(at, rng.below(12)));
+          break;
+      }
+    }
+    const std::string sax = outcome([&] { return detail::read_json_sax(text, "f.json"); });
+    std::optional<std::string> plain;
+    try {
+      if (auto pg = detail::read_json_plain(text, "f.json")) plain = outcome([&] { return *pg; });
+    } catch (const Error& e) {
+      plain = std::string("error: ") + e.what();
+    }
+    if (plain) {
+      EXPECT_EQ(*plain, sax) << text;
+      ++(plain->rfind("error: ", 0) == 0 ? scanned_errors : accepted);
+    } else {
+      ++rejected;
+    }
+    EXPECT_EQ(outcome([&] { return read_json(text, "f.json"); }), sax) << text;
+  }
+  EXPECT_GT(accepted, 300);
+  EXPECT_GT(scanned_errors, 20);
+  EXPECT_GT(rejected, 300);
 }
 
 TEST(Writers, RoundTripRandomGraphsThroughBothFormats) {

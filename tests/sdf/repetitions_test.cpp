@@ -7,6 +7,7 @@
 #include "helpers.hpp"
 #include "sdf/generate.hpp"
 #include "sdf/io.hpp"
+#include "sdf/naive.hpp"
 
 namespace sdf {
 namespace {
@@ -128,6 +129,65 @@ TEST(Repetitions, PerturbedRandomGraphsAreInconsistentAtACycle) {
     }
   }
   EXPECT_GT(inconsistent, 100);
+}
+
+// compute_repetitions against the plain walk (naive::repetitions): the same vector, the same
+// failing channel with the same two sides, the same overflow error, on random graphs with
+// several components, perturbed rates and rates large enough to overflow.
+TEST(Repetitions, MatchesThePlainWalkExactly) {
+  crowddb::Rng rng(44);
+  int inconsistent = 0, overflowed = 0;
+  for (int i = 0; i < 1500; ++i) {
+    Graph g;
+    const uint32_t pieces = 1 + static_cast<uint32_t>(rng.below(3));
+    for (uint32_t p = 0; p < pieces; ++p) {
+      gen::Spec spec;
+      spec.shape = static_cast<gen::Shape>(rng.below(6));
+      spec.actors = 1 + static_cast<uint32_t>(rng.below(30));
+      spec.multirate = rng.below(5) != 0;
+      spec.self_loops = rng.below(3) == 0;
+      const Graph part = gen::generate(spec, rng).graph;
+      const auto base = static_cast<ActorId>(g.actor_count());
+      for (ActorId a = 0; a < part.actor_count(); ++a)
+        g.add_actor("p" + std::to_string(p) + "_" + part.actor_name(a));
+      for (const Channel& c : part.channels())
+        g.add_channel(base + c.src, base + c.dst, c.prd, c.cns, c.delay);
+    }
+    const int perturb = static_cast<int>(rng.below(5));
+    for (int k = 0; k < perturb && g.channel_count() > 0; ++k) {
+      const auto c = static_cast<ChannelId>(rng.below(g.channel_count()));
+      const uint64_t factor = rng.below(2) == 0 ? (uint64_t{1} << 40) + 1 : 2 + rng.below(3);
+      g.set_rates(c, g.channel(c).prd * factor, g.channel(c).cns);
+    }
+    std::optional<Repetitions> fast, slow;
+    std::string fast_error = "-", slow_error = "-";
+    try {
+      fast = compute_repetitions(g);
+    } catch (const Error& e) {
+      fast_error = e.what();
+    }
+    try {
+      slow = naive::repetitions(g);
+    } catch (const Error& e) {
+      slow_error = e.what();
+    }
+    ASSERT_EQ(fast_error, slow_error) << i;
+    ASSERT_EQ(fast.has_value(), slow.has_value()) << i;
+    if (!fast) {
+      ++overflowed;
+      continue;
+    }
+    EXPECT_EQ(fast->consistent, slow->consistent) << i;
+    EXPECT_EQ(fast->q, slow->q) << i;
+    if (!fast->consistent) {
+      ++inconsistent;
+      EXPECT_EQ(fast->channel, slow->channel) << i;
+      EXPECT_EQ(fast->q_src, slow->q_src) << i;
+      EXPECT_EQ(fast->q_dst, slow->q_dst) << i;
+    }
+  }
+  EXPECT_GT(inconsistent, 100);
+  EXPECT_GT(overflowed, 20);
 }
 
 }  // namespace

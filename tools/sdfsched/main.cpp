@@ -166,8 +166,20 @@ int cmd_repetitions(const std::string& path, bool json) {
   if (json) {
     print_json({{"consistent", true}, {"repetitions", per_actor(g, c.rep.q)}});
   } else {
-    for (sdf::ActorId a = 0; a < g.actor_count(); ++a)
-      std::cout << g.actor_name(a) << " " << c.rep.q[a] << "\n";
+    // One buffer, one write: a stream insertion per line costs ~50 ms on 10^6 actors.
+    std::string out;
+    char digits[24];
+    for (sdf::ActorId a = 0; a < g.actor_count(); ++a) {
+      out += g.actor_name(a);
+      out += ' ';
+      out.append(digits, std::to_chars(digits, digits + sizeof digits, c.rep.q[a]).ptr);
+      out += '\n';
+      if (out.size() > (1u << 20)) {
+        std::cout.write(out.data(), static_cast<std::streamsize>(out.size()));
+        out.clear();
+      }
+    }
+    std::cout.write(out.data(), static_cast<std::streamsize>(out.size()));
   }
   return 0;
 }

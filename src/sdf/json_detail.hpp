@@ -1,0 +1,19 @@
+// The two JSON readers behind sdf::read_json, exposed for the tests that compare them.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "sdf/graph.hpp"
+
+namespace sdf::detail {
+
+// nlohmann's SAX reader: every JSON text, every error message.
+Graph read_json_sax(std::string_view text, const std::string& source);
+// The direct scanner of the plain form: nothing when the text is not in it (then the SAX reader
+// decides). Errors found after parsing (duplicate or unknown names) are thrown as by the SAX
+// reader.
+std::optional<Graph> read_json_plain(std::string_view text, const std::string& source);
+
+}  // namespace sdf::detail
