@@ -131,13 +131,7 @@ void run_e1(const Options& opt) {
   }
   dcsv.close();
 
-  const std::string note =
-      machine_note(opt.threads) + "; times: " + ftc::RunClock(opt.threads).what();
-  {
-    std::ofstream txt(opt.out_dir / "e1.txt");
-    txt << "crowddb experiment e1" << (quick ? " --quick" : "") << " --seed " << opt.seed << "\n"
-        << note << "\n";
-  }
+  const std::string note = ftc::write_run_note(opt, "e1");
   plot(
       opt.out_dir, "e1",
       "set terminal pngcairo size 1500,620 font ',11'\n"

@@ -75,19 +75,10 @@ void run_e3(const Options& opt) {
   }
   csv.close();
 
-  const std::string note =
-      machine_note(opt.threads) + "; times: " + ftc::RunClock(opt.threads).what();
-  {
-    std::ofstream txt(opt.out_dir / "e3.txt");
-    txt << "crowddb experiment e3" << (quick ? " --quick" : "") << " --seed " << opt.seed << "\n"
-        << note << "\n";
-  }
+  const std::string note = ftc::write_run_note(opt, "e3");
   auto series = [](const std::string& radii, const std::string& world, const std::string& method,
                    const std::string& style, const std::string& title) {
-    const std::string sel = "(strcol(1) eq '" + radii + "' && strcol(2) eq '" + world +
-                            "' && strcol(3) eq '" + method + "' ? ";
-    return "'e3.csv' using 4:" + sel + "$6 : NaN):" + sel + "lowbar($6, $6-$7) : NaN):" + sel +
-           "$6+$7 : NaN) with yerrorlines " + style + " title \"" + title + "\"";
+    return ftc::series("e3.csv", radii, world, method, style, title);
   };
   auto panel = [&](const std::string& radii, const std::string& title) {
     return "set title '" + title + "'\nplot " +

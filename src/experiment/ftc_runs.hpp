@@ -6,9 +6,11 @@
 
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include "experiment/experiment.hpp"
 #include "index/ftc_tree.hpp"
 #include "query/naive_paths.hpp"
 #include "scenario/builders.hpp"
@@ -150,6 +152,27 @@ inline std::string fmt(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6g", v);
   return buf;
+}
+
+// Writes NAME.txt (the command line and the machine note) and returns the note for the plots.
+inline std::string write_run_note(const Options& opt, const std::string& name) {
+  const std::string note = machine_note(opt.threads) + "; times: " + RunClock(opt.threads).what();
+  std::ofstream txt(opt.out_dir / (name + ".txt"));
+  txt << "crowddb experiment " << name << (opt.quick ? " --quick" : "") << " --seed " << opt.seed
+      << "\n"
+      << note << "\n";
+  return note;
+}
+
+// A gnuplot series of the E2/E3 CSV files: the rows of (radii, world, method), x = n (column 4),
+// y = column 6 with error bars of column 7 (low bars clipped by lowbar()).
+inline std::string series(const std::string& csv, const std::string& radii,
+                          const std::string& world, const std::string& method,
+                          const std::string& style, const std::string& title) {
+  const std::string sel = "(strcol(1) eq '" + radii + "' && strcol(2) eq '" + world +
+                          "' && strcol(3) eq '" + method + "' ? ";
+  return "'" + csv + "' using 4:" + sel + "$6 : NaN):" + sel + "lowbar($6, $6-$7) : NaN):" + sel +
+         "$6+$7 : NaN) with yerrorlines " + style + " title \"" + title + "\"";
 }
 
 }  // namespace crowddb::experiment::ftc
