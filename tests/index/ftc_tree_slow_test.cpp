@@ -9,6 +9,7 @@
 #include "index/ftc_tree.hpp"
 #include "query/naive_paths.hpp"
 #include "scenario/builders.hpp"
+#include "support/random_tables.hpp"
 #include "util/rng.hpp"
 
 namespace crowddb {
@@ -67,29 +68,7 @@ TEST(FtcIndexSlow, RandomTablesEveryOption) {
     Rng rng(seed * 104729 + 3);
     const std::size_t n = rng.below(600);
     const double side = rng.uniform(5, 2000);
-    const double vmax = rng.below(4) == 0 ? 0 : rng.uniform(0.1, 60);
-    const double rmin = rng.uniform(0.01, 3), rmax = rmin + rng.uniform(0, 3);
-    DiscTable t;
-    switch (rng.below(5)) {
-      case 0:
-        t = build::uniform(n, {0, 0, side, side}, vmax, rmin, rmax, seed);
-        break;
-      case 1:
-        t = build::clustered(n, {0, 0, side, side}, 1 + rng.below(5), side / 20, vmax, rmin, rmax,
-                             seed);
-        break;
-      case 2:
-        t = build::lattice(n, rng.uniform(0.5, 5), static_cast<double>(rng.below(3)), rmin, seed);
-        break;
-      case 3:
-        t = build::big_crunch(n, {0, 0, side, side}, rng.uniform(1, 60), rmin, rmax,
-                              static_cast<double>(rng.below(2)), seed);
-        break;
-      default:
-        t = build::duplicates(n, 1 + rng.below(20), {0, 0, side, side}, vmax, rmin, seed);
-        break;
-    }
-    if (rng.below(2)) build::shuffle_ids(t, seed);
+    DiscTable t = test::random_shape_table(rng, n, side, seed);
     if (rng.below(4) == 0) build::offset(t, rng.uniform(-1e7, 1e7), rng.uniform(-1e7, 1e7));
     const double horizon = rng.below(8) == 0 ? INFINITY : rng.uniform(0, 60);
     // Four option sets per table (all of them on every 50th).

@@ -12,6 +12,7 @@
 #include "crowddb/error.hpp"
 #include "query/naive_paths.hpp"
 #include "scenario/builders.hpp"
+#include "support/random_tables.hpp"
 #include "util/rng.hpp"
 
 namespace crowddb {
@@ -364,29 +365,7 @@ TEST(FtcIndex, PropertyManySeeds) {
     Rng rng(seed * 7919 + 1);
     const std::size_t n = rng.below(300);
     const double side = rng.uniform(5, 1000);
-    const double vmax = rng.below(4) == 0 ? 0 : rng.uniform(0.1, 60);
-    const double rmin = rng.uniform(0.01, 3), rmax = rmin + rng.uniform(0, 3);
-    DiscTable t;
-    switch (rng.below(5)) {
-      case 0:
-        t = build::uniform(n, {0, 0, side, side}, vmax, rmin, rmax, seed);
-        break;
-      case 1:
-        t = build::clustered(n, {0, 0, side, side}, 1 + rng.below(5), side / 20, vmax, rmin, rmax,
-                             seed);
-        break;
-      case 2:
-        t = build::lattice(n, rng.uniform(0.5, 5), static_cast<double>(rng.below(3)), rmin, seed);
-        break;
-      case 3:
-        t = build::big_crunch(n, {0, 0, side, side}, rng.uniform(1, 60), rmin, rmax,
-                              static_cast<double>(rng.below(2)), seed);
-        break;
-      default:
-        t = build::duplicates(n, 1 + rng.below(20), {0, 0, side, side}, vmax, rmin, seed);
-        break;
-    }
-    if (rng.below(2)) build::shuffle_ids(t, seed);
+    DiscTable t = test::random_shape_table(rng, n, side, seed);
     if (rng.below(4) == 0) build::offset(t, 1e6, -1e6);
     const double horizon = rng.below(8) == 0 ? INFINITY : rng.uniform(0, 50);
     const StaticScene scene =
