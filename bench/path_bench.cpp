@@ -18,6 +18,7 @@
 #include "path/navigation.hpp"
 #include "path/navmesh.hpp"
 #include "sim/stages.hpp"
+#include "support/configs.hpp"
 #include "util/executor.hpp"
 #include "util/rng.hpp"
 #include "util/stopwatch.hpp"
@@ -190,7 +191,7 @@ Crowd crowd(const path::NavGeometry& g, std::size_t n) {
   Rng rng(11);
   for (int k = 0; k < 50; ++k) {
     const Vec2 p = free_point(g, rng, kRadius);
-    c.world.add_goal({"g" + std::to_string(k), p.x, p.y, 1, 2});
+    c.world.add_goal({"g" + std::to_string(k), p.x, p.y, 1, 2, {}});
   }
   for (std::size_t i = 0; i < n; ++i) {
     AgentSpec s;
@@ -199,6 +200,7 @@ Crowd crowd(const path::NavGeometry& g, std::size_t n) {
     s.y = p.y;
     s.radius = kRadius;
     s.max_speed = 1.3;
+    s.pref_speed = s.max_speed;
     s.goal = static_cast<uint32_t>(rng.below(50));
     c.ids.push_back(c.world.insert(s));
   }
@@ -212,20 +214,20 @@ void BM_ServiceOverhead(benchmark::State& state) {
   const std::size_t n = 10'000;
   constexpr uint64_t kPeriod = 20;
   Crowd c = crowd(g, n);
-  SimConfig cfg;
+  SimConfig cfg = test::thesis_config();
   cfg.navigation.enabled = nav_on;
   cfg.navigation.latency = 2;
   cfg.navigation.budget = static_cast<uint32_t>(std::max<int64_t>(1, state.range(1)));
   cfg.navigation.cell_size = 0.25;
   cfg.navigation.replan_after = 0;
-  cfg.navigation.sight_interval = static_cast<uint32_t>(state.range(3));
+  cfg.navigation.sight_interval = static_cast<double>(state.range(3));  // dt = 1: ticks
   Executor ex(static_cast<int>(state.range(2)));
   std::unique_ptr<path::Navigation> nav;
   if (nav_on) {
     nav = std::make_unique<path::Navigation>(c.world, cfg, ex);  // mesh build: not timed
     nav->request_paths(c.world, 0);
   }
-  sim::Effects fx;
+  sim::Preferred fx;
   Rng rng(5);
   uint64_t tick = 0;
   double apply_s = 0, q1_s = 0, request_s = 0;
@@ -241,14 +243,14 @@ void BM_ServiceOverhead(benchmark::State& state) {
     if (nav) nav->apply_results(c.world, tick);
     apply_s += sw.seconds();
     sw.restart();
-    sim::attraction(c.world.agents(), c.world.goals(), cfg, tick, fx, ex, nav.get());
+    sim::goal_stage(c.world.agents(), c.world.goals(), cfg, tick, {}, fx, ex, nav.get());
     q1_s += sw.seconds();
     sw.restart();
     if (nav) nav->request_paths(c.world, tick);
     request_s += sw.seconds();
   }
   const double per_tick = 1e3 / static_cast<double>(tick);
-  state.counters["q1_ms"] = q1_s * per_tick;  // attraction, with the line-of-sight checks
+  state.counters["q1_ms"] = q1_s * per_tick;  // goal stage, with the line-of-sight checks
   if (nav) {
     const auto s = nav->stats();
     const auto w = nav->service_stats();
@@ -281,9 +283,9 @@ BENCHMARK(BM_ServiceOverhead)
 void BM_TickOverhead(benchmark::State& state) {
   static const path::NavGeometry g = city();
   Crowd c = crowd(g, 10'000);
-  SimConfig cfg;
-  cfg.steering.w_apf = 0;
-  cfg.steering.w_ftc = 0;
+  SimConfig cfg = test::thesis_config();
+  cfg.steering.thesis.w_apf = 0;
+  cfg.steering.thesis.w_ftc = 0;
   cfg.backoff = false;
   cfg.arrival = ArrivalPolicy::retarget;
   cfg.navigation.enabled = state.range(0) != 0;

@@ -67,7 +67,9 @@ struct DiscTable {
 enum class ObstacleCharges {
   centres,   // one charged point per circle at its centre (the thesis's model; `crowddb query
              // field`)
-  boundary,  // circles and polygons sampled along their boundary (the simulation's default)
+  boundary,  // circles and polygons sampled along their boundary
+  none,      // no charged points: obstacles repel by their nearest geometry instead (thesis
+             // model's default, ThesisParams::obstacle_repulsion)
 };
 
 // Static obstacles in the form the queries use, with derived data (bounding boxes, charged
@@ -100,6 +102,17 @@ class StaticScene {
   std::span<const double> point_charge() const { return pc_; }
   std::size_t point_count() const { return px_.size(); }
   bool empty() const { return circles_.empty() && polygons_.empty(); }
+  // Obstacle features (circles, then every polygon edge): feature f < circles().size() is a
+  // circle, the others are edges numbered polygon by polygon (first_edge(p) + e).
+  std::size_t feature_count() const { return circles_.size() + edge_start_.back(); }
+  std::size_t first_edge(std::size_t polygon) const {
+    return circles_.size() + edge_start_[polygon];
+  }
+  // The polygon row and edge index of an edge feature (f >= circles().size()). O(log polygons).
+  std::pair<std::size_t, std::size_t> edge_of(std::size_t f) const;
+  // A distinct number for every scene built in this process: caches keyed by it (an index over
+  // the features) never outlive the scene they were built for.
+  uint64_t generation() const { return generation_; }
 
  private:
   std::vector<CircleObstacle> circles_;
@@ -107,6 +120,8 @@ class StaticScene {
   std::vector<Box> boxes_;
   std::vector<double> px_, py_, pc_;
   std::size_t wall_begin_ = 0;
+  std::vector<uint32_t> edge_start_ = {0};  // polygons().size() + 1 prefix sums of edge counts
+  uint64_t generation_ = 0;
 };
 
 // Per-query counters; the experiments plot them. Methods fill what applies to them.
@@ -225,9 +240,56 @@ std::vector<uint32_t> collision_set(const DiscView& discs, const StaticScene& sc
                                     std::string_view method = "auto", int threads = 1,
                                     QueryStats* stats = nullptr);
 
+// ---------------------------------------------------------------- neighbours (steering models)
+
+// Lists per query row, nearest first: the neighbours of query q are entries
+// [offset[q], offset[q + 1]).
+struct NeighbourLists {
+  std::vector<uint32_t> offset;  // queries + 1
+  std::vector<uint32_t> row;     // rows of the DiscView
+  std::vector<double> dist2;     // squared distance of centres [m^2]
+  std::size_t queries() const { return offset.empty() ? 0 : offset.size() - 1; }
+  std::span<const uint32_t> rows_of(std::size_t q) const {
+    return {row.data() + offset[q], row.data() + offset[q + 1]};
+  }
+};
+
+// For each query disc (the rows in `queries`, or every row when it is empty), the other discs
+// whose centres lie strictly closer than `range`: the k nearest of them (all when k = 0), nearest
+// first, ties in distance by the smaller id. Exact: every method returns the same lists.
+NeighbourLists neighbours(const DiscView& discs, double range, uint32_t k,
+                          std::span<const uint32_t> queries = {}, std::string_view method = "auto",
+                          int threads = 1, QueryStats* stats = nullptr);
+
+// ---------------------------------------------------------------- obstacle features
+
+// Per query point, the obstacle features (StaticScene::feature_count numbering) strictly closer
+// than its reach, in feature order, with their squared distances (feature_dist2).
+struct FeatureLists {
+  std::vector<uint32_t> offset;   // queries + 1
+  std::vector<uint32_t> feature;  // feature numbers, ascending per query
+  std::vector<double> dist2;      // [m^2]
+  std::size_t queries() const { return offset.empty() ? 0 : offset.size() - 1; }
+};
+
+// Squared distance from (px, py) to feature f: to a circle's disc (0 inside), to an edge's
+// segment. The one primitive every method calls, so "exact" comparisons are meaningful.
+double feature_dist2(const StaticScene& scene, std::size_t f, double px, double py);
+// The closest point of feature f to (px, py) (a circle's boundary point; the point itself at its
+// centre).
+Vec2 feature_closest(const StaticScene& scene, std::size_t f, double px, double py);
+
+// For each point (the centres of `points`), the features closer than reach[i] (reach has one
+// entry per point, each >= 0). Exact: every method returns the same lists.
+FeatureLists obstacle_features(const DiscView& points, std::span<const double> reach,
+                               const StaticScene& scene, std::string_view method = "auto",
+                               int threads = 1, QueryStats* stats = nullptr);
+
 // Names of the registered methods of each query, naive first.
 std::vector<std::string> ftc_methods();
 std::vector<std::string> field_methods();
 std::vector<std::string> collision_methods();
+std::vector<std::string> neighbour_methods();
+std::vector<std::string> feature_methods();
 
 }  // namespace crowddb

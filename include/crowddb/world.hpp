@@ -13,6 +13,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "crowddb/error.hpp"
@@ -41,25 +42,51 @@ struct AgentId {
 enum class AgentState : uint8_t {
   active = 0,   // steering normally
   frozen = 1,   // put back by the backoff loop in the last tick
-  arrived = 2,  // reached its goal and idles there (only when arrivals idle)
+  arrived = 2,  // reached its last goal and idles there (only when arrivals idle)
 };
 
-// One agent row as the user supplies it. Units: length, ticks; velocities in length/tick.
+// One agent row as the user supplies it. Units: metres and seconds (velocities in m/s).
 struct AgentSpec {
   double x = 0, y = 0;
   double vx = 0, vy = 0;
-  double radius = 1;                                           // > 0
-  double max_speed = 1;                                        // > 0
-  double max_accel = std::numeric_limits<double>::infinity();  // > 0, may be infinite
+  double radius = 0.25;      // [m] > 0
+  double pref_speed = 1.34;  // [m/s] > 0: the speed it walks at when nothing is in the way
+  double max_speed = 1.34;   // [m/s] >= pref_speed: the fastest it may go (to avoid someone)
+  double max_accel = std::numeric_limits<double>::infinity();  // [m/s^2] > 0, may be infinite
   double charge = 1;  // repulsive strength in the potential field, finite, >= 0
   uint32_t goal = 0;  // row of the goals table
+  // Goals visited after `goal`, in order (a goal sequence); the arrival policy applies only at
+  // the last one.
+  std::vector<uint32_t> then;
 };
 
+// A goal is an area: a disc (the centre and arrival_radius) or a simple polygon. An agent has
+// reached it when its centre is inside (a polygon's boundary counts).
 struct Goal {
   std::string name;
-  double x = 0, y = 0;
-  double charge = 1;          // attraction strength (c_goal), >= 0
-  double arrival_radius = 1;  // an agent whose centre comes this close has arrived; > 0
+  double x = 0, y = 0;        // [m] the disc's centre; for a polygon a point inside it (navigation
+                              // plans towards it when nothing nearer is known)
+  double charge = 1;          // attraction strength (c_goal) of the thesis model, finite
+  double arrival_radius = 1;  // [m] > 0: the disc's radius (ignored for polygons)
+  std::vector<Vec2> area;     // empty: a disc; else a simple polygon, stored counter-clockwise
+  bool is_polygon() const { return !area.empty(); }
+};
+
+// Agents entering over time (the thesis's characters that join a crowd): from `start` on,
+// `rate` agents per second appear at free spots of the area until `count` have entered or `end`
+// has passed. A spot is free when the new disc overlaps no agent and no obstacle; when there is
+// none the agent waits and enters at a later tick (no agent is dropped).
+struct Source {
+  std::string name;
+  std::vector<Vec2> area;  // simple polygon (a box is four corners), counter-clockwise
+  double rate = 1;         // [1/s] > 0
+  uint64_t count = 1;      // agents in all, >= 1
+  double start = 0;        // [s] >= 0
+  double end = std::numeric_limits<double>::infinity();  // [s] > start
+  AgentSpec agent;              // template: position and velocity are drawn, the rest is copied
+  double radius_max = 0;        // > 0: radius drawn uniformly in [agent.radius, radius_max]
+  double pref_speed_max = 0;    // > 0: pref_speed drawn in [agent.pref_speed, pref_speed_max]
+  std::vector<uint32_t> goals;  // non-empty: goal drawn per agent, round robin over these
 };
 
 struct CircleObstacle {
@@ -80,29 +107,44 @@ struct Bounds {
   double height() const { return ymax - ymin; }
 };
 
+// What a stalled agent is doing about it (src/sim/stalemate.hpp).
+enum class StallAction : uint8_t {
+  none = 0,
+  yield = 1,     // steps aside for a neighbour of higher priority
+  sidestep = 2,  // walks off at an angle, no neighbour to yield to (or it has priority)
+};
+
 // The agents table: structure-of-arrays columns, one entry per dense row. Columns are public
 // for reading; only World and the tick write them. Hot per-tick columns first.
 struct AgentTable {
   // hot: read or written every tick
-  std::vector<double> x, y;                // position [length]
-  std::vector<double> vx, vy;              // velocity [length/tick]
-  std::vector<double> radius;              // [length]
-  std::vector<double> max_speed;           // [length/tick]
-  std::vector<double> max_accel;           // [length/tick^2], may be +inf
+  std::vector<double> x, y;                // position [m]
+  std::vector<double> vx, vy;              // velocity [m/s]
+  std::vector<double> radius;              // [m]
+  std::vector<double> pref_speed;          // [m/s]
+  std::vector<double> max_speed;           // [m/s]
+  std::vector<double> max_accel;           // [m/s^2], may be +inf
   std::vector<double> charge;              // potential-field charge
   std::vector<double> target_x, target_y;  // current waypoint (the goal when there is no route)
   std::vector<uint32_t> goal;              // row of the goals table
   std::vector<AgentState> state;
   std::vector<uint32_t> frozen_ticks;  // consecutive ticks frozen by backoff (gridlock detection)
+  // progress watch: an agent that gets no closer to its current waypoint is stalled
+  std::vector<double> progress_best;  // [m] closest distance to the waypoint since it was set
+  std::vector<uint32_t> stall_ticks;  // ticks without progress towards the current waypoint
   // cold: bookkeeping
-  std::vector<uint64_t> id;              // AgentId::value()
-  std::vector<std::vector<Vec2>> route;  // intermediate waypoints still ahead of the goal
+  std::vector<uint64_t> id;                 // AgentId::value()
+  std::vector<std::vector<Vec2>> route;     // intermediate waypoints still ahead of the goal
+  std::vector<std::vector<uint32_t>> then;  // goals still to visit after `goal`, in order
+  // stalemate resolution (only touched for stalled agents)
+  std::vector<StallAction> stall_action;
+  std::vector<uint64_t> stall_until;             // tick at which the action ends
+  std::vector<double> stall_dir_x, stall_dir_y;  // unit direction of the action
   // path service (DESIGN.md §6); only read when navigation is on
   static constexpr uint32_t kNoPath = std::numeric_limits<uint32_t>::max();
-  std::vector<uint32_t> path_goal;    // goal row the route is planned for; kNoPath: none
-  std::vector<uint64_t> path_ticket;  // the path request in flight (0: none)
-  std::vector<double> path_best;      // closest distance to the current waypoint since it was set
-  std::vector<uint32_t> path_stall;   // ticks without progress towards the current waypoint
+  std::vector<uint32_t> path_goal;     // goal row the route is planned for; kNoPath: none
+  std::vector<uint64_t> path_ticket;   // the path request in flight (0: none)
+  std::vector<uint32_t> replan_ticks;  // ticks without progress since the last path request
 
   std::size_t size() const { return x.size(); }
   bool empty() const { return x.empty(); }
@@ -114,7 +156,9 @@ class World {
   explicit World(Bounds bounds) : bounds_(bounds) {}
 
   // ---- static tables; validated, applied immediately ----
-  uint32_t add_goal(const Goal& goal);
+  // Throws InvalidRow naming the field (a polygon goal that is not simple, a duplicate name).
+  uint32_t add_goal(Goal goal);
+  uint32_t add_source(Source source);
   uint32_t add_obstacle(const CircleObstacle& obstacle);
   uint32_t add_obstacle(PolygonObstacle obstacle);
   void set_bounds(Bounds bounds);
@@ -132,6 +176,9 @@ class World {
   // ---- reads ----
   const AgentTable& agents() const { return agents_; }
   std::span<const Goal> goals() const { return goals_; }
+  std::span<const Source> sources() const { return sources_; }
+  // Row of the goal with this name, or nothing.
+  std::optional<uint32_t> goal_named(std::string_view name) const;
   std::span<const CircleObstacle> circles() const { return circles_; }
   std::span<const PolygonObstacle> polygons() const { return polygons_; }
   const Bounds& bounds() const { return bounds_; }
@@ -147,9 +194,14 @@ class World {
   AgentTable& agents_for_tick() { return agents_; }
   // Removes a row by swapping the last row into it; the handle of the removed agent dies.
   void remove_row(std::size_t row);
-  // The current waypoint of a row: next route point, else its goal. Restarts the row's progress
-  // watch (path_best, path_stall) because the waypoint may have changed.
+  // The current waypoint of a row: next route point, else the nearest point of its goal area.
+  // Restarts the row's progress watch because the waypoint may have changed.
   void refresh_target(std::size_t row);
+  // Moves a row on to the next goal of its sequence (its route is dropped, a path re-planned).
+  // Returns false when the goal was its last.
+  bool advance_goal(std::size_t row);
+  // Has the row's centre reached its goal area?
+  bool at_goal(std::size_t row) const;
 
   static void validate_spec(const AgentSpec& spec, std::size_t goal_count);
 
@@ -174,6 +226,7 @@ class World {
   Bounds bounds_{};
   AgentTable agents_;
   std::vector<Goal> goals_;
+  std::vector<Source> sources_;
   std::vector<CircleObstacle> circles_;
   std::vector<PolygonObstacle> polygons_;
   std::vector<Slot> slots_;

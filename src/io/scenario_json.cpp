@@ -15,6 +15,7 @@
 
 #include "crowddb/scenario.hpp"
 #include "io/walkable_wkt.hpp"
+#include "steer/model.hpp"
 #include "util/rng.hpp"
 #include "world/geometry.hpp"
 
@@ -347,6 +348,38 @@ struct Loader {
     walkable_pieces = sc.world.polygons().size();
   }
 
+  // A polygon's point inside it: the centroid when inside, else the middle of the longest
+  // horizontal chord through the centroid's height.
+  static Vec2 point_inside(const std::vector<Vec2>& ring) {
+    double a = 0, cx = 0, cy = 0;
+    for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+      const Vec2& p = ring[i];
+      const Vec2& q = ring[(i + 1) % n];
+      const double c = p.x * q.y - q.x * p.y;
+      a += c;
+      cx += (p.x + q.x) * c;
+      cy += (p.y + q.y) * c;
+    }
+    const Vec2 centroid{cx / (3 * a), cy / (3 * a)};
+    if (point_in_polygon(ring, centroid.x, centroid.y)) return centroid;
+    std::vector<double> xs;
+    for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+      const Vec2& p = ring[i];
+      const Vec2& q = ring[(i + 1) % n];
+      if ((p.y > centroid.y) != (q.y > centroid.y))
+        xs.push_back(p.x + (centroid.y - p.y) * (q.x - p.x) / (q.y - p.y));
+    }
+    std::sort(xs.begin(), xs.end());
+    Vec2 best = ring[0];
+    double width = -1;
+    for (std::size_t i = 0; i + 1 < xs.size(); i += 2)
+      if (xs[i + 1] - xs[i] > width) {
+        width = xs[i + 1] - xs[i];
+        best = {(xs[i] + xs[i + 1]) / 2, centroid.y};
+      }
+    return best;
+  }
+
   void read_goals(Node& root) {
     if (!root.has("goals")) return;
     const json& arr = root.array("goals");
@@ -354,14 +387,75 @@ struct Loader {
       Node g = root.element(arr, "goals", i);
       Goal goal;
       goal.name = g.string("name");
-      goal.x = g.number("x");
-      goal.y = g.number("y");
       goal.charge = g.number("charge", 1.0);
-      goal.arrival_radius = g.positive("arrival_radius", 1.0);
+      if (g.has("area")) {
+        goal.area = g.points("area");
+        if (g.has("arrival_radius"))
+          g.fail("arrival_radius", "a goal with an area arrives inside the area: no radius");
+        if (goal.area.size() < 3) g.fail("area", "a polygon needs at least 3 vertices");
+        if (g.has("x") != g.has("y")) g.fail(g.has("x") ? "y" : "x", "missing (give both or none)");
+        if (g.has("x")) {
+          goal.x = g.number("x");
+          goal.y = g.number("y");
+        } else {
+          std::vector<Vec2> ring = goal.area;
+          if (ring.size() > 3 && ring.front().x == ring.back().x && ring.front().y == ring.back().y)
+            ring.pop_back();
+          if (std::abs(signed_area(ring)) > 0) {
+            const Vec2 c = point_inside(ring);
+            goal.x = c.x;
+            goal.y = c.y;
+          }
+        }
+      } else {
+        goal.x = g.number("x");
+        goal.y = g.number("y");
+        goal.arrival_radius = g.positive("arrival_radius", 0.5);
+      }
       g.finish();
       if (goal_rows.count(goal.name)) g.fail("name", "duplicate goal name '" + goal.name + "'");
-      goal_rows[goal.name] = sc.world.add_goal(goal);
+      try {
+        goal_rows[goal.name] = sc.world.add_goal(goal);
+      } catch (const InvalidRow& e) {
+        g.fail(e.field(), e.what());
+      }
     }
+  }
+
+  // "goal": a name, or an array of names (a sequence: visited in order). Returns the first and
+  // puts the rest in `then`.
+  uint32_t goal_sequence(Node& n, const std::string& key, std::vector<uint32_t>& then) {
+    const json& v = n.raw(key);
+    if (v.is_string()) return goal_named(n, key, v.get<std::string>());
+    if (!v.is_array() || v.empty())
+      n.fail(key, "expected a goal name or a non-empty array of goal names (a sequence)");
+    std::vector<uint32_t> rows;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      if (!v[k].is_string()) n.fail(key + "/" + std::to_string(k), "expected a goal name");
+      rows.push_back(goal_named(n, key + "/" + std::to_string(k), v[k].get<std::string>()));
+    }
+    then.assign(rows.begin() + 1, rows.end());
+    return rows.front();
+  }
+
+  // pref_speed and max_speed of an agent, a group or a source: pref_speed defaults to max_speed
+  // when only that is given (scenarios written for the thesis's rule), else to 1.34 m/s
+  // (Weidmann's free speed); max_speed defaults to the largest pref_speed.
+  std::pair<std::pair<double, double>, double> speeds(Node& n) {
+    std::pair<double, double> pref{1.34, 1.34};
+    std::optional<double> max;
+    if (n.has("max_speed")) max = n.positive("max_speed");
+    if (n.has("pref_speed")) {
+      pref = n.range("pref_speed", pref);
+      if (!(pref.first > 0)) n.fail("pref_speed", "must be > 0");
+    } else if (max) {
+      pref = {*max, *max};
+    }
+    const double m = max ? *max : pref.second;
+    if (m < pref.second)
+      n.fail("max_speed",
+             "must be >= pref_speed (" + Node::fmt(m) + " < " + Node::fmt(pref.second) + ")");
+    return {pref, m};
   }
 
   void read_obstacles(Node& root) {
@@ -419,11 +513,14 @@ struct Loader {
       s.y = a.number("y");
       s.vx = a.number("vx", 0.0);
       s.vy = a.number("vy", 0.0);
-      s.radius = a.positive("radius", 1.0);
-      s.max_speed = a.positive("max_speed", 1.0);
+      s.radius = a.positive("radius", 0.25);
+      const auto [pref, max] = speeds(a);
+      if (pref.first != pref.second) a.fail("pref_speed", "expected a number");
+      s.pref_speed = pref.first;
+      s.max_speed = max;
       s.max_accel = a.positive_or_inf("max_accel", std::numeric_limits<double>::infinity());
       s.charge = a.number("charge", 1.0);
-      s.goal = goal_named(a, "goal", a.string("goal"));
+      s.goal = goal_sequence(a, "goal", s.then);
       std::vector<Vec2> via = a.has("via") ? a.points("via") : std::vector<Vec2>{};
       a.finish();
       add_agent(a, s, std::move(via));
@@ -438,31 +535,39 @@ struct Loader {
       Rng rng = Rng::stream(sc.config.seed, gi);
       g.string("name", std::string());
       const uint64_t count = g.integer("count", std::nullopt, 10'000'000);
-      const auto radius = g.range("radius", {1, 1});
+      const auto radius = g.range("radius", {0.25, 0.25});
       if (!(radius.first > 0)) g.fail("radius", "must be > 0");
       const auto speed = g.range("speed", {0, 0});
       if (!(speed.first >= 0)) g.fail("speed", "must be >= 0");
       const std::string heading = g.choice("heading", {"random", "goal"}, "random");
       AgentSpec base;
-      base.max_speed = g.positive("max_speed", 1.0);
+      const auto [pref, max_speed] = speeds(g);
+      base.max_speed = max_speed;
       base.max_accel = g.positive_or_inf("max_accel", std::numeric_limits<double>::infinity());
       base.charge = g.number("charge", 1.0);
       std::vector<Vec2> via = g.has("via") ? g.points("via") : std::vector<Vec2>{};
 
-      // Goal assignment: one named goal, or a rule over several.
+      // Goal assignment: one named goal (or sequence), or a rule over several.
       std::string assign = "single";
-      std::vector<uint32_t> pool;
-      double antipodal_radius = 1, antipodal_charge = 1;
+      std::vector<uint32_t> pool, then;
+      double own_radius = 0.5, own_charge = 1;  // antipodal and targets: each agent's own goal
+      std::vector<Vec2> targets;
       if (g.has("goal") == g.has("goals")) g.fail("goal", "give exactly one of 'goal' and 'goals'");
       if (g.has("goal")) {
-        pool.push_back(goal_named(g, "goal", g.string("goal")));
+        pool.push_back(goal_sequence(g, "goal", then));
       } else {
         Node rule = g.child("goals");
-        assign =
-            rule.choice("assign", {"round_robin", "random", "nearest", "antipodal"}, "round_robin");
-        if (assign == "antipodal") {
-          antipodal_radius = rule.positive("arrival_radius", 1.0);
-          antipodal_charge = rule.number("charge", 1.0);
+        assign = rule.choice("assign", {"round_robin", "random", "nearest", "antipodal", "targets"},
+                             "round_robin");
+        if (assign == "antipodal" || assign == "targets") {
+          own_radius = rule.positive("arrival_radius", 0.5);
+          own_charge = rule.number("charge", 1.0);
+          if (assign == "targets") {
+            targets = rule.points("points");
+            if (targets.size() != count)
+              rule.fail("points", "expected one target per agent: " + std::to_string(count) +
+                                      " points, got " + std::to_string(targets.size()));
+          }
         } else if (rule.has("from")) {
           const json& names = rule.array("from");
           for (std::size_t k = 0; k < names.size(); ++k) {
@@ -474,9 +579,18 @@ struct Loader {
         } else {
           for (uint32_t k = 0; k < sc.world.goals().size(); ++k) pool.push_back(k);
         }
-        if (assign != "antipodal" && pool.empty()) rule.fail("from", "no goals to assign");
+        if (assign != "antipodal" && assign != "targets" && pool.empty())
+          rule.fail("from", "no goals to assign");
         rule.finish();
       }
+      if (g.has("then")) {
+        const json& names = g.array("then");
+        for (std::size_t k = 0; k < names.size(); ++k) {
+          if (!names[k].is_string()) g.fail("then/" + std::to_string(k), "expected a goal name");
+          then.push_back(goal_named(g, "then/" + std::to_string(k), names[k].get<std::string>()));
+        }
+      }
+      base.then = then;
 
       Node pl = g.child("placement");
       const std::string type = pl.choice("type", {"uniform", "circle", "grid"}, "");
@@ -528,6 +642,8 @@ struct Loader {
         AgentSpec s = base;
         s.radius =
             radius.first == radius.second ? radius.first : rng.uniform(radius.first, radius.second);
+        s.pref_speed =
+            pref.first == pref.second ? pref.first : rng.uniform(pref.first, pref.second);
         // Position.
         if (type == "uniform") {
           bool ok = false;
@@ -556,16 +672,18 @@ struct Loader {
           s.y = region[1] + static_cast<double>(i / cols) * spacing.second;
         }
         // Goal.
-        if (assign == "antipodal") {
+        if (assign == "antipodal" || assign == "targets") {
           Goal goal;
           goal.name = g.pointer() + "#" + std::to_string(i);
-          goal.x = 2 * centre.x - s.x;
-          goal.y = 2 * centre.y - s.y;
-          goal.arrival_radius = antipodal_radius;
-          goal.charge = antipodal_charge;
+          goal.x = assign == "antipodal" ? 2 * centre.x - s.x : targets[i].x;
+          goal.y = assign == "antipodal" ? 2 * centre.y - s.y : targets[i].y;
+          goal.arrival_radius = own_radius;
+          goal.charge = own_charge;
           if (const std::string why = outside_walkable(goal.x, goal.y); !why.empty())
-            g.fail("goals", "the antipodal goal of agent " + std::to_string(i + 1) + " at (" +
-                                Node::fmt(goal.x) + ", " + Node::fmt(goal.y) + ") " + why);
+            g.fail(assign == "antipodal" ? "goals" : "goals/points/" + std::to_string(i),
+                   "the " + std::string(assign == "antipodal" ? "antipodal goal" : "target") +
+                       " of agent " + std::to_string(i + 1) + " at (" + Node::fmt(goal.x) + ", " +
+                       Node::fmt(goal.y) + ") " + why);
           s.goal = sc.world.add_goal(goal);
         } else if (assign == "single" || assign == "round_robin") {
           s.goal = pool[i % pool.size()];
@@ -597,6 +715,69 @@ struct Loader {
     }
   }
 
+  // "sources": agents entering over time (World::sources, src/sim/sources.hpp).
+  void read_sources(Node& root) {
+    if (!root.has("sources")) return;
+    const json& arr = root.array("sources");
+    for (std::size_t si = 0; si < arr.size(); ++si) {
+      Node n = root.element(arr, "sources", si);
+      Source src;
+      src.name = n.string("name", std::string());
+      if (n.has("area") == n.has("polygon"))
+        n.fail("area", "give exactly one of 'area' and 'polygon'");
+      if (n.has("area")) {
+        const auto b = n.numbers("area", 4);
+        if (!(b[2] > b[0] && b[3] > b[1])) n.fail("area", "needs x1 > x0 and y1 > y0");
+        src.area = {{b[0], b[1]}, {b[2], b[1]}, {b[2], b[3]}, {b[0], b[3]}};
+      } else {
+        src.area = n.points("polygon");
+      }
+      src.rate = n.positive("rate");
+      src.count = n.integer("count", std::nullopt, 10'000'000);
+      if (src.count == 0) n.fail("count", "must be >= 1");
+      src.start = n.non_negative("start", 0.0);
+      if (n.has("end")) {
+        src.end = n.number("end");
+        if (!(src.end > src.start)) n.fail("end", "must be later than start");
+      }
+      const auto radius = n.range("radius", {0.25, 0.25});
+      if (!(radius.first > 0)) n.fail("radius", "must be > 0");
+      src.agent.radius = radius.first;
+      if (radius.second != radius.first) src.radius_max = radius.second;
+      const auto [pref, max_speed] = speeds(n);
+      src.agent.pref_speed = pref.first;
+      if (pref.second != pref.first) src.pref_speed_max = pref.second;
+      src.agent.max_speed = max_speed;
+      src.agent.max_accel = n.positive_or_inf("max_accel", std::numeric_limits<double>::infinity());
+      src.agent.charge = n.number("charge", 1.0);
+      if (n.has("goal") == n.has("goals")) n.fail("goal", "give exactly one of 'goal' and 'goals'");
+      if (n.has("goal")) {
+        src.goals.push_back(goal_sequence(n, "goal", src.agent.then));
+      } else {
+        // Round robin over the listed goals.
+        const json& names = n.array("goals");
+        if (names.empty()) n.fail("goals", "expected at least one goal name");
+        for (std::size_t k = 0; k < names.size(); ++k) {
+          if (!names[k].is_string()) n.fail("goals/" + std::to_string(k), "expected a goal name");
+          src.goals.push_back(
+              goal_named(n, "goals/" + std::to_string(k), names[k].get<std::string>()));
+        }
+      }
+      n.finish();
+      for (const Vec2& v : src.area)
+        if (const std::string why = outside_walkable(v.x, v.y); !why.empty() && sc.config.walls) {
+          const Bounds& b = sc.world.bounds();
+          if (v.x < b.xmin || v.x > b.xmax || v.y < b.ymin || v.y > b.ymax)
+            n.fail(n.has("area") ? "area" : "polygon", "a corner lies outside the bounds");
+        }
+      try {
+        sc.world.add_source(std::move(src));
+      } catch (const InvalidRow& e) {
+        n.fail(e.field(), e.what());
+      }
+    }
+  }
+
   void warn_overlaps() {
     double rmax = 0;
     for (const AgentSpec& s : agents) rmax = std::max(rmax, s.radius);
@@ -622,32 +803,88 @@ struct Loader {
   }
 };
 
+// Keys of format 1 (abstract units, ticks, the thesis's weights at the top of "steering") that
+// moved: a file that still uses them gets told where they went instead of "unknown key".
+void reject_moved_keys(Node& n, std::initializer_list<std::pair<const char*, const char*>> moved) {
+  for (const auto& [key, where] : moved)
+    if (n.has(key))
+      n.fail(key, std::string("no longer here: ") + where + " (docs/scenario-format.md)");
+}
+
 void read_steering(Node& root, SimConfig& cfg) {
   if (!root.has("steering")) return;
   Node s = root.child("steering");
+  const char* thesis =
+      "the thesis model's weights live in steering/thesis, with \"model\": \"thesis\"";
+  reject_moved_keys(s, {{"tau", thesis},
+                        {"w_apf", thesis},
+                        {"w_ftc", thesis},
+                        {"horizon", thesis},
+                        {"obstacle_charges", thesis},
+                        {"potential", thesis}});
   SteeringParams& p = cfg.steering;
-  p.tau = s.positive("tau", p.tau);
-  p.w_apf = s.non_negative("w_apf", p.w_apf);
-  p.w_ftc = s.non_negative("w_ftc", p.w_ftc);
-  p.horizon = s.positive("horizon", p.horizon);
-  p.obstacle_charges =
-      s.choice("obstacle_charges", {"boundary", "centres"}, "boundary") == "centres"
-          ? ObstacleCharges::centres
-          : ObstacleCharges::boundary;
-  if (s.has("potential")) {
-    Node pot = s.child("potential");
-    PotentialSpec& ps = p.potential;
-    ps.kernel = pot.choice("kernel", {"exp", "inv"}, "exp") == "inv" ? Kernel::inv : Kernel::exp;
-    const std::string m = pot.choice("metric", {"l1", "l2", "radial"}, "l1");
-    ps.metric = m == "l2" ? Metric::l2 : (m == "radial" ? Metric::radial : Metric::l1);
-    ps.A = pot.number("A", ps.A);
-    ps.k = pot.non_negative("k", ps.k);
-    ps.radial_frames = static_cast<int>(pot.integer("frames", 2, 16));
-    if (ps.radial_frames < 1) pot.fail("frames", "must be in 1..16");
-    ps.inv_floor = pot.positive("inv_floor", ps.inv_floor);
-    pot.finish();
+  p.model = s.string("model", p.model);
+  p.perturbation = s.non_negative("perturbation", p.perturbation);
+  if (s.has("thesis")) {
+    Node t = s.child("thesis");
+    ThesisParams& th = p.thesis;
+    th.tau = t.positive("tau", th.tau);
+    th.w_apf = t.non_negative("w_apf", th.w_apf);
+    th.w_ftc = t.non_negative("w_ftc", th.w_ftc);
+    th.horizon = t.positive("horizon", th.horizon);
+    th.obstacle_repulsion =
+        t.choice("obstacle_repulsion", {"nearest", "charges"}, "nearest") == "charges"
+            ? ThesisParams::ObstacleRepulsion::charges
+            : ThesisParams::ObstacleRepulsion::nearest;
+    th.obstacle_cutoff = t.positive("obstacle_cutoff", th.obstacle_cutoff);
+    th.obstacle_charges =
+        t.choice("obstacle_charges", {"boundary", "centres"}, "boundary") == "centres"
+            ? ObstacleCharges::centres
+            : ObstacleCharges::boundary;
+    if (t.has("potential")) {
+      Node pot = t.child("potential");
+      PotentialSpec& ps = th.potential;
+      ps.kernel = pot.choice("kernel", {"exp", "inv"}, "exp") == "inv" ? Kernel::inv : Kernel::exp;
+      const std::string m = pot.choice("metric", {"l1", "l2", "radial"}, "l1");
+      ps.metric = m == "l2" ? Metric::l2 : (m == "radial" ? Metric::radial : Metric::l1);
+      ps.A = pot.number("A", ps.A);
+      ps.k = pot.non_negative("k", ps.k);
+      ps.radial_frames = static_cast<int>(pot.integer("frames", 2, 16));
+      if (ps.radial_frames < 1) pot.fail("frames", "must be in 1..16");
+      ps.inv_floor = pot.positive("inv_floor", ps.inv_floor);
+      pot.finish();
+    }
+    t.finish();
+  }
+  if (s.has("orca")) {
+    Node o = s.child("orca");
+    OrcaParams& op = p.orca;
+    op.neighbor_dist = o.positive("neighbor_dist", op.neighbor_dist);
+    op.max_neighbors = static_cast<uint32_t>(o.integer("max_neighbors", op.max_neighbors, 1000));
+    if (op.max_neighbors < 1) o.fail("max_neighbors", "must be >= 1");
+    op.time_horizon = o.positive("time_horizon", op.time_horizon);
+    op.time_horizon_obst = o.positive("time_horizon_obst", op.time_horizon_obst);
+    op.first_share = o.positive("first_share", op.first_share);
+    if (!(op.first_share < 1)) o.fail("first_share", "must be < 1");
+    o.finish();
+  }
+  if (s.has("cfsm")) {
+    Node c = s.child("cfsm");
+    CfsmParams& cp = p.cfsm;
+    cp.time_gap = c.positive("time_gap", cp.time_gap);
+    cp.strength_neighbor = c.non_negative("strength_neighbor", cp.strength_neighbor);
+    cp.range_neighbor = c.positive("range_neighbor", cp.range_neighbor);
+    cp.strength_geometry = c.non_negative("strength_geometry", cp.strength_geometry);
+    cp.range_geometry = c.positive("range_geometry", cp.range_geometry);
+    cp.cutoff = c.positive("cutoff", cp.cutoff);
+    c.finish();
   }
   s.finish();
+  try {
+    steer::find_model(p.model);
+  } catch (const Error& e) {
+    s.fail("model", e.what());
+  }
 }
 
 }  // namespace
@@ -720,9 +957,18 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
     root.fail("bounds", e.what());
   }
   SimConfig& cfg = sc.config;
-  cfg.dt = root.positive("dt", 1.0);
+  reject_moved_keys(root, {{"gridlock_ticks", "gridlock_time, in seconds"}});
+  cfg.dt = root.positive("dt", cfg.dt);
   cfg.seed = root.integer("seed", 1);
-  sc.ticks = root.integer("ticks", 100);
+  if (root.has("ticks") && root.has("duration"))
+    root.fail("ticks", "give one of 'ticks' and 'duration', not both");
+  if (root.has("ticks")) {
+    sc.ticks = root.integer("ticks", 0, 1'000'000'000);
+  } else {
+    const double duration = root.non_negative("duration", 60.0);
+    if (duration / cfg.dt > 1e9) root.fail("duration", "is over 10^9 ticks at this dt");
+    sc.ticks = cfg.ticks_for(duration, 0);
+  }
   cfg.backoff = root.boolean("backoff", true);
   cfg.walls = root.boolean("walls", true);
   const std::string arrival = root.choice("arrival", {"remove", "idle", "retarget"}, "remove");
@@ -731,28 +977,35 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
                     : (arrival == "retarget" ? ArrivalPolicy::retarget : ArrivalPolicy::remove);
   cfg.threads = static_cast<int>(root.integer("threads", 1, 256));
   if (cfg.threads < 1) root.fail("threads", "must be >= 1");
-  cfg.gridlock_ticks = static_cast<uint32_t>(root.integer("gridlock_ticks", 50, 1u << 30));
+  cfg.gridlock_time = root.positive("gridlock_time", cfg.gridlock_time);
   cfg.waypoint_radius = root.non_negative("waypoint_radius", 0.0);
-  cfg.nudge_after = static_cast<uint32_t>(root.integer("nudge_after", cfg.nudge_after, 1u << 30));
+  cfg.nudge_after = root.non_negative("nudge_after", cfg.nudge_after);
   read_steering(root, cfg);
+  if (root.has("stall")) {
+    Node st = root.child("stall");
+    StallParams& sp = cfg.stall;
+    sp.after = st.positive("after", sp.after);
+    sp.progress = st.positive("progress", sp.progress);
+    sp.resolve = st.boolean("resolve", sp.resolve);
+    sp.yield_time = st.positive("yield_time", sp.yield_time);
+    sp.sidestep_time = st.positive("sidestep_time", sp.sidestep_time);
+    st.finish();
+  }
   if (root.has("navigation")) {
     Node n = root.child("navigation");
     NavigationParams& nav = cfg.navigation;
     nav.enabled = n.boolean("enabled", true);
-    nav.latency = static_cast<uint32_t>(n.integer("latency", nav.latency, 100000));
-    if (nav.latency < 1) n.fail("latency", "must be >= 1");
+    nav.latency = n.non_negative("latency", nav.latency);
     nav.budget = static_cast<uint32_t>(n.integer("budget", nav.budget, 1u << 30));
     if (nav.budget < 1) n.fail("budget", "must be >= 1");
-    nav.replan_after = static_cast<uint32_t>(n.integer("replan_after", nav.replan_after, 1u << 30));
+    nav.replan_after = n.non_negative("replan_after", nav.replan_after);
     nav.radius_step = n.positive("radius_step", nav.radius_step);
     nav.cell_size = n.non_negative("cell_size", nav.cell_size);
     nav.clearance = n.non_negative("clearance", nav.clearance);
     nav.tile_size = static_cast<uint32_t>(n.integer("tile_size", nav.tile_size, 4096));
     if (nav.tile_size < 16) n.fail("tile_size", "must be in 16..4096");
     nav.skip_visible = n.boolean("skip_visible", nav.skip_visible);
-    nav.sight_interval =
-        static_cast<uint32_t>(n.integer("sight_interval", nav.sight_interval, 1u << 20));
-    if (nav.sight_interval < 1) n.fail("sight_interval", "must be >= 1");
+    nav.sight_interval = n.non_negative("sight_interval", nav.sight_interval);
     n.finish();
   }
   if (root.has("access")) {
@@ -760,6 +1013,8 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
     cfg.access.ftc = a.string("ftc", "auto");
     cfg.access.field = a.string("field", "auto");
     cfg.access.collisions = a.string("collisions", "auto");
+    cfg.access.neighbours = a.string("neighbours", "auto");
+    cfg.access.edges = a.string("edges", "auto");
     a.finish();
   }
   if (root.has("output")) {
@@ -792,8 +1047,9 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
   if (std::isfinite(rmax)) loader.placed = std::make_unique<DiscGrid>(2 * rmax);
   loader.read_agents(root);
   loader.read_groups(root);
+  loader.read_sources(root);
   root.finish();
-  if (!loader.agents.empty() && sc.world.goals().empty())
+  if ((!loader.agents.empty() || !sc.world.sources().empty()) && sc.world.goals().empty())
     root.fail("goals", "agents need at least one goal");
   if (cfg.navigation.enabled)
     for (const auto& via : loader.routes)

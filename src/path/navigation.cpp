@@ -5,16 +5,17 @@
 #include <cstdio>
 #include <sstream>
 
+#include "world/geometry.hpp"
+
 namespace crowddb::path {
-namespace {
-
-// An agent progresses when it gets this much closer to its waypoint than ever before [radii].
-constexpr double kProgress = 0.05;
-
-}  // namespace
 
 Navigation::Navigation(const World& world, const SimConfig& cfg, Executor& ex)
-    : params_(cfg.navigation), geometry_(NavGeometry::of(world)), ex_(ex) {
+    : params_(cfg.navigation),
+      latency_ticks_(cfg.ticks_for(cfg.navigation.latency)),
+      replan_ticks_(cfg.navigation.replan_after > 0 ? cfg.ticks_for(cfg.navigation.replan_after)
+                                                    : 0),
+      geometry_(NavGeometry::of(world)),
+      ex_(ex) {
   service_ = std::make_unique<PathService>();
   const AgentTable& t = world.agents();
   for (std::size_t i = 0; i < t.size(); ++i) mesh_for(t.radius[i]);
@@ -59,10 +60,10 @@ void Navigation::trim_passed(World& world, std::size_t row) {
   AgentTable& t = world.agents_for_tick();
   auto& route = t.route[row];
   const Vec2 p{t.x[row], t.y[row]};
-  const Goal& g = world.goals()[t.goal[row]];
+  const Vec2 goal = goal_target(world.goals()[t.goal[row]], p.x, p.y);
   std::size_t drop = 0;
   while (drop < route.size()) {
-    const Vec2 next = drop + 1 < route.size() ? route[drop + 1] : Vec2{g.x, g.y};
+    const Vec2 next = drop + 1 < route.size() ? route[drop + 1] : goal;
     ++stats_.sight_checks;
     if (!visible(t.radius[row], p, next)) break;
     ++drop;
@@ -101,20 +102,12 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
   std::size_t made = 0;
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (t.state[i] == AgentState::arrived) continue;  // idle at its goal
-    // Progress watch: closer to the current waypoint than ever since it was set?
-    const double d = std::hypot(t.target_x[i] - t.x[i], t.target_y[i] - t.y[i]);
-    if (d < t.path_best[i] - kProgress * t.radius[i]) {
-      t.path_best[i] = d;
-      t.path_stall[i] = 0;
-    } else {
-      ++t.path_stall[i];
-    }
-    const bool stalled = params_.replan_after > 0 && t.path_stall[i] >= params_.replan_after;
+    // The progress watch (stalemate.cpp) counts the ticks without progress since the last request.
+    const bool stalled = replan_ticks_ > 0 && t.replan_ticks[i] >= replan_ticks_;
     const bool new_goal = t.path_goal[i] != t.goal[i];
     if (!new_goal && !stalled) continue;
     if (stalled) {
-      t.path_stall[i] = 0;
-      t.path_best[i] = d;
+      t.replan_ticks[i] = 0;
       if (!new_goal && t.path_ticket[i] != 0) continue;  // a re-plan is on its way already
       ++stats_.replans;
     }
@@ -135,12 +128,12 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
       continue;
     }
     const std::size_t i = *row;
-    const Goal& g = world.goals()[t.goal[i]];
-    jobs.push_back({q.ticket, q.agent, &mesh_for(t.radius[i]), {t.x[i], t.y[i]}, {g.x, g.y}});
+    const Vec2 goal = goal_target(world.goals()[t.goal[i]], t.x[i], t.y[i]);
+    jobs.push_back({q.ticket, q.agent, &mesh_for(t.radius[i]), {t.x[i], t.y[i]}, goal});
   }
   if (!jobs.empty()) {
     stats_.dispatched += jobs.size();
-    service_->submit(tick + params_.latency, std::move(jobs));
+    service_->submit(tick + latency_ticks_, std::move(jobs));
   }
   return made;
 }

@@ -8,10 +8,11 @@
 //
 // Requests: an agent asks for a path when its route was not planned for its current goal (a
 // new agent, a changed goal) or when it made no progress towards its current waypoint for
-// `replan_after` ticks. Requests wait in FIFO order; each tick at most `budget` of them are
-// dispatched to the worker, with the agent's position at that moment, due `latency` ticks later.
-// A newer request for the same agent supersedes an older one (tickets). Everything here is
-// decided from simulation state only, so runs are bit-identical whatever the worker's timing.
+// `replan_after` seconds (the progress watch of src/sim/stalemate.hpp counts the ticks). Requests
+// wait in FIFO order; each tick at most `budget` of them are dispatched to the worker, with the
+// agent's position at that moment, due `latency` ticks later. A newer request for the same agent
+// supersedes an older one (tickets). Everything here is decided from simulation state only, so runs
+// are bit-identical whatever the worker's timing.
 //
 // Thread-safety: apply_results/request_paths on the tick's thread; visible() from any thread
 // during the steering queries (the meshes are read-only then).
@@ -78,6 +79,8 @@ class Navigation {
     uint64_t agent;
   };
   NavigationParams params_;
+  uint64_t latency_ticks_ = 1;  // params_.latency in ticks (>= 1)
+  uint64_t replan_ticks_ = 0;   // params_.replan_after in ticks (0: never)
   NavGeometry geometry_;
   Executor& ex_;
   std::map<int, std::unique_ptr<NavMesh>> meshes_;  // by class (radius = class * radius_step)

@@ -48,6 +48,23 @@ class CollisionPath {
                    Executor& ex, QueryStats& stats) = 0;
 };
 
+class NeighbourPath {
+ public:
+  virtual ~NeighbourPath() = default;
+  // out = the neighbour lists of the query rows (all rows when `queries` is empty): the k
+  // nearest other discs strictly within `range` (all when k = 0), nearest first, ties by id.
+  virtual void run(const DiscView& discs, std::span<const uint32_t> queries, double range,
+                   uint32_t k, NeighbourLists& out, Executor& ex, QueryStats& stats) = 0;
+};
+
+class FeaturePath {
+ public:
+  virtual ~FeaturePath() = default;
+  // out = per point of `points`, the scene's obstacle features closer than reach[i], ascending.
+  virtual void run(const DiscView& points, std::span<const double> reach, const StaticScene& scene,
+                   FeatureLists& out, Executor& ex, QueryStats& stats) = 0;
+};
+
 // What the planner knows about a registered method.
 struct MethodInfo {
   std::string name;
@@ -87,19 +104,38 @@ struct CollisionMethod {
   std::function<std::unique_ptr<CollisionPath>()> make;
 };
 
+struct NeighbourMethod {
+  MethodInfo info;
+  std::function<std::unique_ptr<NeighbourPath>()> make;
+};
+
+struct FeatureMethod {
+  MethodInfo info;
+  std::function<std::unique_ptr<FeaturePath>()> make;
+};
+
 const std::vector<FtcMethod>& ftc_registry();
 const std::vector<FieldMethod>& field_registry();
 const std::vector<CollisionMethod>& collision_registry();
+const std::vector<NeighbourMethod>& neighbour_registry();
+const std::vector<FeatureMethod>& feature_registry();
 
 // Lookup by name; throws Error(usage) naming the valid choices when unknown.
 const FtcMethod& find_ftc_method(std::string_view name);
 const FieldMethod& find_field_method(std::string_view name, const PotentialSpec& spec);
 const CollisionMethod& find_collision_method(std::string_view name,
                                              const CollisionQueryShape& shape);
+const NeighbourMethod& find_neighbour_method(std::string_view name);
+const FeatureMethod& find_feature_method(std::string_view name);
 
 // The planner's choice for "auto".
 const FtcMethod& choose_ftc_method(std::size_t rows);
 const FieldMethod& choose_field_method(std::size_t rows, const PotentialSpec& spec);
 const CollisionMethod& choose_collision_method(const CollisionQueryShape& shape);
+const NeighbourMethod& choose_neighbour_method(std::size_t rows);
+const FeatureMethod& choose_feature_method(std::size_t features);
+// "auto" or a name -> the method (throws Error(usage) for an unknown name).
+const NeighbourMethod& neighbour_method(std::string_view name, std::size_t rows);
+const FeatureMethod& feature_method(std::string_view name, std::size_t features);
 
 }  // namespace crowddb

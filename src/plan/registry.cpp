@@ -6,9 +6,11 @@
 #include "index/collisions_grid.hpp"
 #include "index/collisions_nn.hpp"
 #include "index/collisions_sweep.hpp"
+#include "index/feature_grid.hpp"
 #include "index/field_bh.hpp"
 #include "index/field_index.hpp"
 #include "index/ftc_tree.hpp"
+#include "index/neighbour_grid.hpp"
 #include "plan/access_path.hpp"
 #include "query/naive_paths.hpp"
 
@@ -48,9 +50,9 @@ const std::vector<FtcMethod>& ftc_registry() {
        [] { return std::make_unique<FtcNaive>(); }},
       // auto_min_rows = 64, measured with build/bench/ftc_bench (BM_BuildQuery vs BM_Naive,
       // single thread, medians of 5, load ~7.5 on 2 cores): build + all queries against the nested
-      // loop at n = 16 / 32 / 64 / 128 agents: 1.6 / 3.8 / 11.4 / 26 us vs 1.0 / 5.0 / 18.6 / 137 us
-      // at the E1 density, 2.0 / 5.4 / 12.8 / 31 us vs 1.2 / 4.7 / 17.8 / 133 us on the 640 x 480
-      // plane. The index wins from about 32 rows; 64 leaves a margin for noise.
+      // loop at n = 16 / 32 / 64 / 128 agents: 1.6 / 3.8 / 11.4 / 26 us vs 1.0 / 5.0 / 18.6 / 137
+      // us at the E1 density, 2.0 / 5.4 / 12.8 / 31 us vs 1.2 / 4.7 / 17.8 / 133 us on the 640 x
+      // 480 plane. The index wins from about 32 rows; 64 leaves a margin for noise.
       {{"index", "kinetic k-d tree, exact best-first search (src/index/ftc_tree.hpp)", true, 1, 64},
        [] { return std::make_unique<FtcIndex>(); }},
   };
@@ -114,6 +116,29 @@ const std::vector<CollisionMethod>& collision_registry() {
   return methods;
 }
 
+const std::vector<NeighbourMethod>& neighbour_registry() {
+  static const std::vector<NeighbourMethod> methods = {
+      {{"naive", "scan of all rows per query, O(n) each"},
+       [] { return std::make_unique<NeighbourNaive>(); }},
+      // auto_min_rows 64: see bench/neighbour_bench.cpp (the grid's build pays off from a few
+      // dozen rows).
+      {{"grid", "uniform grid, ring-by-ring k-nearest search with pruning, O(n + k) per tick", true,
+        1, 64},
+       [] { return std::make_unique<index::NeighbourGrid>(); }},
+  };
+  return methods;
+}
+
+const std::vector<FeatureMethod>& feature_registry() {
+  static const std::vector<FeatureMethod> methods = {
+      {{"naive", "every obstacle feature per query"},
+       [] { return std::make_unique<FeatureNaive>(); }},
+      {{"grid", "features bucketed into a uniform grid once per scene", true, 1, 16},
+       [] { return std::make_unique<index::FeatureGrid>(); }},
+  };
+  return methods;
+}
+
 const FtcMethod& find_ftc_method(std::string_view name) {
   if (const auto* m = by_name(ftc_registry(), name)) return *m;
   throw Error(Error::Kind::usage, "unknown first-to-collide method '" + std::string(name) +
@@ -154,6 +179,34 @@ const CollisionMethod& find_collision_method(std::string_view name,
                                         choices(collision_registry()) + ")");
   }
   return *m;
+}
+
+const NeighbourMethod& find_neighbour_method(std::string_view name) {
+  if (const auto* m = by_name(neighbour_registry(), name)) return *m;
+  throw Error(Error::Kind::usage, "unknown neighbours method '" + std::string(name) +
+                                      "' (choose from " + choices(neighbour_registry()) + ")");
+}
+
+const FeatureMethod& find_feature_method(std::string_view name) {
+  if (const auto* m = by_name(feature_registry(), name)) return *m;
+  throw Error(Error::Kind::usage, "unknown obstacle-features method '" + std::string(name) +
+                                      "' (choose from " + choices(feature_registry()) + ")");
+}
+
+const NeighbourMethod& choose_neighbour_method(std::size_t rows) {
+  return pick(neighbour_registry(), rows, [](const NeighbourMethod&) { return true; });
+}
+
+const FeatureMethod& choose_feature_method(std::size_t features) {
+  return pick(feature_registry(), features, [](const FeatureMethod&) { return true; });
+}
+
+const NeighbourMethod& neighbour_method(std::string_view name, std::size_t rows) {
+  return name == "auto" ? choose_neighbour_method(rows) : find_neighbour_method(name);
+}
+
+const FeatureMethod& feature_method(std::string_view name, std::size_t features) {
+  return name == "auto" ? choose_feature_method(features) : find_feature_method(name);
 }
 
 const FtcMethod& choose_ftc_method(std::size_t rows) {

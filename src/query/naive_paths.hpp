@@ -1,6 +1,8 @@
 // The naive (nested-loop) access paths: the oracles every index is tested against.
 #pragma once
 
+#include <algorithm>
+
 #include "plan/access_path.hpp"
 #include "world/geometry.hpp"
 
@@ -25,6 +27,116 @@ class CollisionNaive final : public CollisionPath {
  public:
   void run(const DiscView& discs, const StaticScene& scene, CollisionPairs& out, Executor& ex,
            QueryStats& stats) override;
+};
+
+class NeighbourNaive final : public NeighbourPath {
+ public:
+  void run(const DiscView& discs, std::span<const uint32_t> queries, double range, uint32_t k,
+           NeighbourLists& out, Executor& ex, QueryStats& stats) override;
+};
+
+class FeatureNaive final : public FeaturePath {
+ public:
+  void run(const DiscView& points, std::span<const double> reach, const StaticScene& scene,
+           FeatureLists& out, Executor& ex, QueryStats& stats) override;
+};
+
+// The k-nearest selection every neighbour method uses, so that all agree bit for bit: candidates
+// are offered one at a time; the list keeps the best k by (dist2, id), or with k = 0 every
+// candidate, sorted the same way by finish().
+class NearestK {
+ public:
+  void reset(uint32_t k) {
+    k_ = k;
+    rows_.clear();
+    d2_.clear();
+    ids_.clear();
+  }
+  std::size_t size() const { return rows_.size(); }
+  bool full() const { return k_ && rows_.size() == k_; }
+  // Every candidate strictly farther than this is rejected (k = 0: none is).
+  double bound() const { return full() ? d2_.back() : INFINITY; }
+  void offer(uint32_t row, uint64_t id, double d2) {
+    if (k_ == 0) {
+      rows_.push_back(row);
+      d2_.push_back(d2);
+      ids_.push_back(id);
+      return;
+    }
+    if (full()) {
+      if (!better(d2, id, d2_.back(), ids_.back())) return;
+      rows_.pop_back();
+      d2_.pop_back();
+      ids_.pop_back();
+    }
+    std::size_t i = rows_.size();
+    rows_.push_back(row);
+    d2_.push_back(d2);
+    ids_.push_back(id);
+    for (; i > 0 && better(d2, id, d2_[i - 1], ids_[i - 1]); --i) {
+      rows_[i] = rows_[i - 1];
+      d2_[i] = d2_[i - 1];
+      ids_[i] = ids_[i - 1];
+    }
+    rows_[i] = row;
+    d2_[i] = d2;
+    ids_[i] = id;
+  }
+  // Sorts an unbounded (k = 0) list; a bounded one is kept sorted already.
+  void finish() {
+    if (k_ != 0 || rows_.size() < 2) return;
+    order_.resize(rows_.size());
+    for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<uint32_t>(i);
+    std::sort(order_.begin(), order_.end(),
+              [&](uint32_t a, uint32_t b) { return better(d2_[a], ids_[a], d2_[b], ids_[b]); });
+    scratch_rows_.resize(order_.size());
+    scratch_d2_.resize(order_.size());
+    for (std::size_t i = 0; i < order_.size(); ++i) {
+      scratch_rows_[i] = rows_[order_[i]];
+      scratch_d2_[i] = d2_[order_[i]];
+    }
+    rows_.swap(scratch_rows_);
+    d2_.swap(scratch_d2_);
+  }
+  std::span<const uint32_t> rows() const { return rows_; }
+  std::span<const double> dist2() const { return d2_; }
+
+ private:
+  static bool better(double d2, uint64_t id, double d2b, uint64_t idb) {
+    return d2 < d2b || (d2 == d2b && id < idb);
+  }
+  uint32_t k_ = 0;
+  std::vector<uint32_t> rows_;
+  std::vector<double> d2_;
+  std::vector<uint64_t> ids_;
+  std::vector<uint32_t> order_, scratch_rows_;
+  std::vector<double> scratch_d2_;
+};
+
+// Gathers per-chunk lists into one CSR table in query order (every method shares it).
+struct ListChunks {
+  std::vector<std::vector<uint32_t>> counts, items;
+  std::vector<std::vector<double>> d2;
+  void reset(std::size_t chunks) {
+    counts.assign(chunks, {});
+    items.assign(chunks, {});
+    d2.assign(chunks, {});
+  }
+  template <class Lists>
+  void gather(Lists& out, std::vector<uint32_t> Lists::*items_member) const {
+    out.offset.assign(1, 0);
+    std::size_t total = 0;
+    for (const auto& c : items) total += c.size();
+    (out.*items_member).clear();
+    (out.*items_member).reserve(total);
+    out.dist2.clear();
+    out.dist2.reserve(total);
+    for (std::size_t c = 0; c < counts.size(); ++c) {
+      for (uint32_t n : counts[c]) out.offset.push_back(out.offset.back() + n);
+      (out.*items_member).insert((out.*items_member).end(), items[c].begin(), items[c].end());
+      out.dist2.insert(out.dist2.end(), d2[c].begin(), d2[c].end());
+    }
+  }
 };
 
 // The exact disc-against-obstacle tests of a collision query. Every method calls these for

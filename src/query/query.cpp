@@ -122,6 +122,54 @@ std::vector<uint32_t> collision_set(const DiscView& discs, const StaticScene& sc
   return rows;
 }
 
+NeighbourLists neighbours(const DiscView& discs, double range, uint32_t k,
+                          std::span<const uint32_t> queries, std::string_view method, int threads,
+                          QueryStats* stats) {
+  if (!(range > 0) || !std::isfinite(range))
+    throw Error(Error::Kind::usage, "neighbours: range must be finite and > 0");
+  for (uint32_t q : queries)
+    if (q >= discs.n)
+      throw Error(Error::Kind::usage, "neighbours: query row " + std::to_string(q) +
+                                          " does not exist (" + std::to_string(discs.n) + " rows)");
+  const NeighbourMethod& m = neighbour_method(method, discs.n);
+  auto path = m.make();
+  Executor ex(threads);
+  QueryStats local;
+  NeighbourLists out;
+  path->run(discs, queries, range, k, out, ex, local);
+  if (stats) *stats += local;
+  return out;
+}
+
+FeatureLists obstacle_features(const DiscView& points, std::span<const double> reach,
+                               const StaticScene& scene, std::string_view method, int threads,
+                               QueryStats* stats) {
+  if (reach.size() != points.n)
+    throw Error(Error::Kind::usage, "obstacle_features: one reach per point is needed");
+  for (double r : reach)
+    if (!(r >= 0) || !std::isfinite(r))
+      throw Error(Error::Kind::usage, "obstacle_features: every reach must be finite and >= 0");
+  const FeatureMethod& m = feature_method(method, scene.feature_count());
+  auto path = m.make();
+  Executor ex(threads);
+  QueryStats local;
+  FeatureLists out;
+  path->run(points, reach, scene, out, ex, local);
+  if (stats) *stats += local;
+  return out;
+}
+
+std::vector<std::string> neighbour_methods() {
+  std::vector<std::string> names;
+  for (const auto& m : neighbour_registry()) names.push_back(m.info.name);
+  return names;
+}
+std::vector<std::string> feature_methods() {
+  std::vector<std::string> names;
+  for (const auto& m : feature_registry()) names.push_back(m.info.name);
+  return names;
+}
+
 std::vector<std::string> ftc_methods() {
   std::vector<std::string> names;
   for (const auto& m : ftc_registry()) names.push_back(m.info.name);

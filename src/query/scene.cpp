@@ -1,8 +1,10 @@
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
 
 #include "crowddb/query.hpp"
+#include "world/geometry.hpp"
 
 namespace crowddb {
 
@@ -25,9 +27,13 @@ void sample_segment(const Vec2& a, const Vec2& e, double spacing, double charge,
 StaticScene::StaticScene(std::vector<CircleObstacle> circles, std::vector<PolygonObstacle> polygons,
                          double spacing, ObstacleCharges charges, const Bounds* walls)
     : circles_(std::move(circles)), polygons_(std::move(polygons)) {
+  static std::atomic<uint64_t> scenes{0};
+  generation_ = ++scenes;
   if (!(spacing > 0) || !std::isfinite(spacing)) spacing = 1;
   wall_begin_ = polygons_.size();
+  const bool charged = charges != ObstacleCharges::none;
   for (const CircleObstacle& c : circles_) {
+    if (!charged) break;
     const double circumference = 2 * std::numbers::pi * c.radius;
     if (charges == ObstacleCharges::centres || c.radius <= spacing) {
       px_.push_back(c.x);
@@ -45,7 +51,7 @@ StaticScene::StaticScene(std::vector<CircleObstacle> circles, std::vector<Polygo
   }
   for (const PolygonObstacle& p : polygons_) {
     const std::size_t n = p.vertices.size();
-    for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t i = 0; i < n && charged; ++i)
       sample_segment(p.vertices[i], p.vertices[(i + 1) % n], spacing, p.charge, px_, py_, pc_);
   }
   if (walls) {
@@ -59,8 +65,11 @@ StaticScene::StaticScene(std::vector<CircleObstacle> circles, std::vector<Polygo
     rect(b.xmin, b.ymin - t, b.xmax, b.ymin);          // south
     rect(b.xmin, b.ymax, b.xmax, b.ymax + t);          // north
     const Vec2 c[4] = {{b.xmin, b.ymin}, {b.xmax, b.ymin}, {b.xmax, b.ymax}, {b.xmin, b.ymax}};
-    for (int i = 0; i < 4; ++i) sample_segment(c[i], c[(i + 1) % 4], spacing, 1.0, px_, py_, pc_);
+    for (int i = 0; i < 4 && charged; ++i)
+      sample_segment(c[i], c[(i + 1) % 4], spacing, 1.0, px_, py_, pc_);
   }
+  for (const PolygonObstacle& p : polygons_)
+    edge_start_.push_back(edge_start_.back() + static_cast<uint32_t>(p.vertices.size()));
   for (const PolygonObstacle& p : polygons_) {
     Box b{INFINITY, INFINITY, -INFINITY, -INFINITY};
     for (const Vec2& a : p.vertices)
@@ -68,6 +77,38 @@ StaticScene::StaticScene(std::vector<CircleObstacle> circles, std::vector<Polygo
            std::max(b.ymax, a.y)};
     boxes_.push_back(b);
   }
+}
+
+std::pair<std::size_t, std::size_t> StaticScene::edge_of(std::size_t f) const {
+  // Binary search in the prefix sums of edge counts.
+  const std::size_t e = f - circles_.size();
+  const auto it =
+      std::upper_bound(edge_start_.begin(), edge_start_.end(), static_cast<uint32_t>(e));
+  const auto p = static_cast<std::size_t>(it - edge_start_.begin()) - 1;
+  return {p, e - edge_start_[p]};
+}
+
+double feature_dist2(const StaticScene& scene, std::size_t f, double px, double py) {
+  if (f < scene.circles().size()) {
+    const CircleObstacle& c = scene.circles()[f];
+    const double d = std::hypot(px - c.x, py - c.y) - c.radius;
+    return d > 0 ? d * d : 0.0;
+  }
+  const auto [p, e] = scene.edge_of(f);
+  const auto& v = scene.polygons()[p].vertices;
+  return dist2_to_segment(v[e], v[(e + 1) % v.size()], px, py);
+}
+
+Vec2 feature_closest(const StaticScene& scene, std::size_t f, double px, double py) {
+  if (f < scene.circles().size()) {
+    const CircleObstacle& c = scene.circles()[f];
+    const double dx = px - c.x, dy = py - c.y, d = std::hypot(dx, dy);
+    if (d == 0) return {px, py};
+    return {c.x + dx * c.radius / d, c.y + dy * c.radius / d};
+  }
+  const auto [p, e] = scene.edge_of(f);
+  const auto& v = scene.polygons()[p].vertices;
+  return closest_on_segment(v[e], v[(e + 1) % v.size()], px, py);
 }
 
 }  // namespace crowddb

@@ -1,5 +1,5 @@
-// The tick driver: plans the access paths, runs the operators of stages.hpp in order, commits,
-// and keeps the EXPLAIN ANALYZE counters.
+// The tick driver: runs the stages in their fixed order (stages.hpp, the steering model of
+// src/steer/, backoff, stalemates), commits, and keeps the EXPLAIN ANALYZE counters.
 #include "crowddb/simulation.hpp"
 
 #include <algorithm>
@@ -9,7 +9,11 @@
 #include <sstream>
 
 #include "path/navigation.hpp"
+#include "sim/oplog.hpp"
+#include "sim/sources.hpp"
 #include "sim/stages.hpp"
+#include "sim/stalemate.hpp"
+#include "steer/model.hpp"
 #include "util/rng.hpp"
 #include "util/stopwatch.hpp"
 
@@ -18,13 +22,6 @@ namespace {
 
 void require(bool ok, const char* field, const std::string& what) {
   if (!ok) throw InvalidRow(field, std::string(field) + " " + what);
-}
-
-const char* kernel_name(Kernel k) {
-  return k == Kernel::exp ? "exp" : "inv";
-}
-const char* metric_name(Metric m) {
-  return m == Metric::l1 ? "l1" : (m == Metric::l2 ? "l2" : "radial");
 }
 
 std::string num(double v) {
@@ -37,83 +34,110 @@ std::string num(double v) {
 
 void SimConfig::validate() const {
   require(std::isfinite(dt) && dt > 0, "dt", "must be > 0");
-  require(std::isfinite(steering.tau) && steering.tau > 0, "tau", "must be > 0");
-  require(std::isfinite(steering.w_apf) && steering.w_apf >= 0, "w_apf", "must be >= 0");
-  require(std::isfinite(steering.w_ftc) && steering.w_ftc >= 0, "w_ftc", "must be >= 0");
-  require(std::isfinite(steering.horizon) && steering.horizon > 0, "horizon", "must be > 0");
-  const PotentialSpec& p = steering.potential;
-  require(std::isfinite(p.A), "A", "must be finite");
-  require(std::isfinite(p.k) && p.k >= 0, "k", "must be >= 0");
-  require(p.radial_frames >= 1 && p.radial_frames <= 16, "frames", "must be in 1..16");
-  require(std::isfinite(p.inv_floor) && p.inv_floor > 0, "inv_floor", "must be > 0");
+  steer::find_model(steering.model);  // throws Error(usage) naming the models
+  const ThesisParams& th = steering.thesis;
+  require(std::isfinite(th.tau) && th.tau > 0, "steering/thesis/tau", "must be > 0");
+  require(std::isfinite(th.w_apf) && th.w_apf >= 0, "steering/thesis/w_apf", "must be >= 0");
+  require(std::isfinite(th.w_ftc) && th.w_ftc >= 0, "steering/thesis/w_ftc", "must be >= 0");
+  require(std::isfinite(th.horizon) && th.horizon > 0, "steering/thesis/horizon", "must be > 0");
+  require(std::isfinite(th.obstacle_cutoff) && th.obstacle_cutoff > 0,
+          "steering/thesis/obstacle_cutoff", "must be > 0");
+  const PotentialSpec& p = th.potential;
+  require(std::isfinite(p.A), "steering/thesis/potential/A", "must be finite");
+  require(std::isfinite(p.k) && p.k >= 0, "steering/thesis/potential/k", "must be >= 0");
+  require(p.radial_frames >= 1 && p.radial_frames <= 16, "steering/thesis/potential/frames",
+          "must be in 1..16");
+  require(std::isfinite(p.inv_floor) && p.inv_floor > 0, "steering/thesis/potential/inv_floor",
+          "must be > 0");
+  const OrcaParams& o = steering.orca;
+  require(std::isfinite(o.neighbor_dist) && o.neighbor_dist > 0, "steering/orca/neighbor_dist",
+          "must be > 0");
+  require(o.max_neighbors >= 1, "steering/orca/max_neighbors", "must be >= 1");
+  require(std::isfinite(o.time_horizon) && o.time_horizon > 0, "steering/orca/time_horizon",
+          "must be > 0");
+  require(std::isfinite(o.time_horizon_obst) && o.time_horizon_obst > 0,
+          "steering/orca/time_horizon_obst", "must be > 0");
+  require(std::isfinite(o.first_share) && o.first_share > 0 && o.first_share < 1,
+          "steering/orca/first_share", "must be in (0, 1)");
+  const CfsmParams& c = steering.cfsm;
+  require(std::isfinite(c.time_gap) && c.time_gap > 0, "steering/cfsm/time_gap", "must be > 0");
+  require(std::isfinite(c.strength_neighbor) && c.strength_neighbor >= 0,
+          "steering/cfsm/strength_neighbor", "must be >= 0");
+  require(std::isfinite(c.range_neighbor) && c.range_neighbor > 0, "steering/cfsm/range_neighbor",
+          "must be > 0");
+  require(std::isfinite(c.strength_geometry) && c.strength_geometry >= 0,
+          "steering/cfsm/strength_geometry", "must be >= 0");
+  require(std::isfinite(c.range_geometry) && c.range_geometry > 0, "steering/cfsm/range_geometry",
+          "must be > 0");
+  require(std::isfinite(c.cutoff) && c.cutoff > 0, "steering/cfsm/cutoff", "must be > 0");
+  require(std::isfinite(steering.perturbation) && steering.perturbation >= 0,
+          "steering/perturbation", "must be >= 0");
   require(threads >= 1 && threads <= 256, "threads", "must be in 1..256");
+  require(std::isfinite(gridlock_time) && gridlock_time > 0, "gridlock_time", "must be > 0");
+  require(std::isfinite(nudge_after) && nudge_after >= 0, "nudge_after", "must be >= 0");
   require(std::isfinite(waypoint_radius) && waypoint_radius >= 0, "waypoint_radius",
           "must be >= 0");
+  require(std::isfinite(stall.after) && stall.after > 0, "stall/after", "must be > 0");
+  require(std::isfinite(stall.progress) && stall.progress > 0, "stall/progress", "must be > 0");
+  require(std::isfinite(stall.yield_time) && stall.yield_time > 0, "stall/yield_time",
+          "must be > 0");
+  require(std::isfinite(stall.sidestep_time) && stall.sidestep_time > 0, "stall/sidestep_time",
+          "must be > 0");
   const NavigationParams& n = navigation;
-  require(n.latency >= 1, "navigation/latency", "must be >= 1");
+  require(std::isfinite(n.latency) && n.latency >= 0, "navigation/latency", "must be >= 0");
   require(n.budget >= 1, "navigation/budget", "must be >= 1");
+  require(std::isfinite(n.replan_after) && n.replan_after >= 0, "navigation/replan_after",
+          "must be >= 0");
   require(std::isfinite(n.radius_step) && n.radius_step > 0, "navigation/radius_step",
           "must be > 0");
   require(std::isfinite(n.cell_size) && n.cell_size >= 0, "navigation/cell_size", "must be >= 0");
   require(std::isfinite(n.clearance) && n.clearance >= 0, "navigation/clearance", "must be >= 0");
   require(n.tile_size >= 16 && n.tile_size <= 4096, "navigation/tile_size", "must be in 16..4096");
-  require(n.sight_interval >= 1, "navigation/sight_interval", "must be >= 1");
+  require(std::isfinite(n.sight_interval) && n.sight_interval >= 0, "navigation/sight_interval",
+          "must be >= 0");
+  // Durations become tick counts: keep them representable.
+  for (double d : {gridlock_time, nudge_after, stall.after, stall.yield_time, stall.sidestep_time,
+                   n.latency, n.replan_after, n.sight_interval})
+    require(d / dt < 1e9, "dt", "is too small for the durations given (over 10^9 ticks)");
 }
 
-// Per-operator EXPLAIN ANALYZE counters.
-struct OperatorStats {
-  uint64_t loops = 0;
-  uint64_t rows = 0;
-  double seconds = 0;
-  QueryStats query;
-};
+uint64_t SimConfig::ticks_for(double seconds, uint64_t min) const {
+  // A hair of tolerance so that 0.3 s at dt 0.1 is 3 ticks, not 4.
+  const double t = std::ceil(seconds / dt - 1e-9);
+  const uint64_t n = t <= 0 ? 0 : static_cast<uint64_t>(t);
+  return std::max(n, min);
+}
 
-// The access paths chosen for one tick.
+// The collision-set access path chosen for one tick.
 struct TickPlan {
   std::size_t rows = 0;
-  const FtcMethod* ftc = nullptr;      // null: outer avoidance off (w_ftc = 0)
-  const FieldMethod* field = nullptr;  // null: inner avoidance off (w_apf = 0)
   const CollisionMethod* collisions = nullptr;
   bool collisions_fallback = false;  // the forced method does not apply to this tick (see plan())
 };
 
 struct Simulation::Engine {
-  explicit Engine(int threads) : ex(threads) {}
+  Engine(int threads, const World& w, uint64_t seed) : ex(threads), sources(w, seed) {}
 
   Executor ex;
   StaticScene scene;
   double scene_spacing = INFINITY;
-  sim::Effects fx;
+  std::unique_ptr<steer::Model> model;
+  sim::Preferred pref;
   sim::NextState next;
-  FieldColumns field;
-  std::vector<FtcHit> hits;
-  std::map<std::string, std::unique_ptr<FtcPath>> ftc_paths;
-  std::map<std::string, std::unique_ptr<FieldPath>> field_paths;
+  std::vector<uint32_t> demand;  // active agents per goal row (arrival = idle only)
+  sim::SourceEmitter sources;
   std::map<std::string, std::unique_ptr<CollisionPath>> collision_paths;
+  std::unique_ptr<NeighbourPath> stall_path;
   std::unique_ptr<path::Navigation> nav;  // null: navigation off
-  // EXPLAIN ANALYZE, in operator order.
-  enum Op {
-    kApply,
-    kPathApply,
-    kAttraction,
-    kInner,
-    kOuter,
-    kIntegrate,
-    kBackoff,
-    kCommit,
-    kPathRequest,
-    kOpCount
-  };
-  OperatorStats ops[kOpCount];
-  std::map<std::string, uint64_t> method_ticks;  // "field=naive" -> ticks it was chosen
+  sim::OpLog log;
   // The agents are known to overlap nowhere at the start of the next tick: the last tick ended
   // (with backoff on) without an overlapping agent pair and no agent was inserted since. Only
   // then is a method that finds the collision set but not every pair (nn) exact for the
   // backoff: every overlap is new, so the set is all the freeze loop needs.
   bool start_clean = false;
 
-  // The access paths for the next tick. A collision method forced by name that does not apply
-  // to this tick (nn while agents still overlap from before, or radii that stopped being equal
+  // The collision access path for the next tick. A method forced by name that does not apply to
+  // this tick (nn while agents still overlap from before, or radii that stopped being equal
   // through inserts) is replaced by the planner's exact choice for the tick and EXPLAIN ANALYZE
   // counts it; `strict` (construction) instead rejects a forced method that can never apply:
   // nn with unequal radii or with backoff off (overlap counts need every pair).
@@ -124,13 +148,6 @@ struct Simulation::Engine {
     TickPlan p;
     const AgentTable& t = w.agents();
     p.rows = t.size();
-    if (cfg.steering.w_ftc > 0)
-      p.ftc =
-          cfg.access.ftc == "auto" ? &choose_ftc_method(p.rows) : &find_ftc_method(cfg.access.ftc);
-    if (cfg.steering.w_apf > 0)
-      p.field = cfg.access.field == "auto"
-                    ? &choose_field_method(p.rows, cfg.steering.potential)
-                    : &find_field_method(cfg.access.field, cfg.steering.potential);
     CollisionQueryShape shape;
     shape.rows = p.rows;
     shape.equal_radii =
@@ -159,34 +176,50 @@ struct Simulation::Engine {
     return p;
   }
 
-  template <class Map, class Method>
-  auto& path(Map& map, const Method& m) {
-    auto& slot = map[m.info.name];
-    if (!slot) slot = m.make();
-    return *slot;
-  }
-
-  // The charged points of obstacle boundaries are spaced no wider than the smallest agent
-  // radius (DESIGN.md §2); rebuild the scene when a smaller agent appears.
+  // The thesis model's charged points (obstacle_repulsion = charges) are spaced no wider than the
+  // smallest agent radius (DESIGN.md §2); rebuild the scene when a smaller agent appears. Other
+  // models and the nearest-geometry repulsion need no charged points.
   void refresh_scene(const World& w, const SimConfig& cfg) {
+    const ThesisParams& th = cfg.steering.thesis;
+    const bool charged = cfg.steering.model == "thesis" && th.w_apf > 0 &&
+                         th.obstacle_repulsion == ThesisParams::ObstacleRepulsion::charges;
     double rmin = INFINITY;
-    for (double r : w.agents().radius) rmin = std::min(rmin, r);
+    if (charged)
+      for (double r : w.agents().radius) rmin = std::min(rmin, r);
     if (!std::isfinite(rmin)) rmin = 1;
     if (rmin >= scene_spacing) return;
     scene_spacing = rmin;
     scene = StaticScene({w.circles().begin(), w.circles().end()},
                         {w.polygons().begin(), w.polygons().end()}, scene_spacing,
-                        cfg.steering.obstacle_charges, cfg.walls ? &w.bounds() : nullptr);
+                        charged ? th.obstacle_charges : ObstacleCharges::none,
+                        cfg.walls ? &w.bounds() : nullptr);
+  }
+
+  steer::TickInput input(const World& w, const SimConfig& cfg, uint64_t tick) const {
+    return {w.agents(), w.goals(), scene, cfg, pref.vx, pref.vy, tick};
   }
 };
 
 Simulation::Simulation(World world, SimConfig config)
     : world_(std::move(world)), config_(std::move(config)) {
   config_.validate();
-  engine_ = std::make_unique<Engine>(config_.threads);
+  for (const Source& s : world_.sources())
+    for (uint32_t g : s.goals)
+      if (g >= world_.goals().size())
+        throw InvalidRow("goal",
+                         "a source names goal " + std::to_string(g) + ", which does not exist");
+  engine_ = std::make_unique<Engine>(config_.threads, world_, config_.seed);
   world_.apply_pending();
+  engine_->model = steer::find_model(config_.steering.model).make();
   engine_->refresh_scene(world_, config_);
   engine_->plan(world_, config_, true);  // reject unknown or unsupported methods now, not mid-run
+  neighbour_method(config_.access.neighbours, 0);
+  feature_method(config_.access.edges, 0);
+  if (config_.steering.model == "thesis") {
+    if (config_.access.ftc != "auto") find_ftc_method(config_.access.ftc);
+    if (config_.access.field != "auto")
+      find_field_method(config_.access.field, config_.steering.thesis.potential);
+  }
   if (config_.navigation.enabled) {
     // Meshes for the radius classes present, and the first requests (tick 0: due at `latency`).
     engine_->nav = std::make_unique<path::Navigation>(world_, config_, engine_->ex);
@@ -204,83 +237,86 @@ uint64_t Simulation::state_hash() const {
   return sim::state_hash(world_.agents(), last_.tick);
 }
 
+std::size_t Simulation::waiting_to_enter() const {
+  return engine_->sources.waiting(world_);
+}
+
 const TickMetrics& Simulation::step() {
   Engine& e = *engine_;
   const SimConfig& cfg = config_;
+  sim::OpLog& log = e.log;
   Stopwatch tick_clock;
   TickMetrics m;
   m.tick = last_.tick + 1;
-  auto timed = [&](Engine::Op op, std::size_t rows, auto&& body) {
-    Stopwatch sw;
-    body();
-    e.ops[op].loops += 1;
-    e.ops[op].rows += rows;
-    e.ops[op].seconds += sw.seconds();
-  };
+  m.time = static_cast<double>(m.tick) * cfg.dt;
 
-  // 0. apply the buffered inserts, deletes and re-targets as one batch
+  // 0. apply the buffered inserts, deletes and re-targets (and the sources' entries) as one batch
   std::size_t applied = 0;
-  timed(Engine::kApply, world_.pending_changes(), [&] { applied = world_.apply_pending(); });
+  log.timed("apply_batch", world_.pending_changes(), [&] {
+    if (!world_.sources().empty()) m.entered = e.sources.emit(world_, cfg, e.scene, m.tick);
+    applied = world_.apply_pending();
+  });
   if (applied)
     e.start_clean = false;  // an insert may overlap (erases and re-targets cannot, but are rare)
   if (e.nav) {
     std::size_t routes = 0;
-    timed(Engine::kPathApply, 0, [&] { routes = e.nav->apply_results(world_, m.tick); });
-    e.ops[Engine::kPathApply].rows += routes;
+    log.timed("path results", 0, [&] { routes = e.nav->apply_results(world_, m.tick); });
+    log.at("path results").rows += routes;
   }
   e.refresh_scene(world_, cfg);
   const TickPlan plan = e.plan(world_, cfg);
   AgentTable& t = world_.agents_for_tick();
   const std::size_t n = t.size();
-  const DiscView view = DiscView::of(t);
-  e.fx.reset(n);
+  e.pref.reset(n);
   e.next.resize(n);
 
-  // 1-3. the steering queries, each into its own effect columns
-  if (cfg.nudge_after > 0)
+  // 1. goal stage: preferred velocities
+  if (cfg.arrival == ArrivalPolicy::idle) {
+    e.demand.assign(world_.goals().size(), 0);
     for (std::size_t i = 0; i < n; ++i)
-      m.nudged += t.state[i] != AgentState::arrived && t.frozen_ticks[i] >= cfg.nudge_after;
-  timed(Engine::kAttraction, n,
-        [&] { sim::attraction(t, world_.goals(), cfg, m.tick, e.fx, e.ex, e.nav.get()); });
-  if (plan.field) {
-    ++e.method_ticks["field=" + plan.field->info.name];
-    timed(Engine::kInner, n, [&] {
-      e.path(e.field_paths, *plan.field)
-          .run(view, e.scene, cfg.steering.potential, e.field, e.ex, e.ops[Engine::kInner].query);
-      sim::inner_avoidance(e.field, cfg, e.fx, e.ex);
-    });
+      if (t.state[i] != AgentState::arrived) ++e.demand[t.goal[i]];
+  } else {
+    e.demand.clear();
   }
-  if (plan.ftc) {
-    ++e.method_ticks["ftc=" + plan.ftc->info.name];
-    timed(Engine::kOuter, n, [&] {
-      e.hits.assign(n, FtcHit{});
-      e.path(e.ftc_paths, *plan.ftc)
-          .run(view, e.scene, cfg.steering.horizon, e.hits, e.ex, e.ops[Engine::kOuter].query);
-      sim::outer_avoidance(t, e.scene, e.hits, cfg, e.fx, e.ex);
-    });
-  }
-  // 4. one effect row per agent -> tentative next state
-  timed(Engine::kIntegrate, n, [&] { sim::combine_integrate(t, e.fx, cfg, e.next, e.ex); });
+  const uint64_t nudge_ticks = cfg.nudge_after > 0 ? cfg.ticks_for(cfg.nudge_after) : 0;
+  if (nudge_ticks)
+    for (std::size_t i = 0; i < n; ++i)
+      m.nudged += t.state[i] != AgentState::arrived && t.frozen_ticks[i] >= nudge_ticks;
+  log.timed("goal stage", n, [&] {
+    sim::goal_stage(t, world_.goals(), cfg, m.tick, e.demand, e.pref, e.ex, e.nav.get());
+  });
 
-  // 5. backoff (or, without it, just measure the overlaps)
-  ++e.method_ticks["collisions=" + plan.collisions->info.name +
-                   (plan.collisions_fallback ? " (instead of " + cfg.access.collisions + ")" : "")];
-  CollisionPath& cpath = e.path(e.collision_paths, *plan.collisions);
+  // 2. the steering model: one velocity per row
+  e.model->velocities(e.input(world_, cfg, m.tick), e.next.vx, e.next.vy, e.ex, log);
+
+  // 3. tentative positions
+  log.timed("integrate", n, [&] { sim::integrate(t, e.next, cfg.dt, e.ex); });
+
+  // 4. backoff (or, without it, just measure the overlaps)
+  log.used("collisions=" + plan.collisions->info.name +
+           (plan.collisions_fallback ? " (instead of " + cfg.access.collisions + ")" : ""));
+  CollisionPath& cpath = [&]() -> CollisionPath& {
+    auto& slot = e.collision_paths[plan.collisions->info.name];
+    if (!slot) slot = plan.collisions->make();
+    return *slot;
+  }();
   sim::OverlapReport overlaps;
-  timed(Engine::kBackoff, n, [&] {
-    QueryStats& qs = e.ops[Engine::kBackoff].query;
+  const std::string backoff_name = cfg.backoff ? "backoff" : "overlap count";
+  sim::OperatorStats& bop = log.at(backoff_name);
+  log.timed(backoff_name, n, [&] {
     if (cfg.backoff) {
-      overlaps = sim::backoff(t, e.next, e.scene, cpath, e.ex, qs, m.freeze_iterations);
+      overlaps = sim::backoff(t, e.next, e.scene, cpath, e.ex, bop.query, m.freeze_iterations);
     } else {
-      overlaps = sim::find_overlaps(t, e.next, e.scene, cpath, e.ex, qs);
+      overlaps = sim::find_overlaps(t, e.next, e.scene, cpath, e.ex, bop.query);
     }
   });
   m.overlapping_pairs = overlaps.agent_pairs;
   m.obstacle_overlaps = overlaps.obstacle_hits;
   e.start_clean = cfg.backoff && overlaps.agent_pairs == 0;
 
-  // 6. commit: swap in the next state, advance waypoints, arrivals
-  timed(Engine::kCommit, n, [&] {
+  // 5. commit: swap in the next state, advance waypoints, arrivals, goal sequences
+  const uint64_t gridlock_ticks = cfg.ticks_for(cfg.gridlock_time);
+  log.timed("commit", n, [&] {
     t.x.swap(e.next.x);
     t.y.swap(e.next.y);
     t.vx.swap(e.next.vx);
@@ -292,57 +328,86 @@ const TickMetrics& Simulation::step() {
         ++m.frozen;
         t.state[i] = AgentState::frozen;
         ++t.frozen_ticks[i];
-        if (t.frozen_ticks[i] == cfg.gridlock_ticks) ++m.gridlock_started;
+        if (t.frozen_ticks[i] == gridlock_ticks) ++m.gridlock_started;
         m.longest_frozen = std::max<std::size_t>(m.longest_frozen, t.frozen_ticks[i]);
       } else {
         t.state[i] = AgentState::active;
         t.frozen_ticks[i] = 0;
       }
-      if (t.frozen_ticks[i] >= cfg.gridlock_ticks) ++m.gridlocked;
-      if (e.fx.skip[i] && !t.route[i].empty()) {  // Q1 saw the waypoint after the current one
-        t.route[i].erase(
-            t.route[i].begin(),
-            t.route[i].begin() + std::min<std::size_t>(e.fx.skip[i], t.route[i].size()));
+      if (t.frozen_ticks[i] >= gridlock_ticks) ++m.gridlocked;
+      bool reached = false;                         // a waypoint or an intermediate goal: progress
+      if (e.pref.skip[i] && !t.route[i].empty()) {  // the goal stage saw the waypoint after
+        t.route[i].erase(t.route[i].begin());
         world_.refresh_target(i);
+        reached = true;
       }
       const double reach = cfg.waypoint_radius > 0 ? cfg.waypoint_radius : t.radius[i];
       while (!t.route[i].empty() &&
              std::hypot(t.route[i].front().x - t.x[i], t.route[i].front().y - t.y[i]) <= reach) {
         t.route[i].erase(t.route[i].begin());
         world_.refresh_target(i);
+        reached = true;
       }
-      const Goal& g = world_.goals()[t.goal[i]];
-      if (t.route[i].empty() && std::hypot(g.x - t.x[i], g.y - t.y[i]) <= g.arrival_radius) {
-        ++m.arrived;
-        if (cfg.arrival == ArrivalPolicy::remove) {
-          leaving.push_back(i);
-        } else if (cfg.arrival == ArrivalPolicy::retarget && world_.goals().size() > 1) {
-          // Another goal, from a stream keyed by seed, id and tick: thread- and order-independent.
-          Rng rng = Rng::stream(cfg.seed ^ (m.tick * 0x9e3779b97f4a7c15ull), t.id[i]);
-          const auto others = static_cast<uint32_t>(world_.goals().size() - 1);
-          const auto pick = static_cast<uint32_t>(rng.below(others));
-          t.goal[i] = pick >= t.goal[i] ? pick + 1 : pick;
-          t.route[i].clear();
-          t.path_goal[i] = AgentTable::kNoPath;  // a new goal: re-plan
-          world_.refresh_target(i);
+      if (t.route[i].empty() && world_.at_goal(i)) {
+        reached = true;
+        if (world_.advance_goal(i)) {
+          // an intermediate goal of its sequence: on to the next one
         } else {
-          t.state[i] = AgentState::arrived;
-          t.vx[i] = t.vy[i] = 0;
+          ++m.arrived;
+          if (cfg.arrival == ArrivalPolicy::remove) {
+            leaving.push_back(i);
+          } else if (cfg.arrival == ArrivalPolicy::retarget && world_.goals().size() > 1) {
+            // Another goal, from a stream keyed by seed, id and tick: thread- and
+            // order-independent.
+            Rng rng = Rng::stream(cfg.seed ^ (m.tick * 0x9e3779b97f4a7c15ull), t.id[i]);
+            const auto others = static_cast<uint32_t>(world_.goals().size() - 1);
+            const auto pick = static_cast<uint32_t>(rng.below(others));
+            t.goal[i] = pick >= t.goal[i] ? pick + 1 : pick;
+            t.route[i].clear();
+            t.path_goal[i] = AgentTable::kNoPath;  // a new goal: re-plan
+            world_.refresh_target(i);
+          } else {
+            t.state[i] = AgentState::arrived;
+            t.vx[i] = t.vy[i] = 0;
+          }
         }
+      }
+      if (reached) {
+        t.stall_ticks[i] = 0;
+        t.replan_ticks[i] = 0;
+        t.stall_action[i] = StallAction::none;
       }
     }
     // Descending rows: each swap-remove moves in a row that is staying (or already handled).
     for (auto it = leaving.rbegin(); it != leaving.rend(); ++it) world_.remove_row(*it);
   });
-  // 7. path requests: progress watch, new requests, dispatch to the worker within the budget
+
+  // 6. stalemates: progress watch, then an action for each agent stalled without one
+  log.timed("stalemates", world_.agents().size(), [&] {
+    sim::StallCounts sc = sim::watch_progress(world_, cfg);
+    if (cfg.stall.resolve && sc.stalled) {
+      if (!e.stall_path)
+        e.stall_path = neighbour_method(cfg.access.neighbours, world_.agents().size()).make();
+      sim::resolve_stalemates(world_, cfg, m.tick, *e.stall_path, e.ex, log.at("stalemates").query,
+                              sc);
+    }
+    m.stalled = sc.stalled;
+    m.stall_started = sc.started;
+    m.longest_stall = sc.longest;
+    m.yielding = sc.yielding;
+    m.sidestepping = sc.sidestepping;
+  });
+
+  // 7. path requests: new requests, re-plans, dispatch to the worker within the budget
   if (e.nav) {
     std::size_t made = 0;
-    timed(Engine::kPathRequest, 0, [&] { made = e.nav->request_paths(world_, m.tick); });
-    e.ops[Engine::kPathRequest].rows += made;
+    log.timed("path requests", 0, [&] { made = e.nav->request_paths(world_, m.tick); });
+    log.at("path requests").rows += made;
   }
   m.agents = world_.agents().size();
   m.state_hash = sim::state_hash(world_.agents(), m.tick);
   arrived_total_ += m.arrived;
+  entered_total_ += m.entered;
   m.seconds = tick_clock.seconds();
   last_ = m;
   return last_;
@@ -351,115 +416,104 @@ const TickMetrics& Simulation::step() {
 std::string Simulation::explain() const {
   const Engine& e = *engine_;
   const TickPlan p = e.plan(world_, config_);
-  const SteeringParams& s = config_.steering;
+  const SimConfig& cfg = config_;
   std::ostringstream os;
   os << "TICK PLAN  rows=" << p.rows << " agents, " << world_.circles().size() << " circles, "
-     << world_.polygons().size() << " polygons" << (config_.walls ? " + 4 walls" : "") << " ("
-     << e.scene.point_count() << " charged points), " << world_.goals().size()
-     << " goals; threads=" << config_.threads << "\n";
+     << world_.polygons().size() << " polygons" << (cfg.walls ? " + 4 walls" : "") << " ("
+     << e.scene.feature_count() << " obstacle features, " << e.scene.point_count()
+     << " charged points), " << world_.goals().size() << " goals, " << world_.sources().size()
+     << " sources; model=" << cfg.steering.model << "; dt=" << num(cfg.dt)
+     << " s; threads=" << cfg.threads << "\n";
   os << "  0 apply_batch        buffered inserts, deletes, re-targets (" << world_.pending_changes()
-     << " pending)\n";
-  const NavigationParams& nv = config_.navigation;
+     << " pending)";
+  if (!world_.sources().empty())
+    os << "; sources let agents in at free spots (" << waiting_to_enter() << " still to enter)";
+  os << "\n";
+  const NavigationParams& nv = cfg.navigation;
+  const uint64_t latency = cfg.ticks_for(nv.latency);
   if (e.nav) {
-    os << "  P path results       apply the routes due this tick (requested " << nv.latency
-       << " tick" << (nv.latency == 1 ? "" : "s") << " earlier; waits only for a late worker)\n"
+    os << "  P path results       apply the routes due this tick (requested " << latency << " tick"
+       << (latency == 1 ? "" : "s") << " earlier; waits only for a late worker)\n"
        << "       path service: Recast/Detour navigation mesh per radius class (radius rounded up "
           "to a multiple of "
-       << num(nv.radius_step) << "), findPath + findStraightPath on a worker thread\n"
+       << num(nv.radius_step) << " m), findPath + findStraightPath on a worker thread\n"
        << e.nav->describe_meshes();
   }
-  os << "  1 Q1 attraction      per row: v_pref towards waypoint, (v_pref - v)/tau, tau="
-     << num(s.tau);
-  if (config_.nudge_after) os << "; sidestep after " << config_.nudge_after << " frozen ticks";
+  os << "  1 goal stage         per row: v_pref = pref_speed towards the waypoint (goal areas: "
+        "their"
+        " nearest point)";
+  if (cfg.stall.resolve) os << "; stalemate actions (yield, sidestep)";
+  if (cfg.nudge_after > 0) os << "; sidestep after " << num(cfg.nudge_after) << " s frozen";
+  if (cfg.steering.perturbation > 0)
+    os << "; seeded perturbation " << num(cfg.steering.perturbation) << " m/s";
   os << "\n";
   if (e.nav)
     os << "       waypoints: advance when within "
-       << (config_.waypoint_radius > 0 ? num(config_.waypoint_radius)
-                                       : std::string("the agent's radius"))
-       << (nv.skip_visible ? " or when the next one is in sight (Detour raycast" +
-                                 (nv.sight_interval > 1
-                                      ? ", every " + std::to_string(nv.sight_interval) + " ticks"
-                                      : std::string()) +
-                                 ")"
-                           : std::string())
-       << "\n";
-  if (p.field)
-    os << "  2 Q2 inner avoidance potential field " << kernel_name(s.potential.kernel) << "-"
-       << metric_name(s.potential.metric) << " A=" << num(s.potential.A)
-       << " k=" << num(s.potential.k) << " w_apf=" << num(s.w_apf)
-       << "\n       access path: " << p.field->info.name << " (" << p.field->info.description
-       << ")\n";
-  else
-    os << "  2 Q2 inner avoidance off (w_apf = 0)\n";
-  if (p.ftc)
-    os << "  3 Q3 outer avoidance first-to-collide, horizon=" << num(s.horizon)
-       << " w_ftc=" << num(s.w_ftc) << "\n       access path: " << p.ftc->info.name << " ("
-       << p.ftc->info.description << ")\n";
-  else
-    os << "  3 Q3 outer avoidance off (w_ftc = 0)\n";
-  os << "  4 combine+integrate  sum effects; |a| <= max_accel; |v| <= max_speed; p += v dt, dt="
-     << num(config_.dt) << "\n";
-  os << "  5 "
-     << (config_.backoff
+       << (cfg.waypoint_radius > 0 ? num(cfg.waypoint_radius) + " m"
+                                   : std::string("the agent's radius"))
+       << (nv.skip_visible ? " or when the next one is in sight (Detour raycast)" : "") << "\n";
+  int step = 2;
+  os << "       steering model " << cfg.steering.model << ": "
+     << steer::find_model(cfg.steering.model).description << "\n";
+  e.model->explain(os, e.input(world_, cfg, last_.tick + 1), step);
+  os << "  " << step++ << " integrate          p' = p + v' dt\n";
+  os << "  " << step++ << " "
+     << (cfg.backoff
              ? "backoff            freeze the collision set until empty; one full query, then"
                " probes of the agents frozen last"
              : "overlap count      backoff off: overlaps are only counted")
      << "\n       access path: " << p.collisions->info.name << " ("
      << p.collisions->info.description << ")";
   if (p.collisions_fallback)
-    os << " instead of " << config_.access.collisions << ": agents overlap at the start";
+    os << " instead of " << cfg.access.collisions << ": agents overlap at the start";
   if (!p.collisions->info.exact) os << "; inexact: the zero-overlap invariant is not guaranteed";
   os << "\n";
   // A method that only finds the set (nn) serves once a tick starts with no overlapping agents.
-  const TickPlan clean = e.plan(world_, config_, true, false);
+  const TickPlan clean = e.plan(world_, cfg, true, false);
   if (clean.collisions != p.collisions)
     os << "       then " << clean.collisions->info.name << " ("
        << clean.collisions->info.description
        << ") on ticks that start with no overlapping agents\n";
-  os << "  6 commit             swap columns, waypoints, arrivals ("
-     << (config_.arrival == ArrivalPolicy::remove ? "remove"
-         : config_.arrival == ArrivalPolicy::idle ? "idle"
-                                                  : "retarget")
-     << "), state hash\n";
+  os << "  " << step++ << " commit             swap columns, waypoints, arrivals ("
+     << (cfg.arrival == ArrivalPolicy::remove ? "remove"
+         : cfg.arrival == ArrivalPolicy::idle ? "idle"
+                                              : "retarget")
+     << "), goal sequences, state hash\n";
+  os << "  " << step++ << " stalemates         progress watch: stalled after "
+     << num(cfg.stall.after) << " s without getting " << num(cfg.stall.progress) << " m closer"
+     << (cfg.stall.resolve ? "; resolve: yield by seeded priority, else sidestep" : "; resolve off")
+     << "\n";
   if (e.nav)
-    os << "  7 path requests      new goal or no progress for " << nv.replan_after
-       << " ticks -> FIFO queue; <= " << nv.budget << " dispatched per tick, due " << nv.latency
-       << " tick" << (nv.latency == 1 ? "" : "s") << " later\n";
+    os << "  " << step++ << " path requests      new goal or no progress for "
+       << num(nv.replan_after) << " s -> FIFO queue; <= " << nv.budget
+       << " dispatched per tick, due " << latency << " tick" << (latency == 1 ? "" : "s")
+       << " later\n";
   return os.str();
 }
 
 std::string Simulation::explain_analyze() const {
   const Engine& e = *engine_;
-  static const char* names[] = {"apply_batch",
-                                "path results",
-                                "Q1 attraction",
-                                "Q2 inner avoidance",
-                                "Q3 outer avoidance",
-                                "combine+integrate",
-                                config_.backoff ? "backoff" : "overlap count",
-                                "commit",
-                                "path requests"};
   std::ostringstream os;
   char line[256];
-  std::snprintf(line, sizeof line, "EXPLAIN ANALYZE  %llu ticks\n",
-                static_cast<unsigned long long>(last_.tick));
+  std::snprintf(line, sizeof line, "EXPLAIN ANALYZE  %llu ticks (%.2f s simulated), model %s\n",
+                static_cast<unsigned long long>(last_.tick), time(),
+                config_.steering.model.c_str());
   os << line;
-  std::snprintf(line, sizeof line, "  %-20s %8s %12s %12s %12s\n", "operator", "loops", "rows",
+  std::snprintf(line, sizeof line, "  %-22s %8s %12s %12s %12s\n", "operator", "loops", "rows",
                 "total ms", "ms/loop");
   os << line;
   double total = 0;
-  for (int op = 0; op < Engine::kOpCount; ++op) total += e.ops[op].seconds;
-  for (int op = 0; op < Engine::kOpCount; ++op) {
-    const OperatorStats& s = e.ops[op];
+  for (const auto& [name, s] : e.log.entries()) total += s.seconds;
+  for (const auto& [name, s] : e.log.entries()) {
     if (!s.loops) continue;
-    std::snprintf(line, sizeof line, "  %-20s %8llu %12llu %12.3f %12.4f\n", names[op],
+    std::snprintf(line, sizeof line, "  %-22s %8llu %12llu %12.3f %12.4f\n", name.c_str(),
                   static_cast<unsigned long long>(s.loops), static_cast<unsigned long long>(s.rows),
                   s.seconds * 1e3, s.seconds * 1e3 / static_cast<double>(s.loops));
     os << line;
     const QueryStats& q = s.query;
     if (q.pair_tests || q.nodes_visited || q.queue_pops) {
       std::snprintf(line, sizeof line,
-                    "  %-20s pair tests %llu, nodes %llu, queue pushes %llu, pops %llu\n", "",
+                    "  %-22s pair tests %llu, nodes %llu, queue pushes %llu, pops %llu\n", "",
                     static_cast<unsigned long long>(q.pair_tests),
                     static_cast<unsigned long long>(q.nodes_visited),
                     static_cast<unsigned long long>(q.queue_pushes),
@@ -467,12 +521,17 @@ std::string Simulation::explain_analyze() const {
       os << line;
     }
     if (q.build_seconds > 0) {
-      std::snprintf(line, sizeof line, "  %-20s index build %.3f ms, probes %.3f ms\n", "",
+      std::snprintf(line, sizeof line, "  %-22s index build %.3f ms, probes %.3f ms\n", "",
                     q.build_seconds * 1e3, q.query_seconds * 1e3);
       os << line;
     }
+    if (!s.events_name.empty()) {
+      std::snprintf(line, sizeof line, "  %-22s %s %llu\n", "", s.events_name.c_str(),
+                    static_cast<unsigned long long>(s.events));
+      os << line;
+    }
   }
-  std::snprintf(line, sizeof line, "  %-20s %8s %12s %12.3f\n", "total", "", "", total * 1e3);
+  std::snprintf(line, sizeof line, "  %-22s %8s %12s %12.3f\n", "total", "", "", total * 1e3);
   os << line;
   if (e.nav) {
     const path::NavigationStats ns = e.nav->stats();
@@ -496,8 +555,14 @@ std::string Simulation::explain_analyze() const {
                   e.nav->mesh_build_seconds() * 1e3);
     os << line;
   }
+  std::snprintf(line, sizeof line,
+                "  stalemates now: %zu stalled (longest %.1f s without progress), %zu yielding, "
+                "%zu sidestepping\n",
+                last_.stalled, static_cast<double>(last_.longest_stall) * config_.dt,
+                last_.yielding, last_.sidestepping);
+  os << line;
   os << "  access paths used (ticks):";
-  for (const auto& [k, v] : e.method_ticks) os << " " << k << " x" << v;
+  for (const auto& [k, v] : e.log.methods()) os << " " << k << " x" << v;
   os << "\n";
   return os.str();
 }

@@ -17,45 +17,41 @@ class Navigation;
 
 namespace crowddb::sim {
 
-// The effects table: at most one row per agent, one column pair per steering query.
-// combine() sums them, in this fixed order, into one acceleration per agent.
-struct Effects {
-  std::vector<double> attract_x, attract_y;  // Q1 [length/tick^2]
-  std::vector<double> apf_x, apf_y;          // Q2
-  std::vector<double> ftc_x, ftc_y;          // Q3
-  std::vector<uint8_t> skip;  // Q1: route waypoints passed by line of sight (popped at commit)
+// Preferred velocities: the goal stage's output, every model's input.
+struct Preferred {
+  std::vector<double> vx, vy;  // [m/s]
+  std::vector<uint8_t> skip;   // route waypoints passed by line of sight (popped at commit)
   void reset(std::size_t n);
 };
 
-// Next-state columns written by integrate and backoff, swapped in by commit.
+// Next-state columns written by the model, integrate and backoff, swapped in by commit.
 struct NextState {
   std::vector<double> x, y, vx, vy;
   std::vector<uint8_t> frozen;  // 1 when the backoff loop put the agent back this tick
   void resize(std::size_t n);
 };
 
-// Q1: preferred velocity towards the current waypoint, (v_pref - v) / tau, times the goal's
-// charge; turned aside for agents frozen cfg.nudge_after ticks in a row. Idle (arrived) agents
-// get no effect. `tick` is the tick being computed (it seeds the sidesteps).
-// Waypoint following: with `nav` (and cfg.navigation.skip_visible, every sight_interval ticks
-// per agent), an agent whose waypoint after the current one is in sight (a disc of its radius class
-// can walk straight there) steers at that one instead and records the skipped waypoint in fx.skip;
-// commit pops it.
-void attraction(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,
-                uint64_t tick, Effects& fx, Executor& ex, const path::Navigation* nav = nullptr);
+// Where row i is heading now: its next route waypoint, else the nearest point of its goal area.
+Vec2 current_target(const AgentTable& t, std::span<const Goal> goals, std::size_t i);
+// Distance from row i to what it is heading for (0 inside a polygon goal with no waypoint left).
+double distance_to_target(const AgentTable& t, std::span<const Goal> goals, std::size_t i);
 
-// Q2: -w_apf * gradient of the potential field at each agent.
-void inner_avoidance(const FieldColumns& field, const SimConfig& cfg, Effects& fx, Executor& ex);
+// The goal stage: per row, the preferred velocity pref_speed towards its current target (slower
+// when it would overshoot within one tick). On top of it, in this order:
+// - a stalemate action in progress (yield or sidestep: StallAction) replaces the direction;
+// - an agent frozen nudge_after seconds in a row turns it by a seeded 45-90 degrees;
+// - a tiny seeded perturbation (steering.perturbation) breaks exact symmetries.
+// Idle (arrived) agents prefer to stand still, unless they stand on a goal area that `demand`
+// (active agents per goal row; empty when arrivals do not idle) says others still head for:
+// then they step off it, away from the goal's point, at half their preferred speed.
+// Waypoint following: with `nav` (and skip_visible, every sight interval per agent), an agent whose
+// waypoint after the current one is in sight steers at that one and records the skip.
+void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,
+                uint64_t tick, std::span<const uint32_t> demand, Preferred& pref, Executor& ex,
+                const path::Navigation* nav = nullptr);
 
-// Q3: push away from the first collider along the line of centres predicted at the collision
-// time, scaled by (1 - t/T); the perpendicular of the relative velocity when that line is zero.
-void outer_avoidance(const AgentTable& t, const StaticScene& scene, std::span<const FtcHit> hits,
-                     const SimConfig& cfg, Effects& fx, Executor& ex);
-
-// Sum the effects, clamp |a| <= max_accel, v' = v + a dt clamped to max_speed, p' = p + v' dt.
-// Idle agents stay put with zero velocity.
-void combine_integrate(const AgentTable& t, const Effects& fx, const SimConfig& cfg,
-                       NextState& next, Executor& ex);
+// Tentative positions from the model's velocities: p' = p + v' dt.
+void integrate(const AgentTable& t, NextState& next, double dt, Executor& ex);
 
 // Overlaps among the next-state positions, split into those the backoff must resolve and those
 // it tolerates (pairs that overlapped at the start of the tick and did not get deeper).

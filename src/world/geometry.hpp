@@ -90,6 +90,24 @@ inline bool discs_overlap(double dx, double dy, double rsum) {
   return dx * dx + dy * dy < rsum * rsum;
 }
 
+// Has a point reached a goal area? A disc goal: within arrival_radius of its centre. A polygon
+// goal: inside or on the boundary (within a micrometre, so that an agent that steps exactly onto
+// the nearest boundary point arrives whatever the rounding).
+inline bool inside_goal(const Goal& g, double px, double py) {
+  if (!g.is_polygon()) return std::hypot(g.x - px, g.y - py) <= g.arrival_radius;
+  return point_in_polygon(g.area, px, py) || dist2_to_boundary(g.area, px, py) <= 1e-12;
+}
+
+// Where an agent at p steers for its goal when no waypoint is left: a disc goal's centre, or the
+// nearest point of a polygon goal (p itself when inside).
+inline Vec2 goal_target(const Goal& g, double px, double py) {
+  if (!g.is_polygon()) return {g.x, g.y};
+  if (point_in_polygon(g.area, px, py)) return {px, py};
+  Vec2 c{};
+  dist2_to_boundary(g.area, px, py, &c);
+  return c;
+}
+
 // The first pair of non-adjacent edges (i, j), i < j, that touch or cross, if any. O(v^2).
 std::optional<std::pair<std::size_t, std::size_t>> first_self_intersection(
     std::span<const Vec2> ring);

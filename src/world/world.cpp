@@ -27,6 +27,31 @@ void require_positive(const char* field, double v) {
   if (!(v > 0)) throw InvalidRow(field, std::string(field) + " must be > 0 (got " + fmt(v) + ")");
 }
 
+std::string missing_goal(uint32_t g, std::size_t goal_count) {
+  return "goal " + std::to_string(g) + " does not exist (the world has " +
+         std::to_string(goal_count) + " goals)";
+}
+
+// A simple polygon ring: finite, >= 3 vertices, no repeated closing vertex, non-zero area, no
+// self-intersection; turned counter-clockwise.
+void normalize_ring(std::vector<Vec2>& ring, const char* field) {
+  if (ring.size() > 3 && ring.front().x == ring.back().x && ring.front().y == ring.back().y)
+    ring.pop_back();
+  if (ring.size() < 3)
+    throw InvalidRow(field, std::string("a polygon needs at least 3 vertices (got ") +
+                                std::to_string(ring.size()) + ")");
+  for (const Vec2& v : ring) {
+    require_finite(field, v.x);
+    require_finite(field, v.y);
+  }
+  const double area = signed_area(ring);
+  if (area == 0) throw InvalidRow(field, "polygon has zero area");
+  if (auto bad = first_self_intersection(ring))
+    throw InvalidRow(field, "polygon is not simple: edges " + std::to_string(bad->first) + " and " +
+                                std::to_string(bad->second) + " intersect");
+  if (area < 0) std::reverse(ring.begin(), ring.end());
+}
+
 }  // namespace
 
 void World::validate_spec(const AgentSpec& s, std::size_t goal_count) {
@@ -35,23 +60,64 @@ void World::validate_spec(const AgentSpec& s, std::size_t goal_count) {
   require_finite("vx", s.vx);
   require_finite("vy", s.vy);
   require_positive("radius", s.radius);
+  require_positive("pref_speed", s.pref_speed);
   require_positive("max_speed", s.max_speed);
+  if (s.max_speed < s.pref_speed)
+    throw InvalidRow("max_speed", "max_speed must be >= pref_speed (got " + fmt(s.max_speed) +
+                                      " < " + fmt(s.pref_speed) + ")");
   if (std::isnan(s.max_accel) || !(s.max_accel > 0))
     throw InvalidRow("max_accel",
                      "max_accel must be > 0 or infinite (got " + fmt(s.max_accel) + ")");
   require_finite("charge", s.charge);
-  if (s.goal >= goal_count)
-    throw InvalidRow("goal", "goal " + std::to_string(s.goal) + " does not exist (the world has " +
-                                 std::to_string(goal_count) + " goals)");
+  for (uint32_t g : s.then)
+    if (g >= goal_count) throw InvalidRow("goal", missing_goal(g, goal_count));
+  if (s.goal >= goal_count) throw InvalidRow("goal", missing_goal(s.goal, goal_count));
 }
 
-uint32_t World::add_goal(const Goal& g) {
+std::optional<uint32_t> World::goal_named(std::string_view name) const {
+  for (std::size_t i = 0; i < goals_.size(); ++i)
+    if (goals_[i].name == name) return static_cast<uint32_t>(i);
+  return std::nullopt;
+}
+
+uint32_t World::add_goal(Goal g) {
   require_finite("x", g.x);
   require_finite("y", g.y);
   require_finite("charge", g.charge);
   require_positive("arrival_radius", g.arrival_radius);
-  goals_.push_back(g);
+  if (goal_named(g.name)) throw InvalidRow("name", "duplicate goal name '" + g.name + "'");
+  if (g.is_polygon()) {
+    normalize_ring(g.area, "area");
+    if (!point_in_polygon(g.area, g.x, g.y) && dist2_to_boundary(g.area, g.x, g.y) > 0)
+      throw InvalidRow(
+          "x", "the goal's point (" + fmt(g.x) + ", " + fmt(g.y) + ") lies outside its area");
+  }
+  goals_.push_back(std::move(g));
   return static_cast<uint32_t>(goals_.size() - 1);
+}
+
+uint32_t World::add_source(Source src) {
+  normalize_ring(src.area, "area");
+  if (!std::isfinite(src.rate) || !(src.rate > 0))
+    throw InvalidRow("rate", "rate must be > 0 agents per second (got " + fmt(src.rate) + ")");
+  if (src.count == 0) throw InvalidRow("count", "count must be >= 1");
+  if (!std::isfinite(src.start) || src.start < 0)
+    throw InvalidRow("start", "start must be >= 0 s (got " + fmt(src.start) + ")");
+  if (std::isnan(src.end) || !(src.end > src.start))
+    throw InvalidRow("end", "end must be later than start (got " + fmt(src.end) + ")");
+  if (src.goals.empty()) src.goals.push_back(src.agent.goal);
+  for (uint32_t g : src.goals) {
+    src.agent.goal = g;
+    validate_spec(src.agent, goals_.size());
+  }
+  src.agent.goal = src.goals.front();
+  if (src.radius_max != 0 && !(src.radius_max >= src.agent.radius))
+    throw InvalidRow("radius", "the radius range must have low <= high");
+  if (src.pref_speed_max != 0 &&
+      !(src.pref_speed_max >= src.agent.pref_speed && src.pref_speed_max <= src.agent.max_speed))
+    throw InvalidRow("pref_speed", "the pref_speed range must have low <= high <= max_speed");
+  sources_.push_back(std::move(src));
+  return static_cast<uint32_t>(sources_.size() - 1);
 }
 
 uint32_t World::add_obstacle(const CircleObstacle& c) {
@@ -65,23 +131,7 @@ uint32_t World::add_obstacle(const CircleObstacle& c) {
 
 uint32_t World::add_obstacle(PolygonObstacle p) {
   require_finite("charge", p.charge);
-  if (p.vertices.size() < 3)
-    throw InvalidRow("vertices", "a polygon needs at least 3 vertices (got " +
-                                     std::to_string(p.vertices.size()) + ")");
-  for (const Vec2& v : p.vertices) {
-    require_finite("vertices", v.x);
-    require_finite("vertices", v.y);
-  }
-  // An explicitly closed ring (last == first) is accepted and the duplicate dropped.
-  if (p.vertices.size() > 3 && p.vertices.front().x == p.vertices.back().x &&
-      p.vertices.front().y == p.vertices.back().y)
-    p.vertices.pop_back();
-  const double area = signed_area(p.vertices);
-  if (area == 0) throw InvalidRow("vertices", "polygon has zero area");
-  if (auto bad = first_self_intersection(p.vertices))
-    throw InvalidRow("vertices", "polygon is not simple: edges " + std::to_string(bad->first) +
-                                     " and " + std::to_string(bad->second) + " intersect");
-  if (area < 0) std::reverse(p.vertices.begin(), p.vertices.end());
+  normalize_ring(p.vertices, "vertices");
   polygons_.push_back(std::move(p));
   return static_cast<uint32_t>(polygons_.size() - 1);
 }
@@ -156,20 +206,28 @@ void World::push_row(AgentId id, const AgentSpec& s) {
   t.vx.push_back(s.vx);
   t.vy.push_back(s.vy);
   t.radius.push_back(s.radius);
+  t.pref_speed.push_back(s.pref_speed);
   t.max_speed.push_back(s.max_speed);
   t.max_accel.push_back(s.max_accel);
   t.charge.push_back(s.charge);
-  t.target_x.push_back(goals_[s.goal].x);
-  t.target_y.push_back(goals_[s.goal].y);
+  const Vec2 target = goal_target(goals_[s.goal], s.x, s.y);
+  t.target_x.push_back(target.x);
+  t.target_y.push_back(target.y);
   t.goal.push_back(s.goal);
   t.state.push_back(AgentState::active);
   t.frozen_ticks.push_back(0);
+  t.progress_best.push_back(INFINITY);
+  t.stall_ticks.push_back(0);
   t.id.push_back(id.value());
   t.route.emplace_back();
+  t.then.push_back(s.then);
+  t.stall_action.push_back(StallAction::none);
+  t.stall_until.push_back(0);
+  t.stall_dir_x.push_back(0);
+  t.stall_dir_y.push_back(0);
   t.path_goal.push_back(AgentTable::kNoPath);
   t.path_ticket.push_back(0);
-  t.path_best.push_back(INFINITY);
-  t.path_stall.push_back(0);
+  t.replan_ticks.push_back(0);
   slots_[id.index].row = static_cast<uint32_t>(t.size() - 1);
   slots_[id.index].pending = false;
 }
@@ -187,6 +245,7 @@ void World::remove_row(std::size_t row) {
   move_last(t.vx);
   move_last(t.vy);
   move_last(t.radius);
+  move_last(t.pref_speed);
   move_last(t.max_speed);
   move_last(t.max_accel);
   move_last(t.charge);
@@ -195,12 +254,18 @@ void World::remove_row(std::size_t row) {
   move_last(t.goal);
   move_last(t.state);
   move_last(t.frozen_ticks);
+  move_last(t.progress_best);
+  move_last(t.stall_ticks);
   move_last(t.id);
   move_last(t.route);
+  move_last(t.then);
+  move_last(t.stall_action);
+  move_last(t.stall_until);
+  move_last(t.stall_dir_x);
+  move_last(t.stall_dir_y);
   move_last(t.path_goal);
   move_last(t.path_ticket);
-  move_last(t.path_best);
-  move_last(t.path_stall);
+  move_last(t.replan_ticks);
   if (row != last) slots_[AgentId::from_value(t.id[row]).index].row = static_cast<uint32_t>(row);
   Slot& s = slots_[dead.index];
   s.row = kNoRow;
@@ -216,12 +281,30 @@ void World::refresh_target(std::size_t row) {
     t.target_x[row] = t.route[row].front().x;
     t.target_y[row] = t.route[row].front().y;
   } else {
-    const Goal& g = goals_[t.goal[row]];
-    t.target_x[row] = g.x;
-    t.target_y[row] = g.y;
+    const Vec2 p = goal_target(goals_[t.goal[row]], t.x[row], t.y[row]);
+    t.target_x[row] = p.x;
+    t.target_y[row] = p.y;
   }
-  t.path_best[row] = INFINITY;
-  t.path_stall[row] = 0;
+  // The distance to a new waypoint is not comparable with the old one: the watch restarts.
+  // stall_ticks is kept: a new path is no progress (the commit resets it when a waypoint or a
+  // goal is reached).
+  t.progress_best[row] = INFINITY;
+  t.replan_ticks[row] = 0;
+}
+
+bool World::advance_goal(std::size_t row) {
+  AgentTable& t = agents_;
+  if (t.then[row].empty()) return false;
+  t.goal[row] = t.then[row].front();
+  t.then[row].erase(t.then[row].begin());
+  t.route[row].clear();
+  t.path_goal[row] = AgentTable::kNoPath;  // a new goal: re-plan
+  refresh_target(row);
+  return true;
+}
+
+bool World::at_goal(std::size_t row) const {
+  return inside_goal(goals_[agents_.goal[row]], agents_.x[row], agents_.y[row]);
 }
 
 std::size_t World::apply_pending() {
@@ -247,6 +330,7 @@ std::size_t World::apply_pending() {
         const auto row = row_of(c.id);
         if (!row) break;  // erased earlier in this batch
         agents_.goal[*row] = c.goal;
+        agents_.then[*row].clear();
         agents_.route[*row].clear();
         agents_.path_goal[*row] = AgentTable::kNoPath;  // re-plan, even for the same goal
         if (agents_.state[*row] == AgentState::arrived) agents_.state[*row] = AgentState::active;
@@ -269,6 +353,7 @@ void World::validate() const {
   same(t.vx.size(), "vx");
   same(t.vy.size(), "vy");
   same(t.radius.size(), "radius");
+  same(t.pref_speed.size(), "pref_speed");
   same(t.max_speed.size(), "max_speed");
   same(t.max_accel.size(), "max_accel");
   same(t.charge.size(), "charge");
@@ -277,12 +362,18 @@ void World::validate() const {
   same(t.goal.size(), "goal");
   same(t.state.size(), "state");
   same(t.frozen_ticks.size(), "frozen_ticks");
+  same(t.progress_best.size(), "progress_best");
+  same(t.stall_ticks.size(), "stall_ticks");
   same(t.id.size(), "id");
   same(t.route.size(), "route");
+  same(t.then.size(), "then");
+  same(t.stall_action.size(), "stall_action");
+  same(t.stall_until.size(), "stall_until");
+  same(t.stall_dir_x.size(), "stall_dir_x");
+  same(t.stall_dir_y.size(), "stall_dir_y");
   same(t.path_goal.size(), "path_goal");
   same(t.path_ticket.size(), "path_ticket");
-  same(t.path_best.size(), "path_best");
-  same(t.path_stall.size(), "path_stall");
+  same(t.replan_ticks.size(), "replan_ticks");
   std::size_t live = 0;
   for (std::size_t r = 0; r < n; ++r) {
     const AgentId id = AgentId::from_value(t.id[r]);

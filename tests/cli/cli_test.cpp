@@ -177,7 +177,7 @@ TEST(Cli, OverlappingSpawnIsAWarningAndTheRunGoesOn) {
   TempDir dir;
   const auto sc = dir.write("o.json", R"({"bounds": [0, 0, 100, 100], "ticks": 3,
     "goals": [{"name": "g", "x": 90, "y": 50}],
-    "agents": [{"x": 10, "y": 50, "goal": "g"}, {"x": 11, "y": 50, "goal": "g"}]})");
+    "agents": [{"x": 10, "y": 50, "radius": 1, "goal": "g"}, {"x": 11, "y": 50, "radius": 1, "goal": "g"}]})");
   const CliResult r = run_cli("run " + sc.string() + " --no-output", dir);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;

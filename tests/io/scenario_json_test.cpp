@@ -4,6 +4,7 @@
 
 #include "crowddb/scenario.hpp"
 #include "support/cli.hpp"
+#include "world/geometry.hpp"
 
 namespace crowddb {
 namespace {
@@ -27,12 +28,90 @@ std::string error_of(const std::string& text) {
 TEST(ScenarioJson, MinimalFileHasDefaults) {
   Scenario sc = parse_scenario(kMinimal, "s.json");
   EXPECT_EQ(sc.world.agents().size(), 1u);
-  EXPECT_EQ(sc.ticks, 100u);
-  EXPECT_EQ(sc.config.dt, 1.0);
+  EXPECT_EQ(sc.config.dt, 0.1);
+  EXPECT_EQ(sc.ticks, 600u);  // 60 s
+  EXPECT_EQ(sc.config.steering.model, "orca");
   EXPECT_TRUE(sc.config.backoff);
   EXPECT_EQ(sc.config.access.ftc, "auto");
   EXPECT_TRUE(std::isinf(sc.world.agents().max_accel[0]));
+  // max_speed given alone: pref_speed follows it (files written for the thesis's rule).
+  EXPECT_EQ(sc.world.agents().pref_speed[0], 1.0);
+  EXPECT_EQ(sc.world.goals()[0].arrival_radius, 0.5);
   EXPECT_TRUE(sc.warnings.empty());
+}
+
+TEST(ScenarioJson, UnitsAreMetresAndSeconds) {
+  const std::string text = R"({"bounds": [0, 0, 100, 100], "dt": 0.05, "duration": 12.5,
+    "gridlock_time": 3, "nudge_after": 0.5, "stall": {"after": 2, "progress": 0.2},
+    "navigation": {"latency": 0.25, "replan_after": 6},
+    "steering": {"orca": {"time_horizon": 3, "time_horizon_obst": 1, "neighbor_dist": 4}},
+    "goals": [{"name": "g", "x": 90, "y": 50}],
+    "agents": [{"x": 10, "y": 50, "goal": "g"}, {"x": 10, "y": 60, "pref_speed": 1.1, "goal": "g"},
+               {"x": 10, "y": 70, "pref_speed": 1.1, "max_speed": 2, "goal": "g"}]})";
+  const Scenario sc = parse_scenario(text, "s.json");
+  EXPECT_EQ(sc.ticks, 250u);  // 12.5 s at 0.05 s per tick
+  EXPECT_EQ(sc.config.ticks_for(sc.config.gridlock_time), 60u);
+  EXPECT_EQ(sc.config.ticks_for(sc.config.nudge_after), 10u);
+  EXPECT_EQ(sc.config.ticks_for(sc.config.stall.after), 40u);
+  EXPECT_EQ(sc.config.ticks_for(sc.config.navigation.latency), 5u);
+  EXPECT_EQ(sc.config.steering.orca.time_horizon, 3.0);
+  const AgentTable& t = sc.world.agents();
+  EXPECT_EQ(t.pref_speed[0], 1.34);  // Weidmann's free speed
+  EXPECT_EQ(t.max_speed[0], 1.34);
+  EXPECT_EQ(t.pref_speed[1], 1.1);
+  EXPECT_EQ(t.max_speed[1], 1.1);
+  EXPECT_EQ(t.max_speed[2], 2.0);
+}
+
+TEST(ScenarioJson, GoalAreasSequencesAndTargets) {
+  const std::string text = R"({"bounds": [0, 0, 100, 100],
+    "goals": [{"name": "door", "area": [[90, 40], [100, 40], [100, 60], [90, 60]]},
+              {"name": "L", "area": [[10, 10], [30, 10], [30, 12], [12, 12], [12, 30], [10, 30]]},
+              {"name": "p", "x": 50, "y": 50, "arrival_radius": 2}],
+    "agents": [{"x": 5, "y": 50, "goal": ["p", "door"]}],
+    "groups": [{"count": 3, "placement": {"type": "grid", "region": [40, 80, 60, 90], "spacing": 5},
+                "goals": {"assign": "targets", "points": [[45, 20], [50, 20], [55, 20]], "arrival_radius": 1},
+                "then": ["door"]}]})";
+  const Scenario sc = parse_scenario(text, "s.json");
+  const auto goals = sc.world.goals();
+  ASSERT_EQ(goals.size(), 6u);  // three named, one per target
+  EXPECT_TRUE(goals[0].is_polygon());
+  EXPECT_EQ(goals[0].x, 95);  // its centroid
+  EXPECT_EQ(goals[0].y, 50);
+  // The L's centroid lies outside it: the goal's point is moved inside.
+  EXPECT_TRUE(point_in_polygon(goals[1].area, goals[1].x, goals[1].y));
+  const AgentTable& t = sc.world.agents();
+  EXPECT_EQ(t.goal[0], 2u);
+  EXPECT_EQ(t.then[0], (std::vector<uint32_t>{0}));
+  for (std::size_t i = 1; i < 4; ++i) {
+    EXPECT_EQ(goals[t.goal[i]].x, 40 + 5.0 * static_cast<double>(i));
+    EXPECT_EQ(goals[t.goal[i]].y, 20);
+    EXPECT_EQ(t.then[i], (std::vector<uint32_t>{0}));
+  }
+  // An agent steers for the nearest point of a polygon goal.
+  EXPECT_EQ(goal_target(goals[0], 50, 45).x, 90);
+  EXPECT_EQ(goal_target(goals[0], 50, 45).y, 45);
+}
+
+TEST(ScenarioJson, SourcesAreRead) {
+  const std::string text = R"({"bounds": [0, 0, 100, 100],
+    "goals": [{"name": "a", "x": 90, "y": 50}, {"name": "b", "x": 90, "y": 10}],
+    "sources": [{"name": "gate", "area": [0, 40, 4, 60], "rate": 2, "count": 30, "start": 5, "end": 20,
+                 "radius": [0.2, 0.3], "pref_speed": [1, 1.4], "max_speed": 1.6, "goals": ["a", "b"]},
+                {"polygon": [[10, 10], [20, 10], [15, 20]], "rate": 0.5, "count": 3, "goal": ["b", "a"]}]})";
+  const Scenario sc = parse_scenario(text, "s.json");
+  ASSERT_EQ(sc.world.sources().size(), 2u);
+  const Source& s = sc.world.sources()[0];
+  EXPECT_EQ(s.rate, 2);
+  EXPECT_EQ(s.count, 30u);
+  EXPECT_EQ(s.start, 5);
+  EXPECT_EQ(s.end, 20);
+  EXPECT_EQ(s.agent.radius, 0.2);
+  EXPECT_EQ(s.radius_max, 0.3);
+  EXPECT_EQ(s.pref_speed_max, 1.4);
+  EXPECT_EQ(s.goals, (std::vector<uint32_t>{0, 1}));
+  EXPECT_EQ(sc.world.sources()[1].agent.then, (std::vector<uint32_t>{0}));
+  EXPECT_TRUE(std::isinf(sc.world.sources()[1].end));
 }
 
 TEST(ScenarioJson, SyntaxErrorNamesLineAndColumn) {
@@ -58,10 +137,40 @@ TEST(ScenarioJson, InvalidFieldsNameTheirPointer) {
        "/agents/0/colour: unknown key"},
       {head + R"("agents": [{"x": 1, "y": 1, "max_speed": -1, "goal": "g"}]})",
        "/agents/0/max_speed"},
+      {head + R"("agents": [{"x": 1, "y": 1, "pref_speed": 2, "max_speed": 1, "goal": "g"}]})",
+       "/agents/0/max_speed: must be >= pref_speed"},
+      {head + R"("agents": [{"x": 1, "y": 1, "goal": ["g", "elsewhere"]}]})",
+       "/agents/0/goal/1: unknown goal 'elsewhere'"},
       {head + R"("ticks": -5})", "/ticks"},
+      {head + R"("ticks": 5, "duration": 3})", "/ticks: give one of"},
       {head + R"("dt": 0})", "/dt"},
-      {head + R"("steering": {"horizon": 0}})", "/steering/horizon"},
-      {head + R"("steering": {"potential": {"kernel": "gauss"}}})", "/steering/potential/kernel"},
+      {head + R"("gridlock_ticks": 50})", "/gridlock_ticks: no longer here: gridlock_time"},
+      {head + R"("steering": {"horizon": 0}})", "/steering/horizon: no longer here"},
+      {head + R"("steering": {"model": "boids"}})", "/steering/model: unknown steering model"},
+      {head + R"("steering": {"thesis": {"horizon": 0}}})", "/steering/thesis/horizon"},
+      {head + R"("steering": {"thesis": {"potential": {"kernel": "gauss"}}}})",
+       "/steering/thesis/potential/kernel"},
+      {head + R"("steering": {"orca": {"first_share": 1}}})", "/steering/orca/first_share"},
+      {head + R"("steering": {"cfsm": {"time_gap": -1}}})", "/steering/cfsm/time_gap"},
+      {head + R"("stall": {"after": 0}})", "/stall/after"},
+      {R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "area": [[0,0],[4,4],[4,0],[0,3]]}]})",
+       "/goals/0/area: polygon is not simple"},
+      {R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "area": [[0,0],[2,0],[2,2]], "x": 5, "y": 5}]})",
+       "/goals/0/x: the goal's point (5, 5) lies outside its area"},
+      {R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "area": [[0,0],[2,0],[2,2]], "arrival_radius": 1}]})",
+       "/goals/0/arrival_radius"},
+      {head + R"("sources": [{"area": [0, 0, 1, 1], "rate": 0, "count": 1, "goal": "g"}]})",
+       "/sources/0/rate"},
+      {head +
+           R"("sources": [{"area": [0, 0, 1, 1], "rate": 1, "count": 1, "start": 5, "end": 2, "goal": "g"}]})",
+       "/sources/0/end"},
+      {head + R"("sources": [{"area": [0, 0, 1, 1], "rate": 1, "count": 1}]})",
+       "/sources/0/goal: give exactly one"},
+      {head + R"("sources": [{"area": [0, 0, 200, 1], "rate": 1, "count": 1, "goal": "g"}]})",
+       "/sources/0/area: a corner lies outside the bounds"},
+      {head +
+           R"("groups": [{"count": 2, "placement": {"type": "grid", "region": [0,0,10,10], "spacing": 5}, "goals": {"assign": "targets", "points": [[1, 1]]}}]})",
+       "/groups/0/goals/points: expected one target per agent"},
       {head + R"("arrival": "teleport"})", "/arrival"},
       {head + R"("obstacles": [{"type": "polygon", "vertices": [[0,0],[2,2],[2,0],[0,2]]}]})",
        "/obstacles/0"},
@@ -135,7 +244,8 @@ TEST(ScenarioJson, ShippedScenariosLoadWithoutWarnings) {
   EXPECT_EQ(airport.world.agents().size(), 1000u);
   EXPECT_EQ(airport.world.circles().size(), 24u);
   EXPECT_EQ(airport.world.goals().size(), 12u);
-  EXPECT_EQ(airport.ticks, 1000u);
+  EXPECT_EQ(airport.ticks, 3000u);  // 300 s
+  EXPECT_EQ(airport.world.sources().size(), 2u);
 }
 
 TEST(ScenarioJson, MissingFileIsAnIoError) {

@@ -29,7 +29,7 @@ std::vector<std::string> query(const std::filesystem::path& db, const std::strin
 const char* kScenario = R"({"name": "two", "bounds": [0, 0, 100, 50], "dt": 0.5, "ticks": 10,
   "goals": [{"name": "g", "x": 90, "y": 25, "arrival_radius": 2}],
   "obstacles": [{"type": "circle", "x": 50, "y": 40, "radius": 3}],
-  "agents": [{"x": 10, "y": 25, "goal": "g"}, {"x": 10, "y": 30, "goal": "g"}]})";
+  "agents": [{"x": 10, "y": 25, "radius": 1, "goal": "g"}, {"x": 10, "y": 30, "radius": 1, "goal": "g"}]})";
 
 void run_to(const std::filesystem::path& out, OutputSpec::Format format, uint32_t every = 1) {
   Scenario sc = parse_scenario(kScenario, "two.json");

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "crowddb/simulation.hpp"
+#include "support/configs.hpp"
 
 namespace crowddb {
 namespace {
@@ -16,19 +17,20 @@ namespace {
 // on the start side.
 World walled_world() {
   World w(Bounds{0, 0, 60, 40});
-  w.add_goal({"east", 50, 10, 1, 2});
-  w.add_goal({"west", 5, 35, 1, 2});
+  w.add_goal({"east", 50, 10, 1, 2, {}});
+  w.add_goal({"west", 5, 35, 1, 2, {}});
   w.add_obstacle(PolygonObstacle{{{29, 0}, {31, 0}, {31, 30}, {29, 30}}, 0.1});
   return w;
 }
 
+// The thesis's rule with one tick per second, so latencies in seconds count ticks.
 SimConfig nav_config(uint32_t latency, uint32_t budget = 64) {
-  SimConfig c;
+  SimConfig c = test::thesis_config();
   c.navigation.enabled = true;
   c.navigation.latency = latency;
   c.navigation.budget = budget;
-  c.steering.w_apf = 1;
-  c.steering.w_ftc = 2;
+  c.steering.thesis.w_apf = 1;
+  c.steering.thesis.w_ftc = 2;
   return c;
 }
 
@@ -38,6 +40,7 @@ AgentSpec walker(double x, double y, uint32_t goal = 0) {
   s.y = y;
   s.radius = 0.8;
   s.max_speed = 1;
+  s.pref_speed = s.max_speed;
   s.max_accel = 0.5;
   s.goal = goal;
   return s;
@@ -105,7 +108,7 @@ TEST(Navigation, ANewGoalIsReplanned) {
 TEST(Navigation, NoProgressTriggersReplanning) {
   // The goal sits in a closed box: the path is partial and the agent stalls at the box.
   World w(Bounds{0, 0, 60, 40});
-  w.add_goal({"boxed", 45, 20, 1, 1});
+  w.add_goal({"boxed", 45, 20, 1, 1, {}});
   w.add_obstacle(PolygonObstacle{{{38, 13}, {52, 13}, {52, 15}, {38, 15}}, 0.1});
   w.add_obstacle(PolygonObstacle{{{38, 25}, {52, 25}, {52, 27}, {38, 27}}, 0.1});
   w.add_obstacle(PolygonObstacle{{{38, 15}, {40, 15}, {40, 25}, {38, 25}}, 0.1});
@@ -167,7 +170,7 @@ TEST(Navigation, ExplainShowsThePathService) {
   EXPECT_NE(plan.find("in sight"), std::string::npos) << plan;
   World plain = walled_world();
   plain.insert(walker(10, 10));
-  Simulation off(std::move(plain), SimConfig{});
+  Simulation off(std::move(plain), test::thesis_config());
   EXPECT_EQ(off.explain().find("path results"), std::string::npos);
   EXPECT_EQ(off.explain().find("path requests"), std::string::npos);
 }

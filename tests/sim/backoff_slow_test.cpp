@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "sim/invariant.hpp"
+#include "support/configs.hpp"
 #include "util/rng.hpp"
 
 namespace crowddb::sim {
@@ -94,8 +95,8 @@ TEST(BackoffSlow, Crossing) {
 TEST(BackoffSlow, SpawnedOverlapsNeverDeepenOverALongRun) {
   // Clumps of agents spawned on top of each other (equal radii, so nn takes part once clean).
   World w(Bounds{0, 0, 150, 150});
-  w.add_goal({"ne", 140, 140, 1, 3});
-  w.add_goal({"sw", 10, 10, 1, 3});
+  w.add_goal({"ne", 140, 140, 1, 3, {}});
+  w.add_goal({"sw", 10, 10, 1, 3, {}});
   Rng rng(21);
   for (int c = 0; c < 20; ++c) {
     const double cx = rng.uniform(20, 130), cy = rng.uniform(20, 130);
@@ -105,14 +106,15 @@ TEST(BackoffSlow, SpawnedOverlapsNeverDeepenOverALongRun) {
       s.y = cy + rng.uniform(-2, 2);
       s.radius = 1;
       s.max_speed = 1;
+      s.pref_speed = s.max_speed;
       s.max_accel = 0.5;
       s.goal = static_cast<uint32_t>(c % 2);
       w.insert(s);
     }
   }
-  SimConfig cfg;
-  cfg.steering.w_apf = 2;
-  cfg.steering.w_ftc = 2;
+  SimConfig cfg = test::thesis_config();
+  cfg.steering.thesis.w_apf = 2;
+  cfg.steering.thesis.w_ftc = 2;
   cfg.arrival = ArrivalPolicy::retarget;
   std::vector<uint64_t> reference;
   for (const std::string m : {"grid", "naive", "sweep", "nn"}) {

@@ -7,6 +7,7 @@
 #include "plan/access_path.hpp"
 #include "sim/invariant.hpp"
 #include "sim/stages.hpp"
+#include "support/configs.hpp"
 #include "util/rng.hpp"
 
 namespace crowddb::sim {
@@ -148,12 +149,14 @@ TEST(Backoff, ChainOfFreezesTakesOneIterationPerLink) {
 
 World two_agents_head_on() {
   World w(Bounds{0, 0, 100, 100});
-  w.add_goal({"east", 90, 50, 1, 1});
-  w.add_goal({"west", 10, 50, 1, 1});
+  w.add_goal({"east", 90, 50, 1, 1, {}});
+  w.add_goal({"west", 10, 50, 1, 1, {}});
   AgentSpec a;
   a.x = 40;
   a.y = 50;
+  a.radius = 1;  // the thesis's units: at 1 per tick, smaller discs would pass through each other
   a.max_speed = 1;
+  a.pref_speed = a.max_speed;
   a.goal = 0;
   w.insert(a);
   a.x = 60;
@@ -163,11 +166,11 @@ World two_agents_head_on() {
 }
 
 TEST(Backoff, TickMetricsCountFrozenAgentsAndIterations) {
-  SimConfig cfg;
-  cfg.steering.w_apf = 0;  // no avoidance: they walk into each other
-  cfg.steering.w_ftc = 0;
+  SimConfig cfg = test::thesis_config();
+  cfg.steering.thesis.w_apf = 0;  // no avoidance: they walk into each other
+  cfg.steering.thesis.w_ftc = 0;
   cfg.nudge_after = 0;
-  cfg.gridlock_ticks = 5;
+  cfg.gridlock_time = 5;
   Simulation sim(two_agents_head_on(), cfg);
   std::size_t first_freeze = 0, streak = 0;
   for (int k = 1; k <= 40; ++k) {
@@ -197,9 +200,9 @@ TEST(Backoff, TickMetricsCountFrozenAgentsAndIterations) {
 }
 
 TEST(Backoff, NudgingBreaksAHeadOnDeadlock) {
-  SimConfig cfg;
-  cfg.steering.w_apf = 0;
-  cfg.steering.w_ftc = 0;
+  SimConfig cfg = test::thesis_config();
+  cfg.steering.thesis.w_apf = 0;
+  cfg.steering.thesis.w_ftc = 0;
   cfg.nudge_after = 2;
   Simulation sim(two_agents_head_on(), cfg);
   std::size_t nudged = 0;
@@ -212,8 +215,8 @@ TEST(Backoff, NudgingBreaksAHeadOnDeadlock) {
 // appear, and the overlap metrics equal the brute-force counts.
 World spawned_overlapping(bool equal_radii) {
   World w(Bounds{0, 0, 120, 120});
-  w.add_goal({"a", 110, 110, 1, 3});
-  w.add_goal({"b", 10, 110, 1, 3});
+  w.add_goal({"a", 110, 110, 1, 3, {}});
+  w.add_goal({"b", 10, 110, 1, 3, {}});
   Rng rng(9);
   for (int c = 0; c < 12; ++c) {
     const double cx = rng.uniform(20, 100), cy = rng.uniform(20, 100);
@@ -223,6 +226,7 @@ World spawned_overlapping(bool equal_radii) {
       s.y = cy + rng.uniform(-1.5, 1.5);
       s.radius = equal_radii ? 1.2 : rng.uniform(0.8, 1.6);
       s.max_speed = 1;
+      s.pref_speed = s.max_speed;
       s.max_accel = 0.5;
       s.goal = static_cast<uint32_t>(c % 2);
       w.insert(s);
@@ -233,9 +237,9 @@ World spawned_overlapping(bool equal_radii) {
 
 TEST(Backoff, PreExistingOverlapsNeverDeepen) {
   for (bool equal : {false, true}) {
-    SimConfig cfg;
-    cfg.steering.w_apf = 2;
-    cfg.steering.w_ftc = 2;
+    SimConfig cfg = test::thesis_config();
+    cfg.steering.thesis.w_apf = 2;
+    cfg.steering.thesis.w_ftc = 2;
     cfg.arrival = ArrivalPolicy::idle;
     Simulation sim(spawned_overlapping(equal), cfg);
     ASSERT_FALSE(test::initially_overlap_free(sim.world(), cfg));
@@ -248,9 +252,9 @@ TEST(Backoff, PreExistingOverlapsNeverDeepen) {
 }
 
 TEST(Backoff, ForcedNnFallsBackWhileAgentsOverlapAndMatchesGrid) {
-  SimConfig cfg;
-  cfg.steering.w_apf = 2;
-  cfg.steering.w_ftc = 2;
+  SimConfig cfg = test::thesis_config();
+  cfg.steering.thesis.w_apf = 2;
+  cfg.steering.thesis.w_ftc = 2;
   cfg.arrival = ArrivalPolicy::idle;
   cfg.access.collisions = "nn";
   Simulation nn(spawned_overlapping(true), cfg);
@@ -266,7 +270,7 @@ TEST(Backoff, ForcedNnFallsBackWhileAgentsOverlapAndMatchesGrid) {
 }
 
 TEST(Backoff, ForcedNnIsRejectedWhereItCanNeverServe) {
-  SimConfig cfg;
+  SimConfig cfg = test::thesis_config();
   cfg.access.collisions = "nn";
   EXPECT_THROW(Simulation(spawned_overlapping(false), cfg), Error);  // unequal radii
   cfg.backoff = false;  // overlap counts need every pair
@@ -278,28 +282,27 @@ struct ScenarioRun {
   std::string name;
   uint64_t ticks;
   std::function<void(nlohmann::json&)> edit;
+  bool backoff_busy = true;  // the run must freeze someone (else it proves little)
 };
 
 TEST(Backoff, ShippedScenariosKeepTheInvariantAndAllExactMethodsAgree) {
+  // Under the thesis's rule the backoff has work to do; under the default model (orca) it
+  // should have almost none, and the invariant must hold all the same.
+  // The thesis's rule with its avoidance off: the agents walk into each other.
+  auto thesis = [](nlohmann::json& j) {
+    j["steering"] = {{"model", "thesis"}, {"thesis", {{"w_apf", 0}, {"w_ftc", 0}}}};
+  };
   const std::vector<ScenarioRun> runs = {
-      {"circle", 250, [](nlohmann::json&) {}},
-      {"bottleneck", 300, [](nlohmann::json&) {}},
-      {"airport", 60,
-       [](nlohmann::json& j) {  // a denser, smaller hall: 500 travellers on 250 x 250, field off
-         j["bounds"] = {0, 0, 250, 250};
+      {"circle", 250, thesis},
+      {"bottleneck", 300, thesis},
+      {"airport", 300,
+       [&](nlohmann::json& j) {  // 500 travellers, no sources
          j["groups"][0]["count"] = 500;
-         j["groups"][0]["placement"]["region"] = {8, 8, 242, 242};
-         for (auto& g : j["goals"]) {
-           g["x"] = g["x"].get<double>() / 2;
-           g["y"] = g["y"].get<double>() / 2;
-         }
-         for (auto& o : j["obstacles"]) {
-           o["x"] = o["x"].get<double>() / 2;
-           o["y"] = o["y"].get<double>() / 2;
-           o["radius"] = o["radius"].get<double>() / 2;
-         }
-         j["steering"]["w_apf"] = 0;
+         j.erase("sources");
+         thesis(j);
        }},
+      {"bottleneck", 300, [](nlohmann::json&) {}, false},
+      {"crossing", 300, [](nlohmann::json&) {}, false},
   };
   for (const auto& run : runs) {
     SCOPED_TRACE(run.name);
@@ -328,7 +331,9 @@ TEST(Backoff, ShippedScenariosKeepTheInvariantAndAllExactMethodsAgree) {
         EXPECT_EQ(r.hashes, reference) << m;
       }
     }
-    EXPECT_GT(frozen, 0u);  // the backoff had work to do
+    if (run.backoff_busy) {
+      EXPECT_GT(frozen, 0u) << "the backoff had no work: the run proves little";
+    }
   }
 }
 

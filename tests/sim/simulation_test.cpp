@@ -6,15 +6,18 @@
 
 #include "crowddb/scenario.hpp"
 #include "support/cli.hpp"
+#include "support/configs.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb {
 namespace {
 
-// A small, dense airport: 250 travellers in a 160 x 160 hall with 6 pillars and 4 gates.
+// A small, dense airport under the thesis's rule in its own units: 250 travellers in a 160 x 160
+// hall with 6 pillars and 4 gates.
 std::string small_airport(uint64_t seed, int threads = 1, const char* arrival = "retarget") {
   return std::string(R"({"bounds": [0, 0, 160, 160], "seed": )") + std::to_string(seed) +
-         R"(, "threads": )" + std::to_string(threads) + R"(, "arrival": ")" + arrival + R"(",
+         R"(, "threads": )" + std::to_string(threads) + R"(, "arrival": ")" + arrival + R"(", )" +
+         test::thesis_json() + R"(, "ticks": 100,
     "goals": [{"name": "S", "x": 80, "y": 4, "arrival_radius": 8}, {"name": "N", "x": 80, "y": 156, "arrival_radius": 8},
               {"name": "W", "x": 4, "y": 80, "arrival_radius": 8}, {"name": "E", "x": 156, "y": 80, "arrival_radius": 8}],
     "obstacles": [{"type": "circle", "x": 40, "y": 50, "radius": 8}, {"type": "circle", "x": 80, "y": 50, "radius": 10},
@@ -24,7 +27,8 @@ std::string small_airport(uint64_t seed, int threads = 1, const char* arrival = 
     "groups": [{"count": 250, "radius": [1, 3], "speed": [0, 5], "max_speed": 5, "max_accel": 1,
                 "placement": {"type": "uniform", "region": [5, 5, 155, 155], "gap": 0.5},
                 "goals": {"assign": "round_robin"}}],
-    "steering": {"w_apf": 30, "w_ftc": 3}})";
+    "steering": {"model": "thesis", "perturbation": 0,
+                 "thesis": {"w_apf": 30, "w_ftc": 3, "obstacle_repulsion": "charges"}}})";
 }
 
 std::vector<uint64_t> hashes(const std::string& text, int ticks) {
@@ -71,8 +75,8 @@ TEST(Simulation, WithoutBackoffOverlapsHappen) {
 
 World corridor_world() {
   World w(Bounds{0, 0, 100, 20});
-  w.add_goal({"east", 90, 10, 1, 2});
-  w.add_goal({"west", 10, 10, 1, 2});
+  w.add_goal({"east", 90, 10, 1, 2, {}});
+  w.add_goal({"west", 10, 10, 1, 2, {}});
   return w;
 }
 
@@ -83,6 +87,7 @@ AgentSpec walker(double x, uint32_t goal, double vx = 0) {
   s.vx = vx;
   s.radius = 1;
   s.max_speed = 1;
+  s.pref_speed = s.max_speed;
   s.goal = goal;
   return s;
 }
@@ -90,7 +95,7 @@ AgentSpec walker(double x, uint32_t goal, double vx = 0) {
 TEST(Simulation, ALoneAgentWalksStraightToItsGoalAndLeaves) {
   World w = corridor_world();
   const AgentId a = w.insert(walker(10, 0));
-  Simulation sim(std::move(w), SimConfig{});
+  Simulation sim(std::move(w), test::thesis_config());
   int ticks = 0;
   while (sim.world().contains(a) && ticks < 200) {
     const double y = sim.world().agents().y[*sim.world().row_of(a)];
@@ -109,7 +114,7 @@ TEST(Simulation, ArrivalPoliciesIdleAndRetarget) {
   for (ArrivalPolicy policy : {ArrivalPolicy::idle, ArrivalPolicy::retarget}) {
     World w = corridor_world();
     const AgentId a = w.insert(walker(85, 0));
-    SimConfig cfg;
+    SimConfig cfg = test::thesis_config();
     cfg.arrival = policy;
     Simulation sim(std::move(w), cfg);
     for (int t = 0; t < 10; ++t) sim.step();
@@ -128,7 +133,7 @@ TEST(Simulation, ArrivalPoliciesIdleAndRetarget) {
 TEST(Simulation, ChangesMadeBetweenTicksApplyAtTheNextTickAsOneBatch) {
   World w = corridor_world();
   const AgentId a = w.insert(walker(20, 0));
-  Simulation sim(std::move(w), SimConfig{});
+  Simulation sim(std::move(w), test::thesis_config());
   sim.step();
   const AgentId b = sim.world().insert(walker(60, 1));
   sim.world().retarget(a, 1);
@@ -149,9 +154,9 @@ TEST(Simulation, PreExistingOverlapsNeverDeepen) {
   // Spawned overlapping (centres 1.5 apart, radii 1), both pulled towards each other's side.
   const AgentId a = w.insert(walker(49, 0, 1));
   const AgentId b = w.insert(walker(50.5, 1, -1));
-  SimConfig cfg;
-  cfg.steering.w_apf = 0;  // no repulsion: only backoff stops them
-  cfg.steering.w_ftc = 0;
+  SimConfig cfg = test::thesis_config();
+  cfg.steering.thesis.w_apf = 0;  // no repulsion: only backoff stops them
+  cfg.steering.thesis.w_ftc = 0;
   Simulation sim(std::move(w), cfg);
   double gap = 1.5;
   for (int t = 0; t < 30; ++t) {
@@ -166,14 +171,15 @@ TEST(Simulation, PreExistingOverlapsNeverDeepen) {
 
 TEST(Simulation, WallsKeepAgentsInside) {
   World w(Bounds{0, 0, 50, 50});
-  w.add_goal({"outside", 200, 25, 1, 1});
+  w.add_goal({"outside", 200, 25, 1, 1, {}});
   for (int i = 0; i < 5; ++i) {
     AgentSpec s = walker(30 + 3 * i, 0, 2);
     s.y = 10 + 7 * i;
     s.max_speed = 3;
+    s.pref_speed = s.max_speed;
     w.insert(s);
   }
-  Simulation sim(std::move(w), SimConfig{});
+  Simulation sim(std::move(w), test::thesis_config());
   for (int t = 0; t < 50; ++t) {
     sim.step();
     const AgentTable& tab = sim.world().agents();
@@ -189,7 +195,7 @@ TEST(Simulation, ExplainNamesEveryOperatorAndAccessPath) {
   Simulation sim(std::move(sc.world), sc.config);
   const std::string plan = sim.explain();
   for (const char* s : {"Q1 attraction", "Q2 inner avoidance", "Q3 outer avoidance", "backoff",
-                        "commit", "exp-l1"})
+                        "commit", "exp-l1", "goal stage", "stalemates", "model=thesis"})
     EXPECT_NE(plan.find(s), std::string::npos) << s << "\n" << plan;
   // One access path per indexed query: Q2, Q3 and the backoff's collision set.
   std::size_t paths = 0;

@@ -5,13 +5,15 @@
 #include <cmath>
 #include <limits>
 
+#include "support/configs.hpp"
+
 namespace crowddb {
 namespace {
 
 World world_with_goals(int goals = 2) {
   World w(Bounds{0, 0, 100, 100});
   for (int g = 0; g < goals; ++g)
-    w.add_goal({std::string("g").append(std::to_string(g)), 10.0 * g, 5, 1, 1});
+    w.add_goal({std::string("g").append(std::to_string(g)), 10.0 * g, 5, 1, 1, {}});
   return w;
 }
 
@@ -152,8 +154,8 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(World, InvalidStaticRowsAreRejected) {
   World w = world_with_goals();
-  EXPECT_THROW(w.add_goal({"bad", kNaN, 0, 1, 1}), InvalidRow);
-  EXPECT_THROW(w.add_goal({"bad", 0, 0, 1, 0}), InvalidRow);
+  EXPECT_THROW(w.add_goal({"bad", kNaN, 0, 1, 1, {}}), InvalidRow);
+  EXPECT_THROW(w.add_goal({"bad", 0, 0, 1, 0, {}}), InvalidRow);
   EXPECT_THROW(w.add_obstacle(CircleObstacle{0, 0, -1, 1}), InvalidRow);
   EXPECT_THROW(w.add_obstacle(PolygonObstacle{{{0, 0}, {1, 1}}, 1}), InvalidRow);
   // A bow tie is not a simple polygon.

@@ -26,12 +26,14 @@ extern "C" void on_interrupt(int) {
 struct RunOptions {
   std::string scenario;
   int64_t ticks = -1;
+  double duration = -1;
+  std::string model;
   std::string out, format;
   bool no_output = false;
   bool explain = false, analyze = false, quiet = false, no_backoff = false, no_navigation = false;
   int threads = 0;
   int64_t every = 0;
-  int64_t nudge_after = -1;
+  double nudge_after = -1;
   std::string ftc, field, collisions;
 };
 
@@ -49,9 +51,11 @@ void print_warnings(const Scenario& sc) {
 // Applies the command-line overrides to a loaded scenario.
 void apply_overrides(Scenario& sc, const RunOptions& o) {
   if (o.ticks >= 0) sc.ticks = static_cast<uint64_t>(o.ticks);
+  if (o.duration >= 0) sc.ticks = sc.config.ticks_for(o.duration, 0);
+  if (!o.model.empty()) sc.config.steering.model = o.model;
   if (o.threads > 0) sc.config.threads = o.threads;
   if (o.no_backoff) sc.config.backoff = false;
-  if (o.nudge_after >= 0) sc.config.nudge_after = static_cast<uint32_t>(o.nudge_after);
+  if (o.nudge_after >= 0) sc.config.nudge_after = o.nudge_after;
   if (o.no_navigation) sc.config.navigation.enabled = false;
   if (!o.ftc.empty()) sc.config.access.ftc = o.ftc;
   if (!o.field.empty()) sc.config.access.field = o.field;
@@ -90,6 +94,8 @@ int run(const RunOptions& o) {
   std::size_t max_pairs = 0, max_obstacle = 0, frozen_total = 0;
   std::size_t iterations_total = 0, iterations_max = 0, gridlock_max = 0, gridlock_streaks = 0;
   std::size_t longest_frozen = 0, nudged_total = 0;
+  std::size_t stall_streaks = 0, stall_max = 0, longest_stall = 0, yield_total = 0,
+              sidestep_total = 0;
   uint64_t last_arrival = 0;
   Stopwatch clock, progress_clock;
   try {
@@ -109,6 +115,11 @@ int run(const RunOptions& o) {
       gridlock_streaks += m.gridlock_started;
       longest_frozen = std::max(longest_frozen, m.longest_frozen);
       nudged_total += m.nudged;
+      stall_streaks += m.stall_started;
+      stall_max = std::max(stall_max, m.stalled);
+      longest_stall = std::max(longest_stall, m.longest_stall);
+      yield_total += m.yielding;
+      sidestep_total += m.sidestepping;
       if (m.arrived) last_arrival = m.tick;
       if (writer) {
         writer->frame(t, sim.world());  // the writer keeps every n-th frame
@@ -117,9 +128,12 @@ int run(const RunOptions& o) {
       if (tty && (progress_clock.seconds() > 0.2 || t == sc.ticks)) {
         progress_clock.restart();
         std::fprintf(
-            stderr, "\rtick %llu/%llu  agents %zu  arrived %zu  overlaps %zu  %.1f ticks/s   ",
-            static_cast<unsigned long long>(t), static_cast<unsigned long long>(sc.ticks), m.agents,
-            sim.arrived_total(), m.overlapping_pairs, static_cast<double>(t) / clock.seconds());
+            stderr,
+            "\rtick %llu/%llu (%.1f s)  agents %zu  arrived %zu  stalled %zu  overlaps %zu  "
+            "%.1f ticks/s   ",
+            static_cast<unsigned long long>(t), static_cast<unsigned long long>(sc.ticks), m.time,
+            m.agents, sim.arrived_total(), m.stalled, m.overlapping_pairs,
+            static_cast<double>(t) / clock.seconds());
       }
     }
     if (tty) std::fprintf(stderr, "\n");
@@ -148,31 +162,59 @@ int run(const RunOptions& o) {
   os.setf(std::ios::fixed);
   os.precision(2);
   const std::string name = sc.name.empty() ? o.scenario : sc.name;
-  os << name << ": " << sc.ticks << " ticks in " << total << " s";
+  const double dt = sc.config.dt;
+  const double sim_seconds = static_cast<double>(sc.ticks) * dt;
+  auto g = [](double v) {  // shortest form: 0.2, 5, 1e-05
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return std::string(buf);
+  };
+  auto secs = [&](std::size_t ticks) {
+    std::ostringstream s;
+    s.setf(std::ios::fixed);
+    s.precision(1);
+    s << static_cast<double>(ticks) * dt << " s";
+    return s.str();
+  };
+  os << name << ": " << sc.ticks << " ticks of " << g(dt) << " s (" << sim_seconds
+     << " s simulated) in " << total << " s, model " << sc.config.steering.model;
   if (!tick_seconds.empty()) {
-    os << " (" << static_cast<double>(sc.ticks) / std::max(sum, 1e-12) << " ticks/s; per tick mean "
-       << 1e3 * sum / static_cast<double>(tick_seconds.size()) << " ms, median "
-       << 1e3 * experiment::median(tick_seconds) << " ms; " << sc.config.threads << " thread"
-       << (sc.config.threads > 1 ? "s" : "") << ")";
+    os << "\n  speed: " << static_cast<double>(sc.ticks) / std::max(sum, 1e-12)
+       << " ticks/s; per tick mean " << 1e3 * sum / static_cast<double>(tick_seconds.size())
+       << " ms, median " << 1e3 * experiment::median(tick_seconds) << " ms; " << sc.config.threads
+       << " thread" << (sc.config.threads > 1 ? "s" : "");
   }
-  os << "\n  agents: " << agents_at_start << " at start, " << sim.world().agents().size()
-     << " at end; arrived " << sim.arrived_total();
-  if (last_arrival) os << " (the last at tick " << last_arrival << ")";
-  os << "\n  overlaps after a tick: at most "
-     << max_pairs << " agent pairs and " << max_obstacle << " agent-obstacle; at the end "
-     << sim.last_metrics().overlapping_pairs
+  os << "\n  agents: " << agents_at_start << " at start";
+  if (!sim.world().sources().empty())
+    os << ", " << sim.entered_total() << " entered from sources (" << sim.waiting_to_enter()
+       << " still to enter)";
+  os << ", " << sim.world().agents().size() << " at end; arrived " << sim.arrived_total();
+  if (last_arrival) os << " (the last at " << secs(last_arrival) << ")";
+  if (sim_seconds > 0)
+    os << ", " << static_cast<double>(sim.arrived_total()) * 60 / sim_seconds
+       << " arrivals per minute";
+  os << "\n  overlaps after a tick: at most " << max_pairs << " agent pairs and " << max_obstacle
+     << " agent-obstacle; at the end " << sim.last_metrics().overlapping_pairs
      << " pairs\n  backoff: " << (sc.config.backoff ? "on" : "off") << ", " << frozen_total
      << " agent-ticks frozen";
   if (sc.config.backoff && sc.ticks > 0)
     os << ", freeze rounds per tick mean "
        << static_cast<double>(iterations_total) / static_cast<double>(sc.ticks) << " max "
        << iterations_max;
-  os << "\n  gridlock (frozen " << sc.config.gridlock_ticks
-     << "+ ticks in a row): " << gridlock_streaks << " streaks reached it, at most " << gridlock_max
+  os << "\n  gridlock (frozen " << g(sc.config.gridlock_time)
+     << " s in a row): " << gridlock_streaks << " streaks reached it, at most " << gridlock_max
      << " agents at once, " << sim.last_metrics().gridlocked
-     << " at the end; longest frozen streak " << longest_frozen << " ticks\n  nudge: ";
-  if (sc.config.nudge_after)
-    os << "sidestep after " << sc.config.nudge_after << " frozen ticks, " << nudged_total
+     << " at the end; longest frozen streak " << secs(longest_frozen);
+  os << "\n  stalled (no progress for " << g(sc.config.stall.after) << " s): " << stall_streaks
+     << " times, at most " << stall_max << " agents at once, " << sim.last_metrics().stalled
+     << " at the end; longest " << secs(longest_stall) << " without progress";
+  if (sc.config.stall.resolve)
+    os << "; resolved by " << yield_total << " yields and " << sidestep_total << " sidesteps";
+  else
+    os << "; resolution off";
+  os << "\n  nudge: ";
+  if (sc.config.nudge_after > 0)
+    os << "sidestep after " << g(sc.config.nudge_after) << " s frozen, " << nudged_total
        << " agent-ticks nudged";
   else
     os << "off (nudge_after = 0)";
@@ -193,7 +235,11 @@ void add_run_command(CLI::App& app, Action& action) {
   auto* sub = app.add_subcommand("run", "simulate a scenario file (see docs/scenario-format.md)");
   sub->add_option("scenario", o.scenario, "scenario JSON file")->required();
   sub->add_option("--ticks", o.ticks, "number of ticks (overrides the file)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(int64_t{0}, int64_t{1'000'000'000}));
+  sub->add_option("--duration", o.duration, "simulated seconds (overrides the file)")
+      ->check(CLI::Range(0.0, 1e9))
+      ->excludes("--ticks");
+  sub->add_option("--model", o.model, "steering model: orca, cfsm, thesis (overrides the file)");
   sub->add_option("--out", o.out, "trajectory output: FILE.sqlite (JuPedSim format) or FILE.csv");
   sub->add_option("--format", o.format, "output format when the extension does not say")
       ->check(CLI::IsMember({"sqlite", "csv"}));
@@ -206,9 +252,9 @@ void add_run_command(CLI::App& app, Action& action) {
       ->check(CLI::Range(1, 256));
   sub->add_flag("--no-backoff", o.no_backoff, "switch the backoff freeze loop off");
   sub->add_option("--nudge-after", o.nudge_after,
-                  "sidestep agents frozen this many ticks in a row; 0 = never (overrides the "
+                  "sidestep agents frozen this many seconds in a row; 0 = never (overrides the "
                   "file's nudge_after)")
-      ->check(CLI::Range(int64_t{0}, int64_t{1} << 30));
+      ->check(CLI::Range(0.0, 1e6));
   sub->add_flag("--no-navigation", o.no_navigation,
                 "switch the path service off (agents steer straight at their goals)");
   sub->add_option("--ftc", o.ftc, "first-to-collide access path (auto, naive, ...)");

@@ -1,0 +1,146 @@
+#include "index/feature_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "query/naive_paths.hpp"
+#include "util/stopwatch.hpp"
+
+namespace crowddb::index {
+namespace {
+
+constexpr std::size_t kGrain = 64;
+
+struct Box {
+  double x0, y0, x1, y1;
+};
+
+Box feature_box(const StaticScene& scene, std::size_t f) {
+  if (f < scene.circles().size()) {
+    const CircleObstacle& c = scene.circles()[f];
+    return {c.x - c.radius, c.y - c.radius, c.x + c.radius, c.y + c.radius};
+  }
+  const auto [p, e] = scene.edge_of(f);
+  const auto& v = scene.polygons()[p].vertices;
+  const Vec2 a = v[e], b = v[(e + 1) % v.size()];
+  return {std::min(a.x, b.x), std::min(a.y, b.y), std::max(a.x, b.x), std::max(a.y, b.y)};
+}
+
+}  // namespace
+
+void FeatureGrid::build(const StaticScene& scene, double cell) {
+  generation_ = scene.generation();
+  const std::size_t F = scene.feature_count();
+  x0_ = y0_ = INFINITY;
+  x1_ = y1_ = -INFINITY;
+  for (std::size_t f = 0; f < F; ++f) {
+    const Box b = feature_box(scene, f);
+    x0_ = std::min(x0_, b.x0);
+    y0_ = std::min(y0_, b.y0);
+    x1_ = std::max(x1_, b.x1);
+    y1_ = std::max(y1_, b.y1);
+  }
+  W_ = H_ = 0;
+  start_.assign(1, 0);
+  items_.clear();
+  if (F == 0) return;
+  const double side = std::max({x1_ - x0_, y1_ - y0_, 1e-9});
+  cell_ = std::max(cell, side / 1024);
+  if (!(cell_ > 0) || !std::isfinite(cell_)) cell_ = side;
+  W_ = static_cast<int64_t>(std::floor((x1_ - x0_) / cell_)) + 1;
+  H_ = static_cast<int64_t>(std::floor((y1_ - y0_) / cell_)) + 1;
+  std::vector<std::vector<uint32_t>> cells(static_cast<std::size_t>(W_ * H_));
+  const double half_diag = cell_ * std::sqrt(0.5) * (1 + 1e-9);
+  for (std::size_t f = 0; f < F; ++f) {
+    const Box b = feature_box(scene, f);
+    const int64_t cx0 =
+        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.x0 - x0_) / cell_)), 0, W_ - 1);
+    const int64_t cx1 =
+        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.x1 - x0_) / cell_)), 0, W_ - 1);
+    const int64_t cy0 =
+        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.y0 - y0_) / cell_)), 0, H_ - 1);
+    const int64_t cy1 =
+        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.y1 - y0_) / cell_)), 0, H_ - 1);
+    const bool edge = f >= scene.circles().size();
+    for (int64_t cy = cy0; cy <= cy1; ++cy)
+      for (int64_t cx = cx0; cx <= cx1; ++cx) {
+        if (edge && (cx1 > cx0 + 1 || cy1 > cy0 + 1)) {
+          // A long edge: only the cells it passes near (their centre within half a diagonal).
+          const double mx = x0_ + (static_cast<double>(cx) + 0.5) * cell_;
+          const double my = y0_ + (static_cast<double>(cy) + 0.5) * cell_;
+          if (feature_dist2(scene, f, mx, my) > half_diag * half_diag) continue;
+        }
+        cells[static_cast<std::size_t>(cy * W_ + cx)].push_back(static_cast<uint32_t>(f));
+      }
+  }
+  start_.assign(cells.size() + 1, 0);
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    start_[c + 1] = start_[c] + static_cast<uint32_t>(cells[c].size());
+  items_.reserve(start_.back());
+  for (const auto& c : cells) items_.insert(items_.end(), c.begin(), c.end());
+}
+
+void FeatureGrid::run(const DiscView& p, std::span<const double> reach, const StaticScene& scene,
+                      FeatureLists& out, Executor& ex, QueryStats& stats) {
+  Stopwatch sw;
+  if (generation_ != scene.generation()) {
+    double mean = 0;
+    for (std::size_t i = 0; i < p.n; ++i) mean += reach[i];
+    build(scene, p.n ? mean / static_cast<double>(p.n) : 1.0);
+    stats.build_seconds += sw.seconds();
+    sw.restart();
+  }
+  const std::size_t chunks = (p.n + kGrain - 1) / kGrain;
+  ListChunks lists;
+  lists.reset(chunks);
+  std::vector<uint64_t> tests(chunks, 0);
+  ex.for_each_chunk(p.n, kGrain, [&](std::size_t b, std::size_t e) {
+    const std::size_t c = b / kGrain;
+    std::vector<uint32_t> cand;
+    for (std::size_t i = b; i < e; ++i) {
+      const double px = p.x[i], py = p.y[i], r = reach[i];
+      uint32_t count = 0;
+      cand.clear();
+      if (W_ > 0 && px + r >= x0_ && px - r <= x1_ && py + r >= y0_ && py - r <= y1_) {
+        auto clamp_col = [&](double x) {
+          return std::clamp<int64_t>(static_cast<int64_t>(std::floor((x - x0_) / cell_)), 0,
+                                     W_ - 1);
+        };
+        auto clamp_row = [&](double y) {
+          return std::clamp<int64_t>(static_cast<int64_t>(std::floor((y - y0_) / cell_)), 0,
+                                     H_ - 1);
+        };
+        // One cell of slack on each side against rounding of the box.
+        const int64_t cx0 = std::max<int64_t>(0, clamp_col(px - r) - 1);
+        const int64_t cx1 = std::min<int64_t>(W_ - 1, clamp_col(px + r) + 1);
+        const int64_t cy0 = std::max<int64_t>(0, clamp_row(py - r) - 1);
+        const int64_t cy1 = std::min<int64_t>(H_ - 1, clamp_row(py + r) + 1);
+        for (int64_t cy = cy0; cy <= cy1; ++cy) {
+          const auto base = static_cast<std::size_t>(cy * W_);
+          for (uint32_t a = start_[base + static_cast<std::size_t>(cx0)];
+               a < start_[base + static_cast<std::size_t>(cx1) + 1]; ++a)
+            cand.push_back(items_[a]);
+        }
+        std::sort(cand.begin(), cand.end());
+        cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+        const double r2 = r * r;
+        for (uint32_t f : cand) {
+          const double d2 = feature_dist2(scene, f, px, py);
+          if (d2 < r2) {
+            lists.items[c].push_back(f);
+            lists.d2[c].push_back(d2);
+            ++count;
+          }
+        }
+        tests[c] += cand.size();
+      }
+      lists.counts[c].push_back(count);
+    }
+  });
+  lists.gather(out, &FeatureLists::feature);
+  stats.rows += p.n;
+  for (uint64_t t : tests) stats.pair_tests += t;
+  stats.query_seconds += sw.seconds();
+}
+
+}  // namespace crowddb::index

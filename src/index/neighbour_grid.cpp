@@ -1,0 +1,143 @@
+#include "index/neighbour_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "query/naive_paths.hpp"
+#include "util/stopwatch.hpp"
+
+namespace crowddb::index {
+namespace {
+
+constexpr std::size_t kGrain = 64;
+
+}  // namespace
+
+int64_t NeighbourGrid::col(double x) const {
+  const double c = std::floor((x - x0_) / cell_);
+  return c < 0 ? 0 : (c >= static_cast<double>(W_) ? W_ - 1 : static_cast<int64_t>(c));
+}
+
+int64_t NeighbourGrid::row(double y) const {
+  const double c = std::floor((y - y0_) / cell_);
+  return c < 0 ? 0 : (c >= static_cast<double>(H_) ? H_ - 1 : static_cast<int64_t>(c));
+}
+
+void NeighbourGrid::build(const DiscView& d, double range, uint32_t k) {
+  double xmin = INFINITY, ymin = INFINITY, xmax = -INFINITY, ymax = -INFINITY;
+  for (std::size_t i = 0; i < d.n; ++i) {
+    xmin = std::min(xmin, d.x[i]);
+    xmax = std::max(xmax, d.x[i]);
+    ymin = std::min(ymin, d.y[i]);
+    ymax = std::max(ymax, d.y[i]);
+  }
+  const double w = std::max(xmax - xmin, 1e-9), h = std::max(ymax - ymin, 1e-9);
+  const auto n = static_cast<double>(std::max<std::size_t>(d.n, 1));
+  const double density = n / (w * h);
+  double cell = k ? std::sqrt(2.0 * k / (9.0 * density)) : range / 2;
+  cell = std::min(cell, range);
+  cell = std::max(cell, std::sqrt(w * h / (4 * n)));  // at most ~4 cells per disc
+  if (!(cell > 0) || !std::isfinite(cell)) cell = std::max(w, h);
+  x0_ = xmin;
+  y0_ = ymin;
+  cell_ = cell;
+  W_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(w / cell)) + 1);
+  H_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(h / cell)) + 1);
+  const auto cells = static_cast<std::size_t>(W_ * H_);
+  start_.assign(cells + 1, 0);
+  cell_of_.resize(d.n);
+  for (std::size_t i = 0; i < d.n; ++i) {
+    cell_of_[i] = row(d.y[i]) * W_ + col(d.x[i]);
+    ++start_[static_cast<std::size_t>(cell_of_[i]) + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
+  rows_.resize(d.n);
+  x_.resize(d.n);
+  y_.resize(d.n);
+  id_.resize(d.n);
+  std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
+  for (std::size_t i = 0; i < d.n; ++i) {
+    const uint32_t at = fill[static_cast<std::size_t>(cell_of_[i])]++;
+    rows_[at] = static_cast<uint32_t>(i);
+    x_[at] = d.x[i];
+    y_[at] = d.y[i];
+    id_[at] = d.id[i];
+  }
+}
+
+void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, double range,
+                        uint32_t k, NeighbourLists& out, Executor& ex, QueryStats& stats) {
+  Stopwatch sw;
+  build(d, range, k);
+  stats.build_seconds += sw.seconds();
+  sw.restart();
+  const std::size_t q = queries.empty() ? d.n : queries.size();
+  const double r2 = range * range;
+  const std::size_t chunks = (q + kGrain - 1) / kGrain;
+  ListChunks lists;
+  lists.reset(chunks);
+  std::vector<uint64_t> tests(chunks, 0), rings(chunks, 0);
+  ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
+    const std::size_t c = b / kGrain;
+    NearestK best;
+    for (std::size_t qi = b; qi < e; ++qi) {
+      const std::size_t i = queries.empty() ? qi : queries[qi];
+      const double px = d.x[i], py = d.y[i];
+      best.reset(k);
+      auto scan = [&](int64_t cy, int64_t cx0, int64_t cx1) {
+        const auto base = static_cast<std::size_t>(cy * W_);
+        const uint32_t lo = start_[base + static_cast<std::size_t>(cx0)];
+        const uint32_t hi = start_[base + static_cast<std::size_t>(cx1) + 1];
+        for (uint32_t a = lo; a < hi; ++a) {
+          if (rows_[a] == i) continue;
+          const double dx = x_[a] - px, dy = y_[a] - py;
+          const double d2 = dx * dx + dy * dy;
+          if (d2 < r2) best.offer(rows_[a], id_[a], d2);
+        }
+        tests[c] += hi - lo;
+      };
+      const int64_t qx = col(px), qy = row(py);
+      if (k == 0) {
+        // Every cell the range box touches (one cell of slack against rounding).
+        const int64_t cx0 = std::max<int64_t>(0, col(px - range) - 1);
+        const int64_t cx1 = std::min<int64_t>(W_ - 1, col(px + range) + 1);
+        const int64_t cy0 = std::max<int64_t>(0, row(py - range) - 1);
+        const int64_t cy1 = std::min<int64_t>(H_ - 1, row(py + range) + 1);
+        for (int64_t cy = cy0; cy <= cy1; ++cy) scan(cy, cx0, cx1);
+      } else {
+        const int64_t max_ring = std::max({qx, W_ - 1 - qx, qy, H_ - 1 - qy});
+        for (int64_t rho = 0; rho <= max_ring; ++rho) {
+          const double reach = static_cast<double>(rho - 1) * cell_ * (1 - 1e-9);
+          if (rho >= 2 && (reach >= range || (best.full() && best.bound() < reach * reach))) break;
+          ++rings[c];
+          const int64_t cx0 = std::max<int64_t>(0, qx - rho), cx1 = std::min(W_ - 1, qx + rho);
+          if (rho == 0) {
+            scan(qy, qx, qx);
+            continue;
+          }
+          if (qy - rho >= 0) scan(qy - rho, cx0, cx1);  // bottom row of the ring
+          if (qy + rho < H_) scan(qy + rho, cx0, cx1);  // top row
+          const int64_t cy0 = std::max<int64_t>(0, qy - rho + 1),
+                        cy1 = std::min(H_ - 1, qy + rho - 1);
+          for (int64_t cy = cy0; cy <= cy1; ++cy) {  // the two side columns
+            if (qx - rho >= 0) scan(cy, qx - rho, qx - rho);
+            if (qx + rho < W_) scan(cy, qx + rho, qx + rho);
+          }
+        }
+      }
+      best.finish();
+      lists.counts[c].push_back(static_cast<uint32_t>(best.size()));
+      lists.items[c].insert(lists.items[c].end(), best.rows().begin(), best.rows().end());
+      lists.d2[c].insert(lists.d2[c].end(), best.dist2().begin(), best.dist2().end());
+    }
+  });
+  lists.gather(out, &NeighbourLists::row);
+  stats.rows += q;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    stats.pair_tests += tests[c];
+    stats.nodes_visited += rings[c];
+  }
+  stats.query_seconds += sw.seconds();
+}
+
+}  // namespace crowddb::index

@@ -1,0 +1,55 @@
+// EXPLAIN ANALYZE bookkeeping: rows, loops, time and query counters per named operator, in the
+// order the operators first ran (fixed by the plan, so the report's order is deterministic).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "crowddb/query.hpp"
+#include "util/stopwatch.hpp"
+
+namespace crowddb::sim {
+
+struct OperatorStats {
+  uint64_t loops = 0;
+  uint64_t rows = 0;
+  double seconds = 0;
+  QueryStats query;
+  // A model-specific count shown beside the operator ("3-D fallbacks 12").
+  std::string events_name;
+  uint64_t events = 0;
+};
+
+class OpLog {
+ public:
+  OperatorStats& at(const std::string& name) {
+    for (auto& [n, s] : ops_)
+      if (n == name) return s;
+    ops_.emplace_back(name, OperatorStats{});
+    return ops_.back().second;
+  }
+  // Runs body() and books one loop over `rows` rows and its wall time under `name`.
+  template <class F>
+  void timed(const std::string& name, std::size_t rows, F&& body) {
+    Stopwatch sw;
+    body();
+    OperatorStats& s = at(name);
+    s.loops += 1;
+    s.rows += rows;
+    s.seconds += sw.seconds();
+  }
+  // Counts a tick on which an access path was used ("neighbours=grid").
+  void used(const std::string& method) { ++methods_[method]; }
+
+  const std::vector<std::pair<std::string, OperatorStats>>& entries() const { return ops_; }
+  const std::map<std::string, uint64_t>& methods() const { return methods_; }
+
+ private:
+  std::vector<std::pair<std::string, OperatorStats>> ops_;
+  std::map<std::string, uint64_t> methods_;
+};
+
+}  // namespace crowddb::sim

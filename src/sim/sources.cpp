@@ -1,0 +1,101 @@
+#include "sim/sources.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "query/naive_paths.hpp"
+#include "world/geometry.hpp"
+
+namespace crowddb::sim {
+
+uint64_t source_total(const Source& s) {
+  if (!std::isfinite(s.end)) return s.count;
+  // Agents k with start + k / rate < end.
+  const double span = (s.end - s.start) * s.rate;
+  const double k = std::ceil(span);
+  return std::min<uint64_t>(s.count, k >= 1.8e19 ? s.count : static_cast<uint64_t>(k));
+}
+
+SourceEmitter::SourceEmitter(const World& world, uint64_t seed) {
+  for (std::size_t i = 0; i < world.sources().size(); ++i)
+    state_.push_back({0, Rng::stream(seed ^ 0x50a7ce5ull, i)});
+}
+
+std::size_t SourceEmitter::waiting(const World& world) const {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < state_.size(); ++i)
+    n += source_total(world.sources()[i]) - state_[i].entered;
+  return n;
+}
+
+std::size_t SourceEmitter::emit(World& world, const SimConfig& cfg, const StaticScene& scene,
+                                uint64_t tick) {
+  const double now = static_cast<double>(tick - 1) * cfg.dt;
+  const AgentTable& t = world.agents();
+  std::size_t made = 0;
+  // Discs entering this tick, for the free-spot test beside the table's rows.
+  std::vector<double> nx, ny, nr;
+  for (std::size_t si = 0; si < state_.size(); ++si) {
+    const Source& src = world.sources()[si];
+    State& st = state_[si];
+    const uint64_t total = source_total(src);
+    if (st.entered >= total || now < src.start) continue;
+    // Due so far: agents k with start + k / rate <= now.
+    const double k = std::floor((now - src.start) * src.rate * (1 + 1e-12)) + 1;
+    const uint64_t due = std::min<uint64_t>(total, k >= 1.8e19 ? total : static_cast<uint64_t>(k));
+    if (st.entered >= due) continue;
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    for (const Vec2& v : src.area) {
+      x0 = std::min(x0, v.x);
+      y0 = std::min(y0, v.y);
+      x1 = std::max(x1, v.x);
+      y1 = std::max(y1, v.y);
+    }
+    const double rmax = std::max(src.agent.radius, src.radius_max);
+    // Rows that may touch the area: the free-spot test only looks at them.
+    double table_rmax = 0;
+    for (double r : t.radius) table_rmax = std::max(table_rmax, r);
+    const double grow = rmax + table_rmax;
+    std::vector<uint32_t> near;
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (t.x[i] >= x0 - grow && t.x[i] <= x1 + grow && t.y[i] >= y0 - grow && t.y[i] <= y1 + grow)
+        near.push_back(static_cast<uint32_t>(i));
+    while (st.entered < due) {
+      AgentSpec a = src.agent;
+      if (src.radius_max > 0) a.radius = st.rng.uniform(src.agent.radius, src.radius_max);
+      if (src.pref_speed_max > 0)
+        a.pref_speed = st.rng.uniform(src.agent.pref_speed, src.pref_speed_max);
+      a.goal = src.goals[st.entered % src.goals.size()];
+      bool placed = false;
+      for (int tries = 0; tries < kTries && !placed; ++tries) {
+        a.x = st.rng.uniform(x0, x1);
+        a.y = st.rng.uniform(y0, y1);
+        if (!point_in_polygon(src.area, a.x, a.y)) continue;
+        bool free = true;
+        for (uint32_t j : near)
+          if (discs_overlap(t.x[j] - a.x, t.y[j] - a.y, t.radius[j] + a.radius)) {
+            free = false;
+            break;
+          }
+        for (std::size_t j = 0; free && j < nx.size(); ++j)
+          if (discs_overlap(nx[j] - a.x, ny[j] - a.y, nr[j] + a.radius)) free = false;
+        for (std::size_t c = 0; free && c < scene.circles().size(); ++c)
+          if (disc_hits_circle(scene.circles()[c], a.x, a.y, a.radius)) free = false;
+        for (std::size_t p = 0; free && p < scene.polygons().size(); ++p)
+          if (disc_hits_polygon(scene.polygons()[p], scene.polygon_boxes()[p], a.x, a.y, a.radius))
+            free = false;
+        placed = free;
+      }
+      if (!placed) break;  // the area is full: try again next tick
+      world.insert(a);
+      nx.push_back(a.x);
+      ny.push_back(a.y);
+      nr.push_back(a.radius);
+      ++st.entered;
+      ++made;
+    }
+  }
+  return made;
+}
+
+}  // namespace crowddb::sim

@@ -1,0 +1,42 @@
+// Sources (World::sources): agents entering over time. Agent k of a source is due at
+// start + k / rate (for k < count and start + k / rate < end) and enters at the first tick whose
+// start time is at or after that, at a free spot of the source's area: uniform in the area
+// (rejection in its bounding box, seeded), its disc overlapping no agent (those already in and
+// those entering this tick) and no obstacle or wall. When no free spot turns up in `kTries`
+// draws the agent waits for the next tick, before any later agent of that source; none is
+// dropped. Goals go round robin over the source's list.
+//
+// Deterministic: each source draws from its own stream (seed, source row), in emission order.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "crowddb/query.hpp"
+#include "crowddb/simulation.hpp"
+#include "util/rng.hpp"
+
+namespace crowddb::sim {
+
+class SourceEmitter {
+ public:
+  SourceEmitter(const World& world, uint64_t seed);
+  // Inserts (as pending changes) the agents that enter at the start of tick `tick` (time
+  // (tick - 1) dt). Returns how many.
+  std::size_t emit(World& world, const SimConfig& cfg, const StaticScene& scene, uint64_t tick);
+  // Agents still to enter (due or not).
+  std::size_t waiting(const World& world) const;
+
+ private:
+  static constexpr int kTries = 20;
+  struct State {
+    uint64_t entered = 0;
+    Rng rng;
+  };
+  std::vector<State> state_;
+};
+
+// Agents a source lets in over its whole life: count, or fewer when `end` comes first.
+uint64_t source_total(const Source& s);
+
+}  // namespace crowddb::sim

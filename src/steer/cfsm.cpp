@@ -1,0 +1,207 @@
+// Model "cfsm": the collision-free speed model (Tordeux, Chraibi, Seyfried 2016), JuPedSim's
+// default. A first-order model: no inertia, the velocity is set each tick.
+//
+//   neighbours   every agent within `cutoff` (NeighbourPath, k = 0) that no obstacle edge hides
+//   obstacles    obstacle features within `cutoff` (FeaturePath)
+//   direction    e = unit(e0 + sum_j a exp((l - d_ij) / D) n_ji + sum_walls a_w exp((r - d_iw) /
+//                D_w) n_wi), e0 the unit preferred direction, l = r_i + r_j, n_ji from j to i
+//   speed        v = min(max(s / T, 0), v0), s the spacing to the nearest neighbour ahead within
+//                the corridor of width 2 l along e (distance of centres minus l), v0 = |v_pref|
+//
+// When the repulsions cancel the preferred direction exactly, the agent keeps its heading (the
+// direction of its current velocity) and, standing still, its preferred direction.
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "plan/access_path.hpp"
+#include "steer/model.hpp"
+
+namespace crowddb::steer {
+namespace {
+
+constexpr std::size_t kGrain = 128;
+
+std::string num(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+// Do segments [a, b] and [c, d] intersect (touching counts)?
+bool segments_cross(double ax, double ay, double bx, double by, const Vec2& c, const Vec2& d) {
+  auto orient = [](double px, double py, double qx, double qy, double rx, double ry) {
+    const double v = (qx - px) * (ry - py) - (qy - py) * (rx - px);
+    return (v > 0) - (v < 0);
+  };
+  auto on = [](double px, double py, double qx, double qy, double rx, double ry) {
+    return std::min(px, qx) <= rx && rx <= std::max(px, qx) && std::min(py, qy) <= ry &&
+           ry <= std::max(py, qy);
+  };
+  const int o1 = orient(ax, ay, bx, by, c.x, c.y), o2 = orient(ax, ay, bx, by, d.x, d.y);
+  const int o3 = orient(c.x, c.y, d.x, d.y, ax, ay), o4 = orient(c.x, c.y, d.x, d.y, bx, by);
+  if (o1 != o2 && o3 != o4) return true;
+  return (o1 == 0 && on(ax, ay, bx, by, c.x, c.y)) || (o2 == 0 && on(ax, ay, bx, by, d.x, d.y)) ||
+         (o3 == 0 && on(c.x, c.y, d.x, d.y, ax, ay)) || (o4 == 0 && on(c.x, c.y, d.x, d.y, bx, by));
+}
+
+class CfsmModel final : public Model {
+ public:
+  void velocities(const TickInput& in, std::span<double> vx, std::span<double> vy, Executor& ex,
+                  sim::OpLog& log) override {
+    const AgentTable& t = in.agents;
+    const CfsmParams& p = in.cfg.steering.cfsm;
+    const std::size_t n = t.size();
+    const DiscView view = DiscView::of(t);
+    const NeighbourMethod& nm = neighbour_method(in.cfg.access.neighbours, n);
+    log.used("neighbours=" + nm.info.name);
+    sim::OperatorStats& nop = log.at("CFSM neighbours");
+    log.timed("CFSM neighbours", n, [&] {
+      auto& path = neighbour_paths_[nm.info.name];
+      if (!path) path = nm.make();
+      path->run(view, {}, p.cutoff, 0, nb_, ex, nop.query);
+    });
+    const bool obstacles = in.scene.feature_count() > 0;
+    if (obstacles) {
+      const FeatureMethod& fm = feature_method(in.cfg.access.edges, in.scene.feature_count());
+      log.used("edges=" + fm.info.name);
+      sim::OperatorStats& fop = log.at("CFSM obstacles");
+      log.timed("CFSM obstacles", n, [&] {
+        reach_.assign(n, p.cutoff);
+        auto& path = feature_paths_[fm.info.name];
+        if (!path) path = fm.make();
+        path->run(view, reach_, in.scene, features_, ex, fop.query);
+      });
+    } else {
+      features_.offset.assign(n + 1, 0);
+      features_.feature.clear();
+      features_.dist2.clear();
+    }
+    log.timed("CFSM rule", n, [&] {
+      ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) rule(in, i, vx[i], vy[i]);
+      });
+    });
+  }
+
+  void explain(std::ostream& os, const TickInput& in, int& step) const override {
+    const CfsmParams& p = in.cfg.steering.cfsm;
+    const std::size_t n = in.agents.size();
+    const NeighbourMethod& nm = neighbour_method(in.cfg.access.neighbours, n);
+    os << "  " << step++ << " CFSM neighbours    every agent within " << num(p.cutoff) << " m ("
+       << n << " rows)\n       access path: " << nm.info.name << " (" << nm.info.description
+       << ")\n";
+    if (in.scene.feature_count() > 0) {
+      const FeatureMethod& fm = feature_method(in.cfg.access.edges, in.scene.feature_count());
+      os << "  " << step++ << " CFSM obstacles     obstacle features within " << num(p.cutoff)
+         << " m\n       access path: " << fm.info.name << " (" << fm.info.description << ")\n";
+    }
+    os << "  " << step++
+       << " CFSM rule          direction from exponential repulsion (a=" << num(p.strength_neighbor)
+       << ", D=" << num(p.range_neighbor) << " m; walls a=" << num(p.strength_geometry)
+       << ", D=" << num(p.range_geometry)
+       << " m); speed min(max(s/T, 0), v0), T=" << num(p.time_gap) << " s\n";
+  }
+
+ private:
+  // Is the segment from agent i to agent j blocked by one of i's nearby obstacle edges?
+  bool hidden(const TickInput& in, std::size_t i, std::size_t j) const {
+    const AgentTable& t = in.agents;
+    const StaticScene& scene = in.scene;
+    for (uint32_t a = features_.offset[i]; a < features_.offset[i + 1]; ++a) {
+      const std::size_t f = features_.feature[a];
+      if (f < scene.circles().size()) {
+        // A circle hides j when the segment passes through it.
+        const CircleObstacle& c = scene.circles()[f];
+        const Vec2 p0{t.x[i], t.y[i]}, p1{t.x[j], t.y[j]};
+        const double ex = p1.x - p0.x, ey = p1.y - p0.y, len2 = ex * ex + ey * ey;
+        double s = len2 > 0 ? ((c.x - p0.x) * ex + (c.y - p0.y) * ey) / len2 : 0;
+        s = s < 0 ? 0 : (s > 1 ? 1 : s);
+        const double dx = p0.x + s * ex - c.x, dy = p0.y + s * ey - c.y;
+        if (dx * dx + dy * dy < c.radius * c.radius) return true;
+        continue;
+      }
+      const auto [poly, e] = scene.edge_of(f);
+      const auto& v = scene.polygons()[poly].vertices;
+      if (segments_cross(t.x[i], t.y[i], t.x[j], t.y[j], v[e], v[(e + 1) % v.size()])) return true;
+    }
+    return false;
+  }
+
+  void rule(const TickInput& in, std::size_t i, double& out_x, double& out_y) const {
+    const AgentTable& t = in.agents;
+    const CfsmParams& p = in.cfg.steering.cfsm;
+    const double x = t.x[i], y = t.y[i], r = t.radius[i];
+    const double px = in.pref_vx[i], py = in.pref_vy[i];
+    const double v0 = std::sqrt(px * px + py * py);
+    double e0x = 0, e0y = 0;
+    if (v0 > 0) {
+      e0x = px / v0;
+      e0y = py / v0;
+    }
+    double dx = e0x, dy = e0y;
+    const uint32_t lo = nb_.offset[i], hi = nb_.offset[i + 1];
+    for (uint32_t a = lo; a < hi; ++a) {
+      const uint32_t j = nb_.row[a];
+      const double d = std::sqrt(nb_.dist2[a]);
+      if (d == 0 || hidden(in, i, j)) continue;
+      const double s = p.strength_neighbor * std::exp((r + t.radius[j] - d) / p.range_neighbor);
+      dx += s * (x - t.x[j]) / d;
+      dy += s * (y - t.y[j]) / d;
+    }
+    for (uint32_t a = features_.offset[i]; a < features_.offset[i + 1]; ++a) {
+      const std::size_t f = features_.feature[a];
+      const Vec2 c = feature_closest(in.scene, f, x, y);
+      const double wx = x - c.x, wy = y - c.y, d = std::sqrt(wx * wx + wy * wy);
+      if (d == 0) continue;
+      const double s = p.strength_geometry * std::exp((r - d) / p.range_geometry);
+      dx += s * wx / d;
+      dy += s * wy / d;
+    }
+    double len = std::sqrt(dx * dx + dy * dy);
+    if (len == 0) {  // balanced: keep the heading
+      dx = t.vx[i];
+      dy = t.vy[i];
+      len = std::sqrt(dx * dx + dy * dy);
+      if (len == 0) {
+        dx = e0x;
+        dy = e0y;
+        len = v0 > 0 ? 1 : 0;
+      }
+      if (len == 0) {
+        out_x = out_y = 0;
+        return;
+      }
+    }
+    dx /= len;
+    dy /= len;
+    // Spacing to the nearest neighbour ahead in the corridor of width 2 l along e.
+    double spacing = INFINITY;
+    for (uint32_t a = lo; a < hi; ++a) {
+      const uint32_t j = nb_.row[a];
+      const double rx = t.x[j] - x, ry = t.y[j] - y;
+      if (rx * dx + ry * dy < 0) continue;  // behind
+      const double l = r + t.radius[j];
+      if (std::abs(ry * dx - rx * dy) > l) continue;  // beside the corridor
+      if (hidden(in, i, j)) continue;
+      spacing = std::min(spacing, std::sqrt(nb_.dist2[a]) - l);
+    }
+    const double speed = std::min(std::max(spacing / p.time_gap, 0.0), v0);
+    out_x = dx * speed;
+    out_y = dy * speed;
+  }
+
+  NeighbourLists nb_;
+  FeatureLists features_;
+  std::vector<double> reach_;
+  std::map<std::string, std::unique_ptr<NeighbourPath>> neighbour_paths_;
+  std::map<std::string, std::unique_ptr<FeaturePath>> feature_paths_;
+};
+
+}  // namespace
+
+std::unique_ptr<Model> make_cfsm_model() {
+  return std::make_unique<CfsmModel>();
+}
+
+}  // namespace crowddb::steer

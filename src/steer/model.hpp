@@ -1,0 +1,60 @@
+// Steering models (DESIGN.md §3.0): how agents choose their next velocity. Each model is a small
+// plan of queries over the agent table and the static scene (neighbours, obstacle features,
+// first-to-collide, potential fields: access paths from src/plan/, each with a naive twin) and a
+// per-agent velocity rule. The tick's stages stay a fixed list:
+//
+//   apply batch -> goal stage (preferred velocities) -> model.velocities() -> integrate
+//   -> backoff (the zero-overlap safety net, under every model) -> commit
+//
+// A model reads the current columns and the preferred velocities and writes one velocity per
+// row; it keeps its access-path objects (index storage) from tick to tick. New models register
+// in registry.cpp only.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <ostream>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "crowddb/simulation.hpp"
+#include "sim/oplog.hpp"
+#include "util/executor.hpp"
+
+namespace crowddb::steer {
+
+// What a model reads in one tick.
+struct TickInput {
+  const AgentTable& agents;
+  std::span<const Goal> goals;
+  const StaticScene& scene;
+  const SimConfig& cfg;
+  std::span<const double> pref_vx, pref_vy;  // [m/s] from the goal stage (idle agents: 0, or
+                                             // stepping off a goal area others need)
+  uint64_t tick;                             // the tick being computed
+};
+
+class Model {
+ public:
+  virtual ~Model() = default;
+  // The new velocity of every row [m/s], written to vx and vy (sized agents.size()). Must not
+  // depend on the thread count.
+  virtual void velocities(const TickInput& in, std::span<double> vx, std::span<double> vy,
+                          Executor& ex, sim::OpLog& log) = 0;
+  // EXPLAIN: one line per operator the model runs, numbered from `step` (advanced).
+  virtual void explain(std::ostream& os, const TickInput& in, int& step) const = 0;
+};
+
+struct ModelInfo {
+  std::string name;
+  std::string description;  // one line, shown by EXPLAIN and `--model` errors
+  std::function<std::unique_ptr<Model>()> make;
+};
+
+const std::vector<ModelInfo>& model_registry();
+// Throws Error(usage) naming the registered models when `name` is unknown.
+const ModelInfo& find_model(std::string_view name);
+
+}  // namespace crowddb::steer
