@@ -195,6 +195,43 @@ struct Simulation::Engine {
                         cfg.walls ? &w.bounds() : nullptr);
   }
 
+  // Arrivals that idle gather at their goal: an agent on its last goal also arrives when it
+  // touches (a gap under kJoinGap) an agent already idle at that goal, so the group grows
+  // outwards instead of the later ones pushing through it for ever. joined[i] says who.
+  static constexpr double kJoinGap = 0.1;  // [m]
+  std::vector<uint8_t> joined;
+  std::vector<uint32_t> join_queries;
+  NeighbourLists join_lists;
+  std::unique_ptr<NeighbourPath> join_path;
+  void join_idle_groups(const World& w, const SimConfig& cfg, QueryStats& stats) {
+    const AgentTable& t = w.agents();
+    joined.assign(t.size(), 0);
+    if (cfg.arrival != ArrivalPolicy::idle) return;
+    join_queries.clear();
+    double rmax = 0;
+    bool any_idle = false;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      rmax = std::max(rmax, t.radius[i]);
+      any_idle = any_idle || t.state[i] == AgentState::arrived;
+      if (t.state[i] != AgentState::arrived && t.route[i].empty() && t.then[i].empty())
+        join_queries.push_back(static_cast<uint32_t>(i));
+    }
+    if (!any_idle || join_queries.empty()) return;
+    if (!join_path) join_path = neighbour_method(cfg.access.neighbours, t.size()).make();
+    join_path->run(DiscView::of(t), join_queries, 2 * rmax + kJoinGap, 8, join_lists, ex, stats);
+    for (std::size_t q = 0; q < join_queries.size(); ++q) {
+      const uint32_t i = join_queries[q];
+      for (uint32_t a = join_lists.offset[q]; a < join_lists.offset[q + 1]; ++a) {
+        const uint32_t j = join_lists.row[a];
+        if (t.state[j] != AgentState::arrived || t.goal[j] != t.goal[i]) continue;
+        if (std::sqrt(join_lists.dist2[a]) - t.radius[i] - t.radius[j] < kJoinGap) {
+          joined[i] = 1;
+          break;
+        }
+      }
+    }
+  }
+
   steer::TickInput input(const World& w, const SimConfig& cfg, uint64_t tick) const {
     return {w.agents(), w.goals(), scene, cfg, pref.vx, pref.vy, tick};
   }
@@ -321,6 +358,7 @@ const TickMetrics& Simulation::step() {
     t.y.swap(e.next.y);
     t.vx.swap(e.next.vx);
     t.vy.swap(e.next.vy);
+    e.join_idle_groups(world_, cfg, log.at("commit").query);
     std::vector<std::size_t> leaving;
     for (std::size_t i = 0; i < n; ++i) {
       if (t.state[i] == AgentState::arrived) continue;
@@ -348,7 +386,7 @@ const TickMetrics& Simulation::step() {
         world_.refresh_target(i);
         reached = true;
       }
-      if (t.route[i].empty() && world_.at_goal(i)) {
+      if (t.route[i].empty() && (world_.at_goal(i) || e.joined[i])) {
         reached = true;
         if (world_.advance_goal(i)) {
           // an intermediate goal of its sequence: on to the next one

@@ -10,6 +10,13 @@
 //
 // When the repulsions cancel the preferred direction exactly, the agent keeps its heading (the
 // direction of its current velocity) and, standing still, its preferred direction.
+//
+// Contact clipping (ours): the headway rule only looks at neighbours inside the corridor ahead,
+// so a turned direction can run a disc into a neighbour beside it or into a wall, which JuPedSim
+// reports as a model violation and our backoff would freeze (two people in a 0.7 m corridor froze
+// for good). So the speed along e is also capped so that the move closes at most half of the gap
+// to any visible neighbour and all but a micrometre of the gap to any obstacle feature within one
+// tick. Both agents of a pair keep to their half, so no move of the model overlaps.
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -21,6 +28,7 @@ namespace crowddb::steer {
 namespace {
 
 constexpr std::size_t kGrain = 128;
+constexpr double kSkin = 1e-6;  // [m] kept clear of touching, against rounding
 
 std::string num(double v) {
   std::ostringstream os;
@@ -186,7 +194,29 @@ class CfsmModel final : public Model {
       if (hidden(in, i, j)) continue;
       spacing = std::min(spacing, std::sqrt(nb_.dist2[a]) - l);
     }
-    const double speed = std::min(std::max(spacing / p.time_gap, 0.0), v0);
+    double speed = std::min(std::max(spacing / p.time_gap, 0.0), v0);
+    // Contact clipping: at most half the gap to a neighbour, all of it to an obstacle, per tick.
+    const double dt = in.cfg.dt;
+    for (uint32_t a = lo; a < hi && speed > 0; ++a) {
+      const uint32_t j = nb_.row[a];
+      const double d = std::sqrt(nb_.dist2[a]);
+      if (d == 0) continue;
+      const double along = ((t.x[j] - x) * dx + (t.y[j] - y) * dy) / d;  // e . n_ij
+      if (along <= 0) continue;
+      const double gap = std::max(0.0, d - r - t.radius[j] - kSkin);
+      speed = std::min(speed, 0.5 * gap / (dt * along));
+    }
+    for (uint32_t a = features_.offset[i]; a < features_.offset[i + 1] && speed > 0; ++a) {
+      const Vec2 c = feature_closest(in.scene, features_.feature[a], x, y);
+      const double wx = c.x - x, wy = c.y - y, d = std::sqrt(wx * wx + wy * wy);
+      if (d == 0) {
+        speed = 0;
+        break;
+      }
+      const double along = (wx * dx + wy * dy) / d;
+      if (along <= 0) continue;
+      speed = std::min(speed, std::max(0.0, d - r - kSkin) / (dt * along));
+    }
     out_x = dx * speed;
     out_y = dy * speed;
   }

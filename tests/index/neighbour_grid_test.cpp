@@ -1,0 +1,105 @@
+#include "index/neighbour_grid.hpp"
+
+#include <gtest/gtest.h>
+
+#include "query/naive_paths.hpp"
+#include "support/random_tables.hpp"
+#include "util/rng.hpp"
+
+namespace crowddb::index {
+namespace {
+
+NeighbourLists run(NeighbourPath& p, const DiscView& d, double range, uint32_t k,
+                   std::span<const uint32_t> q = {}, int threads = 1) {
+  Executor ex(threads);
+  QueryStats st;
+  NeighbourLists out;
+  p.run(d, q, range, k, out, ex, st);
+  return out;
+}
+
+void expect_same(const NeighbourLists& a, const NeighbourLists& b) {
+  ASSERT_EQ(a.offset, b.offset);
+  EXPECT_EQ(a.row, b.row);
+  EXPECT_EQ(a.dist2, b.dist2);  // bit for bit
+}
+
+// Every table shape of the property tests, every k from "all" to more than the table holds, and
+// ranges from below the typical spacing to beyond the world.
+TEST(NeighbourGrid, EqualsNaiveOnRandomShapes) {
+  Rng rng(5);
+  NeighbourNaive naive;
+  NeighbourGrid grid;
+  for (int c = 0; c < 60; ++c) {
+    const std::size_t n = 1 + rng.below(600);
+    const double side = rng.uniform(5, 500);
+    const DiscTable t = test::random_shape_table(rng, n, side, 100 + static_cast<uint64_t>(c));
+    const DiscView d = t.view();
+    const double range = side * std::pow(10, rng.uniform(-2.5, 0.5));
+    const uint32_t k = rng.below(3) == 0 ? 0 : static_cast<uint32_t>(1 + rng.below(40));
+    SCOPED_TRACE("case " + std::to_string(c) + " n " + std::to_string(n) + " k " +
+                 std::to_string(k) + " range " + std::to_string(range));
+    const NeighbourLists want = run(naive, d, range, k);
+    expect_same(run(grid, d, range, k), want);
+    expect_same(run(grid, d, range, k, {}, 3), want);  // threads change nothing
+    // A subset of query rows, in an arbitrary order.
+    std::vector<uint32_t> q;
+    for (std::size_t i = 0; i < n; i += 1 + rng.below(5)) q.push_back(static_cast<uint32_t>(i));
+    std::reverse(q.begin(), q.end());
+    expect_same(run(grid, d, range, k, q), run(naive, d, range, k, q));
+  }
+}
+
+// Ties: a square lattice (equal distances everywhere), coincident discs (distance 0), and
+// neighbours at exactly the range (excluded: strictly closer only).
+TEST(NeighbourGrid, TiesCoincidentPointsAndTheRangeBoundary) {
+  DiscTable t;
+  for (int i = 0; i < 15; ++i)
+    for (int j = 0; j < 15; ++j)
+      t.push_back(static_cast<uint64_t>(1000 - 15 * i - j), i * 0.5, j * 0.5, 0, 0, 0.2);
+  for (int r = 0; r < 6; ++r) t.push_back(static_cast<uint64_t>(5000 + r), 3.0, 3.0, 0, 0, 0.2);
+  NeighbourNaive naive;
+  NeighbourGrid grid;
+  for (double range : {0.5, 0.50000000001, 1.0, 1.5, 100.0})
+    for (uint32_t k : {0u, 1u, 3u, 4u, 5u, 8u, 12u}) {
+      SCOPED_TRACE("range " + std::to_string(range) + " k " + std::to_string(k));
+      const NeighbourLists want = run(naive, t.view(), range, k);
+      expect_same(run(grid, t.view(), range, k), want);
+    }
+  // At range 0.5 the lattice neighbours (0.5 away) are out; only discs at distance 0 are in:
+  // the five other coincident discs and the lattice node under them at (3, 3).
+  const NeighbourLists at = run(grid, t.view(), 0.5, 0);
+  const std::size_t dup = 15 * 15;  // first coincident disc
+  EXPECT_EQ(at.offset[dup + 1] - at.offset[dup], 6u);
+  EXPECT_EQ(at.offset[1] - at.offset[0], 0u);
+}
+
+TEST(NeighbourGrid, HugeAndSparseWorlds) {
+  NeighbourNaive naive;
+  NeighbourGrid grid;
+  for (double offset : {0.0, 1e6, -3e9}) {
+    DiscTable t = build::uniform(300, {offset, offset, offset + 1e6, offset + 1e6}, 1, 0.5, 2, 9);
+    t.push_back(77777, offset, offset, 0, 0, 1);  // a far corner
+    for (double range : {10.0, 5e4, 3e6}) {
+      SCOPED_TRACE("offset " + std::to_string(offset) + " range " + std::to_string(range));
+      expect_same(run(grid, t.view(), range, 10), run(naive, t.view(), range, 10));
+      expect_same(run(grid, t.view(), range, 0), run(naive, t.view(), range, 0));
+    }
+  }
+}
+
+TEST(NeighbourQuery, PublicFunctionChecksItsArguments) {
+  const DiscTable t = build::uniform(10, {0, 0, 10, 10}, 1, 0.2, 0.3, 1);
+  EXPECT_THROW(neighbours(t.view(), 0, 3), Error);
+  EXPECT_THROW(neighbours(t.view(), NAN, 3), Error);
+  const uint32_t bad[] = {10};
+  EXPECT_THROW(neighbours(t.view(), 1, 3, bad), Error);
+  EXPECT_THROW(neighbours(t.view(), 1, 3, {}, "kd"), Error);
+  for (const std::string& m : neighbour_methods()) {
+    const NeighbourLists l = neighbours(t.view(), 4, 2, {}, m);
+    EXPECT_EQ(l.queries(), 10u);
+  }
+}
+
+}  // namespace
+}  // namespace crowddb::index

@@ -1,0 +1,106 @@
+// The steering models inside the tick: their queries' access paths change nothing (naive twins
+// and indices give bit-identical runs), thread counts change nothing, and their basic behaviour.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "crowddb/scenario.hpp"
+#include "crowddb/simulation.hpp"
+
+namespace crowddb {
+namespace {
+
+// A room with pillars and a wall, two groups crossing: neighbours and obstacle features matter.
+std::string mixed(const std::string& model, int threads = 1, const std::string& access = "") {
+  return R"({"bounds": [0, 0, 24, 16], "duration": 12, "seed": 4, "threads": )" +
+         std::to_string(threads) + R"(,
+    "steering": {"model": ")" +
+         model + R"("}, )" + (access.empty() ? "" : access + ",") + R"(
+    "obstacles": [{"type": "circle", "x": 12, "y": 8, "radius": 1},
+                  {"type": "polygon", "vertices": [[8, 2], [9, 2], [9, 6], [8, 6]]}],
+    "goals": [{"name": "E", "area": [[23, 0], [24, 0], [24, 16], [23, 16]]},
+              {"name": "N", "x": 12, "y": 15, "arrival_radius": 1}],
+    "groups": [{"count": 60, "placement": {"type": "uniform", "region": [0.5, 0.5, 6, 15.5], "gap": 0.05},
+                "radius": [0.2, 0.25], "pref_speed": [1, 1.4], "goal": "E"},
+               {"count": 40, "placement": {"type": "uniform", "region": [10, 0.5, 22, 4], "gap": 0.05},
+                "radius": [0.2, 0.25], "goal": "N"}]})";
+}
+
+std::vector<uint64_t> hashes(const std::string& text, std::size_t* frozen = nullptr,
+                             std::size_t* arrived = nullptr) {
+  Scenario sc = parse_scenario(text, "t.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  std::vector<uint64_t> h;
+  for (uint64_t t = 0; t < sc.ticks; ++t) {
+    const TickMetrics& m = sim.step();
+    h.push_back(m.state_hash);
+    EXPECT_EQ(m.overlapping_pairs, 0u);
+    EXPECT_EQ(m.obstacle_overlaps, 0u);
+    if (frozen) *frozen += m.frozen;
+  }
+  if (arrived) *arrived = sim.arrived_total();
+  return h;
+}
+
+class Models : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(Models, AccessPathsAndThreadsChangeNothing) {
+  const std::string model = GetParam();
+  const auto reference = hashes(mixed(model));
+  EXPECT_EQ(hashes(mixed(model, 2)), reference);
+  EXPECT_EQ(hashes(mixed(model, 1,
+                         R"("access": {"neighbours": "naive", "edges": "naive", "ftc": "naive",
+                                       "collisions": "naive"})")),
+            reference);
+  EXPECT_EQ(hashes(mixed(model, 3, R"("access": {"neighbours": "grid", "edges": "grid"})")),
+            reference);
+}
+
+INSTANTIATE_TEST_SUITE_P(All, Models, ::testing::Values("orca", "cfsm", "thesis"));
+
+// ORCA's contact planes keep the crowd overlap-free by themselves: the backoff finds nothing.
+TEST(Orca, TheBackoffHasNothingToDoAndEveryoneArrives) {
+  std::size_t frozen = 0, arrived = 0;
+  std::string text = mixed("orca");
+  text.replace(text.find(R"("duration": 12)"), 14, R"("duration": 60)");
+  hashes(text, &frozen, &arrived);
+  EXPECT_EQ(frozen, 0u);
+  EXPECT_EQ(arrived, 100u);
+}
+
+// A lone walker keeps its preferred speed (RiMEA test 1's premise) under every model.
+TEST(Models, ALoneWalkerKeepsItsPreferredSpeed) {
+  for (const char* model : {"orca", "cfsm", "thesis"}) {
+    SCOPED_TRACE(model);
+    // No walls: the thesis's 30 s look-ahead would brake for the end wall 40 m ahead.
+    const std::string text = std::string(R"({"bounds": [0, 0, 50, 4], "duration": 40,
+      "walls": false, "steering": {"model": ")") +
+                             model + R"("},
+      "goals": [{"name": "end", "area": [[45, 0], [46, 0], [46, 4], [45, 4]]}],
+      "agents": [{"x": 5, "y": 2, "pref_speed": 1.33, "goal": "end"}]})";
+    Scenario sc = parse_scenario(text, "t.json");
+    Simulation sim(std::move(sc.world), sc.config);
+    uint64_t arrival = 0;
+    for (uint64_t t = 1; t <= sc.ticks && !arrival; ++t)
+      if (sim.step().arrived) arrival = t;
+    // 40 m at 1.33 m/s: 30.1 s; the thesis's rule accelerates with tau = 2 s (about 2 s lost).
+    const double seconds = static_cast<double>(arrival) * sc.config.dt;
+    EXPECT_GE(seconds, 30.0);
+    EXPECT_LE(seconds, std::string(model) == "thesis" ? 33.0 : 30.4);
+  }
+}
+
+TEST(Models, UnknownModelIsAUsageError) {
+  SimConfig cfg;
+  cfg.steering.model = "boids";
+  try {
+    Simulation sim(World(Bounds{0, 0, 1, 1}), cfg);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::usage);
+    EXPECT_NE(std::string(e.what()).find("orca, cfsm, thesis"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace crowddb
