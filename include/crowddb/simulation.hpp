@@ -111,10 +111,11 @@ struct NavigationParams {
 };
 
 // Stalemates (issue "crowds that flow"): an agent that gets no closer to its current waypoint
-// for `after` seconds, frozen or not, is stalled. With `resolve`, a stalled agent that has a
-// stalled neighbour of higher seeded priority in its way yields (steps aside for yield_time),
-// otherwise it sidesteps at a seeded angle (for sidestep_time); with navigation, one that stays
-// stalled re-plans (NavigationParams::replan_after).
+// for `after` seconds, frozen or not, and is not just queueing behind someone walking its way,
+// is stalled. With `resolve`, a stalled agent that has a stalled neighbour of higher seeded
+// priority in its way yields (steps aside for yield_time), otherwise it sidesteps at a seeded
+// angle (for sidestep_time); with navigation, one that stays stalled re-plans
+// (NavigationParams::replan_after). src/sim/stalemate.hpp has the detail.
 struct StallParams {
   double after = 4;       // [s] (> 0)
   double progress = 0.1;  // [m] getting this much closer than ever counts as progress (> 0)
@@ -163,7 +164,9 @@ struct TickMetrics {
   std::size_t gridlock_started = 0;   // agents whose frozen streak reached gridlock_time now
   std::size_t longest_frozen = 0;     // longest current frozen streak [ticks] among the agents
   std::size_t nudged = 0;             // agents that sidestepped in this tick (nudge_after)
-  std::size_t stalled = 0;            // agents stalled now (no progress for stall.after)
+  std::size_t stalled = 0;            // agents stalled now (no progress for stall.after, not
+                                      // queueing behind someone walking their way)
+  std::size_t queueing = 0;           // agents waiting behind someone walking their way
   std::size_t stall_started = 0;      // agents that became stalled in this tick
   std::size_t longest_stall = 0;      // longest current stretch without progress [ticks]
   std::size_t yielding = 0;           // stalled agents yielding in this tick

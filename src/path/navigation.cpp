@@ -60,7 +60,7 @@ void Navigation::trim_passed(World& world, std::size_t row) {
   AgentTable& t = world.agents_for_tick();
   auto& route = t.route[row];
   const Vec2 p{t.x[row], t.y[row]};
-  const Vec2 goal = goal_target(world.goals()[t.goal[row]], p.x, p.y);
+  const Vec2 goal = goal_target(world.goals()[t.goal[row]], p.x, p.y, t.radius[row]);
   std::size_t drop = 0;
   while (drop < route.size()) {
     const Vec2 next = drop + 1 < route.size() ? route[drop + 1] : goal;
@@ -92,6 +92,10 @@ std::size_t Navigation::apply_results(World& world, uint64_t tick) {
       if (params_.skip_visible) trim_passed(world, i);
     }
     world.refresh_target(i);
+    // A new route changes the path-left measure of the progress watch (the first route of a
+    // serpentine is 2.5 times the straight line it replaces): it gets a new reference; its clock
+    // runs on.
+    t.progress_best[i] = INFINITY;
     ++applied;
   }
   return applied;
@@ -128,7 +132,7 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
       continue;
     }
     const std::size_t i = *row;
-    const Vec2 goal = goal_target(world.goals()[t.goal[i]], t.x[i], t.y[i]);
+    const Vec2 goal = goal_target(world.goals()[t.goal[i]], t.x[i], t.y[i], t.radius[i]);
     jobs.push_back({q.ticket, q.agent, &mesh_for(t.radius[i]), {t.x[i], t.y[i]}, goal});
   }
   if (!jobs.empty()) {

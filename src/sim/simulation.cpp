@@ -373,21 +373,17 @@ const TickMetrics& Simulation::step() {
         t.frozen_ticks[i] = 0;
       }
       if (t.frozen_ticks[i] >= gridlock_ticks) ++m.gridlocked;
-      bool reached = false;                         // a waypoint or an intermediate goal: progress
       if (e.pref.skip[i] && !t.route[i].empty()) {  // the goal stage saw the waypoint after
         t.route[i].erase(t.route[i].begin());
         world_.refresh_target(i);
-        reached = true;
       }
       const double reach = cfg.waypoint_radius > 0 ? cfg.waypoint_radius : t.radius[i];
       while (!t.route[i].empty() &&
              std::hypot(t.route[i].front().x - t.x[i], t.route[i].front().y - t.y[i]) <= reach) {
         t.route[i].erase(t.route[i].begin());
         world_.refresh_target(i);
-        reached = true;
       }
       if (t.route[i].empty() && (world_.at_goal(i) || e.joined[i])) {
-        reached = true;
         if (world_.advance_goal(i)) {
           // an intermediate goal of its sequence: on to the next one
         } else {
@@ -403,17 +399,14 @@ const TickMetrics& Simulation::step() {
             t.goal[i] = pick >= t.goal[i] ? pick + 1 : pick;
             t.route[i].clear();
             t.path_goal[i] = AgentTable::kNoPath;  // a new goal: re-plan
+            t.progress_best[i] = INFINITY;
+            t.stall_ticks[i] = 0;
             world_.refresh_target(i);
           } else {
             t.state[i] = AgentState::arrived;
             t.vx[i] = t.vy[i] = 0;
           }
         }
-      }
-      if (reached) {
-        t.stall_ticks[i] = 0;
-        t.replan_ticks[i] = 0;
-        t.stall_action[i] = StallAction::none;
       }
     }
     // Descending rows: each swap-remove moves in a row that is staying (or already handled).
@@ -422,16 +415,14 @@ const TickMetrics& Simulation::step() {
 
   // 6. stalemates: progress watch, then an action for each agent stalled without one
   log.timed("stalemates", world_.agents().size(), [&] {
-    sim::StallCounts sc = sim::watch_progress(world_, cfg);
-    if (cfg.stall.resolve && sc.stalled) {
-      if (!e.stall_path)
-        e.stall_path = neighbour_method(cfg.access.neighbours, world_.agents().size()).make();
-      sim::resolve_stalemates(world_, cfg, m.tick, *e.stall_path, e.ex, log.at("stalemates").query,
-                              sc);
-    }
+    if (!e.stall_path)
+      e.stall_path = neighbour_method(cfg.access.neighbours, world_.agents().size()).make();
+    const sim::StallCounts sc =
+        sim::stalemates(world_, cfg, m.tick, *e.stall_path, e.ex, log.at("stalemates").query);
     m.stalled = sc.stalled;
     m.stall_started = sc.started;
     m.longest_stall = sc.longest;
+    m.queueing = sc.queueing;
     m.yielding = sc.yielding;
     m.sidestepping = sc.sidestepping;
   });

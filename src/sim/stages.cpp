@@ -36,12 +36,18 @@ void NextState::resize(std::size_t n) {
 
 Vec2 current_target(const AgentTable& t, std::span<const Goal> goals, std::size_t i) {
   if (!t.route[i].empty()) return t.route[i].front();
-  return goal_target(goals[t.goal[i]], t.x[i], t.y[i]);
+  return goal_target(goals[t.goal[i]], t.x[i], t.y[i], t.radius[i]);
 }
 
-double distance_to_target(const AgentTable& t, std::span<const Goal> goals, std::size_t i) {
-  const Vec2 c = current_target(t, goals, i);
-  return std::hypot(c.x - t.x[i], c.y - t.y[i]);
+double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i) {
+  double x = t.x[i], y = t.y[i], len = 0;
+  for (const Vec2& w : t.route[i]) {
+    len += std::hypot(w.x - x, w.y - y);
+    x = w.x;
+    y = w.y;
+  }
+  const Vec2 e = goal_target(goals[t.goal[i]], x, y, t.radius[i]);
+  return len + std::hypot(e.x - x, e.y - y);
 }
 
 void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,
@@ -86,8 +92,9 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
       if (sight && !t.route[i].empty() && (tick + t.id[i]) % sight_ticks == 0) {
         // The waypoint after the current one: the next route point, or the goal.
         const auto& route = t.route[i];
-        const Vec2 next =
-            route.size() > 1 ? route[1] : goal_target(goals[t.goal[i]], t.x[i], t.y[i]);
+        const Vec2 next = route.size() > 1
+                              ? route[1]
+                              : goal_target(goals[t.goal[i]], t.x[i], t.y[i], t.radius[i]);
         if (nav->visible(t.radius[i], {t.x[i], t.y[i]}, next)) {
           pref.skip[i] = 1;
           target = next;

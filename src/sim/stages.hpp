@@ -33,8 +33,10 @@ struct NextState {
 
 // Where row i is heading now: its next route waypoint, else the nearest point of its goal area.
 Vec2 current_target(const AgentTable& t, std::span<const Goal> goals, std::size_t i);
-// Distance from row i to what it is heading for (0 inside a polygon goal with no waypoint left).
-double distance_to_target(const AgentTable& t, std::span<const Goal> goals, std::size_t i);
+// Length of the path still ahead of row i: to its waypoint, along its route, to its goal's
+// target point. Continuous when a waypoint is passed, so progress along a route can be watched
+// with one number across waypoint changes.
+double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i);
 
 // The goal stage: per row, the preferred velocity pref_speed towards its current target (slower
 // when it would overshoot within one tick). On top of it, in this order:

@@ -11,27 +11,41 @@ namespace crowddb::sim {
 namespace {
 
 constexpr double kBlockGap = 0.6;  // [m] a blocker's disc is this close to the agent's, or less
+constexpr double kSameWay = 0.5;   // cos 60 degrees: directions this close are the same way
 
 uint64_t priority(uint64_t seed, uint64_t id) {
   uint64_t s = seed ^ (id * 0x9e3779b97f4a7c15ull);
   return splitmix64(s);
 }
 
+// Unit direction from row i to its current target (0, 0 when on it).
+Vec2 heading(const AgentTable& t, std::span<const Goal> goals, std::size_t i) {
+  const Vec2 c = current_target(t, goals, i);
+  const double dx = c.x - t.x[i], dy = c.y - t.y[i], l = std::sqrt(dx * dx + dy * dy);
+  return l > 0 ? Vec2{dx / l, dy / l} : Vec2{0, 0};
+}
+
 }  // namespace
 
-StallCounts watch_progress(World& world, const SimConfig& cfg) {
+StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, NeighbourPath& path,
+                       Executor& ex, QueryStats& stats) {
   AgentTable& t = world.agents_for_tick();
+  const auto goals = world.goals();
   const uint64_t after = cfg.ticks_for(cfg.stall.after);
   StallCounts c;
+  // 1. progress watch
+  std::vector<uint32_t> looked_at;
+  double rmax = 0;
   for (std::size_t i = 0; i < t.size(); ++i) {
+    rmax = std::max(rmax, t.radius[i]);
     if (t.state[i] == AgentState::arrived) {
       t.stall_ticks[i] = 0;
       t.stall_action[i] = StallAction::none;
       continue;
     }
-    const double d = distance_to_target(t, world.goals(), i);
+    const double d = path_left(t, goals, i);
     if (!std::isfinite(t.progress_best[i])) {
-      t.progress_best[i] = d;  // a new target (or path): this tick is the reference
+      t.progress_best[i] = d;  // a new goal: this tick is the reference
     } else if (d < t.progress_best[i] - cfg.stall.progress) {
       t.progress_best[i] = d;
       t.stall_ticks[i] = 0;
@@ -41,51 +55,83 @@ StallCounts watch_progress(World& world, const SimConfig& cfg) {
       ++t.stall_ticks[i];
       ++t.replan_ticks[i];
     }
-    if (t.stall_ticks[i] >= after) ++c.stalled;
-    if (t.stall_ticks[i] == after) ++c.started;
-    c.longest = std::max<std::size_t>(c.longest, t.stall_ticks[i]);
-  }
-  return c;
-}
-
-void resolve_stalemates(World& world, const SimConfig& cfg, uint64_t tick, NeighbourPath& path,
-                        Executor& ex, QueryStats& stats, StallCounts& counts) {
-  AgentTable& t = world.agents_for_tick();
-  const uint64_t after = cfg.ticks_for(cfg.stall.after);
-  std::vector<uint32_t> deciding;
-  double rmax = 0;
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    rmax = std::max(rmax, t.radius[i]);
     if (t.stall_action[i] != StallAction::none && tick >= t.stall_until[i])
       t.stall_action[i] = StallAction::none;
-    if (t.state[i] != AgentState::arrived && t.stall_ticks[i] >= after &&
-        t.stall_action[i] == StallAction::none)
-      deciding.push_back(static_cast<uint32_t>(i));
+    if (t.stall_ticks[i] >= after) looked_at.push_back(static_cast<uint32_t>(i));
   }
-  if (deciding.empty()) return;
+  if (looked_at.empty()) return c;
+  // 2. blockers, queueing
   NeighbourLists nb;
-  path.run(DiscView::of(t), deciding, 2 * rmax + kBlockGap, 6, nb, ex, stats);
-  for (std::size_t q = 0; q < deciding.size(); ++q) {
-    const uint32_t i = deciding[q];
-    const Vec2 target = current_target(t, world.goals(), i);
-    double dx = target.x - t.x[i], dy = target.y - t.y[i];
-    const double dl = std::sqrt(dx * dx + dy * dy);
-    if (dl == 0) continue;
-    dx /= dl;
-    dy /= dl;
-    int64_t blocker = -1;
+  path.run(DiscView::of(t), looked_at, 2 * rmax + kBlockGap, 6, nb, ex, stats);
+  std::vector<int64_t> blocker(looked_at.size(), -1);
+  std::vector<Vec2> dir(looked_at.size());
+  std::vector<uint8_t> same_way(looked_at.size(), 0), queueing(looked_at.size(), 0);
+  std::vector<int64_t> pos(t.size(), -1);
+  for (std::size_t q = 0; q < looked_at.size(); ++q) pos[looked_at[q]] = static_cast<int64_t>(q);
+  for (std::size_t q = 0; q < looked_at.size(); ++q) {
+    const uint32_t i = looked_at[q];
+    dir[q] = heading(t, goals, i);
     for (uint32_t j : nb.rows_of(q)) {
       const double rx = t.x[j] - t.x[i], ry = t.y[j] - t.y[i];
       const double gap = std::sqrt(rx * rx + ry * ry) - t.radius[i] - t.radius[j];
-      if (gap < kBlockGap && rx * dx + ry * dy > 0) {
-        blocker = j;
+      if (gap < kBlockGap && rx * dir[q].x + ry * dir[q].y > 0) {
+        blocker[q] = j;
         break;
       }
     }
-    const auto j = static_cast<std::size_t>(blocker);
-    const bool blocker_stalled =
-        blocker >= 0 && t.state[j] != AgentState::arrived && t.stall_ticks[j] >= after;
-    if (blocker_stalled && priority(cfg.seed, t.id[j]) > priority(cfg.seed, t.id[i])) {
+    if (blocker[q] < 0) continue;
+    const auto j = static_cast<std::size_t>(blocker[q]);
+    const Vec2 dj = heading(t, goals, j);
+    same_way[q] = t.state[j] == AgentState::arrived || t.goal[j] == t.goal[i] ||
+                  dj.x * dir[q].x + dj.y * dir[q].y >= kSameWay;
+  }
+  // A queue ends in someone who moves: an agent waits in one when its same-way blocker is
+  // progressing (not looked at) or waits in one itself. Chains resolve outwards from a moving
+  // head; a cycle of mutual blockers (people arching in a door) never does: it is a stalemate.
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::size_t q = 0; q < looked_at.size(); ++q) {
+      if (queueing[q] || !same_way[q]) continue;
+      const auto j = static_cast<std::size_t>(blocker[q]);
+      if (t.state[j] == AgentState::arrived || pos[j] < 0 ||
+          queueing[static_cast<std::size_t>(pos[j])]) {
+        queueing[q] = 1;
+        changed = true;
+      }
+    }
+  }
+  // Waiting in a queue is no stalemate: no action, and the clock is held at the threshold (so
+  // a queueing agent never passes for a moving head, and should it become a stalled head, its
+  // stall is counted from then).
+  for (std::size_t q = 0; q < looked_at.size(); ++q)
+    if (queueing[q]) {
+      t.stall_action[looked_at[q]] = StallAction::none;
+      t.stall_ticks[looked_at[q]] = static_cast<uint32_t>(after);
+      ++c.queueing;
+    }
+  for (std::size_t q = 0; q < looked_at.size(); ++q) {
+    if (queueing[q]) continue;
+    const uint32_t i = looked_at[q];
+    ++c.stalled;
+    if (t.stall_ticks[i] == after + 1) ++c.started;
+    c.longest = std::max<std::size_t>(c.longest, t.stall_ticks[i]);
+  }
+  if (!cfg.stall.resolve) return c;
+  // 3. actions for the stalled ones that have none running
+  for (std::size_t q = 0; q < looked_at.size(); ++q) {
+    const uint32_t i = looked_at[q];
+    if (queueing[q] || t.stall_action[i] != StallAction::none) continue;
+    const double dx = dir[q].x, dy = dir[q].y;
+    if (dx == 0 && dy == 0) continue;
+    const auto j = static_cast<std::size_t>(blocker[q]);
+    const bool blocker_stalled = blocker[q] >= 0 && t.stall_ticks[j] >= after &&
+                                 !(pos[j] >= 0 && queueing[static_cast<std::size_t>(pos[j])]);
+    // The one with less of its path left goes first (at a clogged door: the one nearest to
+    // getting through), as in orca's right of way; ties by the seeded rank.
+    const double li = path_left(t, goals, i), lj = blocker_stalled ? path_left(t, goals, j) : 0;
+    const bool j_first =
+        lj < li || (lj == li && priority(cfg.seed, t.id[j]) > priority(cfg.seed, t.id[i]));
+    if (blocker_stalled && j_first) {
       // Yield: back away from the blocker and to the side it is not on.
       const double rx = t.x[i] - t.x[j], ry = t.y[i] - t.y[j];
       const double rl = std::max(std::sqrt(rx * rx + ry * ry), 1e-12);
@@ -104,21 +150,22 @@ void resolve_stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neigh
       t.stall_dir_x[i] = yx;
       t.stall_dir_y[i] = yy;
       t.stall_until[i] = tick + cfg.ticks_for(cfg.stall.yield_time);
-      ++counts.yielding;
+      ++c.yielding;
     } else if (blocker_stalled) {
       continue;  // the blocker yields to this one
     } else {
       Rng rng = Rng::stream(cfg.seed ^ (tick * 0xbf58476d1ce4e5b9ull), t.id[i]);
       const double turn =
           rng.uniform(std::numbers::pi / 4, std::numbers::pi / 2) * (rng.below(2) ? 1 : -1);
-      const double c = std::cos(turn), s = std::sin(turn);
+      const double cs = std::cos(turn), sn = std::sin(turn);
       t.stall_action[i] = StallAction::sidestep;
-      t.stall_dir_x[i] = c * dx - s * dy;
-      t.stall_dir_y[i] = s * dx + c * dy;
+      t.stall_dir_x[i] = cs * dx - sn * dy;
+      t.stall_dir_y[i] = sn * dx + cs * dy;
       t.stall_until[i] = tick + cfg.ticks_for(cfg.stall.sidestep_time);
-      ++counts.sidestepping;
+      ++c.sidestepping;
     }
   }
+  return c;
 }
 
 }  // namespace crowddb::sim

@@ -1,18 +1,28 @@
 // Stalemates: agents that make no progress, frozen or not (two agents that settle 1 m apart at
 // speed 0 in a doorway are never frozen, so the backoff's nudge never sees them).
 //
-// Progress watch (every tick, after commit): an agent progresses when it gets `progress` metres
-// closer to its current target than ever since the target was set; stall_ticks counts the ticks
-// since. It is stalled from `after` seconds on.
-//
-// Resolution (deterministic: it depends on the committed state, the seed and the ids only):
-// a stalled agent looks for its blocker, the nearest agent in front of it (towards its target)
-// within 0.6 m of its disc. Every agent has a seeded priority (a hash of seed and id).
-//   - the blocker is stalled and has the higher priority: yield, i.e. step back from it and to
-//     the side away from it at half speed for yield_time;
-//   - the blocker is stalled and has the lower priority: keep going (the blocker yields);
-//   - otherwise (no blocker, an idle or a moving one, or walls): sidestep, i.e. walk at a
-//     seeded angle of 45-90 degrees off the target direction for sidestep_time.
+// Progress watch (every tick, after commit): an agent progresses when the path still ahead of it
+// (sim::path_left: to its waypoint, along its route, to its goal) gets `progress` metres shorter
+// than ever since its goal was set; stall_ticks counts the ticks since. Passing or skipping a
+// waypoint, or a re-planned route, is no progress by itself (an agent wedged at a door jamb
+// re-plans and skips waypoints every few seconds without getting anywhere). From `after` seconds on
+// the agent is looked at: its blocker is the nearest agent in front of it (towards its target)
+// within 0.6 m of its disc.
+//   - queueing: the blocker walks the same way (the same goal, or directions within 60 degrees)
+//     or stands idle at the goal, and is itself progressing or queueing: a queue ends in someone
+//     who moves. Waiting in one is no stalemate (the back of a queue of 500 at a 1 m exit gains a
+//     few centimetres a second): no action, not counted as stalled. A cycle of mutual blockers
+//     (people arching in a door, all heading for it) has no moving head: they are stalled.
+//   - stalled: no blocker (walls, a local minimum) or a blocker heading elsewhere.
+// Resolution (deterministic: it depends on the committed state, the seed and the ids only). Of
+// two stalled agents the one with less of its path left goes first (at a clogged door: the one
+// nearest to getting through, as in orca's right of way); ties go by a seeded rank (a hash of
+// seed and id):
+//   - the blocker is stalled too and goes first: yield, i.e. step back from it and to the side
+//     away from it at half speed for yield_time;
+//   - the blocker is stalled too and goes second: keep going (the blocker yields);
+//   - otherwise: sidestep, i.e. walk at a seeded angle of 45-90 degrees off the target direction
+//     for sidestep_time.
 // After the action the agent heads for its target again; with navigation, one that stays stalled
 // also re-plans its path (NavigationParams::replan_after).
 #pragma once
@@ -26,15 +36,12 @@
 namespace crowddb::sim {
 
 struct StallCounts {
-  std::size_t stalled = 0, started = 0, longest = 0, yielding = 0, sidestepping = 0;
+  std::size_t stalled = 0, started = 0, longest = 0, queueing = 0, yielding = 0, sidestepping = 0;
 };
 
-// Updates the progress watch of every active row and returns the counts (before resolution).
-StallCounts watch_progress(World& world, const SimConfig& cfg);
-
-// Picks an action for each stalled row that has none running; `tick` is the tick just committed.
-// Adds the new actions to `counts`.
-void resolve_stalemates(World& world, const SimConfig& cfg, uint64_t tick, NeighbourPath& path,
-                        Executor& ex, QueryStats& stats, StallCounts& counts);
+// The progress watch, the queueing test and (with cfg.stall.resolve) the actions, for the tick
+// `tick` just committed.
+StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, NeighbourPath& path,
+                       Executor& ex, QueryStats& stats);
 
 }  // namespace crowddb::sim

@@ -49,6 +49,7 @@
 #include <sstream>
 
 #include "plan/access_path.hpp"
+#include "sim/stages.hpp"
 #include "steer/model.hpp"
 #include "steer/orca_lp.hpp"
 #include "util/rng.hpp"
@@ -166,7 +167,7 @@ class OrcaModel final : public Model {
     remaining_.resize(n);
     rank_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
-      remaining_[i] = t.state[i] == AgentState::arrived ? INFINITY : path_left(in, i);
+      remaining_[i] = t.state[i] == AgentState::arrived ? INFINITY : sim::path_left(t, in.goals, i);
       uint64_t h = in.cfg.seed ^ (t.id[i] * 0x9e3779b97f4a7c15ull);
       rank_[i] = splitmix64(h);
     }
@@ -283,21 +284,6 @@ class OrcaModel final : public Model {
   bool first(std::size_t i, std::size_t j) const {
     return remaining_[i] < remaining_[j] || (remaining_[i] == remaining_[j] && rank_[i] > rank_[j]);
   }
-  // Length of the path still ahead of row i: to its waypoint, along its route, to its goal.
-  static double path_left(const TickInput& in, std::size_t i) {
-    const AgentTable& t = in.agents;
-    const auto& route = t.route[i];
-    const Goal& g = in.goals[t.goal[i]];
-    double x = t.x[i], y = t.y[i], len = 0;
-    for (const Vec2& w : route) {
-      len += std::hypot(w.x - x, w.y - y);
-      x = w.x;
-      y = w.y;
-    }
-    const Vec2 e = goal_target(g, x, y);
-    return len + std::hypot(e.x - x, e.y - y);
-  }
-
   NeighbourLists nb_;
   FeatureLists features_;
   std::vector<double> reach_;

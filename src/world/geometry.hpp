@@ -99,12 +99,19 @@ inline bool inside_goal(const Goal& g, double px, double py) {
 }
 
 // Where an agent at p steers for its goal when no waypoint is left: a disc goal's centre, or the
-// nearest point of a polygon goal (p itself when inside).
-inline Vec2 goal_target(const Goal& g, double px, double py) {
+// nearest point of a polygon goal (p itself when inside), pulled inwards by the agent's radius r
+// towards the goal's interior point, so that a disc aiming at a goal area behind a door aims
+// where it fits through (the nearest point itself may lie against a jamb).
+inline Vec2 goal_target(const Goal& g, double px, double py, double r = 0) {
   if (!g.is_polygon()) return {g.x, g.y};
   if (point_in_polygon(g.area, px, py)) return {px, py};
   Vec2 c{};
   dist2_to_boundary(g.area, px, py, &c);
+  const double dx = g.x - c.x, dy = g.y - c.y, l = std::sqrt(dx * dx + dy * dy);
+  if (r > 0 && l > 0) {
+    const double s = std::min(r, l) / l;
+    c = {c.x + dx * s, c.y + dy * s};
+  }
   return c;
 }
 

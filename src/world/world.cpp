@@ -210,7 +210,7 @@ void World::push_row(AgentId id, const AgentSpec& s) {
   t.max_speed.push_back(s.max_speed);
   t.max_accel.push_back(s.max_accel);
   t.charge.push_back(s.charge);
-  const Vec2 target = goal_target(goals_[s.goal], s.x, s.y);
+  const Vec2 target = goal_target(goals_[s.goal], s.x, s.y, s.radius);
   t.target_x.push_back(target.x);
   t.target_y.push_back(target.y);
   t.goal.push_back(s.goal);
@@ -281,14 +281,12 @@ void World::refresh_target(std::size_t row) {
     t.target_x[row] = t.route[row].front().x;
     t.target_y[row] = t.route[row].front().y;
   } else {
-    const Vec2 p = goal_target(goals_[t.goal[row]], t.x[row], t.y[row]);
+    const Vec2 p = goal_target(goals_[t.goal[row]], t.x[row], t.y[row], t.radius[row]);
     t.target_x[row] = p.x;
     t.target_y[row] = p.y;
   }
-  // The distance to a new waypoint is not comparable with the old one: the watch restarts.
-  // stall_ticks is kept: a new path is no progress (the commit resets it when a waypoint or a
-  // goal is reached).
-  t.progress_best[row] = INFINITY;
+  // A new route gets its time to work before the next re-plan. The progress watch measures the
+  // path left to the goal, so it carries on (a new route is no progress by itself).
   t.replan_ticks[row] = 0;
 }
 
@@ -299,6 +297,8 @@ bool World::advance_goal(std::size_t row) {
   t.then[row].erase(t.then[row].begin());
   t.route[row].clear();
   t.path_goal[row] = AgentTable::kNoPath;  // a new goal: re-plan
+  t.progress_best[row] = INFINITY;         // and a new reference for the progress watch
+  t.stall_ticks[row] = 0;
   refresh_target(row);
   return true;
 }
@@ -333,6 +333,8 @@ std::size_t World::apply_pending() {
         agents_.then[*row].clear();
         agents_.route[*row].clear();
         agents_.path_goal[*row] = AgentTable::kNoPath;  // re-plan, even for the same goal
+        agents_.progress_best[*row] = INFINITY;
+        agents_.stall_ticks[*row] = 0;
         if (agents_.state[*row] == AgentState::arrived) agents_.state[*row] = AgentState::active;
         refresh_target(*row);
         break;

@@ -88,9 +88,14 @@ TEST(ScenarioJson, GoalAreasSequencesAndTargets) {
     EXPECT_EQ(goals[t.goal[i]].y, 20);
     EXPECT_EQ(t.then[i], (std::vector<uint32_t>{0}));
   }
-  // An agent steers for the nearest point of a polygon goal.
+  // An agent steers for the nearest point of a polygon goal, pulled inwards by its radius
+  // towards the goal's interior point (where its disc fits, not against a door jamb).
   EXPECT_EQ(goal_target(goals[0], 50, 45).x, 90);
   EXPECT_EQ(goal_target(goals[0], 50, 45).y, 45);
+  const Vec2 pulled = goal_target(goals[0], 50, 45, 0.5);
+  EXPECT_NEAR(std::hypot(pulled.x - 90, pulled.y - 45), 0.5, 1e-12);
+  EXPECT_GT(pulled.x, 90);
+  EXPECT_GT(pulled.y, 45);
 }
 
 TEST(ScenarioJson, SourcesAreRead) {

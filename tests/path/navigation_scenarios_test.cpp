@@ -82,11 +82,11 @@ TEST_P(NavigationScenario, EveryAgentArrivesOutsideObstaclesOnANearShortestPath)
   // goal. Walked: the path it took until the last tick it was seen, completed by the straight
   // line from there to the goal (it left the table within the arrival radius on the next tick).
   const Scenario sc = load_scenario(scenario_path(name));
-  const testing::DiscWorld dw = testing::DiscWorld::of(sc.world, sc.config.walls);
+  const path::DiscWorld dw = path::DiscWorld::of(sc.world, sc.config.walls);
   double worst = 0, sum = 0;
   for (const auto& [id, w] : r.walks) {
     const Goal& g = sc.world.goals()[w.goal];
-    const double shortest = testing::shortest_path(dw, w.radius, w.spawn, {g.x, g.y});
+    const double shortest = path::shortest_path(dw, w.radius, w.spawn, {g.x, g.y});
     ASSERT_TRUE(std::isfinite(shortest)) << name << ": agent " << id << " has no reference path";
     const double walked = w.walked + std::hypot(g.x - w.last.x, g.y - w.last.y);
     const double ratio = walked / shortest;

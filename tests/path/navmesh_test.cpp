@@ -19,8 +19,8 @@ PolygonObstacle rect(double x0, double y0, double x1, double y1) {
   return {{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, 1};
 }
 
-testing::DiscWorld disc_world(const NavGeometry& g) {
-  testing::DiscWorld d;
+path::DiscWorld disc_world(const NavGeometry& g) {
+  path::DiscWorld d;
   d.bounds = g.bounds;
   d.circles = g.circles;
   for (const auto& p : g.polygons) d.polygons.push_back(p.vertices);
@@ -28,7 +28,7 @@ testing::DiscWorld disc_world(const NavGeometry& g) {
 }
 
 // Every point of the path (sampled every 0.02) keeps at least `need` from obstacles and walls.
-double min_clearance(const testing::DiscWorld& w, const PathResult& r) {
+double min_clearance(const path::DiscWorld& w, const PathResult& r) {
   std::vector<Vec2> pts{r.start};
   pts.insert(pts.end(), r.corners.begin(), r.corners.end());
   pts.push_back(r.end);
@@ -38,7 +38,7 @@ double min_clearance(const testing::DiscWorld& w, const PathResult& r) {
     const int n = std::max(1, static_cast<int>(len / 0.02));
     for (int k = 0; k <= n; ++k) {
       const double t = static_cast<double>(k) / n;
-      worst = std::min(worst, testing::clearance_at(w, {pts[i].x + t * (pts[i + 1].x - pts[i].x),
+      worst = std::min(worst, path::clearance_at(w, {pts[i].x + t * (pts[i + 1].x - pts[i].x),
                                                         pts[i].y + t * (pts[i + 1].y - pts[i].y)}));
     }
   }
@@ -78,9 +78,9 @@ TEST(NavMesh, WallWithAGapMatchesTheVisibilityGraph) {
   EXPECT_GE(r.corners.size(), 1u);
   for (const Vec2& c : r.corners) EXPECT_GT(c.y, 30);  // around the wall's end
   const auto dw = disc_world(g);
-  const double exact = testing::shortest_path(dw, p.radius, {10, 10}, {50, 10});
+  const double exact = path::shortest_path(dw, p.radius, {10, 10}, {50, 10});
   const double inflated =
-      testing::shortest_path(dw, mesh->clearance() + 2 * p.cell_size, {10, 10}, {50, 10});
+      path::shortest_path(dw, mesh->clearance() + 2 * p.cell_size, {10, 10}, {50, 10});
   // Never shorter than the true shortest path of the disc, about that of a disc as wide as the
   // mesh's clearance (plus two cells: the grid rounds the eroded boundary outwards).
   EXPECT_GE(r.length, exact * (1 - 1e-4));
@@ -122,10 +122,10 @@ TEST(NavMesh, NonConvexPolygonsAndCirclesAreRespected) {
   ASSERT_EQ(r.status, PathStatus::ok);
   const auto dw = disc_world(g);
   EXPECT_GE(min_clearance(dw, r), p.radius);
-  EXPECT_GE(r.length, testing::shortest_path(dw, p.radius, {20, 40}, {86, 40}) * (1 - 1e-4));
+  EXPECT_GE(r.length, path::shortest_path(dw, p.radius, {20, 40}, {86, 40}) * (1 - 1e-4));
   EXPECT_LE(
       r.length,
-      testing::shortest_path(dw, mesh->clearance() + 2 * p.cell_size, {20, 40}, {86, 40}) * 1.02);
+      path::shortest_path(dw, mesh->clearance() + 2 * p.cell_size, {20, 40}, {86, 40}) * 1.02);
   EXPECT_FALSE(mesh->visible({50, 40}, {86, 40}));  // from inside the U
 }
 
@@ -172,13 +172,13 @@ TEST(NavMesh, RandomWorldsAgreeWithTheVisibilityGraphOracle) {
     for (int q = 0; q < 8; ++q) {
       const Vec2 a{rng.uniform(2, 58), rng.uniform(2, 43)},
           b{rng.uniform(2, 58), rng.uniform(2, 43)};
-      const double wide = testing::shortest_path(dw, wide_radius, a, b);
+      const double wide = path::shortest_path(dw, wide_radius, a, b);
       if (!std::isfinite(wide)) continue;  // start or goal too close to an obstacle, or no passage
       const PathResult r = f.find(a, b);
       ASSERT_EQ(r.status, PathStatus::ok) << "world " << world << " query " << q;
       const double total = r.length + std::hypot(r.start.x - a.x, r.start.y - a.y) +
                            std::hypot(r.end.x - b.x, r.end.y - b.y);
-      const double exact = testing::shortest_path(dw, radius, a, b);
+      const double exact = path::shortest_path(dw, radius, a, b);
       EXPECT_GE(total, exact * (1 - 1e-4)) << "world " << world << " query " << q;
       EXPECT_LE(total, wide * 1.10) << "world " << world << " query " << q;
       const double c = min_clearance(dw, r);

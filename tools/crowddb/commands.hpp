@@ -16,6 +16,7 @@ void add_run_command(CLI::App& app, Action& action);
 void add_validate_command(CLI::App& app, Action& action);
 void add_experiment_command(CLI::App& app, Action& action);
 void add_fit_kernel_command(CLI::App& app, Action& action);
+void add_verify_command(CLI::App& app, Action& action);
 
 // Shortest decimal that reads back as the same double.
 std::string format_number(double v);

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   crowddb::cli::add_query_commands(app, action);
   crowddb::cli::add_experiment_command(app, action);
   crowddb::cli::add_fit_kernel_command(app, action);
+  crowddb::cli::add_verify_command(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,4 +1,5 @@
-// Reference shortest paths for a disc among static obstacles, independent of Recast/Detour:
+// Reference shortest paths (the oracle of the navigation mesh in tests, and the yardstick of
+// crowddb verify's path-length criteria) for a disc among static obstacles, independent of Recast/Detour:
 // a visibility graph over the obstacles inflated by the disc radius, then Dijkstra.
 //
 // The free space for a disc of radius r is the plane minus every obstacle grown by r (and, with
@@ -20,7 +21,7 @@
 
 #include "crowddb/world.hpp"
 
-namespace crowddb::testing {
+namespace crowddb::path {
 
 struct DiscWorld {
   Bounds bounds{};
@@ -167,4 +168,4 @@ inline double clearance_at(const DiscWorld& w, Vec2 p) {
   return d;
 }
 
-}  // namespace crowddb::testing
+}  // namespace crowddb::path
