@@ -1,6 +1,9 @@
 #include "world/geometry.hpp"
 
 #include <algorithm>
+#include <vector>
+
+#include "world/halfplane_lp.hpp"
 
 namespace crowddb {
 namespace {
@@ -50,6 +53,54 @@ std::optional<std::pair<std::size_t, std::size_t>> first_self_intersection(
     }
   }
   return std::nullopt;
+}
+
+namespace {
+
+bool convex_ccw(std::span<const Vec2> ring) {
+  for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+    const Vec2& a = ring[i];
+    const Vec2& b = ring[(i + 1) % n];
+    const Vec2& c = ring[(i + 2) % n];
+    if (cross(b.x - a.x, b.y - a.y, c.x - b.x, c.y - b.y) < 0) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Vec2 goal_target(const Goal& g, double px, double py, double r) {
+  if (!g.is_polygon()) return {g.x, g.y};
+  if (point_in_polygon(g.area, px, py)) return {px, py};
+  Vec2 c{};
+  dist2_to_boundary(g.area, px, py, &c);
+  if (!(r > 0) || !convex_ccw(g.area)) return c;
+  // The area's edges moved inwards by r, as half-planes (the area is counter-clockwise: inside
+  // is left of each edge); the closest point to p within them.
+  std::vector<HalfPlane> planes;
+  double extent = std::abs(px) + std::abs(py);
+  for (const Vec2& a : g.area) extent = std::max(extent, std::abs(a.x) + std::abs(a.y));
+  auto eroded = [&](double by) {
+    planes.clear();
+    for (std::size_t i = 0, n = g.area.size(); i < n; ++i) {
+      const Vec2& a = g.area[i];
+      const Vec2& b = g.area[(i + 1) % n];
+      const double ex = b.x - a.x, ey = b.y - a.y, l = std::sqrt(ex * ex + ey * ey);
+      const double nx = -ey / l, ny = ex / l;
+      planes.push_back({a.x + nx * by, a.y + ny * by, nx, ny});
+    }
+    return solve_velocity_lp(planes, 0, 4 * extent + 1, px, py);
+  };
+  LpResult q = eroded(r);
+  if (!q.feasible) {
+    // The disc is wider than the area somewhere: erode by the largest radius that fits (the
+    // area's inradius: r less the smallest worst violation the program found), just inside.
+    double worst = 0;
+    for (const HalfPlane& h : planes)
+      worst = std::max(worst, -((q.vx - h.px) * h.nx + (q.vy - h.py) * h.ny));
+    q = eroded(std::max(0.0, (r - worst) * (1 - 1e-9)));
+  }
+  return {q.vx, q.vy};
 }
 
 }  // namespace crowddb

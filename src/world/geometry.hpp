@@ -98,22 +98,12 @@ inline bool inside_goal(const Goal& g, double px, double py) {
   return point_in_polygon(g.area, px, py) || dist2_to_boundary(g.area, px, py) <= 1e-12;
 }
 
-// Where an agent at p steers for its goal when no waypoint is left: a disc goal's centre, or the
-// nearest point of a polygon goal (p itself when inside), pulled inwards by the agent's radius r
-// towards the goal's interior point, so that a disc aiming at a goal area behind a door aims
-// where it fits through (the nearest point itself may lie against a jamb).
-inline Vec2 goal_target(const Goal& g, double px, double py, double r = 0) {
-  if (!g.is_polygon()) return {g.x, g.y};
-  if (point_in_polygon(g.area, px, py)) return {px, py};
-  Vec2 c{};
-  dist2_to_boundary(g.area, px, py, &c);
-  const double dx = g.x - c.x, dy = g.y - c.y, l = std::sqrt(dx * dx + dy * dy);
-  if (r > 0 && l > 0) {
-    const double s = std::min(r, l) / l;
-    c = {c.x + dx * s, c.y + dy * s};
-  }
-  return c;
-}
+// Where an agent at p steers for its goal when no waypoint is left: a disc goal's centre, or a
+// polygon goal's nearest point where a disc of radius r fits (the nearest point of the area
+// eroded by r; when the area is thinner than the disc, its middle across), so that a disc aiming
+// at a goal area behind a door aims through the door, not at a jamb. p itself when inside.
+// Non-convex areas: their nearest point (the edge offsets do not make their erosion).
+Vec2 goal_target(const Goal& g, double px, double py, double r = 0);
 
 // The first pair of non-adjacent edges (i, j), i < j, that touch or cross, if any. O(v^2).
 std::optional<std::pair<std::size_t, std::size_t>> first_self_intersection(

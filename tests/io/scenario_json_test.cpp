@@ -88,14 +88,21 @@ TEST(ScenarioJson, GoalAreasSequencesAndTargets) {
     EXPECT_EQ(goals[t.goal[i]].y, 20);
     EXPECT_EQ(t.then[i], (std::vector<uint32_t>{0}));
   }
-  // An agent steers for the nearest point of a polygon goal, pulled inwards by its radius
-  // towards the goal's interior point (where its disc fits, not against a door jamb).
+  // An agent steers for the nearest point of a polygon goal where its disc fits: the nearest
+  // point of the area eroded by its radius (in the middle across an area thinner than the disc).
   EXPECT_EQ(goal_target(goals[0], 50, 45).x, 90);
   EXPECT_EQ(goal_target(goals[0], 50, 45).y, 45);
-  const Vec2 pulled = goal_target(goals[0], 50, 45, 0.5);
-  EXPECT_NEAR(std::hypot(pulled.x - 90, pulled.y - 45), 0.5, 1e-12);
-  EXPECT_GT(pulled.x, 90);
-  EXPECT_GT(pulled.y, 45);
+  const Vec2 fit = goal_target(goals[0], 50, 45, 0.5);
+  EXPECT_NEAR(fit.x, 90.5, 1e-12);
+  EXPECT_NEAR(fit.y, 45, 1e-12);
+  const Vec2 corner = goal_target(goals[0], 50, 20, 0.5);  // below the area: its eroded corner
+  EXPECT_NEAR(corner.x, 90.5, 1e-12);
+  EXPECT_NEAR(corner.y, 40.5, 1e-12);
+  Goal slot{"slot", 22.5, 20.75, 1, 1, {{22, 20.5}, {23, 20.5}, {23, 21}, {22, 21}}};
+  // 0.5 m deep, thinner than a disc of radius 0.3: eroded by the 0.25 m that fits.
+  const Vec2 door = goal_target(slot, 22.8, 19.86, 0.3);
+  EXPECT_NEAR(door.x, 22.75, 1e-6);  // beside the jamb: pulled in to fit
+  EXPECT_NEAR(door.y, 20.75, 1e-6);  // the middle across
 }
 
 TEST(ScenarioJson, SourcesAreRead) {

@@ -1,8 +1,9 @@
-// The velocity selection of ORCA (van den Berg, Guy, Lin, Manocha 2011, §5): the velocity
-// closest to the preferred one inside the speed disc and every half-plane of permitted
-// velocities; when the half-planes leave nothing, the velocity that violates the agents' planes
-// least (the paper's 3-D linear program over (v, d): minimise d subject to every agent plane
-// moved back by d), while the obstacle planes stay hard.
+// The closest point to a target inside a disc and a set of half-planes; when the half-planes
+// leave nothing, the point that violates the soft ones least (a 3-D linear program over (v, d):
+// minimise d subject to every soft plane moved back by d) while the hard ones hold. It is ORCA's
+// velocity selection (van den Berg, Guy, Lin, Manocha 2011, §5: velocities, a speed disc, agent
+// planes soft, obstacle planes hard) and also where a disc aims in a goal area (the nearest point
+// of the area eroded by the disc's radius, geometry.hpp goal_target).
 //
 // Solved the incremental way (Seidel-style, planes in the given order, not shuffled, so the
 // result is deterministic): the optimum only changes when a plane is violated, and then it lies
@@ -14,7 +15,7 @@
 #include <cstddef>
 #include <span>
 
-namespace crowddb::steer {
+namespace crowddb {
 
 // Permitted velocities v with (v - point) . normal >= 0; `normal` has unit length.
 struct HalfPlane {
@@ -33,4 +34,4 @@ struct LpResult {
 LpResult solve_velocity_lp(std::span<const HalfPlane> planes, std::size_t hard, double max_speed,
                            double pref_x, double pref_y);
 
-}  // namespace crowddb::steer
+}  // namespace crowddb

@@ -1,9 +1,9 @@
-#include "steer/orca_lp.hpp"
+#include "world/halfplane_lp.hpp"
 
 #include <cmath>
 #include <vector>
 
-namespace crowddb::steer {
+namespace crowddb {
 namespace {
 
 // Parallel lines: |sin| of the angle between a line and a normal below this are treated as
@@ -137,4 +137,4 @@ LpResult solve_velocity_lp(std::span<const HalfPlane> planes, std::size_t hard, 
   return r;
 }
 
-}  // namespace crowddb::steer
+}  // namespace crowddb

@@ -1,4 +1,4 @@
-#include "steer/orca_lp.hpp"
+#include "world/halfplane_lp.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 
 #include "util/rng.hpp"
 
-namespace crowddb::steer {
+namespace crowddb {
 namespace {
 
 double violation(const HalfPlane& h, double x, double y) {
@@ -63,7 +63,7 @@ Oracle brute_force(const std::vector<HalfPlane>& p, double R, double px, double 
   return best;
 }
 
-TEST(OrcaLp, FeasibleProgramsMatchTheBruteForceOptimum) {
+TEST(HalfPlaneLp, FeasibleProgramsMatchTheBruteForceOptimum) {
   Rng rng(17);
   int feasible = 0;
   for (int c = 0; c < 4000; ++c) {
@@ -88,7 +88,7 @@ TEST(OrcaLp, FeasibleProgramsMatchTheBruteForceOptimum) {
 
 // Infeasible programs: the hard planes hold, and the largest violation of the soft ones is
 // no worse than the best a fine search of the disc finds (the 3-D program's optimum).
-TEST(OrcaLp, InfeasibleProgramsKeepTheHardPlanesAndMinimiseTheWorstViolation) {
+TEST(HalfPlaneLp, InfeasibleProgramsKeepTheHardPlanesAndMinimiseTheWorstViolation) {
   Rng rng(23);
   int checked = 0;
   for (int c = 0; c < 400; ++c) {
@@ -128,7 +128,7 @@ TEST(OrcaLp, InfeasibleProgramsKeepTheHardPlanesAndMinimiseTheWorstViolation) {
   EXPECT_GT(checked, 100);
 }
 
-TEST(OrcaLp, NoPlanesGivesThePreferredVelocityClippedToTheSpeed) {
+TEST(HalfPlaneLp, NoPlanesGivesThePreferredVelocityClippedToTheSpeed) {
   const LpResult a = solve_velocity_lp({}, 0, 2, 1, 1);
   EXPECT_EQ(a.vx, 1);
   EXPECT_EQ(a.vy, 1);
@@ -138,4 +138,4 @@ TEST(OrcaLp, NoPlanesGivesThePreferredVelocityClippedToTheSpeed) {
 }
 
 }  // namespace
-}  // namespace crowddb::steer
+}  // namespace crowddb
