@@ -77,6 +77,13 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
   ListChunks lists;
   lists.reset(chunks);
   std::vector<uint64_t> tests(chunks, 0), rings(chunks, 0);
+  // Raw pointers into the grid, hoisted: writes to the per-query lists could otherwise alias
+  // them and force a reload of every vector's data pointer per candidate.
+  const double* const X = x_.data();
+  const double* const Y = y_.data();
+  const uint32_t* const R = rows_.data();
+  const uint64_t* const I = id_.data();
+  const uint32_t* const S = start_.data();
   ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
     const std::size_t c = b / kGrain;
     NearestK best;
@@ -86,13 +93,17 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
       best.reset(k);
       auto scan = [&](int64_t cy, int64_t cx0, int64_t cx1) {
         const auto base = static_cast<std::size_t>(cy * W_);
-        const uint32_t lo = start_[base + static_cast<std::size_t>(cx0)];
-        const uint32_t hi = start_[base + static_cast<std::size_t>(cx1) + 1];
+        const uint32_t lo = S[base + static_cast<std::size_t>(cx0)];
+        const uint32_t hi = S[base + static_cast<std::size_t>(cx1) + 1];
+        // Candidates beyond the k-th best (ties may still win on id) never reach offer().
+        double limit = std::min(r2, best.bound());
         for (uint32_t a = lo; a < hi; ++a) {
-          if (rows_[a] == i) continue;
-          const double dx = x_[a] - px, dy = y_[a] - py;
+          const double dx = X[a] - px, dy = Y[a] - py;
           const double d2 = dx * dx + dy * dy;
-          if (d2 < r2) best.offer(rows_[a], id_[a], d2);
+          if (d2 < r2 && d2 <= limit && R[a] != i) {
+            best.offer(R[a], I[a], d2);
+            limit = std::min(r2, best.bound());
+          }
         }
         tests[c] += hi - lo;
       };
@@ -105,23 +116,41 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         const int64_t cy1 = std::min<int64_t>(H_ - 1, row(py + range) + 1);
         for (int64_t cy = cy0; cy <= cy1; ++cy) scan(cy, cx0, cx1);
       } else {
+        // Cells are skipped when even their nearest point is farther than the k-th best so
+        // far (and than the range); `slack` keeps the test conservative under rounding of the
+        // cell coordinates (an entry may sit a rounding error outside its cell's rectangle).
+        const double slack = 1e-9 * (cell_ + std::abs(px) + std::abs(py));
+        auto cell_far = [&](int64_t cx, int64_t cy) {
+          const double lx = x0_ + static_cast<double>(cx) * cell_;
+          const double ly = y0_ + static_cast<double>(cy) * cell_;
+          const double ddx = std::max({lx - px - slack, px - (lx + cell_) - slack, 0.0});
+          const double ddy = std::max({ly - py - slack, py - (ly + cell_) - slack, 0.0});
+          const double near2 = ddx * ddx + ddy * ddy;
+          return near2 >= r2 || (best.full() && near2 > best.bound());
+        };
+        auto scan_cell = [&](int64_t cx, int64_t cy) {
+          if (!cell_far(cx, cy)) scan(cy, cx, cx);
+        };
         const int64_t max_ring = std::max({qx, W_ - 1 - qx, qy, H_ - 1 - qy});
         for (int64_t rho = 0; rho <= max_ring; ++rho) {
           const double reach = static_cast<double>(rho - 1) * cell_ * (1 - 1e-9);
-          if (rho >= 2 && (reach >= range || (best.full() && best.bound() < reach * reach))) break;
+          if (rho >= 2 && (reach >= range || (best.full() && best.bound() < reach * reach)))
+            break;
           ++rings[c];
-          const int64_t cx0 = std::max<int64_t>(0, qx - rho), cx1 = std::min(W_ - 1, qx + rho);
           if (rho == 0) {
             scan(qy, qx, qx);
             continue;
           }
-          if (qy - rho >= 0) scan(qy - rho, cx0, cx1);  // bottom row of the ring
-          if (qy + rho < H_) scan(qy + rho, cx0, cx1);  // top row
+          const int64_t cx0 = std::max<int64_t>(0, qx - rho), cx1 = std::min(W_ - 1, qx + rho);
+          for (int64_t cx = cx0; cx <= cx1; ++cx) {
+            if (qy - rho >= 0) scan_cell(cx, qy - rho);  // bottom row of the ring
+            if (qy + rho < H_) scan_cell(cx, qy + rho);  // top row
+          }
           const int64_t cy0 = std::max<int64_t>(0, qy - rho + 1),
                         cy1 = std::min(H_ - 1, qy + rho - 1);
           for (int64_t cy = cy0; cy <= cy1; ++cy) {  // the two side columns
-            if (qx - rho >= 0) scan(cy, qx - rho, qx - rho);
-            if (qx + rho < W_) scan(cy, qx + rho, qx + rho);
+            if (qx - rho >= 0) scan_cell(qx - rho, cy);
+            if (qx + rho < W_) scan_cell(qx + rho, cy);
           }
         }
       }

@@ -4,7 +4,8 @@
 // Search: the rings of cells around the query's cell are visited outwards. Every disc in ring
 // rho (Chebyshev cell distance rho) is at least (rho - 1) * cell away from the query, so once the
 // list holds k entries whose worst distance is below that bound, or the bound reaches the range,
-// no further ring can contribute. Candidates are offered to the same NearestK selection as the
+// no further ring can contribute; within a ring, a cell whose nearest point is farther than the
+// k-th best so far is skipped. Candidates are offered to the same NearestK selection as the
 // naive scan, computing the same squared distance from the same doubles, so both give identical
 // lists. The bound is lowered by a relative 1e-9 to stay conservative under rounding of the cell
 // coordinates (bucketing decides only which candidates are looked at, never the answer).

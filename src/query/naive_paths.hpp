@@ -43,52 +43,56 @@ class FeatureNaive final : public FeaturePath {
 
 // The k-nearest selection every neighbour method uses, so that all agree bit for bit: candidates
 // are offered one at a time; the list keeps the best k by (dist2, id), or with k = 0 every
-// candidate, sorted the same way by finish().
+// candidate, sorted the same way by finish(). Up to kInline entries live in the object itself
+// (the usual k of a steering query), so the hot loop touches no heap.
 class NearestK {
  public:
+  static constexpr uint32_t kInline = 32;
+
   void reset(uint32_t k) {
     k_ = k;
+    n_ = 0;
+    small_ = k != 0 && k <= kInline;
     rows_.clear();
     d2_.clear();
     ids_.clear();
   }
-  std::size_t size() const { return rows_.size(); }
-  bool full() const { return k_ && rows_.size() == k_; }
+  std::size_t size() const { return small_ ? n_ : rows_.size(); }
+  bool full() const { return k_ && size() == k_; }
   // Every candidate strictly farther than this is rejected (k = 0: none is).
-  double bound() const { return full() ? d2_.back() : INFINITY; }
+  double bound() const {
+    if (!full()) return INFINITY;
+    return small_ ? sd2_[n_ - 1] : d2_.back();
+  }
   void offer(uint32_t row, uint64_t id, double d2) {
+    if (small_) {
+      offer_into(srows_, sd2_, sids_, n_, row, id, d2);
+      return;
+    }
     if (k_ == 0) {
       rows_.push_back(row);
       d2_.push_back(d2);
       ids_.push_back(id);
       return;
     }
-    if (full()) {
-      if (!better(d2, id, d2_.back(), ids_.back())) return;
-      rows_.pop_back();
-      d2_.pop_back();
-      ids_.pop_back();
+    const bool was_full = full();
+    if (was_full && !better(d2, id, d2_.back(), ids_.back())) return;
+    if (!was_full) {  // room for one more: offer_into fills the new slot
+      rows_.push_back(0);
+      d2_.push_back(0);
+      ids_.push_back(0);
     }
-    std::size_t i = rows_.size();
-    rows_.push_back(row);
-    d2_.push_back(d2);
-    ids_.push_back(id);
-    for (; i > 0 && better(d2, id, d2_[i - 1], ids_[i - 1]); --i) {
-      rows_[i] = rows_[i - 1];
-      d2_[i] = d2_[i - 1];
-      ids_[i] = ids_[i - 1];
-    }
-    rows_[i] = row;
-    d2_[i] = d2;
-    ids_[i] = id;
+    std::size_t n = rows_.size() - (was_full ? 0 : 1);
+    offer_into(rows_.data(), d2_.data(), ids_.data(), n, row, id, d2);
   }
   // Sorts an unbounded (k = 0) list; a bounded one is kept sorted already.
   void finish() {
     if (k_ != 0 || rows_.size() < 2) return;
     order_.resize(rows_.size());
     for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<uint32_t>(i);
-    std::sort(order_.begin(), order_.end(),
-              [&](uint32_t a, uint32_t b) { return better(d2_[a], ids_[a], d2_[b], ids_[b]); });
+    std::sort(order_.begin(), order_.end(), [&](uint32_t a, uint32_t b) {
+      return better(d2_[a], ids_[a], d2_[b], ids_[b]);
+    });
     scratch_rows_.resize(order_.size());
     scratch_d2_.resize(order_.size());
     for (std::size_t i = 0; i < order_.size(); ++i) {
@@ -98,14 +102,41 @@ class NearestK {
     rows_.swap(scratch_rows_);
     d2_.swap(scratch_d2_);
   }
-  std::span<const uint32_t> rows() const { return rows_; }
-  std::span<const double> dist2() const { return d2_; }
+  std::span<const uint32_t> rows() const {
+    return small_ ? std::span<const uint32_t>(srows_, n_) : std::span<const uint32_t>(rows_);
+  }
+  std::span<const double> dist2() const {
+    return small_ ? std::span<const double>(sd2_, n_) : std::span<const double>(d2_);
+  }
 
  private:
   static bool better(double d2, uint64_t id, double d2b, uint64_t idb) {
     return d2 < d2b || (d2 == d2b && id < idb);
   }
+  // Inserts into the sorted arrays holding n entries (capacity k_), dropping the worst when full.
+  void offer_into(uint32_t* rows, double* d2s, uint64_t* ids, std::size_t& n, uint32_t row,
+                  uint64_t id, double d2) const {
+    if (n == k_) {
+      if (!better(d2, id, d2s[n - 1], ids[n - 1])) return;
+      --n;
+    }
+    std::size_t i = n++;
+    for (; i > 0 && better(d2, id, d2s[i - 1], ids[i - 1]); --i) {
+      rows[i] = rows[i - 1];
+      d2s[i] = d2s[i - 1];
+      ids[i] = ids[i - 1];
+    }
+    rows[i] = row;
+    d2s[i] = d2;
+    ids[i] = id;
+  }
+
   uint32_t k_ = 0;
+  bool small_ = false;
+  std::size_t n_ = 0;
+  uint32_t srows_[kInline];
+  double sd2_[kInline];
+  uint64_t sids_[kInline];
   std::vector<uint32_t> rows_;
   std::vector<double> d2_;
   std::vector<uint64_t> ids_;

@@ -42,12 +42,14 @@ Vec2 current_target(const AgentTable& t, std::span<const Goal> goals, std::size_
 double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i) {
   double x = t.x[i], y = t.y[i], len = 0;
   for (const Vec2& w : t.route[i]) {
-    len += std::hypot(w.x - x, w.y - y);
+    const double dx = w.x - x, dy = w.y - y;
+    len += std::sqrt(dx * dx + dy * dy);
     x = w.x;
     y = w.y;
   }
   const Vec2 e = goal_target(goals[t.goal[i]], x, y, t.radius[i]);
-  return len + std::hypot(e.x - x, e.y - y);
+  const double dx = e.x - x, dy = e.y - y;
+  return len + std::sqrt(dx * dx + dy * dy);
 }
 
 void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,

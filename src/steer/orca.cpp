@@ -204,9 +204,10 @@ class OrcaModel final : public Model {
             const bool i_first = first(i, j);
             double vjx = t.vx[j], vjy = t.vy[j];
             if (!i_first) {
-              const double want = std::hypot(in.pref_vx[j], in.pref_vy[j]);
+              const double want =
+                  std::sqrt(in.pref_vx[j] * in.pref_vx[j] + in.pref_vy[j] * in.pref_vy[j]);
               const double held =
-                  want > 0 ? std::clamp(1 - std::hypot(vjx, vjy) / want, 0.0, 1.0) : 0.0;
+                  want > 0 ? std::clamp(1 - std::sqrt(vjx * vjx + vjy * vjy) / want, 0.0, 1.0) : 0.0;
               vjx += held * (in.pref_vx[j] - vjx);
               vjy += held * (in.pref_vy[j] - vjy);
             }
