@@ -84,11 +84,21 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
   const uint32_t* const R = rows_.data();
   const uint64_t* const I = id_.data();
   const uint32_t* const S = start_.data();
+  // Every row with a bounded k: walk the queries in the grid's cell order (neighbouring queries
+  // read the same cells, which stay in cache) and write each list into its row's own slot of k;
+  // the slots are compacted into the CSR in row order afterwards. Otherwise: query order, lists
+  // gathered per chunk.
+  const bool spatial = queries.empty() && k > 0;
+  if (spatial) {
+    slot_count_.assign(d.n, 0);
+    slot_row_.resize(d.n * k);
+    slot_d2_.resize(d.n * k);
+  }
   ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
     const std::size_t c = b / kGrain;
     NearestK best;
     for (std::size_t qi = b; qi < e; ++qi) {
-      const std::size_t i = queries.empty() ? qi : queries[qi];
+      const std::size_t i = spatial ? R[qi] : queries.empty() ? qi : queries[qi];
       const double px = d.x[i], py = d.y[i];
       best.reset(k);
       auto scan = [&](int64_t cy, int64_t cx0, int64_t cx1) {
@@ -134,8 +144,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         const int64_t max_ring = std::max({qx, W_ - 1 - qx, qy, H_ - 1 - qy});
         for (int64_t rho = 0; rho <= max_ring; ++rho) {
           const double reach = static_cast<double>(rho - 1) * cell_ * (1 - 1e-9);
-          if (rho >= 2 && (reach >= range || (best.full() && best.bound() < reach * reach)))
-            break;
+          if (rho >= 2 && (reach >= range || (best.full() && best.bound() < reach * reach))) break;
           ++rings[c];
           if (rho == 0) {
             scan(qy, qx, qx);
@@ -155,12 +164,34 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         }
       }
       best.finish();
+      if (spatial) {
+        slot_count_[i] = static_cast<uint32_t>(best.size());
+        std::copy(best.rows().begin(), best.rows().end(),
+                  slot_row_.begin() + static_cast<std::ptrdiff_t>(i * k));
+        std::copy(best.dist2().begin(), best.dist2().end(),
+                  slot_d2_.begin() + static_cast<std::ptrdiff_t>(i * k));
+        continue;
+      }
       lists.counts[c].push_back(static_cast<uint32_t>(best.size()));
       lists.items[c].insert(lists.items[c].end(), best.rows().begin(), best.rows().end());
       lists.d2[c].insert(lists.d2[c].end(), best.dist2().begin(), best.dist2().end());
     }
   });
-  lists.gather(out, &NeighbourLists::row);
+  if (spatial) {
+    out.offset.resize(d.n + 1);
+    out.offset[0] = 0;
+    for (std::size_t i = 0; i < d.n; ++i) out.offset[i + 1] = out.offset[i] + slot_count_[i];
+    out.row.resize(out.offset[d.n]);
+    out.dist2.resize(out.offset[d.n]);
+    for (std::size_t i = 0; i < d.n; ++i) {
+      std::copy_n(slot_row_.begin() + static_cast<std::ptrdiff_t>(i * k), slot_count_[i],
+                  out.row.begin() + out.offset[i]);
+      std::copy_n(slot_d2_.begin() + static_cast<std::ptrdiff_t>(i * k), slot_count_[i],
+                  out.dist2.begin() + out.offset[i]);
+    }
+  } else {
+    lists.gather(out, &NeighbourLists::row);
+  }
   stats.rows += q;
   for (std::size_t c = 0; c < chunks; ++c) {
     stats.pair_tests += tests[c];

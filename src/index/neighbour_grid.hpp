@@ -38,7 +38,9 @@ class NeighbourGrid final : public NeighbourPath {
   std::vector<uint32_t> rows_;   // table rows in cell order
   std::vector<double> x_, y_;    // their positions, copied in cell order
   std::vector<uint64_t> id_;
-  std::vector<int64_t> cell_of_;  // scratch: cell per row
+  std::vector<int64_t> cell_of_;                 // scratch: cell per row
+  std::vector<uint32_t> slot_count_, slot_row_;  // scratch: per-row lists of k (spatial order)
+  std::vector<double> slot_d2_;
 };
 
 }  // namespace crowddb::index

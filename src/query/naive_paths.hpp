@@ -90,9 +90,8 @@ class NearestK {
     if (k_ != 0 || rows_.size() < 2) return;
     order_.resize(rows_.size());
     for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<uint32_t>(i);
-    std::sort(order_.begin(), order_.end(), [&](uint32_t a, uint32_t b) {
-      return better(d2_[a], ids_[a], d2_[b], ids_[b]);
-    });
+    std::sort(order_.begin(), order_.end(),
+              [&](uint32_t a, uint32_t b) { return better(d2_[a], ids_[a], d2_[b], ids_[b]); });
     scratch_rows_.resize(order_.size());
     scratch_d2_.resize(order_.size());
     for (std::size_t i = 0; i < order_.size(); ++i) {

@@ -1,0 +1,138 @@
+// crowddb's orca tick against RVO2's doStep on the same agents, side by side in one run.
+//
+// Built only when the CMake option CROWDDB_RVO2_DIR names a checkout of RVO2
+// (https://github.com/snape/RVO2; nothing of it is in this repository): docs/benchmarks.md says
+// how. Both get identical agents (uniform without overlaps at a given density in a square,
+// radius 0.25 m, preferred speed 1.3 m/s, four goals on the walls, round robin), identical
+// parameters (neighbour distance 5 m, 10 neighbours, horizons 2 s and 0.5 s, dt 0.1 s) and the
+// walls as obstacles. Steps are interleaved (crowddb, RVO2, crowddb, ...) so that load changes
+// hit both alike; the medians and minima over `steps` steps are printed with the load average.
+// crowddb's tick is the whole Simulation::step (goal stage, queries, LP, integrate, backoff,
+// commit, stalemates); RVO2's step is setting the preferred velocities plus doStep.
+//
+//   rvo2_side_by_side [--agents 20000] [--threads 1] [--steps 60] [--density 0.5] [--csv FILE]
+#include <RVO.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "crowddb/scenario.hpp"
+#include "crowddb/simulation.hpp"
+
+using namespace crowddb;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double load_average() {
+  std::ifstream f("/proc/loadavg");
+  double l = -1;
+  f >> l;
+  return l;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int agents = 20000, threads = 1, steps = 60;
+  double density = 0.5;
+  std::string csv;
+  for (int a = 1; a + 1 < argc; a += 2) {
+    const std::string k = argv[a];
+    if (k == "--agents")
+      agents = std::atoi(argv[a + 1]);
+    else if (k == "--threads")
+      threads = std::atoi(argv[a + 1]);
+    else if (k == "--steps")
+      steps = std::atoi(argv[a + 1]);
+    else if (k == "--density")
+      density = std::atof(argv[a + 1]);
+    else if (k == "--csv")
+      csv = argv[a + 1];
+    else {
+      std::fprintf(stderr, "rvo2_side_by_side: unknown option %s\n", argv[a]);
+      return 2;
+    }
+  }
+  if (agents < 1 || threads < 1 || steps < 1 || !(density > 0)) {
+    std::fprintf(stderr, "rvo2_side_by_side: options must be positive\n");
+    return 2;
+  }
+  const double side = std::sqrt(agents / density);
+  char doc[2048];
+  std::snprintf(doc, sizeof doc, R"({"bounds": [0, 0, %.17g, %.17g], "dt": 0.1, "seed": 3,
+    "threads": %d, "steering": {"model": "orca", "orca": {"neighbor_dist": 5, "max_neighbors": 10,
+    "time_horizon": 2, "time_horizon_obst": 0.5}},
+    "goals": [{"name": "S", "x": %.17g, "y": 1}, {"name": "E", "x": %.17g, "y": %.17g},
+              {"name": "W", "x": 1, "y": %.17g}, {"name": "N", "x": %.17g, "y": %.17g}],
+    "groups": [{"count": %d, "placement": {"type": "uniform", "region": [0, 0, %.17g, %.17g],
+                "gap": 0.02}, "radius": 0.25, "pref_speed": 1.3, "goals": {"assign": "round_robin"}}]})",
+                side, side, threads, side / 2, side - 1, side / 2, side / 2, side / 2, side - 1,
+                agents, side, side);
+  Scenario sc = parse_scenario(doc, "side-by-side");
+  const AgentTable& t = sc.world.agents();
+
+  RVO::RVOSimulator rvo;
+  rvo.setTimeStep(0.1f);
+  rvo.setAgentDefaults(5.0f, 10, 2.0f, 0.5f, 0.25f, 1.3f);
+  std::vector<RVO::Vector2> goal;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    rvo.addAgent(RVO::Vector2(static_cast<float>(t.x[i]), static_cast<float>(t.y[i])));
+    const Goal& g = sc.world.goals()[t.goal[i]];
+    goal.emplace_back(static_cast<float>(g.x), static_cast<float>(g.y));
+  }
+  // The walls: the same four rectangles outside the bounds that crowddb uses (counter-clockwise).
+  const auto s = static_cast<float>(side), w = s;
+  const std::vector<std::vector<RVO::Vector2>> walls = {
+      {{-w, -w}, {0, -w}, {0, s + w}, {-w, s + w}},
+      {{s, -w}, {s + w, -w}, {s + w, s + w}, {s, s + w}},
+      {{0, -w}, {s, -w}, {s, 0}, {0, 0}},
+      {{0, s}, {s, s}, {s, s + w}, {0, s + w}}};
+  for (const auto& poly : walls) rvo.addObstacle(poly);
+  rvo.processObstacles();
+
+  Simulation sim(std::move(sc.world), sc.config);
+  std::vector<double> ours, theirs;
+  const double load_before = load_average();
+  for (int k = 0; k < steps; ++k) {
+    auto a = Clock::now();
+    sim.step();
+    ours.push_back(std::chrono::duration<double>(Clock::now() - a).count());
+    a = Clock::now();
+    for (std::size_t i = 0; i < goal.size(); ++i) {
+      const RVO::Vector2 d = goal[i] - rvo.getAgentPosition(i);
+      const float l = RVO::abs(d);
+      rvo.setAgentPrefVelocity(i, l > 0 ? d / l * std::min(1.3f, l / 0.1f) : RVO::Vector2());
+    }
+    rvo.doStep();
+    theirs.push_back(std::chrono::duration<double>(Clock::now() - a).count());
+  }
+  const double load_after = load_average();
+  const double mo = median(ours) * 1e3, mt = median(theirs) * 1e3;
+  const double lo = *std::min_element(ours.begin(), ours.end()) * 1e3;
+  const double lt = *std::min_element(theirs.begin(), theirs.end()) * 1e3;
+  std::printf(
+      "agents %d, threads %d (RVO2: OMP_NUM_THREADS=%s), %d steps, load %.2f -> %.2f\n"
+      "  crowddb orca tick  median %8.2f ms  min %8.2f ms\n"
+      "  RVO2 doStep        median %8.2f ms  min %8.2f ms\n"
+      "  ratio crowddb / RVO2: median %.2f, min %.2f\n",
+      agents, threads, std::getenv("OMP_NUM_THREADS") ? std::getenv("OMP_NUM_THREADS") : "unset",
+      steps, load_before, load_after, mo, lo, mt, lt, mo / mt, lo / lt);
+  if (!csv.empty()) {
+    std::ofstream f(csv, std::ios::app);
+    f << agents << "," << threads << "," << steps << "," << load_before << "," << mo << "," << lo
+      << "," << mt << "," << lt << "\n";
+  }
+  return 0;
+}
