@@ -8,9 +8,15 @@ void run_e2(const Options& opt);  // e2.cpp
 void run_e3(const Options& opt);  // e3.cpp
 void run_e4(const Options& opt);  // e4.cpp
 void run_e5(const Options& opt);  // e5.cpp
+void run_fd(const Options& opt);          // flows.cpp
+void run_bottleneck(const Options& opt);  // flows.cpp
 
 const std::vector<Experiment>& registry() {
   static const std::vector<Experiment> experiments = {
+      {"bottleneck",
+       "flow through a bottleneck of 0.8-2.5 m per steering model, beside the Juelich specific "
+       "flow",
+       run_bottleneck},
       {"e1",
        "first-to-collide scaling: index build/query vs naive, n = 1,000..15,000 (and 10^6 at E1 "
        "density)",
@@ -24,6 +30,8 @@ const std::vector<Experiment>& registry() {
        run_e4},
       {"e5", "potential-field speed: aggregate index vs naive, density x n = 1, n up to 10^6",
        run_e5},
+      {"fd", "speed against density in a 4 m corridor (RiMEA 4) per steering model, beside Weidmann",
+       run_fd},
   };
   return experiments;
 }
