@@ -19,12 +19,12 @@ class CsvWriter final : public TrajectoryWriter {
   }
   ~CsvWriter() override { abort(); }
 
-  void begin(const Scenario&, const World&) override {
+  void begin(const Scenario& sc, const World&) override {
+    dt_ = sc.config.dt;
     open(traj_, partial(path_), "frame,id,x,y,vx,vy,radius,state,goal\n");
     open(metrics_, partial(metrics_path_),
-         "tick,agents,arrived,frozen,freeze_iterations,overlapping_pairs,obstacle_overlaps,"
-         "gridlocked,tick_seconds,"
-         "state_hash\n");
+         "tick,time,agents,entered,arrived,frozen,freeze_iterations,overlapping_pairs,"
+         "obstacle_overlaps,gridlocked,stalled,queueing,longest_stall,tick_seconds,state_hash\n");
   }
 
   void frame(uint64_t tick, const World& world) override {
@@ -48,9 +48,12 @@ class CsvWriter final : public TrajectoryWriter {
   void metrics(const TickMetrics& m) override {
     char hash[24];
     std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(m.state_hash));
-    metrics_ << m.tick << "," << m.agents << "," << m.arrived << "," << m.frozen << ","
-             << m.freeze_iterations << "," << m.overlapping_pairs << "," << m.obstacle_overlaps
-             << "," << m.gridlocked << "," << num(m.seconds) << "," << hash << "\n";
+    metrics_ << m.tick << "," << num(m.time) << "," << m.agents << "," << m.entered << ","
+             << m.arrived << "," << m.frozen << "," << m.freeze_iterations << ","
+             << m.overlapping_pairs << "," << m.obstacle_overlaps << "," << m.gridlocked << ","
+             << m.stalled << "," << m.queueing << ","
+             << num(static_cast<double>(m.longest_stall) * dt_) << "," << num(m.seconds) << ","
+             << hash << "\n";
     check(metrics_, metrics_path_);
   }
 
@@ -77,6 +80,7 @@ class CsvWriter final : public TrajectoryWriter {
   }
 
  private:
+  double dt_ = 1;  // [s] per tick, for the metrics in seconds
   static std::filesystem::path partial(const std::filesystem::path& p) {
     return p.string() + ".partial";
   }

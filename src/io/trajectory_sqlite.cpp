@@ -3,8 +3,9 @@
 //   geometry(hash, wkt), frame_data(frame, geometry_hash)
 // and crowddb's own tables beside them:
 //   crowddb_agent_state(frame, id, vel_x, vel_y, radius, state, goal)
-//   crowddb_tick_metrics(tick, agents, arrived, frozen, freeze_iterations, overlapping_pairs,
-//                        obstacle_overlaps, gridlocked, tick_seconds, state_hash)
+//   crowddb_tick_metrics(tick, time, agents, entered, arrived, frozen, freeze_iterations,
+//                        overlapping_pairs, obstacle_overlaps, gridlocked, stalled, queueing,
+//                        longest_stall, tick_seconds, state_hash)
 //   crowddb_run(key, value): scenario name and text, seed, threads, ticks, final state hash
 // WAL journal, frames batched into transactions; the file is renamed into place at the end.
 #include <sqlite3.h>
@@ -59,6 +60,7 @@ class SqliteWriter final : public TrajectoryWriter {
   ~SqliteWriter() override { abort(); }
 
   void begin(const Scenario& sc, const World& world) override {
+    dt_ = sc.config.dt;
     remove_partial();
     if (sqlite3_open_v2(partial_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
                         nullptr) != SQLITE_OK) {
@@ -83,11 +85,12 @@ class SqliteWriter final : public TrajectoryWriter {
         "NOT NULL, "
         "vel_y REAL NOT NULL, radius REAL NOT NULL, state TEXT NOT NULL, goal INTEGER NOT NULL)");
     exec(
-        "CREATE TABLE crowddb_tick_metrics (tick INTEGER PRIMARY KEY, agents INTEGER NOT NULL, "
-        "arrived INTEGER NOT NULL, frozen INTEGER NOT NULL, freeze_iterations INTEGER NOT NULL, "
-        "overlapping_pairs INTEGER NOT NULL, obstacle_overlaps INTEGER NOT NULL, gridlocked "
-        "INTEGER NOT NULL, "
-        "tick_seconds REAL NOT NULL, state_hash TEXT NOT NULL)");
+        "CREATE TABLE crowddb_tick_metrics (tick INTEGER PRIMARY KEY, time REAL NOT NULL, "
+        "agents INTEGER NOT NULL, entered INTEGER NOT NULL, arrived INTEGER NOT NULL, frozen "
+        "INTEGER NOT NULL, freeze_iterations INTEGER NOT NULL, overlapping_pairs INTEGER NOT "
+        "NULL, obstacle_overlaps INTEGER NOT NULL, gridlocked INTEGER NOT NULL, stalled INTEGER "
+        "NOT NULL, queueing INTEGER NOT NULL, longest_stall REAL NOT NULL, tick_seconds REAL NOT "
+        "NULL, state_hash TEXT NOT NULL)");
     exec("CREATE TABLE crowddb_run (key TEXT NOT NULL UNIQUE PRIMARY KEY, value TEXT NOT NULL)");
     exec(
         "CREATE TABLE crowddb_goals (goal INTEGER PRIMARY KEY, name TEXT NOT NULL, x REAL NOT "
@@ -132,9 +135,10 @@ class SqliteWriter final : public TrajectoryWriter {
     state_ = Statement(db_, "INSERT INTO crowddb_agent_state VALUES (?, ?, ?, ?, ?, ?, ?)",
                        path_.string());
     frame_ = Statement(db_, "INSERT INTO frame_data VALUES (?, ?)", path_.string());
-    metric_ =
-        Statement(db_, "INSERT INTO crowddb_tick_metrics VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                  path_.string());
+    metric_ = Statement(
+        db_,
+        "INSERT INTO crowddb_tick_metrics VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+        path_.string());
   }
 
   void frame(uint64_t tick, const World& world) override {
@@ -170,17 +174,24 @@ class SqliteWriter final : public TrajectoryWriter {
 
   void metrics(const TickMetrics& m) override {
     sqlite3_stmt* s = metric_.get();
-    sqlite3_bind_int64(s, 1, static_cast<int64_t>(m.tick));
-    sqlite3_bind_int64(s, 2, static_cast<int64_t>(m.agents));
-    sqlite3_bind_int64(s, 3, static_cast<int64_t>(m.arrived));
-    sqlite3_bind_int64(s, 4, static_cast<int64_t>(m.frozen));
-    sqlite3_bind_int64(s, 5, static_cast<int64_t>(m.freeze_iterations));
-    sqlite3_bind_int64(s, 6, static_cast<int64_t>(m.overlapping_pairs));
-    sqlite3_bind_int64(s, 7, static_cast<int64_t>(m.obstacle_overlaps));
-    sqlite3_bind_int64(s, 8, static_cast<int64_t>(m.gridlocked));
-    sqlite3_bind_double(s, 9, m.seconds);
+    int col = 0;
+    auto i64 = [&](uint64_t v) { sqlite3_bind_int64(s, ++col, static_cast<int64_t>(v)); };
+    i64(m.tick);
+    sqlite3_bind_double(s, ++col, m.time);
+    i64(m.agents);
+    i64(m.entered);
+    i64(m.arrived);
+    i64(m.frozen);
+    i64(m.freeze_iterations);
+    i64(m.overlapping_pairs);
+    i64(m.obstacle_overlaps);
+    i64(m.gridlocked);
+    i64(m.stalled);
+    i64(m.queueing);
+    sqlite3_bind_double(s, ++col, static_cast<double>(m.longest_stall) * dt_);
+    sqlite3_bind_double(s, ++col, m.seconds);
     const std::string h = hex(m.state_hash);
-    sqlite3_bind_text(s, 10, h.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(s, ++col, h.c_str(), -1, SQLITE_TRANSIENT);
     step(metric_);
   }
 
@@ -219,6 +230,7 @@ class SqliteWriter final : public TrajectoryWriter {
   }
 
  private:
+  double dt_ = 1;  // [s] per tick, for the metrics in seconds
   static std::string num(double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.17g", v);

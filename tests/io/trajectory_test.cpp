@@ -112,6 +112,13 @@ TEST(TrajectoryCsv, RoundTripsExactly) {
   EXPECT_EQ(text.rfind("frame,id,x,y,vx,vy,radius,state,goal\n0,0,10,25,0,0,1,active,0\n", 0), 0u)
       << text.substr(0, 120);
   const std::string metrics = test::slurp(dir / "run.metrics.csv");
+  // Stalemates are reported per tick (seconds in seconds, not ticks).
+  EXPECT_EQ(metrics.rfind("tick,time,agents,entered,arrived,frozen,freeze_iterations,"
+                          "overlapping_pairs,obstacle_overlaps,gridlocked,stalled,queueing,"
+                          "longest_stall,tick_seconds,state_hash\n",
+                          0),
+            0u)
+      << metrics.substr(0, 200);
   EXPECT_EQ(std::count(metrics.begin(), metrics.end(), '\n'), 11);
   EXPECT_FALSE(std::filesystem::exists(dir / "run.csv.partial"));
 }
