@@ -30,7 +30,7 @@ const std::vector<Experiment>& registry() {
        run_e4},
       {"e5", "potential-field speed: aggregate index vs naive, density x n = 1, n up to 10^6",
        run_e5},
-      {"fd", "speed against density in a 4 m corridor (RiMEA 4) per steering model, beside Weidmann",
+      {"fd", "speed against density in a 4 m wide ring corridor (RiMEA 4 with periodic ends) per steering model, beside Weidmann",
        run_fd},
   };
   return experiments;
