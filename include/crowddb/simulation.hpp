@@ -153,6 +153,7 @@ struct TickMetrics {
   uint64_t tick = 0;        // ticks completed so far (1 after the first step)
   double time = 0;          // [s] simulated time after the tick (tick * dt)
   std::size_t agents = 0;   // rows after the tick
+  std::size_t active = 0;   // rows still heading for a goal (not arrived)
   std::size_t entered = 0;  // agents that entered from sources at the start of this tick
   std::size_t arrived = 0;  // agents that reached their last goal in this tick
   std::size_t frozen = 0;   // agents the backoff loop froze in this tick

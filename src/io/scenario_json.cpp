@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "crowddb/scenario.hpp"
+#include "io/scenario_doc.hpp"
 #include "io/walkable_wkt.hpp"
 #include "steer/model.hpp"
 #include "util/rng.hpp"
@@ -24,18 +25,37 @@ namespace {
 
 using nlohmann::json;
 
+// The document being read: its file name for messages and, for a document converted from another
+// format, where its fields came from.
+struct DocSource {
+  std::string file;
+  const io::Origins* origins = nullptr;
+
+  // "file: /pointer" or, for a converted document, "file:LINE: <element>" of the nearest origin.
+  std::string where(const std::string& pointer) const {
+    if (origins) {
+      for (std::string p = pointer; !p.empty(); p.resize(p.rfind('/'))) {
+        const auto it = origins->find(p);
+        if (it != origins->end())
+          return it->second + " (converted: " + (pointer.empty() ? "/" : pointer) + ")";
+      }
+    }
+    return file + ": " + (pointer.empty() ? "/" : pointer);
+  }
+};
+
 // A JSON object being read: typed getters that know the object's pointer, and a check that
 // every key was used.
 class Node {
  public:
-  Node(const json& j, std::string pointer, const std::string* file)
+  Node(const json& j, std::string pointer, const DocSource* file)
       : j_(j), ptr_(std::move(pointer)), file_(file) {
     if (!j_.is_object()) fail("", "expected an object");
   }
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    const std::string where = key.empty() ? (ptr_.empty() ? "/" : ptr_) : ptr_ + "/" + key;
-    throw Error(Error::Kind::input, *file_ + ": " + where + ": " + what);
+    throw Error(Error::Kind::input,
+                file_->where(key.empty() ? ptr_ : ptr_ + "/" + key) + ": " + what);
   }
 
   bool has(const std::string& key) const { return j_.contains(key); }
@@ -181,7 +201,7 @@ class Node {
   }
 
   const std::string& pointer() const { return ptr_; }
-  const std::string& file() const { return *file_; }
+  const std::string& file() const { return file_->file; }
 
   static std::string fmt(double v) {
     std::ostringstream os;
@@ -193,7 +213,7 @@ class Node {
  private:
   const json& j_;
   std::string ptr_;
-  const std::string* file_;
+  const DocSource* file_;
   std::set<std::string> used_;
 };
 
@@ -889,7 +909,9 @@ void read_steering(Node& root, SimConfig& cfg) {
 
 }  // namespace
 
-Scenario parse_scenario(std::string_view text, const std::string& source) {
+namespace io {
+
+Scenario parse_document(std::string_view text, const std::string& source, const Origins* origins) {
   Scenario sc;
   sc.source = source;
   sc.text = std::string(text);
@@ -916,7 +938,8 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
     throw Error(Error::Kind::input, source + ": malformed JSON: " + e.what());
   }
 
-  Node root(doc, "", &source);
+  const DocSource src{source, origins};
+  Node root(doc, "", &src);
   sc.name = root.string("name", std::string());
   root.string("description", std::string());
   // The walkable area (WKT), if any: it may stand in for the bounds.
@@ -969,6 +992,7 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
     if (duration / cfg.dt > 1e9) root.fail("duration", "is over 10^9 ticks at this dt");
     sc.ticks = cfg.ticks_for(duration, 0);
   }
+  sc.stop_when_all_arrived = root.boolean("stop_when_all_arrived", false);
   cfg.backoff = root.boolean("backoff", true);
   cfg.walls = root.boolean("walls", true);
   const std::string arrival = root.choice("arrival", {"remove", "idle", "retarget"}, "remove");
@@ -1076,14 +1100,10 @@ Scenario parse_scenario(std::string_view text, const std::string& source) {
   return sc;
 }
 
-Scenario load_scenario(const std::filesystem::path& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw Error(Error::Kind::io, path.string() + ": cannot open file");
-  if (std::filesystem::is_directory(path))
-    throw Error(Error::Kind::io, path.string() + ": is a directory");
-  std::ostringstream os;
-  os << f.rdbuf();
-  return parse_scenario(os.str(), path.string());
+}  // namespace io
+
+Scenario parse_scenario(std::string_view text, const std::string& source) {
+  return io::parse_document(text, source, nullptr);
 }
 
 }  // namespace crowddb

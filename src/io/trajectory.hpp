@@ -8,9 +8,11 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
+#include "metrics/steerbench.hpp"
 
 namespace crowddb::io {
 
@@ -21,6 +23,8 @@ struct RunInfo {
   uint64_t ticks = 0;
   uint64_t final_hash = 0;
   double seconds = 0;
+  std::string summary_json;                                    // the run's summary (JSON)
+  const std::vector<metrics::AgentScore>* scores = nullptr;  // SteerBench, per agent
 };
 
 class TrajectoryWriter {

@@ -1,6 +1,7 @@
 // CSV trajectories: PATH holds frame,id,x,y,vx,vy,radius,state,goal; PATH with its extension
-// replaced by .metrics.csv holds one row of tick metrics per tick. Numbers are written in
-// shortest round-trip form, so a CSV run reads back bit-identical.
+// replaced by .metrics.csv holds one row of tick metrics per tick, and by .steerbench.csv the
+// SteerBench metrics per agent (src/metrics/steerbench.hpp). Numbers are written in shortest
+// round-trip form, so a CSV run reads back bit-identical.
 #include <charconv>
 #include <cstdio>
 #include <fstream>
@@ -16,6 +17,8 @@ class CsvWriter final : public TrajectoryWriter {
       : path_(std::move(path)), every_(every ? every : 1) {
     metrics_path_ = path_;
     metrics_path_.replace_extension(".metrics.csv");
+    steerbench_path_ = path_;
+    steerbench_path_.replace_extension(".steerbench.csv");
   }
   ~CsvWriter() override { abort(); }
 
@@ -57,12 +60,22 @@ class CsvWriter final : public TrajectoryWriter {
     check(metrics_, metrics_path_);
   }
 
-  void finish(const RunInfo&) override {
+  void finish(const RunInfo& info) override {
     traj_.close();
     metrics_.close();
     check(traj_, path_);
     check(metrics_, metrics_path_);
-    for (const auto* p : {&path_, &metrics_path_}) {
+    open(steerbench_, partial(steerbench_path_),
+         "id,collisions,time,path_length,energy,acceleration,score01,score02,arrived\n");
+    if (info.scores)
+      for (const metrics::AgentScore& a : *info.scores)
+        steerbench_ << a.id << "," << a.collisions << "," << num(a.time) << ","
+                    << num(a.path_length) << "," << num(a.energy) << "," << num(a.acceleration)
+                    << "," << num(a.score01()) << "," << num(a.score02()) << ","
+                    << (a.arrived ? 1 : 0) << "\n";
+    steerbench_.close();
+    check(steerbench_, steerbench_path_);
+    for (const auto* p : {&path_, &metrics_path_, &steerbench_path_}) {
       std::error_code ec;
       std::filesystem::rename(partial(*p), *p, ec);
       if (ec)
@@ -74,9 +87,10 @@ class CsvWriter final : public TrajectoryWriter {
   void abort() noexcept override {
     if (traj_.is_open()) traj_.close();
     if (metrics_.is_open()) metrics_.close();
+    if (steerbench_.is_open()) steerbench_.close();
     std::error_code ec;
-    std::filesystem::remove(partial(path_), ec);
-    std::filesystem::remove(partial(metrics_path_), ec);
+    for (const auto* p : {&path_, &metrics_path_, &steerbench_path_})
+      std::filesystem::remove(partial(*p), ec);
   }
 
  private:
@@ -98,9 +112,9 @@ class CsvWriter final : public TrajectoryWriter {
     if (!f) throw Error(Error::Kind::io, p.string() + ": write failed");
   }
 
-  std::filesystem::path path_, metrics_path_;
+  std::filesystem::path path_, metrics_path_, steerbench_path_;
   uint32_t every_;
-  std::ofstream traj_, metrics_;
+  std::ofstream traj_, metrics_, steerbench_;
 };
 
 }  // namespace

@@ -61,6 +61,7 @@ class SqliteWriter final : public TrajectoryWriter {
 
   void begin(const Scenario& sc, const World& world) override {
     dt_ = sc.config.dt;
+    format_ = sc.format;
     remove_partial();
     if (sqlite3_open_v2(partial_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
                         nullptr) != SQLITE_OK) {
@@ -203,8 +204,32 @@ class SqliteWriter final : public TrajectoryWriter {
             {"threads", std::to_string(info.threads)},
             {"ticks", std::to_string(info.ticks)},
             {"final_state_hash", hex(info.final_hash)},
-            {"run_seconds", num(info.seconds)}})
+            {"run_seconds", num(info.seconds)},
+            {"scenario_format", format_},
+            {"summary_json", info.summary_json}})
         insert_text(run, k, v);
+    }
+    if (info.scores) {
+      exec(
+          "CREATE TABLE crowddb_steerbench (id INTEGER PRIMARY KEY, collisions INTEGER NOT NULL, "
+          "time REAL NOT NULL, path_length REAL NOT NULL, energy REAL NOT NULL, acceleration "
+          "REAL NOT NULL, score01 REAL NOT NULL, score02 REAL NOT NULL, arrived INTEGER NOT "
+          "NULL)");
+      Statement sb(db_, "INSERT INTO crowddb_steerbench VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                   path_.string());
+      for (const metrics::AgentScore& a : *info.scores) {
+        sqlite3_stmt* st = sb.get();
+        sqlite3_bind_int64(st, 1, static_cast<int64_t>(a.id));
+        sqlite3_bind_int64(st, 2, static_cast<int64_t>(a.collisions));
+        sqlite3_bind_double(st, 3, a.time);
+        sqlite3_bind_double(st, 4, a.path_length);
+        sqlite3_bind_double(st, 5, a.energy);
+        sqlite3_bind_double(st, 6, a.acceleration);
+        sqlite3_bind_double(st, 7, a.score01());
+        sqlite3_bind_double(st, 8, a.score02());
+        sqlite3_bind_int64(st, 9, a.arrived ? 1 : 0);
+        step(sb);
+      }
     }
     // Indices after the bulk load: cheaper than maintaining them row by row.
     exec("CREATE INDEX frame_id_idx ON trajectory_data(frame, id)");
@@ -231,6 +256,7 @@ class SqliteWriter final : public TrajectoryWriter {
 
  private:
   double dt_ = 1;  // [s] per tick, for the metrics in seconds
+  std::string format_;
   static std::string num(double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.17g", v);

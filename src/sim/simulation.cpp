@@ -263,6 +263,7 @@ Simulation::Simulation(World world, SimConfig config)
     engine_->nav->request_paths(world_, 0);
   }
   last_.agents = world_.agents().size();
+  for (AgentState st : world_.agents().state) last_.active += st != AgentState::arrived;
   last_.state_hash = sim::state_hash(world_.agents(), 0);
 }
 
@@ -434,6 +435,8 @@ const TickMetrics& Simulation::step() {
     log.at("path requests").rows += made;
   }
   m.agents = world_.agents().size();
+  m.active = 0;
+  for (AgentState st : world_.agents().state) m.active += st != AgentState::arrived;
   m.state_hash = sim::state_hash(world_.agents(), m.tick);
   arrived_total_ += m.arrived;
   entered_total_ += m.entered;

@@ -7,6 +7,8 @@
 #include <functional>
 #include <string>
 
+#include "crowddb/scenario.hpp"
+
 namespace crowddb::cli {
 
 using Action = std::function<int()>;
@@ -17,6 +19,11 @@ void add_validate_command(CLI::App& app, Action& action);
 void add_experiment_command(CLI::App& app, Action& action);
 void add_fit_kernel_command(CLI::App& app, Action& action);
 void add_verify_command(CLI::App& app, Action& action);
+void add_convert_command(CLI::App& app, Action& action);
+void add_bench_command(CLI::App& app, Action& action);
+
+// Prints a loaded scenario's warnings on stderr, one line each, naming the file.
+void print_warnings(const Scenario& sc);
 
 // Shortest decimal that reads back as the same double.
 std::string format_number(double v);

@@ -15,6 +15,8 @@ int main(int argc, char** argv) {
   crowddb::cli::add_experiment_command(app, action);
   crowddb::cli::add_fit_kernel_command(app, action);
   crowddb::cli::add_verify_command(app, action);
+  crowddb::cli::add_convert_command(app, action);
+  crowddb::cli::add_bench_command(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,148 @@
+#include "io/import/builder.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "world/geometry.hpp"
+
+namespace crowddb::io {
+namespace {
+
+uint64_t cell_key(int64_t cx, int64_t cy) {
+  return (static_cast<uint64_t>(cx) << 32) ^ static_cast<uint64_t>(cy & 0xffffffff);
+}
+
+}  // namespace
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(15);
+  os << v;
+  return os.str();
+}
+
+DocBuilder::DocBuilder() {
+  doc_ = nlohmann::json::object();
+  doc_["goals"] = nlohmann::json::array();
+  doc_["obstacles"] = nlohmann::json::array();
+  doc_["agents"] = nlohmann::json::array();
+}
+
+std::string DocBuilder::disc_goal(Vec2 c, double arrival_radius, const std::string& origin) {
+  nlohmann::json g = {{"x", c.x}, {"y", c.y}, {"arrival_radius", arrival_radius}};
+  const std::string key = g.dump();
+  if (auto it = goal_names_.find(key); it != goal_names_.end()) return it->second;
+  const std::string name = "g" + std::to_string(doc_["goals"].size());
+  g["name"] = name;
+  origins_["/goals/" + std::to_string(doc_["goals"].size())] = origin;
+  doc_["goals"].push_back(g);
+  goal_names_[key] = name;
+  extent_.add(c.x - arrival_radius, c.y - arrival_radius);
+  extent_.add(c.x + arrival_radius, c.y + arrival_radius);
+  return name;
+}
+
+std::string DocBuilder::area_goal(const std::vector<Vec2>& polygon, const std::string& origin) {
+  nlohmann::json area = nlohmann::json::array();
+  for (const Vec2& v : polygon) {
+    area.push_back({v.x, v.y});
+    extent_.add(v.x, v.y);
+  }
+  nlohmann::json g = {{"area", area}};
+  const std::string key = g.dump();
+  if (auto it = goal_names_.find(key); it != goal_names_.end()) return it->second;
+  const std::string name = "g" + std::to_string(doc_["goals"].size());
+  g["name"] = name;
+  origins_["/goals/" + std::to_string(doc_["goals"].size())] = origin;
+  doc_["goals"].push_back(g);
+  goal_names_[key] = name;
+  return name;
+}
+
+void DocBuilder::polygon(const std::vector<Vec2>& vertices, const std::string& origin) {
+  nlohmann::json vs = nlohmann::json::array();
+  for (const Vec2& v : vertices) {
+    vs.push_back({v.x, v.y});
+    extent_.add(v.x, v.y);
+  }
+  origins_["/obstacles/" + std::to_string(doc_["obstacles"].size())] = origin;
+  doc_["obstacles"].push_back({{"type", "polygon"}, {"vertices", vs}});
+  polygons_.push_back(vertices);
+}
+
+void DocBuilder::circle(Vec2 c, double r, const std::string& origin) {
+  origins_["/obstacles/" + std::to_string(doc_["obstacles"].size())] = origin;
+  doc_["obstacles"].push_back({{"type", "circle"}, {"x", c.x}, {"y", c.y}, {"radius", r}});
+  extent_.add(c.x - r, c.y - r);
+  extent_.add(c.x + r, c.y + r);
+  circles_.push_back({c.x, c.y, r});
+}
+
+std::size_t DocBuilder::agent(nlohmann::json row, const std::string& origin) {
+  const std::size_t i = doc_["agents"].size();
+  origins_["/agents/" + std::to_string(i)] = origin;
+  const double x = row.value("x", 0.0), y = row.value("y", 0.0), r = row.value("radius", 0.25);
+  extent_.add(x - r, y - r);
+  extent_.add(x + r, y + r);
+  doc_["agents"].push_back(std::move(row));
+  return i;
+}
+
+void DocBuilder::source(nlohmann::json src, const std::string& origin) {
+  if (!doc_.contains("sources")) doc_["sources"] = nlohmann::json::array();
+  origins_["/sources/" + std::to_string(doc_["sources"].size())] = origin;
+  doc_["sources"].push_back(std::move(src));
+}
+
+void DocBuilder::warn(const std::string& kind, const std::string& text) {
+  if (auto it = warning_index_.find(kind); it != warning_index_.end()) {
+    ++warning_repeats_[it->second];
+    return;
+  }
+  warning_index_[kind] = warnings_.size();
+  warnings_.emplace_back(kind, text);
+  warning_repeats_.push_back(0);
+}
+
+bool DocBuilder::free(double x, double y, double r, bool agents) const {
+  for (const Disc& c : circles_)
+    if (discs_overlap(c.x - x, c.y - y, c.r + r)) return false;
+  for (const auto& p : polygons_)
+    if (disc_overlaps_polygon(p, x, y, r)) return false;
+  if (!agents) return true;
+  const double reach = r + rmax_;
+  const auto c0x = static_cast<int64_t>(std::floor((x - reach) / kCell));
+  const auto c1x = static_cast<int64_t>(std::floor((x + reach) / kCell));
+  const auto c0y = static_cast<int64_t>(std::floor((y - reach) / kCell));
+  const auto c1y = static_cast<int64_t>(std::floor((y + reach) / kCell));
+  for (int64_t cx = c0x; cx <= c1x; ++cx)
+    for (int64_t cy = c0y; cy <= c1y; ++cy) {
+      const auto it = discs_.find(cell_key(cx, cy));
+      if (it == discs_.end()) continue;
+      for (const Disc& d : it->second)
+        if (discs_overlap(d.x - x, d.y - y, d.r + r)) return false;
+    }
+  return true;
+}
+
+void DocBuilder::occupy(double x, double y, double r) {
+  rmax_ = std::max(rmax_, r);
+  discs_[cell_key(static_cast<int64_t>(std::floor(x / kCell)),
+                  static_cast<int64_t>(std::floor(y / kCell)))]
+      .push_back({x, y, r});
+}
+
+Imported DocBuilder::finish() {
+  Imported im;
+  im.doc = std::move(doc_);
+  im.origins = std::move(origins_);
+  for (std::size_t k = 0; k < warnings_.size(); ++k) {
+    std::string w = warnings_[k].second;
+    if (warning_repeats_[k])
+      w += " (and " + std::to_string(warning_repeats_[k]) + " more like it)";
+    im.warnings.push_back(std::move(w));
+  }
+  return im;
+}
+
+}  // namespace crowddb::io

@@ -1,0 +1,173 @@
+#include "metrics/steerbench.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "world/geometry.hpp"
+
+namespace crowddb::metrics {
+namespace {
+
+constexpr double kCollision = 0.001;  // [m] SteerSuite's COLLISION_EPSILON
+
+uint64_t cell_key(int64_t cx, int64_t cy) {
+  return (static_cast<uint64_t>(cx) << 32) ^ static_cast<uint64_t>(cy & 0xffffffff);
+}
+
+}  // namespace
+
+void SteerBench::start(const World& world) {
+  tick_ = 0;
+  const AgentTable& t = world.agents();
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t.state[i] == AgentState::arrived) continue;
+    scores_.push_back({.id = t.id[i]});
+    known_.insert(t.id[i]);
+    active_.emplace(t.id[i], Track{scores_.size() - 1, t.x[i], t.y[i]});
+  }
+}
+
+void SteerBench::tick(const World& world, const TickMetrics& m) {
+  ++tick_;
+  const AgentTable& t = world.agents();
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const uint64_t id = t.id[i];
+    auto it = active_.find(id);
+    if (it == active_.end()) {
+      // New in the table (a source, an insert): measured from here on. An agent measured before
+      // and closed on arrival stays closed.
+      if (t.state[i] == AgentState::arrived || !known_.insert(id).second) continue;
+      scores_.push_back({.id = id});
+      active_.emplace(id, Track{scores_.size() - 1, t.x[i], t.y[i], 0, 0, false, tick_});
+      continue;
+    }
+    Track& tr = it->second;
+    AgentScore& s = scores_[tr.score];
+    if (t.state[i] == AgentState::arrived) {  // arrived in this tick: the tick is not counted
+      s.arrived = true;
+      active_.erase(it);
+      continue;
+    }
+    tr.seen = tick_;
+    const double dx = t.x[i] - tr.x, dy = t.y[i] - tr.y;
+    const double vx = dx / dt_, vy = dy / dt_;
+    s.time += dt_;
+    s.path_length += std::sqrt(dx * dx + dy * dy);
+    s.energy += 0.5 * (vx * vx + vy * vy);
+    if (tr.has_v) {
+      const double ax = vx - tr.vx, ay = vy - tr.vy;
+      s.acceleration += std::sqrt(ax * ax + ay * ay) / dt_;
+    }
+    tr.x = t.x[i];
+    tr.y = t.y[i];
+    tr.vx = vx;
+    tr.vy = vy;
+    tr.has_v = true;
+  }
+  // Agents no longer in the table left it on arrival (or were deleted).
+  for (auto it = active_.begin(); it != active_.end();) {
+    if (it->second.seen != tick_) {
+      scores_[it->second.score].arrived = true;
+      it = active_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  if (m.overlapping_pairs > 0 || m.obstacle_overlaps > 0 || !open_pairs_.empty() ||
+      !open_obstacles_.empty())
+    collisions(world);
+}
+
+void SteerBench::collisions(const World& world) {
+  const AgentTable& t = world.agents();
+  std::vector<std::size_t> rows;
+  double rmax = 0;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (t.state[i] != AgentState::arrived) {
+      rows.push_back(i);
+      rmax = std::max(rmax, t.radius[i]);
+    }
+  std::set<std::pair<uint64_t, uint64_t>> pairs;
+  std::set<std::pair<uint64_t, int64_t>> obstacles;
+  if (!rows.empty()) {
+    const double cell = std::max(2 * rmax, 1e-6);
+    std::unordered_map<uint64_t, std::vector<std::size_t>> grid;
+    for (std::size_t i : rows)
+      grid[cell_key(static_cast<int64_t>(std::floor(t.x[i] / cell)),
+                    static_cast<int64_t>(std::floor(t.y[i] / cell)))]
+          .push_back(i);
+    for (std::size_t i : rows) {
+      const auto cx = static_cast<int64_t>(std::floor(t.x[i] / cell));
+      const auto cy = static_cast<int64_t>(std::floor(t.y[i] / cell));
+      for (int64_t gx = cx - 1; gx <= cx + 1; ++gx)
+        for (int64_t gy = cy - 1; gy <= cy + 1; ++gy) {
+          const auto it = grid.find(cell_key(gx, gy));
+          if (it == grid.end()) continue;
+          for (std::size_t j : it->second) {
+            if (t.id[j] <= t.id[i]) continue;
+            const double d = std::hypot(t.x[j] - t.x[i], t.y[j] - t.y[i]);
+            if (t.radius[i] + t.radius[j] - d > kCollision) pairs.insert({t.id[i], t.id[j]});
+          }
+        }
+      const double x = t.x[i], y = t.y[i], r = t.radius[i];
+      const auto circles = world.circles();
+      for (std::size_t k = 0; k < circles.size(); ++k)
+        if (r + circles[k].radius - std::hypot(circles[k].x - x, circles[k].y - y) > kCollision)
+          obstacles.insert({t.id[i], static_cast<int64_t>(k)});
+      const auto polys = world.polygons();
+      for (std::size_t k = 0; k < polys.size(); ++k) {
+        const auto& v = polys[k].vertices;
+        const double pen = point_in_polygon(v, x, y)
+                               ? r
+                               : r - std::sqrt(dist2_to_boundary(v, x, y));
+        if (pen > kCollision)
+          obstacles.insert({t.id[i], static_cast<int64_t>(circles.size() + k)});
+      }
+      if (walls_) {
+        const Bounds& b = world.bounds();
+        const double gaps[4] = {x - b.xmin, b.xmax - x, y - b.ymin, b.ymax - y};
+        for (int k = 0; k < 4; ++k)
+          if (r - gaps[k] > kCollision) obstacles.insert({t.id[i], -1 - k});
+      }
+    }
+  }
+  auto count = [&](uint64_t id) {
+    const auto it = active_.find(id);
+    if (it != active_.end()) ++scores_[it->second.score].collisions;
+  };
+  for (const auto& p : pairs)
+    if (!open_pairs_.count(p)) {
+      count(p.first);
+      count(p.second);
+    }
+  for (const auto& o : obstacles)
+    if (!open_obstacles_.count(o)) count(o.first);
+  open_pairs_ = std::move(pairs);
+  open_obstacles_ = std::move(obstacles);
+}
+
+SteerBenchTotals SteerBench::totals() const {
+  SteerBenchTotals s;
+  s.agents = scores_.size();
+  if (scores_.empty()) return s;
+  double c = 0, tm = 0, e = 0, a = 0, p = 0;
+  for (const AgentScore& x : scores_) {
+    s.collisions += x.collisions;
+    c += static_cast<double>(x.collisions);
+    tm += x.time;
+    e += x.energy;
+    a += x.acceleration;
+    p += x.path_length;
+  }
+  const double n = static_cast<double>(scores_.size());
+  s.avg_collisions = c / n;
+  s.avg_time = tm / n;
+  s.avg_energy = e / n;
+  s.avg_acceleration = a / n;
+  s.avg_path = p / n;
+  s.composite01 = 50 * s.avg_collisions + s.avg_time + s.avg_energy;
+  s.composite02 = s.composite01 + s.avg_acceleration;
+  return s;
+}
+
+}  // namespace crowddb::metrics

@@ -1,0 +1,83 @@
+// SteerBench's metrics (Singh, Kapadia, Faloutsos, Reinman 2009), computed the way SteerSuite's
+// AgentMetricsCollector and CompositeTechnique01/02 compute them, so that scores compare with
+// published ones when dt is SteerSuite's 0.05 s:
+//
+//   per agent, per tick while it is measured (from its first tick in the table to the tick it
+//   arrives, which is not counted, or to the end of the run):
+//     time          += dt
+//     path length   += |p_n - p_{n-1}|
+//     energy        += 0.5 |v_n|^2              (mass 1, NOT times dt: SteerBench's sum)
+//     acceleration  += |v_n - v_{n-1}| / dt     (from the second measured tick on)
+//   with v_n = (p_n - p_{n-1}) / dt (finite differences, as SteerSuite);
+//   collisions: episodes of penetration > 1 mm with another agent or an obstacle (walls
+//   included), counted once per episode and per agent involved.
+//   composite01 = 50 * avg collisions + avg time + avg energy
+//   composite02 = composite01 + avg acceleration
+// Averages are over every measured agent (SteerSuite measures the agents present at the start;
+// agents from sources are measured from their entry).
+#pragma once
+
+#include <cstdint>
+#include <set>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include "crowddb/simulation.hpp"
+#include "crowddb/world.hpp"
+
+namespace crowddb::metrics {
+
+struct AgentScore {
+  uint64_t id = 0;
+  std::size_t collisions = 0;  // unique collision episodes
+  double time = 0;             // [s] measured
+  double path_length = 0;      // [m]
+  double energy = 0;           // sum of 0.5 |v|^2 per tick [m^2/s^2]
+  double acceleration = 0;     // sum of |dv| / dt per tick [m/s^2]
+  bool arrived = false;
+  double score01() const { return 50.0 * static_cast<double>(collisions) + time + energy; }
+  double score02() const { return score01() + acceleration; }
+};
+
+struct SteerBenchTotals {
+  std::size_t agents = 0;
+  std::size_t collisions = 0;  // sum over agents (an agent-agent episode counts for both)
+  double avg_collisions = 0, avg_time = 0, avg_energy = 0, avg_acceleration = 0, avg_path = 0;
+  double composite01 = 0, composite02 = 0;
+};
+
+class SteerBench {
+ public:
+  // `walls`: the world's bounds are solid (SimConfig::walls), so touching them is a collision.
+  SteerBench(double dt, bool walls) : dt_(dt), walls_(walls) {}
+  // The agents at the start (tick 0).
+  void start(const World& world);
+  // After each tick. `m` tells whether anything overlaps at all (when nothing does, no collision
+  // can have started and the per-pair search is skipped).
+  void tick(const World& world, const TickMetrics& m);
+  // In order of first appearance.
+  const std::vector<AgentScore>& scores() const { return scores_; }
+  SteerBenchTotals totals() const;
+
+ private:
+  struct Track {
+    std::size_t score;  // index in scores_
+    double x, y, vx = 0, vy = 0;
+    bool has_v = false;
+    uint64_t seen = 0;  // tick it was last in the table
+  };
+  void collisions(const World& world);
+
+  double dt_;
+  bool walls_;
+  uint64_t tick_ = 0;
+  std::vector<AgentScore> scores_;
+  std::unordered_map<uint64_t, Track> active_;  // by agent id
+  std::unordered_set<uint64_t> known_;          // every id measured so far
+  std::set<std::pair<uint64_t, uint64_t>> open_pairs_;      // agent ids, smaller first
+  std::set<std::pair<uint64_t, int64_t>> open_obstacles_;  // id, obstacle (-1..-4: walls)
+};
+
+}  // namespace crowddb::metrics
