@@ -1,5 +1,6 @@
 // The importers, how a file's format is recognised, and the loading entry points that dispatch on
 // it (load_scenario, convert_scenario, scenario_format).
+#include <cctype>
 #include <fstream>
 #include <sstream>
 
@@ -42,6 +43,18 @@ const Importer kImporters[] = {
      menge_claims, import_menge},
     {"vadere", "Vadere .scenario files (JSON, releases 0.1 to 2.4)", vadere_claims, import_vadere},
 };
+
+// A file no importer claims is read as crowddb JSON; an XML one gets an error naming its root.
+void reject_unknown_xml(const std::filesystem::path& path, std::string_view text) {
+  std::size_t i = text.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
+  while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+  if (i >= text.size() || text[i] != '<') return;
+  const std::string root = xml_root_name(text);
+  throw Error(Error::Kind::input,
+              path.string() + ": an XML file with root <" + root +
+                  "> is not a format crowddb reads (SteerSuite <SteerBenchTestCase>, Menge "
+                  "<Project>, <Experiment> or <BFSM>; docs/importers.md)");
+}
 
 }  // namespace
 
@@ -108,6 +121,7 @@ Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& opt
   const std::string text = io::read_file(path);
   const io::Importer* imp = io::importer_for(path, text);
   if (!imp) {
+    io::reject_unknown_xml(path, text);
     if (!options.behavior.empty())
       throw Error(Error::Kind::usage,
                   path.string() + ": a behaviour file goes with a Menge scene, not with a " +
@@ -125,6 +139,7 @@ Converted convert_scenario(const std::filesystem::path& path, const LoadOptions&
   const std::string text = io::read_file(path);
   const io::Importer* imp = io::importer_for(path, text);
   if (!imp) {
+    io::reject_unknown_xml(path, text);
     parse_scenario(text, path.string());  // a crowddb file converts to itself, if it is valid
     return {text, "crowddb", {}};
   }

@@ -1,4 +1,5 @@
-// Vadere files -> a crowddb scenario document (docs/importers.md).
+// Vadere .scenario files (JSON, releases 0.1 to 2.4) -> a crowddb scenario document
+// (docs/importers/vadere.md lists every element and key and what becomes of it).
 #pragma once
 
 #include <filesystem>
@@ -9,6 +10,6 @@
 namespace crowddb::io {
 
 Imported import_vadere(const std::filesystem::path& path, std::string_view text,
-                   const LoadOptions& options);
+                       const LoadOptions& options);
 
 }  // namespace crowddb::io
