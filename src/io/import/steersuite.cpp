@@ -66,8 +66,8 @@ class SteerRng {
 
 class Reader {
  public:
-  Reader(const std::filesystem::path& path, std::string_view text)
-      : f_(text, path.string()), rng_(2), goal_rng_(2) {}
+  Reader(const std::filesystem::path& path, std::string_view text, std::size_t max_agents)
+      : f_(text, path.string()), rng_(2), goal_rng_(2), max_agents_(max_agents) {}
 
   Imported run() {
     const xml_node root = f_.root();
@@ -167,7 +167,6 @@ class Reader {
       return v;
     }
     if (!any) f_.fail(n, "expected <x>, <y>, <z> (or <random>true</random>)");
-    if (v.y != 0) heights_ = true;
     return v;
   }
 
@@ -297,8 +296,10 @@ class Reader {
     const auto size = f_.child_number(n, "obstacleSize");
     if (!count) f_.fail(n, "missing <numObstacles>");
     if (!size) f_.fail(n, "missing <obstacleSize>");
-    if (*count < 0 || *count != std::floor(*count) || *count > 1e6)
-      f_.fail(n, "<numObstacles> must be a whole number in 0..10^6");
+    if (*count < 0 || *count != std::floor(*count) ||
+        *count > static_cast<double>(std::min<std::size_t>(max_agents_, 100000)))
+      f_.fail(n, "<numObstacles> must be a whole number, at most " +
+                     std::to_string(std::min<std::size_t>(max_agents_, 100000)));
     if (!(*size > 0)) f_.fail(n, "<obstacleSize> must be > 0");
     const xml_node rb = f_.only_child(n, "regionBounds");
     if (!rb) f_.fail(n, "missing <regionBounds>");
@@ -338,6 +339,7 @@ class Reader {
     if (const xml_node p = f_.only_child(ic, "position")) {
       a.position = xyz(p, true);
       a.random_position = a.position.random;
+      heights_ |= a.position.y != 0;
     } else if (region) {
       a.random_position = true;
     } else {
@@ -357,8 +359,9 @@ class Reader {
     const auto count = f_.child_number(n, "numAgents");
     if (!count) f_.fail(n, "missing <numAgents>");
     if (*count < 0 || *count != std::floor(*count) ||
-        *count > static_cast<double>(kMaxAgents - out.size()))
-      f_.fail(n, "<numAgents> must be a whole number in 0..10^7");
+        *count > static_cast<double>(max_agents_ - std::min(max_agents_, out.size())))
+      f_.fail(n, "<numAgents> must be a whole number, at most " + std::to_string(max_agents_) +
+                     " agents in all");
     const xml_node rb = f_.only_child(n, "regionBounds");
     if (!rb) f_.fail(n, "missing <regionBounds>");
     a.region = bounding_box(rb, true, "regionBounds");
@@ -384,6 +387,7 @@ class Reader {
       const xml_node t = f_.only_child(g, "targetLocation");
       if (!t) f_.fail(g, "missing <targetLocation>");
       out.target = xyz(t, true);
+      heights_ |= out.target.y != 0;
     } else if (type == "fleeStaticTarget" || type == "seekDynamicTarget" ||
                type == "fleeDynamicTarget" || type == "flowStaticDirection" ||
                type == "flowDynamicDirection" || type == "idle" || type == "groupTarget") {
@@ -542,6 +546,7 @@ class Reader {
   xml_node world_node_;
   std::string name_, description_;
   bool heights_ = false;
+  std::size_t max_agents_;
 };
 
 }  // namespace
@@ -552,7 +557,13 @@ Imported import_steersuite(const std::filesystem::path& path, std::string_view t
     throw Error(Error::Kind::usage,
                 path.string() + ": a behaviour file goes with a Menge scene, not a SteerSuite "
                                 "test case");
-  return Reader(path, text).run();
+  return Reader(path, text, kMaxAgents).run();
+}
+
+Imported import_steersuite(const std::filesystem::path& path, std::string_view text,
+                           const LoadOptions& options, std::size_t max_agents) {
+  if (!options.behavior.empty()) return import_steersuite(path, text, options);
+  return Reader(path, text, std::min(max_agents, kMaxAgents)).run();
 }
 
 }  // namespace crowddb::io

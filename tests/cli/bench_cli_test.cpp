@@ -1,0 +1,105 @@
+// `crowddb bench`, `crowddb convert` and `crowddb run --summary-json` end to end.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "support/cli.hpp"
+
+namespace crowddb::test {
+namespace {
+
+const char* kWalk = R"({"name": "walk", "bounds": [0, 0, 20, 10], "duration": 30,
+  "stop_when_all_arrived": true,
+  "goals": [{"name": "g", "x": 15, "y": 5, "arrival_radius": 0.3}],
+  "agents": [{"x": 5, "y": 5, "goal": "g", "pref_speed": 1}]})";
+
+const char* kCase = R"(<SteerBenchTestCase xmlns="http://www.magix.ucla.edu/steerbench">
+  <header><name>pair</name><worldBounds><xmin>-20</xmin><xmax>20</xmax><ymin>0</ymin><ymax>0</ymax>
+    <zmin>-20</zmin><zmax>20</zmax></worldBounds></header>
+  <agent><initialConditions><radius>0.5</radius><position><x>-10</x><y>0</y><z>0</z></position>
+    <direction><x>1</x><y>0</y><z>0</z></direction><speed>0</speed></initialConditions>
+    <goalSequence><seekStaticTarget><targetLocation><x>10</x><y>0</y><z>0</z></targetLocation>
+    <desiredSpeed>1.3</desiredSpeed></seekStaticTarget></goalSequence></agent>
+  <agent><initialConditions><radius>0.5</radius><position><x>10</x><y>0</y><z>0.1</z></position>
+    <direction><x>-1</x><y>0</y><z>0</z></direction><speed>0</speed></initialConditions>
+    <goalSequence><seekStaticTarget><targetLocation><x>-10</x><y>0</y><z>0.1</z></targetLocation>
+    <desiredSpeed>1.3</desiredSpeed></seekStaticTarget></goalSequence></agent>
+</SteerBenchTestCase>)";
+
+TEST(SummaryJson, KeysAgreeWithTheRun) {
+  TempDir dir;
+  const auto sc = dir.write("walk.json", kWalk);
+  const CliResult r = run_cli("run " + sc.string() + " --summary-json " +
+                                  (dir / "s.json").string() + " --no-output --quiet",
+                              dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(dir / "s.json"));
+  for (const char* k :
+       {"agents_total", "arrived", "all_arrived", "last_arrival_s", "sim_seconds", "ticks",
+        "max_overlapping_pairs", "max_obstacle_overlaps", "stalled_at_end", "max_stalled_s",
+        "frozen_agent_ticks", "wall_seconds", "ms_per_tick_median", "state_hash", "steerbench",
+        "model"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_EQ(j["agents_total"], 1);
+  EXPECT_EQ(j["arrived"], 1);
+  EXPECT_EQ(j["all_arrived"], true);
+  EXPECT_EQ(j["stopped_when_all_arrived"], true);
+  // 9.7 m at 1 m/s: the run ends at the tick of the arrival.
+  const double last = j["last_arrival_s"];
+  EXPECT_NEAR(last, 9.7, 0.11);
+  EXPECT_NEAR(j["sim_seconds"].get<double>(), last, 1e-9);
+  EXPECT_EQ(j["model"], "orca");
+  EXPECT_EQ(j["steerbench"]["agents"], 1);
+  EXPECT_EQ(j["steerbench"]["collisions"], 0);
+  // SteerBench's time stops before the arrival tick; the agent walked about 9.7 m.
+  EXPECT_NEAR(j["steerbench"]["avg_time_s"].get<double>(), last - 0.1, 1e-6);
+  EXPECT_NEAR(j["steerbench"]["avg_path_length_m"].get<double>(), 9.6, 0.15);
+  // "-": the JSON on standard output, no text summary.
+  const CliResult s = run_cli("run " + sc.string() + " --summary-json - --no-output --quiet", dir);
+  ASSERT_EQ(s.status, 0) << s.err;
+  EXPECT_EQ(nlohmann::json::parse(s.out)["state_hash"], j["state_hash"]);
+}
+
+TEST(Convert, ImportedFileConvertsToAScenarioThatRunsTheSame) {
+  TempDir dir;
+  const auto xml = dir.write("pair.xml", kCase);
+  const CliResult c = run_cli("convert " + xml.string() + " --to json", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  const auto json = dir.write("pair.json", c.out);
+  const CliResult a = run_cli("run " + xml.string() + " --summary-json - --no-output --quiet", dir);
+  const CliResult b = run_cli("run " + json.string() + " --summary-json - --no-output --quiet", dir);
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(b.status, 0) << b.err;
+  const auto ja = nlohmann::json::parse(a.out), jb = nlohmann::json::parse(b.out);
+  EXPECT_EQ(ja["state_hash"], jb["state_hash"]);
+  EXPECT_EQ(ja["format"], "steersuite");
+  EXPECT_EQ(jb["format"], "crowddb");
+  EXPECT_EQ(ja["arrived"], 2);
+  const CliResult bad = run_cli("convert " + xml.string() + " --to yaml", dir);
+  EXPECT_EQ(bad.status, 2);
+}
+
+TEST(Bench, OneRowPerScenarioAndErrorsDoNotStopTheOthers) {
+  TempDir dir;
+  std::filesystem::create_directories(dir / "set");
+  dir.write("set/walk.json", kWalk);
+  dir.write("set/pair.xml", kCase);
+  dir.write("set/broken.json", "{\"bounds\": [0, 0, 1]}");
+  const CliResult r = run_cli("bench " + (dir / "set").string() + " --quiet --csv " +
+                                  (dir / "b.csv").string(),
+                              dir);
+  EXPECT_EQ(r.status, 1) << r.err;  // one scenario failed
+  EXPECT_NE(r.out.find("3 scenarios: 2 with everyone arrived, 0 with someone left, 1 failed"),
+            std::string::npos)
+      << r.out;
+  const std::string csv = slurp(dir / "b.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4) << csv;
+  EXPECT_NE(csv.find("broken.json,,,,error,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",steersuite,pair,orca,ok,2,2,1,"), std::string::npos) << csv;
+  EXPECT_FALSE(std::filesystem::exists(dir / "b.csv.partial"));
+  const CliResult missing = run_cli("bench " + (dir / "nothing").string(), dir);
+  EXPECT_EQ(missing.status, 1);
+}
+
+}  // namespace
+}  // namespace crowddb::test
