@@ -371,16 +371,19 @@ struct Loader {
   // A polygon's point inside it: the centroid when inside, else the middle of the longest
   // horizontal chord through the centroid's height.
   static Vec2 point_inside(const std::vector<Vec2>& ring) {
+    // Relative to the first vertex: far from the origin (UTM coordinates, 10^6 m) the products
+    // of absolute coordinates lose the centroid's precision.
+    const Vec2 o = ring[0];
     double a = 0, cx = 0, cy = 0;
     for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
-      const Vec2& p = ring[i];
-      const Vec2& q = ring[(i + 1) % n];
+      const Vec2 p{ring[i].x - o.x, ring[i].y - o.y};
+      const Vec2 q{ring[(i + 1) % n].x - o.x, ring[(i + 1) % n].y - o.y};
       const double c = p.x * q.y - q.x * p.y;
       a += c;
       cx += (p.x + q.x) * c;
       cy += (p.y + q.y) * c;
     }
-    const Vec2 centroid{cx / (3 * a), cy / (3 * a)};
+    const Vec2 centroid{o.x + cx / (3 * a), o.y + cy / (3 * a)};
     if (point_in_polygon(ring, centroid.x, centroid.y)) return centroid;
     std::vector<double> xs;
     for (std::size_t i = 0, n = ring.size(); i < n; ++i) {

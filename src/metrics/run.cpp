@@ -132,6 +132,9 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
 }
 
 std::string RunSummary::json() const {
+  // Times are tick counts times dt: 229 * 0.1 prints as 22.900000000000002; a nanosecond grid
+  // keeps them readable without losing anything a tick can resolve.
+  auto ns = [](double v) { return std::round(v * 1e9) / 1e9; };
   nlohmann::ordered_json j;
   j["name"] = name;
   j["source"] = source;
@@ -140,7 +143,7 @@ std::string RunSummary::json() const {
   j["dt"] = dt;
   j["threads"] = threads;
   j["ticks"] = ticks;
-  j["sim_seconds"] = sim_seconds;
+  j["sim_seconds"] = ns(sim_seconds);
   j["stopped_when_all_arrived"] = stopped_when_all_arrived;
   j["agents_at_start"] = agents_at_start;
   j["entered"] = entered;
@@ -150,7 +153,7 @@ std::string RunSummary::json() const {
   j["still_walking"] = still_walking;
   j["all_arrived"] = all_arrived;
   if (last_arrival_s >= 0)
-    j["last_arrival_s"] = last_arrival_s;
+    j["last_arrival_s"] = ns(last_arrival_s);
   else
     j["last_arrival_s"] = nullptr;
   j["max_overlapping_pairs"] = max_overlapping_pairs;
@@ -158,10 +161,10 @@ std::string RunSummary::json() const {
   j["overlapping_pairs_at_end"] = overlapping_pairs_at_end;
   j["frozen_agent_ticks"] = frozen_agent_ticks;
   j["gridlocked_at_end"] = gridlocked_at_end;
-  j["longest_frozen_s"] = longest_frozen_s;
+  j["longest_frozen_s"] = ns(longest_frozen_s);
   j["stall_streaks"] = stall_streaks;
   j["stalled_at_end"] = stalled_at_end;
-  j["max_stalled_s"] = max_stalled_s;
+  j["max_stalled_s"] = ns(max_stalled_s);
   j["yields"] = yields;
   j["sidesteps"] = sidesteps;
   j["wall_seconds"] = wall_seconds;

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sstream>
 
 #include "crowddb/scenario.hpp"
 #include "support/cli.hpp"
@@ -268,6 +269,27 @@ TEST(ScenarioJson, MissingFileIsAnIoError) {
     EXPECT_EQ(e.kind(), Error::Kind::io);
     EXPECT_NE(std::string(e.what()).find("/nonexistent/x.json"), std::string::npos);
   }
+}
+
+}  // namespace
+}  // namespace crowddb
+
+namespace crowddb {
+namespace {
+
+TEST(ScenarioJson, PolygonGoalPointIsExactFarFromTheOrigin) {
+  // A 2 x 1 m exit in UTM coordinates (osm2vadere's files use such).
+  const double x0 = 692152.09, y0 = 5337384.67;
+  std::ostringstream os;
+  os.precision(17);
+  os << R"({"bounds": [)" << x0 - 10 << ", " << y0 - 10 << ", " << x0 + 10 << ", " << y0 + 10
+     << R"(], "goals": [{"name": "exit", "area": [[)" << x0 << ", " << y0 << "], [" << x0 + 2
+     << ", " << y0 << "], [" << x0 + 2 << ", " << y0 + 1 << "], [" << x0 << ", " << y0 + 1
+     << R"(]]}], "agents": [{"x": )" << x0 - 5 << ", \"y\": " << y0 << R"(, "goal": "exit"}]})";
+  Scenario sc = parse_scenario(os.str(), "utm.json");
+  const Goal& g = sc.world.goals()[0];
+  EXPECT_NEAR(g.x, x0 + 1, 1e-6);
+  EXPECT_NEAR(g.y, y0 + 0.5, 1e-6);
 }
 
 }  // namespace
