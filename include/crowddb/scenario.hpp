@@ -50,6 +50,10 @@ struct LoadOptions {
   // Menge: the behaviour file to pair with a scene file. Empty: a project file names both, and a
   // scene NameS.xml pairs with NameB.xml beside it.
   std::filesystem::path behavior;
+  // Fields to set in the (converted) document before it is validated: "KEY=VALUE", KEY a dotted
+  // path ("steering.orca.time_gap", "groups.0.count"), VALUE JSON or a plain string (crowddb
+  // run/bench --set). Applied in order.
+  std::vector<std::string> overrides;
 };
 
 // The format of a file: "crowddb", "steersuite", "menge" or "vadere" (by extension and content).

@@ -49,6 +49,9 @@ struct OrcaParams {
   // Share of an avoidance taken by the agent that goes first (less path left), in (0, 1); the
   // other takes the rest. 0.5: the paper's even split (steer/orca.cpp explains why not).
   double first_share = 0.25;
+  // [s] headway: the preferred speed is capped at spacing / time_gap to the agent ahead going the
+  // same way or standing (>= 0; 0: off, the default). steer/orca.cpp says when it helps.
+  double time_gap = 0;
 };
 
 // The collision-free speed model (Tordeux, Chraibi, Seyfried 2016), model "cfsm"; defaults are

@@ -889,6 +889,7 @@ void read_steering(Node& root, SimConfig& cfg) {
     op.time_horizon_obst = o.positive("time_horizon_obst", op.time_horizon_obst);
     op.first_share = o.positive("first_share", op.first_share);
     if (!(op.first_share < 1)) o.fail("first_share", "must be < 1");
+    op.time_gap = o.non_negative("time_gap", op.time_gap);
     o.finish();
   }
   if (s.has("cfsm")) {

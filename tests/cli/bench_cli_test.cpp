@@ -34,11 +34,10 @@ TEST(SummaryJson, KeysAgreeWithTheRun) {
                               dir);
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(slurp(dir / "s.json"));
-  for (const char* k :
-       {"agents_total", "arrived", "all_arrived", "last_arrival_s", "sim_seconds", "ticks",
-        "max_overlapping_pairs", "max_obstacle_overlaps", "stalled_at_end", "max_stalled_s",
-        "frozen_agent_ticks", "wall_seconds", "ms_per_tick_median", "state_hash", "steerbench",
-        "model"})
+  for (const char* k : {"agents_total", "arrived", "all_arrived", "last_arrival_s", "sim_seconds",
+                        "ticks", "max_overlapping_pairs", "max_obstacle_overlaps", "stalled_at_end",
+                        "max_stalled_s", "frozen_agent_ticks", "wall_seconds", "ms_per_tick_median",
+                        "state_hash", "steerbench", "model"})
     EXPECT_TRUE(j.contains(k)) << k;
   EXPECT_EQ(j["agents_total"], 1);
   EXPECT_EQ(j["arrived"], 1);
@@ -67,7 +66,8 @@ TEST(Convert, ImportedFileConvertsToAScenarioThatRunsTheSame) {
   ASSERT_EQ(c.status, 0) << c.err;
   const auto json = dir.write("pair.json", c.out);
   const CliResult a = run_cli("run " + xml.string() + " --summary-json - --no-output --quiet", dir);
-  const CliResult b = run_cli("run " + json.string() + " --summary-json - --no-output --quiet", dir);
+  const CliResult b =
+      run_cli("run " + json.string() + " --summary-json - --no-output --quiet", dir);
   ASSERT_EQ(a.status, 0) << a.err;
   ASSERT_EQ(b.status, 0) << b.err;
   const auto ja = nlohmann::json::parse(a.out), jb = nlohmann::json::parse(b.out);
@@ -79,15 +79,42 @@ TEST(Convert, ImportedFileConvertsToAScenarioThatRunsTheSame) {
   EXPECT_EQ(bad.status, 2);
 }
 
+// --set changes the run of a crowddb file and of an import alike; a bad value names its field.
+TEST(Set, OverridesReachEveryFormatAndBadValuesNameTheirField) {
+  TempDir dir;
+  const auto sc = dir.write("walk.json", kWalk);
+  const auto xml = dir.write("pair.xml", kCase);
+  for (const auto& file : {sc, xml}) {
+    const CliResult a =
+        run_cli("run " + file.string() + " --summary-json - --no-output --quiet", dir);
+    const CliResult b = run_cli(
+        "run " + file.string() + " --set steering.model=cfsm --summary-json - --no-output --quiet",
+        dir);
+    ASSERT_EQ(a.status, 0) << a.err;
+    ASSERT_EQ(b.status, 0) << b.err;
+    EXPECT_EQ(nlohmann::json::parse(a.out)["model"], "orca");
+    EXPECT_EQ(nlohmann::json::parse(b.out)["model"], "cfsm");
+  }
+  const CliResult c = run_cli("convert " + xml.string() + " --set steering.orca.time_gap=0.5", dir);
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_EQ(nlohmann::json::parse(c.out)["steering"]["orca"]["time_gap"], 0.5);
+  const CliResult bad =
+      run_cli("validate " + sc.string() + " --set steering.orca.time_gap=-1", dir);
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("/steering/orca/time_gap: must be >= 0"), std::string::npos) << bad.err;
+  const CliResult usage = run_cli("bench " + sc.string() + " --set steering", dir);
+  EXPECT_EQ(usage.status, 2);
+  EXPECT_NE(usage.err.find("--set 'steering': expected KEY=VALUE"), std::string::npos) << usage.err;
+}
+
 TEST(Bench, OneRowPerScenarioAndErrorsDoNotStopTheOthers) {
   TempDir dir;
   std::filesystem::create_directories(dir / "set");
   dir.write("set/walk.json", kWalk);
   dir.write("set/pair.xml", kCase);
   dir.write("set/broken.json", "{\"bounds\": [0, 0, 1]}");
-  const CliResult r = run_cli("bench " + (dir / "set").string() + " --quiet --csv " +
-                                  (dir / "b.csv").string(),
-                              dir);
+  const CliResult r = run_cli(
+      "bench " + (dir / "set").string() + " --quiet --csv " + (dir / "b.csv").string(), dir);
   EXPECT_EQ(r.status, 1) << r.err;  // one scenario failed
   EXPECT_NE(r.out.find("3 scenarios: 2 with everyone arrived, 0 with someone left, 1 failed"),
             std::string::npos)

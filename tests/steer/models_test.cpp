@@ -58,6 +58,51 @@ TEST_P(Models, AccessPathsAndThreadsChangeNothing) {
 
 INSTANTIATE_TEST_SUITE_P(All, Models, ::testing::Values("orca", "cfsm", "thesis"));
 
+// ORCA's opt-in headway takes part in the same guarantees: same runs on any access path and
+// thread count, zero overlaps.
+TEST(Orca, HeadwayChangesNothingAcrossAccessPathsAndThreads) {
+  auto with_gap = [](std::string text) {
+    const std::string model = R"("model": "orca")";
+    return text.replace(text.find(model), model.size(), model + R"(, "orca": {"time_gap": 0.5})");
+  };
+  const auto reference = hashes(with_gap(mixed("orca")));
+  EXPECT_NE(reference, hashes(mixed("orca")));  // it does change the run
+  EXPECT_EQ(hashes(with_gap(mixed("orca", 2))), reference);
+  EXPECT_EQ(hashes(with_gap(mixed("orca", 1,
+                                  R"("access": {"neighbours": "naive", "edges": "naive",
+                                                "ftc": "naive", "collisions": "naive"})"))),
+            reference);
+}
+
+// The headway caps the wish at spacing / time_gap behind a neighbour going the same way, and
+// leaves it alone for one coming towards. Two agents 0.5 m apart (spacing), both start at rest.
+double first_tick_speed_of_follower(const std::string& leader_goal, double time_gap) {
+  const std::string text = R"({"bounds": [0, 0, 40, 4], "duration": 1, "walls": false,
+    "steering": {"model": "orca", "orca": {"time_gap": )" +
+                           std::to_string(time_gap) + R"(}},
+    "goals": [{"name": "E", "x": 39, "y": 2}, {"name": "W", "x": 1, "y": 2}],
+    "agents": [{"x": 10, "y": 2, "radius": 0.25, "pref_speed": 1.3, "goal": "E"},
+               {"x": 11, "y": 2, "radius": 0.25, "pref_speed": 1.3, "goal": ")" +
+                           leader_goal + R"("}]})";
+  Scenario sc = parse_scenario(text, "t.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  sim.step();
+  const AgentTable& t = sim.world().agents();
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (t.x[i] < 10.5) return std::sqrt(t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i]);
+  ADD_FAILURE() << "the follower is missing";
+  return 0;
+}
+
+TEST(Orca, HeadwayCapsTheWishBehindAnAgentGoingTheSameWay) {
+  // Same way: at most 0.5 m / 2 s = 0.25 m/s, while without the headway the follower, going
+  // second, avoids where the leader wants to go and starts at walking speed.
+  EXPECT_LE(first_tick_speed_of_follower("E", 2), 0.25 + 1e-9);
+  EXPECT_GT(first_tick_speed_of_follower("E", 0), 1.0);
+  // Head-on: the headway leaves the wish alone; the planes alone decide, as without it.
+  EXPECT_EQ(first_tick_speed_of_follower("W", 2), first_tick_speed_of_follower("W", 0));
+}
+
 // ORCA's contact planes keep the crowd overlap-free by themselves: the backoff finds nothing.
 TEST(Orca, TheBackoffHasNothingToDoAndEveryoneArrives) {
   std::size_t frozen = 0, arrived = 0;

@@ -7,13 +7,15 @@
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
-#include <map>
 #include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "commands.hpp"
 #include "crowddb/error.hpp"
 #include "io/import/importer.hpp"
+#include "io/overrides.hpp"
 #include "metrics/run.hpp"
 #include "util/stopwatch.hpp"
 
@@ -25,6 +27,7 @@ namespace fs = std::filesystem;
 struct BenchOptions {
   std::vector<std::string> paths;
   std::string model, csv;
+  std::vector<std::string> overrides;
   int threads = 0;
   double duration = -1;
   bool quiet = false;
@@ -81,6 +84,10 @@ std::string csv_field(const std::string& s) {
 }
 
 int bench(const BenchOptions& o) {
+  {  // a malformed --set is the command's error, not every row's
+    nlohmann::json probe = nlohmann::json::object();
+    io::apply_overrides(probe, o.overrides);
+  }
   std::vector<fs::path> files;
   for (const std::string& p : o.paths) {
     std::error_code ec;
@@ -106,7 +113,7 @@ int bench(const BenchOptions& o) {
     Row row;
     row.file = files[k].string();
     try {
-      Scenario sc = load_scenario(files[k]);
+      Scenario sc = load_scenario(files[k], LoadOptions{{}, o.overrides});
       if (!o.model.empty()) sc.config.steering.model = o.model;
       if (o.threads > 0) sc.config.threads = o.threads;
       if (o.duration >= 0) sc.ticks = sc.config.ticks_for(o.duration, 0);
@@ -133,9 +140,9 @@ int bench(const BenchOptions& o) {
     }
     if (tty) std::fprintf(stderr, "\r\033[K");
     if (!o.quiet)
-      std::fprintf(stderr, "[%zu/%zu] %s: %s\n", k + 1, files.size(), row.file.c_str(),
-                   row.error.empty() ? (row.s.all_arrived ? "everyone arrived" : "ran")
-                                     : row.error.c_str());
+      std::fprintf(
+          stderr, "[%zu/%zu] %s: %s\n", k + 1, files.size(), row.file.c_str(),
+          row.error.empty() ? (row.s.all_arrived ? "everyone arrived" : "ran") : row.error.c_str());
     rows.push_back(std::move(row));
   }
 
@@ -145,7 +152,8 @@ int bench(const BenchOptions& o) {
     << std::setw(7) << "agents" << std::setw(8) << "arrived" << std::setw(5) << "all"
     << std::setw(9) << "last [s]" << std::setw(9) << "overlaps" << std::setw(8) << "stalled"
     << std::setw(10) << "stall [s]" << std::setw(8) << "frozen" << std::setw(12) << "composite02"
-    << std::setw(9) << "wall [s]" << std::setw(9) << "ms/tick" << "\n";
+    << std::setw(9) << "wall [s]" << std::setw(9) << "ms/tick"
+    << "\n";
   std::size_t all_arrived = 0;
   for (const Row& r : rows) {
     std::string name = r.file;
@@ -183,11 +191,11 @@ int bench(const BenchOptions& o) {
         c << ",,,error,,,,,,,,,,,,,,,,,," << csv_field(r.error) << "\n";
         continue;
       }
-      c << s.format << "," << csv_field(s.name) << "," << s.model << ",ok," << s.agents_total
-        << "," << s.arrived << "," << (s.all_arrived ? 1 : 0) << ","
+      c << s.format << "," << csv_field(s.name) << "," << s.model << ",ok," << s.agents_total << ","
+        << s.arrived << "," << (s.all_arrived ? 1 : 0) << ","
         << (s.last_arrival_s >= 0 ? format_number(s.last_arrival_s) : "") << ","
-        << format_number(s.sim_seconds) << "," << s.ticks << "," << s.max_overlapping_pairs
-        << "," << s.max_obstacle_overlaps << "," << s.stalled_at_end << ","
+        << format_number(s.sim_seconds) << "," << s.ticks << "," << s.max_overlapping_pairs << ","
+        << s.max_obstacle_overlaps << "," << s.stalled_at_end << ","
         << format_number(s.max_stalled_s) << "," << s.frozen_agent_ticks << ","
         << s.steerbench.collisions << "," << format_number(s.steerbench.composite01) << ","
         << format_number(s.steerbench.composite02) << "," << format_number(s.wall_seconds) << ","
@@ -207,6 +215,9 @@ void add_bench_command(CLI::App& app, Action& action) {
   sub->add_option("paths", o.paths, "scenario files, or directories to search (recursively)")
       ->required();
   sub->add_option("--model", o.model, "steering model for every run: orca, cfsm, thesis");
+  sub->add_option("--set", o.overrides,
+                  "set a field of every scenario before it is checked: KEY=VALUE, KEY a dotted "
+                  "path (steering.orca.time_gap), VALUE JSON or a string; repeatable");
   sub->add_option("--csv", o.csv, "also write the table as CSV to FILE (\"-\": standard output)");
   sub->add_option("--threads", o.threads, "threads per run (results do not depend on it)")
       ->check(CLI::Range(1, 256));

@@ -8,6 +8,7 @@ namespace crowddb::cli {
 
 void add_convert_command(CLI::App& app, Action& action) {
   static std::string file, to = "json", out = "-", behavior;
+  static std::vector<std::string> overrides;
   auto* sub = app.add_subcommand(
       "convert",
       "write a SteerSuite, Menge or Vadere scenario as a crowddb scenario (docs/importers.md)");
@@ -16,9 +17,12 @@ void add_convert_command(CLI::App& app, Action& action) {
       ->check(CLI::IsMember({"json"}));
   sub->add_option("--out", out, "output file (default: standard output)");
   sub->add_option("--behavior", behavior, "Menge: the behaviour file of a scene");
+  sub->add_option("--set", overrides,
+                  "set a field of the scenario before it is checked: KEY=VALUE, KEY a dotted path "
+                  "(steering.orca.time_gap), VALUE JSON or a string; repeatable");
   sub->callback([&action] {
     action = [] {
-      const Converted c = convert_scenario(file, LoadOptions{behavior});
+      const Converted c = convert_scenario(file, LoadOptions{behavior, overrides});
       for (const std::string& w : c.warnings) std::cerr << "crowddb: warning: " << w << "\n";
       write_output(out, c.json);
       if (out != "-")

@@ -4,16 +4,16 @@
 #include <algorithm>
 #include <atomic>
 #include <csignal>
-#include <filesystem>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 
 #include "commands.hpp"
+#include "crowddb/error.hpp"
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
 #include "experiment/experiment.hpp"
-#include "crowddb/error.hpp"
 #include "io/trajectory.hpp"
 #include "metrics/run.hpp"
 #include "util/stopwatch.hpp"
@@ -39,6 +39,7 @@ struct RunOptions {
   double nudge_after = -1;
   std::string ftc, field, collisions;
   std::string behavior, summary_json;
+  std::vector<std::string> overrides;
 };
 
 }  // namespace
@@ -79,7 +80,7 @@ void apply_overrides(Scenario& sc, const RunOptions& o) {
 }
 
 int run(const RunOptions& o) {
-  Scenario sc = load_scenario(o.scenario, LoadOptions{o.behavior});
+  Scenario sc = load_scenario(o.scenario, LoadOptions{o.behavior, o.overrides});
   apply_overrides(sc, o);
   print_warnings(sc);
   // Check the summary's path before running: a typo should not cost the whole run.
@@ -159,6 +160,9 @@ void add_run_command(CLI::App& app, Action& action) {
   sub->add_option("--summary-json", o.summary_json,
                   "write the run's summary as JSON to FILE (\"-\": standard output, instead of "
                   "the text summary); keys in docs/summary-json.md");
+  sub->add_option("--set", o.overrides,
+                  "set a field of the scenario before it is checked: KEY=VALUE, KEY a dotted path "
+                  "(steering.orca.time_gap), VALUE JSON or a string; repeatable");
   sub->add_option("--ticks", o.ticks, "number of ticks (overrides the file)")
       ->check(CLI::Range(int64_t{0}, int64_t{1'000'000'000}));
   sub->add_option("--duration", o.duration, "simulated seconds (overrides the file)")
@@ -191,20 +195,24 @@ void add_run_command(CLI::App& app, Action& action) {
 
 void add_validate_command(CLI::App& app, Action& action) {
   static std::string file, behavior;
+  static std::vector<std::string> overrides;
   auto* sub = app.add_subcommand("validate", "check a scenario file without running it");
   sub->add_option("scenario", file, "scenario file (any supported format)")->required();
   sub->add_option("--behavior", behavior, "Menge: the behaviour file of a scene");
+  sub->add_option("--set", overrides,
+                  "set a field of the scenario before it is checked: KEY=VALUE, KEY a dotted path "
+                  "(steering.orca.time_gap), VALUE JSON or a string; repeatable");
   sub->callback([&action] {
     action = [] {
-      Scenario sc = load_scenario(file, LoadOptions{behavior});
+      Scenario sc = load_scenario(file, LoadOptions{behavior, overrides});
       print_warnings(sc);
       const std::size_t agents = sc.world.agents().size(), goals = sc.world.goals().size();
       const std::size_t circles = sc.world.circles().size(), polygons = sc.world.polygons().size();
       Simulation sim(std::move(sc.world), sc.config);  // also checks the access-path choices
-      std::cout << file << ": ok" << (sc.format == "crowddb" ? "" : " (" + sc.format + ")")
-                << ": " << (sc.name.empty() ? "(unnamed)" : sc.name) << ", " << agents
-                << " agents, " << goals << " goals, " << circles << " circles, " << polygons
-                << " polygons, " << sc.ticks << " ticks\n";
+      std::cout << file << ": ok" << (sc.format == "crowddb" ? "" : " (" + sc.format + ")") << ": "
+                << (sc.name.empty() ? "(unnamed)" : sc.name) << ", " << agents << " agents, "
+                << goals << " goals, " << circles << " circles, " << polygons << " polygons, "
+                << sc.ticks << " ticks\n";
       return 0;
     };
   });

@@ -2,6 +2,7 @@
 // it (load_scenario, convert_scenario, scenario_format).
 #include <cctype>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "crowddb/error.hpp"
@@ -9,6 +10,7 @@
 #include "io/import/menge.hpp"
 #include "io/import/steersuite.hpp"
 #include "io/import/vadere.hpp"
+#include "io/overrides.hpp"
 
 namespace crowddb::io {
 namespace {
@@ -54,6 +56,17 @@ void reject_unknown_xml(const std::filesystem::path& path, std::string_view text
               path.string() + ": an XML file with root <" + root +
                   "> is not a format crowddb reads (SteerSuite <SteerBenchTestCase>, Menge "
                   "<Project>, <Experiment> or <BFSM>; docs/importers.md)");
+}
+
+// A crowddb file's text with the options' overrides applied (the file is checked as it stands
+// first, so its own errors keep their line numbers).
+std::string with_overrides(const std::filesystem::path& path, const std::string& text,
+                           const LoadOptions& options) {
+  parse_scenario(text, path.string());
+  if (options.overrides.empty()) return text;
+  nlohmann::json doc = nlohmann::json::parse(text);
+  apply_overrides(doc, options.overrides);
+  return doc.dump(2) + "\n";
 }
 
 }  // namespace
@@ -126,9 +139,11 @@ Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& opt
       throw Error(Error::Kind::usage,
                   path.string() + ": a behaviour file goes with a Menge scene, not with a " +
                       "crowddb scenario");
-    return parse_scenario(text, path.string());
+    if (options.overrides.empty()) return parse_scenario(text, path.string());
+    return parse_scenario(io::with_overrides(path, text, options), path.string());
   }
   io::Imported im = imp->read(path, text, options);
+  io::apply_overrides(im.doc, options.overrides);
   Scenario sc = io::parse_document(im.doc.dump(2) + "\n", path.string(), &im.origins);
   sc.format = imp->name;
   sc.warnings.insert(sc.warnings.begin(), im.warnings.begin(), im.warnings.end());
@@ -140,10 +155,13 @@ Converted convert_scenario(const std::filesystem::path& path, const LoadOptions&
   const io::Importer* imp = io::importer_for(path, text);
   if (!imp) {
     io::reject_unknown_xml(path, text);
-    parse_scenario(text, path.string());  // a crowddb file converts to itself, if it is valid
-    return {text, "crowddb", {}};
+    // A crowddb file converts to itself (with the overrides), if it is valid.
+    const std::string json = io::with_overrides(path, text, options);
+    if (!options.overrides.empty()) parse_scenario(json, path.string());
+    return {json, "crowddb", {}};
   }
   io::Imported im = imp->read(path, text, options);
+  io::apply_overrides(im.doc, options.overrides);
   Converted c{im.doc.dump(2) + "\n", imp->name, std::move(im.warnings)};
   // Check that it loads, so that a converted file is never one that fails to run.
   io::parse_document(c.json, path.string(), &im.origins);
