@@ -16,6 +16,13 @@ namespace {
 
 void apply_overrides(nlohmann::json& doc, const std::vector<std::string>& overrides) {
   for (const std::string& item : overrides) {
+    try {  // a document holds UTF-8 only (writing it out would throw)
+      (void)nlohmann::json(item).dump();
+    } catch (const nlohmann::json::type_error&) {
+      const std::string shown =
+          nlohmann::json(item).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+      fail(shown.substr(1, shown.size() - 2), "not valid UTF-8");
+    }
     const auto eq = item.find('=');
     if (eq == std::string::npos || eq == 0) fail(item, "expected KEY=VALUE");
     const std::string key = item.substr(0, eq), text = item.substr(eq + 1);

@@ -38,6 +38,7 @@ TEST(Overrides, MalformedOverridesNameThemselves) {
       {"name.x=1", "'name' is not an object"},
       {"groups.x=1", "'x' indexes an array"},
       {"groups.4.count=1", "index 4 is past the array's end (1 elements)"},
+      {"name=\xC3(", "not valid UTF-8"},
   };
   for (const auto& [item, message] : cases) {
     json doc = json::parse(R"({"name": "n", "groups": [{"count": 5}]})");
