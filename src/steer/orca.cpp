@@ -49,9 +49,10 @@
 // that goes the same way (preferred directions within 60 degrees) or stands: the collision-free
 // speed model's speed rule (cfsm.cpp), applied to the wish only, so the planes still decide.
 // People coming towards or across are left to the planes (capping for them froze counter-flows).
-// Measured on SteerSuite's 101 test cases with T = 0.5 s: office-complex 610 -> 1000 of 1000
-// arrived, bottleneck-squeeze 275 -> 431 of 1000; free-tickets2 47 -> 30 of 100,
-// bottleneck-evacuation 16 -> 11 of 200 (docs/steering.md). Off by default for that reason.
+// Measured on SteerSuite's 101 test cases with T = 0.5 s: 12,947 instead of 11,945 of 20,312
+// agents arrive (office-complex 610 -> 1000 of 1000), but bottleneck-evacuation 16 -> 11 of 200
+// and the longest stalls of the concentric circles and airport-5000 grow (docs/steering.md).
+// Off by default for that reason.
 //
 // An agent already overlapping a neighbour (spawned so) gets the horizon plane that separates them
 // within one tick (horizon dt), as in the paper, and a contact plane that keeps them from getting

@@ -1,6 +1,7 @@
 // `crowddb bench`, `crowddb convert` and `crowddb run --summary-json` end to end.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "support/cli.hpp"
@@ -105,6 +106,23 @@ TEST(Set, OverridesReachEveryFormatAndBadValuesNameTheirField) {
   const CliResult usage = run_cli("bench " + sc.string() + " --set steering", dir);
   EXPECT_EQ(usage.status, 2);
   EXPECT_NE(usage.err.find("--set 'steering': expected KEY=VALUE"), std::string::npos) << usage.err;
+}
+
+// A folder laid out as Menge's examples (projects beside folders holding their scene, behaviour
+// and viewer files) gives one row per project: the scenes the projects name, the behaviours and
+// the <View> files are not scenarios of their own.
+TEST(Bench, MengeFoldersGiveOneRowPerProject) {
+  TempDir dir;
+  namespace fs = std::filesystem;
+  fs::copy(fs::path(CROWDDB_SOURCE_DIR) / "tests/data/import/menge/core", dir / "core",
+           fs::copy_options::recursive);
+  dir.write("core/4square/4squareV.xml", "<?xml version=\"1.0\"?>\n<View width=\"640\"/>\n");
+  const CliResult r = run_cli("bench " + (dir / "core").string() + " --duration 1 --quiet", dir);
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("3 scenarios: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("0 failed"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("4squareS.xml"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("4squareV.xml"), std::string::npos) << r.out;
 }
 
 TEST(Bench, OneRowPerScenarioAndErrorsDoNotStopTheOthers) {

@@ -10,6 +10,8 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
 #include <sstream>
 
 #include "commands.hpp"
@@ -39,8 +41,18 @@ bool scenario_extension(const fs::path& p) {
   return e == ".json" || e == ".xml" || e == ".scenario";
 }
 
+// The scene a Menge project names (its `scene` attribute, relative to the project), if any.
+fs::path project_scene(const fs::path& project, const std::string& head) {
+  static const std::regex scene(R"re(\bscene\s*=\s*"([^"]*)")re");
+  std::smatch m;
+  if (!std::regex_search(head, m, scene)) return {};
+  std::error_code ec;
+  return fs::weakly_canonical(project.parent_path() / m[1].str(), ec);
+}
+
 // The files a directory contributes: scenarios of every format, but of Menge only what runs on
-// its own: projects, and scenes in folders without a project (behaviour files never).
+// its own: projects, and scenes that no project names and whose folder has no project (never
+// behaviour files or the viewer's <View> files).
 std::vector<fs::path> files_in(const fs::path& dir) {
   std::vector<fs::path> all;
   for (const auto& e : fs::recursive_directory_iterator(dir))
@@ -48,16 +60,23 @@ std::vector<fs::path> files_in(const fs::path& dir) {
   std::sort(all.begin(), all.end());
   std::vector<fs::path> out;
   std::map<fs::path, bool> has_project;
+  std::set<fs::path> named_scenes;
   std::vector<std::pair<fs::path, std::string>> roots;
   for (const fs::path& p : all) {
     std::string head = io::read_file(p).substr(0, 4096);
     const std::string root = io::xml_root_name(head);
     roots.emplace_back(p, root);
-    if (root == "Project") has_project[p.parent_path()] = true;
+    if (root == "Project") {
+      has_project[p.parent_path()] = true;
+      if (fs::path scene = project_scene(p, head); !scene.empty()) named_scenes.insert(scene);
+    }
   }
   for (const auto& [p, root] : roots) {
-    if (root == "BFSM") continue;
-    if (root == "Experiment" && has_project.count(p.parent_path())) continue;
+    if (root == "BFSM" || root == "View") continue;
+    std::error_code ec;
+    if (root == "Experiment" &&
+        (has_project.count(p.parent_path()) || named_scenes.count(fs::weakly_canonical(p, ec))))
+      continue;
     out.push_back(p);
   }
   return out;
