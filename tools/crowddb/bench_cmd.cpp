@@ -10,7 +10,6 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <set>
 #include <sstream>
 
@@ -43,11 +42,22 @@ bool scenario_extension(const fs::path& p) {
 
 // The scene a Menge project names (its `scene` attribute, relative to the project), if any.
 fs::path project_scene(const fs::path& project, const std::string& head) {
-  static const std::regex scene(R"re(\bscene\s*=\s*"([^"]*)")re");
-  std::smatch m;
-  if (!std::regex_search(head, m, scene)) return {};
-  std::error_code ec;
-  return fs::weakly_canonical(project.parent_path() / m[1].str(), ec);
+  auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
+  for (std::size_t at = head.find("scene"); at != std::string::npos;
+       at = head.find("scene", at + 1)) {
+    if (at == 0 || !space(head[at - 1])) continue;
+    std::size_t k = at + 5;
+    while (k < head.size() && space(head[k])) ++k;
+    if (k >= head.size() || head[k] != '=') continue;
+    ++k;
+    while (k < head.size() && space(head[k])) ++k;
+    if (k >= head.size() || (head[k] != '"' && head[k] != '\'')) continue;
+    const auto end = head.find(head[k], k + 1);
+    if (end == std::string::npos) return {};
+    std::error_code ec;
+    return fs::weakly_canonical(project.parent_path() / head.substr(k + 1, end - k - 1), ec);
+  }
+  return {};
 }
 
 // The files a directory contributes: scenarios of every format, but of Menge only what runs on
