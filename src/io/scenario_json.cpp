@@ -231,6 +231,9 @@ std::string line_col(std::string_view text, std::size_t byte) {
   return std::to_string(line) + ":" + std::to_string(col);
 }
 
+// Overlapping spawned pairs are counted up to this many (a warning, not a list).
+constexpr uint64_t kOverlapCountCap = 1'000'000;
+
 // Spatial hash of placed discs, for overlap-free placement and overlap warnings.
 class DiscGrid {
  public:
@@ -243,10 +246,16 @@ class DiscGrid {
     rmax_ = std::max(rmax_, r);
     cells_[key(cell_of(x), cell_of(y))].push_back(i);
   }
-  // Index of a placed disc overlapping (x, y, r) with the extra gap, or npos.
-  std::size_t overlapping(double x, double y, double r, double gap = 0,
-                          std::size_t skip = SIZE_MAX) const {
+  // Does a placed disc overlap (x, y, r) with the extra gap? A window wider than the discs are
+  // many (a huge gap) scans the discs instead of the cells: work stays bounded by the input.
+  bool any_overlap(double x, double y, double r, double gap) const {
     const double reach = r + rmax_ + gap;
+    const double side = 2 * reach / cell_ + 2;  // cells per side of the window
+    if (!(side * side <= static_cast<double>(xs_.size()))) {
+      for (std::size_t j = 0; j < xs_.size(); ++j)
+        if (discs_overlap(xs_[j] - x, ys_[j] - y, rs_[j] + r + gap)) return true;
+      return false;
+    }
     const int64_t x0 = cell_of(x - reach), x1 = cell_of(x + reach);
     const int64_t y0 = cell_of(y - reach), y1 = cell_of(y + reach);
     for (int64_t cx = x0; cx <= x1; ++cx)
@@ -254,30 +263,48 @@ class DiscGrid {
         auto it = cells_.find(key(cx, cy));
         if (it == cells_.end()) continue;
         for (std::size_t j : it->second)
-          if (j != skip && discs_overlap(xs_[j] - x, ys_[j] - y, rs_[j] + r + gap)) return j;
+          if (discs_overlap(xs_[j] - x, ys_[j] - y, rs_[j] + r + gap)) return true;
       }
-    return SIZE_MAX;
+    return false;
   }
-  // Overlapping pairs (i < j) among the placed discs.
-  std::vector<std::pair<std::size_t, std::size_t>> pairs() const {
-    std::vector<std::pair<std::size_t, std::size_t>> out;
-    for (std::size_t i = 0; i < xs_.size(); ++i) {
+  // Overlapping pairs (i < j) among the placed discs: how many (counting stops at `cap`, so a
+  // pile of 10^5 discs on one spot costs no more than the cap) and the first in (i, j) order.
+  struct PairCount {
+    uint64_t count = 0;
+    bool capped = false, found = false;
+    std::size_t first_i = 0, first_j = 0;
+  };
+  PairCount count_pairs(uint64_t cap) const {
+    PairCount out;
+    for (std::size_t i = 0; i < xs_.size() && !out.capped; ++i) {
       const double reach = rs_[i] + rmax_;
+      std::size_t first_j = SIZE_MAX;
       for (int64_t cx = cell_of(xs_[i] - reach); cx <= cell_of(xs_[i] + reach); ++cx)
         for (int64_t cy = cell_of(ys_[i] - reach); cy <= cell_of(ys_[i] + reach); ++cy) {
           auto it = cells_.find(key(cx, cy));
           if (it == cells_.end()) continue;
           for (std::size_t j : it->second)
-            if (j > i && discs_overlap(xs_[j] - xs_[i], ys_[j] - ys_[i], rs_[i] + rs_[j]))
-              out.push_back({i, j});
+            if (j > i && discs_overlap(xs_[j] - xs_[i], ys_[j] - ys_[i], rs_[i] + rs_[j])) {
+              first_j = std::min(first_j, j);
+              if (++out.count >= cap) out.capped = true;
+            }
         }
+      if (first_j != SIZE_MAX && !out.found) {
+        out.found = true;
+        out.first_i = i;
+        out.first_j = first_j;
+      }
     }
-    std::sort(out.begin(), out.end());
     return out;
   }
 
  private:
-  int64_t cell_of(double v) const { return static_cast<int64_t>(std::floor(v / cell_)); }
+  // Clamped: a cell number beyond int64 (positions near 1e308) would be undefined behaviour.
+  int64_t cell_of(double v) const {
+    const double c = std::floor(v / cell_);
+    if (!(c > -0x1p62)) return c == c ? -(int64_t{1} << 62) : 0;
+    return c < 0x1p62 ? static_cast<int64_t>(c) : int64_t{1} << 62;
+  }
   static uint64_t key(int64_t cx, int64_t cy) {
     return (static_cast<uint64_t>(cx) * 0x9e3779b97f4a7c15ull) ^ static_cast<uint64_t>(cy);
   }
@@ -675,14 +702,14 @@ struct Loader {
                               std::max(region[0] + s.radius, region[2] - s.radius));
             s.y = rng.uniform(region[1] + s.radius,
                               std::max(region[1] + s.radius, region[3] - s.radius));
-            ok = placed->overlapping(s.x, s.y, s.radius, gap) == SIZE_MAX &&
+            ok = !placed->any_overlap(s.x, s.y, s.radius, gap) &&
                  !blocked_by_obstacle(s.x, s.y, s.radius, gap);
           }
           if (!ok)
             pl.fail("", "could not place agent " + std::to_string(i + 1) + " of " +
                             std::to_string(count) + " without overlaps in " +
                             std::to_string(attempts) +
-                            " attempts (region too crowded: enlarge it, lower count or radius)");
+                            " attempts (region too crowded: enlarge it, lower count, radius or gap)");
         } else if (type == "circle") {
           const double a =
               2 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(count);
@@ -806,11 +833,12 @@ struct Loader {
     for (const AgentSpec& s : agents) rmax = std::max(rmax, s.radius);
     DiscGrid all(2 * rmax);
     for (const AgentSpec& s : agents) all.add(s.x, s.y, s.radius);
-    const auto pairs = all.pairs();
-    if (!pairs.empty())
+    const DiscGrid::PairCount pairs = all.count_pairs(kOverlapCountCap);
+    if (pairs.found)
       sc.warnings.push_back(
-          "agents spawned overlapping: " + std::to_string(pairs.size()) + " pairs (first: agents " +
-          std::to_string(pairs[0].first) + " and " + std::to_string(pairs[0].second) +
+          "agents spawned overlapping: " + std::string(pairs.capped ? "at least " : "") +
+          std::to_string(pairs.count) + " pairs (first: agents " + std::to_string(pairs.first_i) +
+          " and " + std::to_string(pairs.first_j) +
           " in spawn order); they are allowed to separate but not to overlap deeper");
     std::size_t blocked = 0, outside = 0;
     const Bounds& b = sc.world.bounds();

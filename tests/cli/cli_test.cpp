@@ -27,6 +27,33 @@ TEST(Cli, UsageErrorsExitWith2) {
   }
 }
 
+// Numbers on the command line: NaN, infinities and fractions where a whole number is due are
+// usage errors naming the option and the bound in plain words.
+TEST(Cli, BadNumbersAreUsageErrorsInPlainWords) {
+  TempDir dir;
+  const auto sc = dir.write("walk.json", R"({"bounds": [0, 0, 10, 10], "duration": 1,
+    "goals": [{"name": "g", "x": 8, "y": 5}], "agents": [{"x": 2, "y": 5, "goal": "g"}]})");
+  const auto agents = dir.write("a.csv", "id,x,y,vx,vy,radius\n1,0,0,0,0,1\n");
+  const std::string run = "run " + sc.string() + " --no-output --quiet ";
+  const std::pair<std::string, std::string> cases[] = {
+      {run + "--duration nan", "--duration: must be a finite number >= 0 and <= 1e+09 (got nan)"},
+      {run + "--nudge-after inf", "--nudge-after: must be a finite number >= 0"},
+      {run + "--every 0", "--every: must be a whole number >= 1 (got 0)"},
+      {run + "--every 2.5", "--every: must be a whole number >= 1 (got 2.5)"},
+      {run + "--threads 300", "--threads: must be a whole number from 1 to 256 (got 300)"},
+      {"query ftc --agents " + agents.string() + " --horizon nan",
+       "--horizon: must be a finite number >= 0 (got nan)"},
+      {"bench " + sc.string() + " --duration -1", "--duration: must be a finite number >= 0"},
+  };
+  for (const auto& [args, message] : cases) {
+    const CliResult r = run_cli(args, dir);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << args << ": " << r.err;
+  }
+  EXPECT_EQ(run_cli(run + "--duration 0.5 --every 2", dir).status, 0);
+}
+
 TEST(Cli, UnknownMethodIsAUsageError) {
   TempDir dir;
   const auto agents = dir.write("a.csv", "id,x,y,vx,vy,radius\n1,0,0,0,0,1\n");

@@ -246,6 +246,57 @@ TEST(ScenarioJson, CircleWithAntipodalGoalsAndOverlapWarning) {
   EXPECT_NE(sc.warnings[0].find("overlapping"), std::string::npos);
 }
 
+// The overlap warning counts pairs exactly (brute force beside it) and names the first one.
+TEST(ScenarioJson, OverlapWarningCountsPairsExactly) {
+  const std::string text = R"({"bounds": [0, 0, 100, 100], "seed": 3,
+    "groups": [{"count": 120, "radius": [0.2, 0.6], "placement": {"type": "circle", "center": [50, 50], "radius": 4},
+                "goals": {"assign": "antipodal"}}]})";
+  const Scenario sc = parse_scenario(text, "s.json");
+  const AgentTable& t = sc.world.agents();
+  std::size_t pairs = 0, fi = 0, fj = 0;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    for (std::size_t j = i + 1; j < t.size(); ++j)
+      if (std::hypot(t.x[i] - t.x[j], t.y[i] - t.y[j]) < t.radius[i] + t.radius[j] && !pairs++) {
+        fi = i;
+        fj = j;
+      }
+  ASSERT_GT(pairs, 0u);
+  ASSERT_EQ(sc.warnings.size(), 1u);
+  EXPECT_NE(sc.warnings[0].find("overlapping: " + std::to_string(pairs) + " pairs (first: agents " +
+                                std::to_string(fi) + " and " + std::to_string(fj) + " "),
+            std::string::npos)
+      << sc.warnings[0];
+}
+
+// Work is bounded by the input, not by its numbers: 20,000 agents on one spot (2 * 10^8 pairs)
+// are counted up to a cap; a huge placement gap fails at once instead of scanning 10^18 cells.
+TEST(ScenarioJson, HugePilesAndGapsStayCheap) {
+  const Scenario pile = parse_scenario(R"({"bounds": [0, 0, 100, 100],
+    "groups": [{"count": 20000, "radius": 0.25, "placement": {"type": "circle", "center": [50, 50], "radius": 0.01},
+                "goals": {"assign": "antipodal"}}]})",
+                                       "s.json");
+  ASSERT_EQ(pile.warnings.size(), 1u);
+  EXPECT_NE(pile.warnings[0].find("overlapping: at least 1"), std::string::npos)
+      << pile.warnings[0];
+  for (const char* gap : {"1e9", "1e308"}) {
+    const std::string e = error_of(
+        std::string(R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "x": 5, "y": 5}],
+      "groups": [{"count": 10, "goal": "g", "placement": {"type": "uniform", "region": [0, 0, 100, 100], "gap": )") +
+        gap + "}}]}");
+    EXPECT_NE(e.find("/groups/0/placement: could not place agent 2 of 10"), std::string::npos) << e;
+  }
+  // A gap wider than the agents are many scans the agents instead of the cells: the gap holds.
+  const Scenario wide = parse_scenario(
+      R"({"bounds": [0, 0, 200, 200], "seed": 5, "goals": [{"name": "g", "x": 5, "y": 5}],
+      "groups": [{"count": 6, "goal": "g", "radius": 0.25, "placement": {"type": "uniform", "region": [0, 0, 200, 200], "gap": 30}}]})",
+      "s.json");
+  const AgentTable& t = wide.world.agents();
+  ASSERT_EQ(t.size(), 6u);
+  for (std::size_t i = 0; i < t.size(); ++i)
+    for (std::size_t j = i + 1; j < t.size(); ++j)
+      EXPECT_GE(std::hypot(t.x[i] - t.x[j], t.y[i] - t.y[j]), 30.5);
+}
+
 TEST(ScenarioJson, ShippedScenariosLoadWithoutWarnings) {
   for (const char* name : {"airport", "circle", "crossing", "bottleneck"}) {
     const Scenario sc =

@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "crowddb/error.hpp"
 #include "io/import/importer.hpp"
@@ -249,9 +250,9 @@ void add_bench_command(CLI::App& app, Action& action) {
                   "path (steering.orca.time_gap), VALUE JSON or a string; repeatable");
   sub->add_option("--csv", o.csv, "also write the table as CSV to FILE (\"-\": standard output)");
   sub->add_option("--threads", o.threads, "threads per run (results do not depend on it)")
-      ->check(CLI::Range(1, 256));
+      ->check(cli_checks::whole(1, 256));
   sub->add_option("--duration", o.duration, "simulated seconds per run (overrides the files)")
-      ->check(CLI::Range(0.0, 1e9));
+      ->check(cli_checks::finite(0, 1e9));
   sub->add_flag("--quiet", o.quiet, "no progress and no warnings on stderr");
   sub->callback([&action] { action = [] { return bench(o); }; });
 }

@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "crowddb/error.hpp"
 #include "experiment/experiment.hpp"
@@ -20,7 +21,7 @@ void add_experiment_command(CLI::App& app, Action& action) {
       ->required();
   sub->add_option("--out", out, "output folder (created if missing)")->required();
   sub->add_flag("--quick", opts.quick, "small sizes, for tests and a first look");
-  sub->add_option("--threads", opts.threads, "threads")->check(CLI::Range(1, 256));
+  sub->add_option("--threads", opts.threads, "threads")->check(cli_checks::whole(1, 256));
   sub->add_option("--seed", opts.seed, "base seed");
   sub->callback([&action] {
     action = [] {

@@ -3,6 +3,7 @@
 #include <limits>
 #include <numeric>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "crowddb/query.hpp"
 #include "io/csv_tables.hpp"
@@ -22,7 +23,7 @@ void add_common(CLI::App* sub, Common& c, bool method_required = false) {
                             "access path: auto, naive or an index (see --help of run)");
   if (method_required) m->required();
   sub->add_option("--threads", c.threads, "threads (the answer does not depend on it)")
-      ->check(CLI::Range(1, 256));
+      ->check(cli_checks::whole(1, 256));
   sub->add_option("--out", c.out, "output file ('-' for stdout)");
 }
 
@@ -61,7 +62,7 @@ void add_query_commands(CLI::App& app, Action& action) {
   add_common(ftc, fc);
   ftc->add_option("--horizon", horizon, "look-ahead T in ticks; collisions after T are ignored")
       ->required()
-      ->check(CLI::NonNegativeNumber);
+      ->check(cli_checks::non_negative());
   ftc->callback([&action] {
     action = [] {
       Inputs in = load(fc, ObstacleCharges::centres);
@@ -105,18 +106,18 @@ void add_query_commands(CLI::App& app, Action& action) {
   field->add_option("--A", spec.A, "kernel scale A")->capture_default_str();
   field->add_option("--k", spec.k, "exp kernel rate k")->capture_default_str();
   field->add_option("--frames", spec.radial_frames, "rotated frames of the radial metric")
-      ->check(CLI::Range(1, 16))
+      ->check(cli_checks::whole(1, 16))
       ->capture_default_str();
   field
       ->add_option("--floor", floor_value,
                    "inv kernel: distance floor (default: a tenth of the smallest radius)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli_checks::positive());
   static double fd_step = 0;
   field
       ->add_option("--fd-step", fd_step,
                    "gradient by the thesis's forward finite differences with this step instead of "
                    "analytically")
-      ->check(CLI::PositiveNumber);
+      ->check(cli_checks::positive());
   field->callback([&action] {
     action = [] {
       Inputs in = load(pc, ObstacleCharges::centres);

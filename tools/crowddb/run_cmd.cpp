@@ -9,6 +9,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "crowddb/error.hpp"
 #include "crowddb/scenario.hpp"
@@ -164,26 +165,27 @@ void add_run_command(CLI::App& app, Action& action) {
                   "set a field of the scenario before it is checked: KEY=VALUE, KEY a dotted path "
                   "(steering.orca.time_gap), VALUE JSON or a string; repeatable");
   sub->add_option("--ticks", o.ticks, "number of ticks (overrides the file)")
-      ->check(CLI::Range(int64_t{0}, int64_t{1'000'000'000}));
+      ->check(cli_checks::whole(0, 1'000'000'000));
   sub->add_option("--duration", o.duration, "simulated seconds (overrides the file)")
-      ->check(CLI::Range(0.0, 1e9))
+      ->check(cli_checks::finite(0, 1e9))
       ->excludes("--ticks");
   sub->add_option("--model", o.model, "steering model: orca, cfsm, thesis (overrides the file)");
   sub->add_option("--out", o.out, "trajectory output: FILE.sqlite (JuPedSim format) or FILE.csv");
   sub->add_option("--format", o.format, "output format when the extension does not say")
       ->check(CLI::IsMember({"sqlite", "csv"}));
   sub->add_flag("--no-output", o.no_output, "write no trajectories");
-  sub->add_option("--every", o.every, "write every n-th frame")->check(CLI::PositiveNumber);
+  sub->add_option("--every", o.every, "write every n-th frame")
+      ->check(cli_checks::whole_at_least(1));
   sub->add_flag("--explain", o.explain, "print the tick's query plan and exit");
   sub->add_flag("--explain-analyze", o.analyze,
                 "run, then print the plan with rows and time per operator");
   sub->add_option("--threads", o.threads, "threads (results do not depend on it)")
-      ->check(CLI::Range(1, 256));
+      ->check(cli_checks::whole(1, 256));
   sub->add_flag("--no-backoff", o.no_backoff, "switch the backoff freeze loop off");
   sub->add_option("--nudge-after", o.nudge_after,
                   "sidestep agents frozen this many seconds in a row; 0 = never (overrides the "
                   "file's nudge_after)")
-      ->check(CLI::Range(0.0, 1e6));
+      ->check(cli_checks::finite(0, 1e6));
   sub->add_flag("--no-navigation", o.no_navigation,
                 "switch the path service off (agents steer straight at their goals)");
   sub->add_option("--ftc", o.ftc, "first-to-collide access path (auto, naive, ...)");

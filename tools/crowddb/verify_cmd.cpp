@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "crowddb/error.hpp"
 #include "crowddb/simulation.hpp"
@@ -139,7 +140,7 @@ void add_verify_command(CLI::App& app, Action& action) {
   sub->add_option("--case", o.cases, "run only this case (repeatable; --list shows them)");
   sub->add_option("--csv", o.csv, "also write every check as CSV to this file");
   sub->add_option("--threads", o.threads, "threads (results do not depend on it)")
-      ->check(CLI::Range(1, 256));
+      ->check(cli_checks::whole(1, 256));
   sub->add_option("--write", o.write_dir,
                   "write each case's scenario files into this folder instead of running them");
   sub->add_flag("--list", o.list, "list the cases and exit");

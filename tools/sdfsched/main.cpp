@@ -9,6 +9,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "cli_checks.hpp"
 #include "sdf/checker.hpp"
 #include "sdf/claims.hpp"
 #include "sdf/graph.hpp"
@@ -133,11 +134,11 @@ struct RunFlags {
         ->check(CLI::IsMember({"floor", "one"}));
     cmd->add_option("--max-decisions", max_decisions,
                     "online: stop with outcome `limit` after this many decisions")
-        ->check(CLI::PositiveNumber);
+        ->check(crowddb::cli_checks::whole_at_least(1));
     cmd->add_option("--growth-periods", growth_periods,
                     "online: a channel holding more than its delay plus this many periods' tokens "
                     "is `unbounded`")
-        ->check(CLI::PositiveNumber);
+        ->check(crowddb::cli_checks::whole_at_least(1));
     cmd->add_option("--max-list", max_list, "list firings/runs only up to this many");
   }
   sdf::OnlineRunOptions options(bool bounded) const {
@@ -538,7 +539,8 @@ int main(int argc, char** argv) {
   uint64_t graphs = 100, seed = 1;
   std::string save;
   auto* cl = app.add_subcommand("claims", "test the thesis's claims on random consistent graphs");
-  cl->add_option("--graphs", graphs, "graphs per class")->check(CLI::PositiveNumber);
+  cl->add_option("--graphs", graphs, "graphs per class")
+      ->check(crowddb::cli_checks::whole_at_least(1));
   cl->add_option("--seed", seed, "random seed");
   cl->add_option("--save-counterexamples", save, "directory for the smallest counter-examples");
   cl->add_flag("--json", json, "JSON output");
