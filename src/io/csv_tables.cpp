@@ -13,11 +13,11 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <unordered_set>
 
 #include "crowddb/error.hpp"
+#include "util/read_file.hpp"
 
 namespace crowddb::io {
 namespace {
@@ -27,14 +27,7 @@ std::string where(const std::string& path, unsigned line, const char* field) {
 }
 
 std::string read_file(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw Error(Error::Kind::io, path.string() + ": is a directory");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw Error(Error::Kind::io, path.string() + ": cannot open file");
-  std::ostringstream os;
-  os << f.rdbuf();
-  return os.str();
+  return read_input_file(path);
 }
 
 // One-line message of a library error, without its trailing period.

@@ -7,12 +7,12 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 
 namespace sdf {
 
 namespace {
+
+constexpr uint64_t kMaxGraphBytes = uint64_t{1} << 30;  // 1 GiB
 
 bool ends_with(const std::string& s, const char* suffix) {
   const size_t n = std::strlen(suffix);
@@ -48,14 +48,28 @@ Graph parse_graph_text(std::string_view text, const std::string& path) {
 
 Graph read_graph_file(const std::string& path) {
   // A regular file is mapped rather than copied into a string (a 100 MB file costs a copy and
-  // the page faults of a fresh buffer otherwise); anything else (a pipe, an empty file) is read.
+  // the page faults of a fresh buffer otherwise); a pipe is read. Devices (/dev/zero), sockets
+  // and directories are refused, and nothing longer than kMaxGraphBytes is read.
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) throw Error(Error::Kind::io, path + ": cannot open (" + std::strerror(errno) + ")");
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
   struct stat st {};
-  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+  if (::fstat(fd, &st) != 0)
+    throw Error(Error::Kind::io, path + ": cannot read (" + std::strerror(errno) + ")");
+  if (S_ISDIR(st.st_mode)) throw Error(Error::Kind::io, path + ": is a directory");
+  if (!S_ISREG(st.st_mode) && !S_ISFIFO(st.st_mode))
+    throw Error(Error::Kind::io, path + ": not a regular file (a device or socket)");
+  const auto too_long = [&] {
+    return Error(Error::Kind::io, path + ": longer than " + std::to_string(kMaxGraphBytes >> 20) +
+                                      " MiB, the limit for a graph file");
+  };
+  if (S_ISREG(st.st_mode) && static_cast<uint64_t>(st.st_size) > kMaxGraphBytes) throw too_long();
+  if (S_ISREG(st.st_mode) && st.st_size > 0) {
     const auto size = static_cast<size_t>(st.st_size);
     void* p = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
-    ::close(fd);
     if (p == MAP_FAILED)
       throw Error(Error::Kind::io, path + ": cannot map (" + std::strerror(errno) + ")");
     struct Unmap {
@@ -65,13 +79,17 @@ Graph read_graph_file(const std::string& path) {
     } unmap{p, size};
     return parse_graph_text(std::string_view(static_cast<const char*>(p), size), path);
   }
-  ::close(fd);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(Error::Kind::io, path + ": cannot open (" + std::strerror(errno) + ")");
-  std::ostringstream buf;
-  buf << in.rdbuf();
-  if (in.bad()) throw Error(Error::Kind::io, path + ": read error");
-  return parse_graph_text(std::move(buf).str(), path);
+  std::string text;
+  char buf[1 << 16];
+  while (true) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw Error(Error::Kind::io, path + ": read error (" + std::strerror(errno) + ")");
+    if (n == 0) break;
+    if (text.size() + static_cast<size_t>(n) > kMaxGraphBytes) throw too_long();
+    text.append(buf, static_cast<size_t>(n));
+  }
+  return parse_graph_text(std::move(text), path);
 }
 
 std::string write_dot(const Graph& g) {

@@ -88,6 +88,17 @@ TEST(Cli, BadCsvFilesExitWith1NamingFileLineAndField) {
     EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.text << " -> " << r.err;
     EXPECT_TRUE(r.out.empty());
   }
+  // Devices and directories are refused at once (reading /dev/zero would never end).
+  const std::string device_cases[] = {"validate /dev/zero", "run /dev/zero",
+                                      "query collisions --agents /dev/zero",
+                                      "validate " + dir.path().string()};
+  for (const std::string& args : device_cases) {
+    const CliResult r = run_cli(args, dir);
+    EXPECT_EQ(r.status, 1) << args << ": " << r.err;
+    EXPECT_TRUE(r.err.find("not a regular file") != std::string::npos ||
+                r.err.find("is a directory") != std::string::npos)
+        << args << ": " << r.err;
+  }
   const CliResult missing =
       run_cli("query collisions --agents " + (dir / "nope.csv").string(), dir);
   EXPECT_EQ(missing.status, 1);

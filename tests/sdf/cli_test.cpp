@@ -162,6 +162,8 @@ TEST(SdfschedCli, BadInputAndUsage) {
       {"repetitions " + graph("unconnected_port_crlf.xml"), 1,
        "unconnected_port_crlf.xml:12: port 'spare'"},
       {"repetitions /nonexistent.json", 1, "/nonexistent.json: cannot open"},
+      {"repetitions /dev/zero", 1, "/dev/zero: not a regular file"},
+      {"claims --graphs 0", 2, "--graphs: must be a whole number >= 1 (got 0)"},
       {"schedule " + graph("cd2dat.json") + " --policy fastest", 2, "--policy"},
       {"schedule", 2, "graph"},
       {"frobnicate", 2, ""},

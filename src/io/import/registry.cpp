@@ -1,7 +1,6 @@
 // The importers, how a file's format is recognised, and the loading entry points that dispatch on
 // it (load_scenario, convert_scenario, scenario_format).
 #include <cctype>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -11,6 +10,7 @@
 #include "io/import/steersuite.hpp"
 #include "io/import/vadere.hpp"
 #include "io/overrides.hpp"
+#include "util/read_file.hpp"
 
 namespace crowddb::io {
 namespace {
@@ -109,15 +109,7 @@ std::string xml_root_name(std::string_view t) {
 }
 
 std::string read_file(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw Error(Error::Kind::io, path.string() + ": is a directory");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw Error(Error::Kind::io, path.string() + ": cannot open file");
-  std::ostringstream os;
-  os << f.rdbuf();
-  if (f.bad()) throw Error(Error::Kind::io, path.string() + ": read error");
-  return os.str();
+  return read_input_file(path);
 }
 
 }  // namespace crowddb::io
