@@ -101,6 +101,9 @@ struct PolygonObstacle {
   double charge = 1;
 };
 
+// [m] The largest world coordinate: 10^9 m, far beyond any site (UTM northings reach 10^7).
+inline constexpr double kMaxCoordinate = 1e9;
+
 struct Bounds {
   double xmin = 0, ymin = 0, xmax = 0, ymax = 0;
   double width() const { return xmax - xmin; }
@@ -161,6 +164,8 @@ class World {
   uint32_t add_source(Source source);
   uint32_t add_obstacle(const CircleObstacle& obstacle);
   uint32_t add_obstacle(PolygonObstacle obstacle);
+  // Throws InvalidRow unless xmin < xmax, ymin < ymax and every coordinate lies within
+  // ±kMaxCoordinate (beyond it, distances and navigation meshes lose all precision or overflow).
   void set_bounds(Bounds bounds);
 
   // ---- agent changes: validated now, applied by apply_pending() (start of the next tick) ----

@@ -143,6 +143,12 @@ void World::set_bounds(Bounds b) {
   require_finite("bounds", b.ymax);
   if (!(b.xmax > b.xmin) || !(b.ymax > b.ymin))
     throw InvalidRow("bounds", "bounds must have xmax > xmin and ymax > ymin");
+  for (double v : {b.xmin, b.ymin, b.xmax, b.ymax})
+    if (std::abs(v) > kMaxCoordinate) {
+      std::ostringstream os;
+      os << "coordinates must lie within +-1e9 m (got " << v << ")";
+      throw InvalidRow("bounds", os.str());
+    }
   bounds_ = b;
 }
 

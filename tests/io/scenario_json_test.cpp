@@ -165,6 +165,8 @@ TEST(ScenarioJson, InvalidFieldsNameTheirPointer) {
        "/steering/thesis/potential/kernel"},
       {head + R"("steering": {"orca": {"first_share": 1}}})", "/steering/orca/first_share"},
       {head + R"("steering": {"orca": {"time_gap": -0.5}}})", "/steering/orca/time_gap"},
+      {R"({"bounds": [-1e308, -1e308, 1e308, 1e308]})",
+       "/bounds: coordinates must lie within +-1e9 m (got -1e+308)"},
       {head + R"("steering": {"cfsm": {"time_gap": -1}}})", "/steering/cfsm/time_gap"},
       {head + R"("stall": {"after": 0}})", "/stall/after"},
       {R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "area": [[0,0],[4,4],[4,0],[0,3]]}]})",
