@@ -245,9 +245,7 @@ void add_bench_command(CLI::App& app, Action& action) {
   sub->add_option("paths", o.paths, "scenario files, or directories to search (recursively)")
       ->required();
   sub->add_option("--model", o.model, "steering model for every run: orca, cfsm, thesis");
-  sub->add_option("--set", o.overrides,
-                  "set a field of every scenario before it is checked: KEY=VALUE, KEY a dotted "
-                  "path (steering.orca.time_gap), VALUE JSON or a string; repeatable");
+  add_set_option(sub, o.overrides);
   sub->add_option("--csv", o.csv, "also write the table as CSV to FILE (\"-\": standard output)");
   sub->add_option("--threads", o.threads, "threads per run (results do not depend on it)")
       ->check(cli_checks::whole(1, 256));

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "crowddb/scenario.hpp"
 
@@ -21,6 +22,9 @@ void add_fit_kernel_command(CLI::App& app, Action& action);
 void add_verify_command(CLI::App& app, Action& action);
 void add_convert_command(CLI::App& app, Action& action);
 void add_bench_command(CLI::App& app, Action& action);
+
+// The --set KEY=VALUE option (LoadOptions::overrides) of the commands that load scenarios.
+void add_set_option(CLI::App* sub, std::vector<std::string>& overrides);
 
 // Prints a loaded scenario's warnings on stderr, one line each, naming the file.
 void print_warnings(const Scenario& sc);

@@ -17,9 +17,7 @@ void add_convert_command(CLI::App& app, Action& action) {
       ->check(CLI::IsMember({"json"}));
   sub->add_option("--out", out, "output file (default: standard output)");
   sub->add_option("--behavior", behavior, "Menge: the behaviour file of a scene");
-  sub->add_option("--set", overrides,
-                  "set a field of the scenario before it is checked: KEY=VALUE, KEY a dotted path "
-                  "(steering.orca.time_gap), VALUE JSON or a string; repeatable");
+  add_set_option(sub, overrides);
   sub->callback([&action] {
     action = [] {
       const Converted c = convert_scenario(file, LoadOptions{behavior, overrides});

@@ -46,6 +46,12 @@ struct RunOptions {
 }  // namespace
 
 // Warnings of an import already name their file and line.
+void add_set_option(CLI::App* sub, std::vector<std::string>& overrides) {
+  sub->add_option("--set", overrides,
+                  "set a field of the scenario before it is checked: KEY=VALUE, KEY a dotted path "
+                  "(steering.orca.time_gap), VALUE JSON or a string; repeatable");
+}
+
 void print_warnings(const Scenario& sc) {
   for (const auto& w : sc.warnings) {
     if (w.compare(0, sc.source.size() + 1, sc.source + ":") == 0)
@@ -161,9 +167,7 @@ void add_run_command(CLI::App& app, Action& action) {
   sub->add_option("--summary-json", o.summary_json,
                   "write the run's summary as JSON to FILE (\"-\": standard output, instead of "
                   "the text summary); keys in docs/summary-json.md");
-  sub->add_option("--set", o.overrides,
-                  "set a field of the scenario before it is checked: KEY=VALUE, KEY a dotted path "
-                  "(steering.orca.time_gap), VALUE JSON or a string; repeatable");
+  add_set_option(sub, o.overrides);
   sub->add_option("--ticks", o.ticks, "number of ticks (overrides the file)")
       ->check(cli_checks::whole(0, 1'000'000'000));
   sub->add_option("--duration", o.duration, "simulated seconds (overrides the file)")
@@ -201,9 +205,7 @@ void add_validate_command(CLI::App& app, Action& action) {
   auto* sub = app.add_subcommand("validate", "check a scenario file without running it");
   sub->add_option("scenario", file, "scenario file (any supported format)")->required();
   sub->add_option("--behavior", behavior, "Menge: the behaviour file of a scene");
-  sub->add_option("--set", overrides,
-                  "set a field of the scenario before it is checked: KEY=VALUE, KEY a dotted path "
-                  "(steering.orca.time_gap), VALUE JSON or a string; repeatable");
+  add_set_option(sub, overrides);
   sub->callback([&action] {
     action = [] {
       Scenario sc = load_scenario(file, LoadOptions{behavior, overrides});

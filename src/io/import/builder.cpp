@@ -29,16 +29,19 @@ DocBuilder::DocBuilder() {
 }
 
 std::string DocBuilder::disc_goal(Vec2 c, double arrival_radius, const std::string& origin) {
-  nlohmann::json g = {{"x", c.x}, {"y", c.y}, {"arrival_radius", arrival_radius}};
+  extent_.add(c.x - arrival_radius, c.y - arrival_radius);
+  extent_.add(c.x + arrival_radius, c.y + arrival_radius);
+  return named_goal({{"x", c.x}, {"y", c.y}, {"arrival_radius", arrival_radius}}, origin);
+}
+
+std::string DocBuilder::named_goal(nlohmann::json g, const std::string& origin) {
   const std::string key = g.dump();
   if (auto it = goal_names_.find(key); it != goal_names_.end()) return it->second;
   const std::string name = "g" + std::to_string(doc_["goals"].size());
   g["name"] = name;
   origins_["/goals/" + std::to_string(doc_["goals"].size())] = origin;
-  doc_["goals"].push_back(g);
+  doc_["goals"].push_back(std::move(g));
   goal_names_[key] = name;
-  extent_.add(c.x - arrival_radius, c.y - arrival_radius);
-  extent_.add(c.x + arrival_radius, c.y + arrival_radius);
   return name;
 }
 
@@ -48,15 +51,7 @@ std::string DocBuilder::area_goal(const std::vector<Vec2>& polygon, const std::s
     area.push_back({v.x, v.y});
     extent_.add(v.x, v.y);
   }
-  nlohmann::json g = {{"area", area}};
-  const std::string key = g.dump();
-  if (auto it = goal_names_.find(key); it != goal_names_.end()) return it->second;
-  const std::string name = "g" + std::to_string(doc_["goals"].size());
-  g["name"] = name;
-  origins_["/goals/" + std::to_string(doc_["goals"].size())] = origin;
-  doc_["goals"].push_back(g);
-  goal_names_[key] = name;
-  return name;
+  return named_goal({{"area", area}}, origin);
 }
 
 void DocBuilder::polygon(const std::vector<Vec2>& vertices, const std::string& origin) {
@@ -138,8 +133,7 @@ Imported DocBuilder::finish() {
   im.origins = std::move(origins_);
   for (std::size_t k = 0; k < warnings_.size(); ++k) {
     std::string w = warnings_[k].second;
-    if (warning_repeats_[k])
-      w += " (and " + std::to_string(warning_repeats_[k]) + " more like it)";
+    if (warning_repeats_[k]) w += " (and " + std::to_string(warning_repeats_[k]) + " more like it)";
     im.warnings.push_back(std::move(w));
   }
   return im;

@@ -68,6 +68,8 @@ class DocBuilder {
   Imported finish();
 
  private:
+  // The goal `g` under a new name, or the name of an identical goal added before.
+  std::string named_goal(nlohmann::json g, const std::string& origin);
   struct Disc {
     double x, y, r;
   };
