@@ -12,6 +12,7 @@ namespace {
 
 constexpr double kBlockGap = 0.6;  // [m] a blocker's disc is this close to the agent's, or less
 constexpr double kSameWay = 0.5;   // cos 60 degrees: directions this close are the same way
+constexpr double kFreeWalk = 0.5;  // walking at half the preferred speed towards the target
 
 uint64_t priority(uint64_t seed, uint64_t id) {
   uint64_t s = seed ^ (id * 0x9e3779b97f4a7c15ull);
@@ -123,6 +124,10 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     if (queueing[q] || t.stall_action[i] != StallAction::none) continue;
     const double dx = dir[q].x, dy = dir[q].y;
     if (dx == 0 && dy == 0) continue;
+    // Nobody in front and walking towards the target: it is making its way back to where it
+    // was pushed from (a counter-stream carried it backwards), not stuck; a sidestep would only
+    // slow it down.
+    if (blocker[q] < 0 && t.vx[i] * dx + t.vy[i] * dy >= kFreeWalk * t.pref_speed[i]) continue;
     const auto j = static_cast<std::size_t>(blocker[q]);
     const bool blocker_stalled = blocker[q] >= 0 && t.stall_ticks[j] >= after &&
                                  !(pos[j] >= 0 && queueing[static_cast<std::size_t>(pos[j])]);

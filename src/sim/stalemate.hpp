@@ -21,6 +21,9 @@
 //   - the blocker is stalled too and goes first: yield, i.e. step back from it and to the side
 //     away from it at half speed for yield_time;
 //   - the blocker is stalled too and goes second: keep going (the blocker yields);
+//   - no blocker and already walking towards the target at half its preferred speed or more:
+//     nothing (it is walking back to where a counter-stream carried it from; it stays counted as
+//     stalled until it gets there, but a sidestep would only slow it down);
 //   - otherwise: sidestep, i.e. walk at a seeded angle of 45-90 degrees off the target direction
 //     for sidestep_time.
 // After the action the agent heads for its target again; with navigation, one that stays stalled
