@@ -52,6 +52,10 @@ struct OrcaParams {
   // [s] headway: the preferred speed is capped at spacing / time_gap to the agent ahead going the
   // same way or standing (>= 0; 0: off, the default). steer/orca.cpp says when it helps.
   double time_gap = 0;
+  // No sweeping back: a hard plane keeps the velocity's component against the preferred direction
+  // at most max_retreat * pref_speed (>= 0; a value >= max_speed / pref_speed never binds, so a
+  // large one such as 10 switches it off). steer/orca.cpp says why.
+  double max_retreat = 0.25;
 };
 
 // The collision-free speed model (Tordeux, Chraibi, Seyfried 2016), model "cfsm"; defaults are

@@ -706,10 +706,10 @@ struct Loader {
                  !blocked_by_obstacle(s.x, s.y, s.radius, gap);
           }
           if (!ok)
-            pl.fail("", "could not place agent " + std::to_string(i + 1) + " of " +
-                            std::to_string(count) + " without overlaps in " +
-                            std::to_string(attempts) +
-                            " attempts (region too crowded: enlarge it, lower count, radius or gap)");
+            pl.fail("",
+                    "could not place agent " + std::to_string(i + 1) + " of " +
+                        std::to_string(count) + " without overlaps in " + std::to_string(attempts) +
+                        " attempts (region too crowded: enlarge it, lower count, radius or gap)");
         } else if (type == "circle") {
           const double a =
               2 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(count);
@@ -918,6 +918,7 @@ void read_steering(Node& root, SimConfig& cfg) {
     op.first_share = o.positive("first_share", op.first_share);
     if (!(op.first_share < 1)) o.fail("first_share", "must be < 1");
     op.time_gap = o.non_negative("time_gap", op.time_gap);
+    op.max_retreat = o.non_negative("max_retreat", op.max_retreat);
     o.finish();
   }
   if (s.has("cfsm")) {

@@ -2,6 +2,7 @@
 // and indices give bit-identical runs), thread counts change nothing, and their basic behaviour.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "crowddb/scenario.hpp"
@@ -101,6 +102,63 @@ TEST(Orca, HeadwayCapsTheWishBehindAnAgentGoingTheSameWay) {
   EXPECT_GT(first_tick_speed_of_follower("E", 0), 1.0);
   // Head-on: the headway leaves the wish alone; the planes alone decide, as without it.
   EXPECT_EQ(first_tick_speed_of_follower("W", 2), first_tick_speed_of_follower("W", 0));
+}
+
+// A lone walker meets a group in a 2 m corridor. The group goes first (less path left); without
+// the retreat plane ORCA's nearest permitted velocity carries the walker backwards with it (11 m
+// when measured); with it the walker gives way sideways or stands, never moving against its
+// preferred direction faster than max_retreat * pref_speed. Stalemate actions are off so that
+// the preferred direction is the direction to the goal point.
+struct Swept {
+  double carried_back = 0;   // [m] furthest east of the start
+  double worst_retreat = 0;  // [m/s] most negative v . u, u towards the goal
+  uint64_t arrival_tick = 0;
+};
+Swept lone_walker_against_a_group(double max_retreat) {
+  const std::string text = R"({"bounds": [0, 0, 40, 2], "duration": 60, "seed": 3,
+    "stall": {"resolve": false}, "steering": {"orca": {"max_retreat": )" +
+                           std::to_string(max_retreat) + R"(}},
+    "goals": [{"name": "E", "area": [[39, 0], [40, 0], [40, 2], [39, 2]]},
+              {"name": "W", "x": 1, "y": 1}],
+    "groups": [{"count": 20, "placement": {"type": "uniform", "region": [14, 0, 22, 2], "gap": 0.05},
+                "radius": [0.2, 0.25], "pref_speed": [1.2, 1.4], "goal": "E"}],
+    "agents": [{"x": 28, "y": 1, "radius": 0.25, "pref_speed": 1.3, "goal": "W"}]})";
+  Scenario sc = parse_scenario(text, "t.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  Swept s;
+  for (uint64_t tick = 1; tick <= sc.ticks && !s.arrival_tick; ++tick) {
+    const AgentTable& t = sim.world().agents();
+    std::size_t w = t.size();
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (t.goal[i] == 1) w = i;
+    if (w == t.size()) break;
+    const double ux = 1 - t.x[w], uy = 1 - t.y[w], ul = std::hypot(ux, uy);
+    const uint64_t id = t.id[w];
+    const TickMetrics& m = sim.step();
+    EXPECT_EQ(m.overlapping_pairs, 0u);
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (t.id[i] != id) continue;
+      s.carried_back = std::max(s.carried_back, t.x[i] - 28);
+      s.worst_retreat = std::min(s.worst_retreat, (t.vx[i] * ux + t.vy[i] * uy) / ul);
+    }
+    if (m.arrived > 0 &&
+        std::none_of(t.goal.begin(), t.goal.end(), [](uint32_t g) { return g == 1; }))
+      s.arrival_tick = tick;
+  }
+  return s;
+}
+
+TEST(Orca, AWalkerIsNotSweptBackwardsByAGroup) {
+  const Swept off = lone_walker_against_a_group(10);  // >= max_speed / pref_speed: never binds
+  const Swept on = lone_walker_against_a_group(0.25);
+  EXPECT_GT(off.carried_back, 5.0);
+  EXPECT_LT(off.worst_retreat, -0.5);
+  EXPECT_LT(on.carried_back, 1.5);
+  // The preferred direction carries 1e-4 m/s of seeded noise: tolerance for it.
+  EXPECT_GE(on.worst_retreat, -0.25 * 1.3 - 1e-3);
+  ASSERT_GT(on.arrival_tick, 0u);
+  ASSERT_GT(off.arrival_tick, 0u);
+  EXPECT_LT(on.arrival_tick, off.arrival_tick);
 }
 
 // ORCA's contact planes keep the crowd overlap-free by themselves: the backoff finds nothing.
