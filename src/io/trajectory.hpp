@@ -2,7 +2,12 @@
 // that format (PedPy) read our runs, plus crowddb's own tables; or CSV files.
 //
 // Output appears atomically: everything is written to PATH.partial and renamed to PATH only by
-// finish(). A run that fails or is interrupted leaves no file that looks complete.
+// finish(), so no file named PATH is ever incomplete. Nothing written is thrown away either:
+// frames are committed in batches (at most 100 frames or 2 s of wall time each), so a run
+// killed outright (kill -9, power aside) loses at most one batch, and a run stopped by a
+// signal or an error keeps PATH.partial with what it wrote, marked incomplete (SQLite:
+// crowddb_run keys status, last_tick and stop_reason). While a run writes PATH it holds
+// PATH.lock (io/output_lock.hpp); an earlier run's PATH.partial is never overwritten.
 #pragma once
 
 #include <filesystem>
@@ -23,23 +28,28 @@ struct RunInfo {
   uint64_t ticks = 0;
   uint64_t final_hash = 0;
   double seconds = 0;
-  std::string summary_json;                                    // the run's summary (JSON)
+  std::string summary_json;                                  // the run's summary (JSON)
   const std::vector<metrics::AgentScore>* scores = nullptr;  // SteerBench, per agent
 };
 
 class TrajectoryWriter {
  public:
   virtual ~TrajectoryWriter() = default;
-  // Creates PATH.partial and writes the static parts (metadata, geometry).
+  // Locks the output, creates PATH.partial and writes the static parts (metadata, geometry).
+  // Refuses (Error(io)) when another run holds the lock or an earlier run's PATH.partial is
+  // there (move or remove it first: it may hold an interrupted run).
   virtual void begin(const Scenario& scenario, const World& world) = 0;
   // One frame: positions (and velocities, states) of every agent after `tick` ticks.
   virtual void frame(uint64_t tick, const World& world) = 0;
-  // The metrics of one tick (written for every tick, whatever the frame stride).
+  // The metrics of one tick (written for every tick, whatever the frame stride), after that
+  // tick's frame: a batch may be committed here, covering everything up to m.tick.
   virtual void metrics(const TickMetrics& m) = 0;
   // Flushes, closes and renames PATH.partial to PATH.
   virtual void finish(const RunInfo& info) = 0;
-  // Removes the partial output; safe to call at any time, never throws.
-  virtual void abort() noexcept = 0;
+  // Stops an unfinished run: keeps everything written so far in PATH.partial, marked incomplete
+  // up to `tick` because of `reason`, and releases the lock. Returns the file kept, or an empty
+  // path when nothing was begun. Safe to call at any time, never throws.
+  virtual std::filesystem::path stop(uint64_t tick, const std::string& reason) noexcept = 0;
 };
 
 std::unique_ptr<TrajectoryWriter> make_sqlite_writer(const std::filesystem::path& path,

@@ -1,11 +1,16 @@
 // CSV trajectories: PATH holds frame,id,x,y,vx,vy,radius,state,goal; PATH with its extension
 // replaced by .metrics.csv holds one row of tick metrics per tick, and by .steerbench.csv the
 // SteerBench metrics per agent (src/metrics/steerbench.hpp). Numbers are written in shortest
-// round-trip form, so a CSV run reads back bit-identical.
+// round-trip form, so a CSV run reads back bit-identical. The streams are flushed in batches
+// (io/trajectory.hpp); a stopped run keeps its .partial files (the metrics file's last row is
+// the last tick).
 #include <charconv>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 
+#include "io/output_lock.hpp"
 #include "io/trajectory.hpp"
 
 namespace crowddb::io {
@@ -20,10 +25,19 @@ class CsvWriter final : public TrajectoryWriter {
     steerbench_path_ = path_;
     steerbench_path_.replace_extension(".steerbench.csv");
   }
-  ~CsvWriter() override { abort(); }
+  ~CsvWriter() override { stop(0, "the run ended without finishing its output"); }
 
   void begin(const Scenario& sc, const World&) override {
     dt_ = sc.config.dt;
+    lock_.emplace(path_);
+    for (const auto* p : {&path_, &metrics_path_, &steerbench_path_}) {
+      std::error_code ec;
+      if (std::filesystem::exists(partial(*p), ec))
+        throw Error(Error::Kind::io, partial(*p).string() +
+                                         ": an earlier run's unfinished output is kept here; "
+                                         "move or remove it first");
+    }
+    batch_start_ = std::chrono::steady_clock::now();
     open(traj_, partial(path_), "frame,id,x,y,vx,vy,radius,state,goal\n");
     open(metrics_, partial(metrics_path_),
          "tick,time,agents,entered,arrived,frozen,freeze_iterations,overlapping_pairs,"
@@ -58,6 +72,13 @@ class CsvWriter final : public TrajectoryWriter {
              << num(static_cast<double>(m.longest_stall) * dt_) << "," << num(m.seconds) << ","
              << hash << "\n";
     check(metrics_, metrics_path_);
+    if (std::chrono::steady_clock::now() - batch_start_ >= std::chrono::seconds(2)) {
+      traj_.flush();
+      metrics_.flush();
+      check(traj_, path_);
+      check(metrics_, metrics_path_);
+      batch_start_ = std::chrono::steady_clock::now();
+    }
   }
 
   void finish(const RunInfo& info) override {
@@ -82,15 +103,16 @@ class CsvWriter final : public TrajectoryWriter {
         throw Error(Error::Kind::io,
                     p->string() + ": cannot move output into place: " + ec.message());
     }
+    lock_.reset();
   }
 
-  void abort() noexcept override {
+  std::filesystem::path stop(uint64_t, const std::string&) noexcept override {
+    const bool begun = traj_.is_open();
     if (traj_.is_open()) traj_.close();
     if (metrics_.is_open()) metrics_.close();
     if (steerbench_.is_open()) steerbench_.close();
-    std::error_code ec;
-    for (const auto* p : {&path_, &metrics_path_, &steerbench_path_})
-      std::filesystem::remove(partial(*p), ec);
+    lock_.reset();
+    return begun ? partial(path_) : std::filesystem::path();
   }
 
  private:
@@ -115,6 +137,8 @@ class CsvWriter final : public TrajectoryWriter {
   std::filesystem::path path_, metrics_path_, steerbench_path_;
   uint32_t every_;
   std::ofstream traj_, metrics_, steerbench_;
+  std::chrono::steady_clock::time_point batch_start_;
+  std::optional<OutputLock> lock_;
 };
 
 }  // namespace

@@ -6,20 +6,26 @@
 //   crowddb_tick_metrics(tick, time, agents, entered, arrived, frozen, freeze_iterations,
 //                        overlapping_pairs, obstacle_overlaps, gridlocked, stalled, queueing,
 //                        longest_stall, tick_seconds, state_hash)
-//   crowddb_run(key, value): scenario name and text, seed, threads, ticks, final state hash
-// WAL journal, frames batched into transactions; the file is renamed into place at the end.
+//   crowddb_run(key, value): scenario name and text, seed, threads, ticks, final state hash;
+//                            status (running, complete, stopped), last_tick, stop_reason
+// WAL journal, frames committed in batches (io/trajectory.hpp); renamed into place at the end.
 #include <sqlite3.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 
+#include "io/output_lock.hpp"
 #include "io/trajectory.hpp"
 #include "io/walkable_wkt.hpp"
 
 namespace crowddb::io {
 namespace {
 
-constexpr uint64_t kFramesPerTransaction = 100;
+constexpr uint64_t kFramesPerBatch = 100;
+constexpr std::chrono::seconds kSecondsPerBatch{2};
 
 std::string hex(uint64_t v) {
   char buf[24];
@@ -57,12 +63,20 @@ class SqliteWriter final : public TrajectoryWriter {
  public:
   SqliteWriter(std::filesystem::path path, uint32_t every)
       : path_(std::move(path)), partial_(path_.string() + ".partial"), every_(every ? every : 1) {}
-  ~SqliteWriter() override { abort(); }
+  ~SqliteWriter() override {
+    if (db_) stop(last_tick_, "the run ended without finishing its output");
+    lock_.reset();
+  }
 
   void begin(const Scenario& sc, const World& world) override {
     dt_ = sc.config.dt;
     format_ = sc.format;
-    remove_partial();
+    lock_.emplace(path_);
+    std::error_code ec;
+    if (std::filesystem::exists(partial_, ec))
+      throw Error(Error::Kind::io, partial_ +
+                                       ": an earlier run's unfinished output is kept here; move "
+                                       "or remove it first");
     if (sqlite3_open_v2(partial_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
                         nullptr) != SQLITE_OK) {
       const std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
@@ -114,7 +128,9 @@ class SqliteWriter final : public TrajectoryWriter {
                                {"scenario_json", sc.text},
                                {"seed", std::to_string(sc.config.seed)},
                                {"dt", num(sc.config.dt)},
-                               {"frame_every", std::to_string(every_)}})
+                               {"frame_every", std::to_string(every_)},
+                               {"status", "running"},
+                               {"last_tick", "0"}})
       insert_text(run, k, v);
     wkt_ = walkable_area_wkt(world);
     geometry_hash_ = text_hash(wkt_);
@@ -140,6 +156,8 @@ class SqliteWriter final : public TrajectoryWriter {
         db_,
         "INSERT INTO crowddb_tick_metrics VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
         path_.string());
+    set_run_ = Statement(db_, "INSERT OR REPLACE INTO crowddb_run VALUES (?, ?)", path_.string());
+    batch_start_ = std::chrono::steady_clock::now();
   }
 
   void frame(uint64_t tick, const World& world) override {
@@ -166,11 +184,7 @@ class SqliteWriter final : public TrajectoryWriter {
     sqlite3_bind_int64(frame_.get(), 1, frame);
     sqlite3_bind_int64(frame_.get(), 2, geometry_hash_);
     step(frame_);
-    if (++frames_in_txn_ >= kFramesPerTransaction) {
-      exec("COMMIT");
-      exec("BEGIN");
-      frames_in_txn_ = 0;
-    }
+    ++frames_in_batch_;
   }
 
   void metrics(const TickMetrics& m) override {
@@ -194,6 +208,15 @@ class SqliteWriter final : public TrajectoryWriter {
     const std::string h = hex(m.state_hash);
     sqlite3_bind_text(s, ++col, h.c_str(), -1, SQLITE_TRANSIENT);
     step(metric_);
+    last_tick_ = m.tick;
+    if (frames_in_batch_ >= kFramesPerBatch ||
+        std::chrono::steady_clock::now() - batch_start_ >= kSecondsPerBatch) {
+      insert_text(set_run_, "last_tick", std::to_string(last_tick_));
+      exec("COMMIT");
+      exec("BEGIN");
+      frames_in_batch_ = 0;
+      batch_start_ = std::chrono::steady_clock::now();
+    }
   }
 
   void finish(const RunInfo& info) override {
@@ -209,6 +232,8 @@ class SqliteWriter final : public TrajectoryWriter {
             {"summary_json", info.summary_json}})
         insert_text(run, k, v);
     }
+    insert_text(set_run_, "status", "complete");
+    insert_text(set_run_, "last_tick", std::to_string(info.ticks));
     if (info.scores) {
       exec(
           "CREATE TABLE crowddb_steerbench (id INTEGER PRIMARY KEY, collisions INTEGER NOT NULL, "
@@ -245,13 +270,31 @@ class SqliteWriter final : public TrajectoryWriter {
     if (ec)
       throw Error(Error::Kind::io,
                   path_.string() + ": cannot move output into place: " + ec.message());
+    lock_.reset();
   }
 
-  void abort() noexcept override {
+  std::filesystem::path stop(uint64_t tick, const std::string& reason) noexcept override {
+    if (!db_) {
+      lock_.reset();
+      return {};
+    }
+    try {
+      // Commit everything written; last_tick is the last tick with both its frame and metrics.
+      if (!sqlite3_get_autocommit(db_)) {
+        insert_text(set_run_, "status", "stopped");
+        insert_text(set_run_, "last_tick", std::to_string(std::min(tick, last_tick_)));
+        insert_text(set_run_, "stop_reason", reason);
+        exec("COMMIT");
+      }
+    } catch (...) {
+      // Disk full or the like: the batches committed before stay readable.
+    }
     release_statements();
-    if (db_) sqlite3_close(db_);
+    sqlite3_exec(db_, "PRAGMA journal_mode=DELETE", nullptr, nullptr, nullptr);
+    sqlite3_close(db_);
     db_ = nullptr;
-    remove_partial();
+    lock_.reset();
+    return partial_;
   }
 
  private:
@@ -264,13 +307,7 @@ class SqliteWriter final : public TrajectoryWriter {
   }
 
   void release_statements() noexcept {
-    for (Statement* s : {&traj_, &state_, &frame_, &metric_}) *s = Statement();
-  }
-
-  void remove_partial() noexcept {
-    std::error_code ec;
-    for (const char* suffix : {"", "-wal", "-shm", "-journal"})
-      std::filesystem::remove(partial_ + suffix, ec);
+    for (Statement* s : {&traj_, &state_, &frame_, &metric_, &set_run_}) *s = Statement();
   }
 
   void exec(const char* sql) {
@@ -298,10 +335,13 @@ class SqliteWriter final : public TrajectoryWriter {
   std::string partial_;
   uint32_t every_;
   sqlite3* db_ = nullptr;
-  Statement traj_, state_, frame_, metric_;
+  Statement traj_, state_, frame_, metric_, set_run_;
   std::string wkt_;
   int64_t geometry_hash_ = 0;
-  uint64_t frames_in_txn_ = 0;
+  uint64_t frames_in_batch_ = 0;
+  uint64_t last_tick_ = 0;  // the last tick whose metrics were written
+  std::chrono::steady_clock::time_point batch_start_;
+  std::optional<OutputLock> lock_;
 };
 
 }  // namespace

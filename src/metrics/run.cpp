@@ -60,8 +60,7 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
     if (w) w->frame(0, sim.world());
     for (uint64_t t = 1; t <= sc.ticks; ++t) {
       if (control.interrupted && control.interrupted())
-        throw Error(Error::Kind::io,
-                    "interrupted at tick " + std::to_string(t - 1) + "; no output kept");
+        throw Error(Error::Kind::io, "interrupted at tick " + std::to_string(t - 1));
       const TickMetrics& m = sim.step();
       tick_seconds.push_back(m.seconds);
       bench.tick(sim.world(), m);
@@ -104,8 +103,18 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
       info.scores = &bench.scores();
       w->finish(info);
     }
+  } catch (const Error& e) {
+    // Keep what was written: the frames up to the last tick, marked as an incomplete run.
+    const std::filesystem::path kept = w ? w->stop(s.ticks, e.what()) : std::filesystem::path();
+    if (kept.empty()) throw;
+    throw Error(e.kind(), std::string(e.what()) + "; the run's output up to tick " +
+                              std::to_string(s.ticks) + " is kept in " + kept.string() +
+                              " (incomplete)");
+  } catch (const std::bad_alloc&) {
+    if (w) w->stop(s.ticks, "out of memory");
+    throw;
   } catch (...) {
-    if (w) w->abort();
+    if (w) w->stop(s.ticks, "stopped by an unexpected error");
     throw;
   }
   const TickMetrics& last = sim.last_metrics();
@@ -126,7 +135,8 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
   double sum = 0;
   for (double x : tick_seconds) sum += x;
   s.ms_per_tick_median = 1e3 * median(tick_seconds);
-  s.ms_per_tick_mean = tick_seconds.empty() ? 0 : 1e3 * sum / static_cast<double>(tick_seconds.size());
+  s.ms_per_tick_mean =
+      tick_seconds.empty() ? 0 : 1e3 * sum / static_cast<double>(tick_seconds.size());
   if (scores) *scores = bench.scores();
   return s;
 }
@@ -194,8 +204,7 @@ std::string RunSummary::text(const SimConfig& cfg) const {
     o << v << " s";
     return o.str();
   };
-  os << name << ": " << ticks << " ticks of " << g(dt) << " s (" << sim_seconds
-     << " s simulated";
+  os << name << ": " << ticks << " ticks of " << g(dt) << " s (" << sim_seconds << " s simulated";
   if (stopped_when_all_arrived) os << ", stopped when everyone had arrived";
   os << ") in " << wall_seconds << " s, model " << model;
   if (format != "crowddb") os << ", imported from " << format;
@@ -205,8 +214,7 @@ std::string RunSummary::text(const SimConfig& cfg) const {
        << " thread" << (threads > 1 ? "s" : "");
   os << "\n  agents: " << agents_at_start << " at start";
   if (entered || waiting_to_enter)
-    os << ", " << entered << " entered from sources (" << waiting_to_enter
-       << " still to enter)";
+    os << ", " << entered << " entered from sources (" << waiting_to_enter << " still to enter)";
   os << ", " << agents_at_end << " at end; arrived " << arrived;
   if (last_arrival_s >= 0) os << " (the last at " << secs(last_arrival_s) << ")";
   if (sim_seconds > 0)

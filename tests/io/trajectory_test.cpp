@@ -87,15 +87,111 @@ TEST(TrajectorySqlite, EveryNthFrameAndFps) {
   EXPECT_EQ(std::stod(query(db, "SELECT value FROM metadata WHERE key = 'fps'").at(0)), 0.4);
 }
 
-TEST(TrajectorySqlite, AbortLeavesNothingBehind) {
+// A stopped run keeps what it wrote, marked incomplete, under a name no finished run has.
+TEST(TrajectorySqlite, StopKeepsEverythingWrittenMarkedIncomplete) {
   test::TempDir dir;
   Scenario sc = parse_scenario(kScenario, "two.json");
   Simulation sim(std::move(sc.world), sc.config);
   auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
   w->begin(sc, sim.world());
   w->frame(0, sim.world());
-  w->abort();
+  for (uint64_t t = 1; t <= 3; ++t) {
+    const TickMetrics& m = sim.step();
+    w->frame(t, sim.world());
+    w->metrics(m);
+  }
+  EXPECT_EQ(w->stop(3, "interrupted at tick 3"), dir / "run.sqlite.partial");
+  EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.lock"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.partial-wal"));
+  const auto db = dir / "run.sqlite.partial";
+  auto run_key = [&](const std::string& k) {
+    return query(db, "SELECT value FROM crowddb_run WHERE key = '" + k + "'");
+  };
+  EXPECT_EQ(run_key("status"), std::vector<std::string>{"stopped"});
+  EXPECT_EQ(run_key("last_tick"), std::vector<std::string>{"3"});
+  EXPECT_EQ(run_key("stop_reason"), std::vector<std::string>{"interrupted at tick 3"});
+  EXPECT_EQ(query(db, "SELECT count(DISTINCT frame) FROM trajectory_data"),
+            std::vector<std::string>{"4"});
+  EXPECT_EQ(query(db, "SELECT max(tick) FROM crowddb_tick_metrics"), std::vector<std::string>{"3"});
+  // The kept run is not overwritten by the next one.
+  auto again = io::make_sqlite_writer(dir / "run.sqlite", 1);
+  try {
+    again->begin(sc, sim.world());
+    ADD_FAILURE() << "an earlier run's .partial was overwritten";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("run.sqlite.partial: an earlier run's unfinished output"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(run_key("status"), std::vector<std::string>{"stopped"});
+}
+
+TEST(TrajectorySqlite, StopBeforeBeginKeepsNothing) {
+  test::TempDir dir;
+  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
+  EXPECT_EQ(w->stop(0, "never begun"), std::filesystem::path());
   EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+}
+
+// Frames are committed in batches while the run goes on: another reader (or the file left by
+// kill -9) sees every batch but the open one.
+TEST(TrajectorySqlite, BatchesAreCommittedWhileTheRunGoesOn) {
+  test::TempDir dir;
+  Scenario sc = parse_scenario(kScenario, "two.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
+  w->begin(sc, sim.world());
+  w->frame(0, sim.world());
+  for (uint64_t t = 1; t <= 250; ++t) {
+    const TickMetrics& m = sim.step();
+    w->frame(t, sim.world());
+    w->metrics(m);
+  }
+  const auto db = dir / "run.sqlite.partial";
+  const std::vector<std::string> seen =
+      query(db, "SELECT value FROM crowddb_run WHERE key IN ('status', 'last_tick') ORDER BY key");
+  ASSERT_EQ(seen.size(), 2u);
+  const int last = std::stoi(seen[0]);
+  EXPECT_EQ(seen[1], "running");
+  EXPECT_GE(last, 199);  // 100 frames per batch at most (or 2 s, whichever comes first)
+  EXPECT_EQ(query(db, "SELECT max(tick) FROM crowddb_tick_metrics"),
+            std::vector<std::string>{std::to_string(last)});
+  EXPECT_EQ(query(db, "SELECT max(frame) FROM frame_data"),
+            std::vector<std::string>{std::to_string(last)});
+  w->finish({});
+  EXPECT_EQ(query(dir / "run.sqlite", "SELECT value FROM crowddb_run WHERE key = 'status'"),
+            std::vector<std::string>{"complete"});
+}
+
+// Two runs writing one output: the second stops at once and the first is untouched.
+TEST(TrajectoryOutput, ASecondWriterOfTheSameOutputIsRefused) {
+  for (const auto format : {OutputSpec::Format::sqlite, OutputSpec::Format::csv}) {
+    test::TempDir dir;
+    Scenario sc = parse_scenario(kScenario, "two.json");
+    Simulation sim(std::move(sc.world), sc.config);
+    const auto out = dir / (format == OutputSpec::Format::csv ? "run.csv" : "run.sqlite");
+    auto first = io::make_writer({out.string(), format, 1});
+    first->begin(sc, sim.world());
+    first->frame(0, sim.world());
+    EXPECT_TRUE(std::filesystem::exists(out.string() + ".lock"));
+    auto second = io::make_writer({out.string(), format, 1});
+    try {
+      second->begin(sc, sim.world());
+      ADD_FAILURE() << "two writers of " << out;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("another crowddb run is writing this output"),
+                std::string::npos)
+          << e.what();
+    }
+    second.reset();
+    const TickMetrics& m = sim.step();
+    first->frame(1, sim.world());
+    first->metrics(m);
+    first->finish({});
+    EXPECT_TRUE(std::filesystem::exists(out));
+    EXPECT_FALSE(std::filesystem::exists(out.string() + ".lock"));
+  }
 }
 
 TEST(TrajectorySqlite, UnwritablePathFailsAtBegin) {
