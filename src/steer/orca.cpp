@@ -49,8 +49,8 @@
 // that goes the same way (preferred directions within 60 degrees) or stands: the collision-free
 // speed model's speed rule (cfsm.cpp), applied to the wish only, so the planes still decide.
 // People coming towards or across are left to the planes: they are to be passed, not followed.
-// Measured on SteerSuite's 101 test cases with T = 0.5 s: 12,947 instead of 11,945 of 20,312
-// agents arrive (office-complex 610 -> 1000 of 1000), but bottleneck-evacuation 16 -> 11 of 200
+// Measured on SteerSuite's 101 test cases with T = 0.5 s: 12,882 instead of 11,947 of 20,312
+// agents arrive (office-complex 625 -> 1000 of 1000), but bottleneck-evacuation 20 -> 8 of 200
 // and the longest stalls of the concentric circles and airport-5000 grow (docs/steering.md).
 // Off by default for that reason.
 //
