@@ -12,6 +12,7 @@ packages=(
   librecast-dev                                # navigation meshes
   libpugixml-dev                               # SDF3 XML
   gnuplot-nox graphviz                         # experiment plots, DOT rendering
+  clang libclang-rt-14-dev                     # libFuzzer targets (scripts/fuzz.sh)
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite: a Release build with every test, then the same tests built with
-# AddressSanitizer + UndefinedBehaviorSanitizer. Tests labelled `slow` run only with
-# CROWDDB_SLOW_TESTS=1. Exits non-zero on the first failure.
+# AddressSanitizer + UndefinedBehaviorSanitizer, then every parser's libFuzzer target (clang):
+# its seed corpus replayed and FUZZ_SECONDS (default 60) of fuzzing (scripts/fuzz.sh). Tests
+# labelled `slow` run only with CROWDDB_SLOW_TESTS=1. Exits non-zero on the first failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
@@ -20,4 +21,6 @@ cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_REL
 cmake --build build-asan -j "$jobs"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-asan "${ctest_args[@]}" -LE "slow|nosan"
+echo "== fuzzing (clang, libFuzzer, ASan+UBSan)"
+bash scripts/fuzz.sh
 echo "== all tests passed"

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Fuzzing stage of the test suite: builds every libFuzzer target with clang (the library
+# instrumented for coverage, ASan + UBSan), replays each seed corpus as a regression test, then
+# fuzzes each target for FUZZ_SECONDS (default 60) from a copy of its corpus. Any crash, leak,
+# sanitizer report or timeout fails the stage and leaves the input under build-fuzz/findings/.
+# New interesting inputs stay in build-fuzz/corpus/ (add the useful ones to fuzz/corpus/).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${FUZZ_SECONDS:-60}
+jobs=$(nproc)
+
+# target : seed files (the corpus replayed as a regression test and fuzzed from)
+declare -A seeds=(
+  [scenario_fuzz]="fuzz/corpus/scenario"
+  [csv_fuzz]="fuzz/corpus/csv"
+  [steersuite_fuzz]="fuzz/corpus/steersuite"
+  [menge_fuzz]="fuzz/corpus/menge"
+  [vadere_fuzz]="fuzz/corpus/vadere"
+  [overrides_fuzz]="fuzz/corpus/overrides"
+  [sdf_sdf3_fuzz]="tests/sdf/data/*.xml"
+  [sdf_json_fuzz]="tests/sdf/data/*.json"
+)
+targets=(scenario_fuzz csv_fuzz steersuite_fuzz menge_fuzz vadere_fuzz overrides_fuzz sdf_sdf3_fuzz sdf_json_fuzz)
+
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCROWDDB_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCROWDDB_BUILD_TESTS=OFF \
+  -DCROWDDB_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build build-fuzz -j "$jobs" --target "${targets[@]}"
+
+rm -rf build-fuzz/findings build-fuzz/corpus build-fuzz/logs
+mkdir -p build-fuzz/findings build-fuzz/corpus build-fuzz/logs
+export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+
+fuzz_one() {
+  local t=$1 pattern=$2 seconds=$3
+  local bin=build-fuzz/fuzz/$t corpus=build-fuzz/corpus/$t log=build-fuzz/logs/$t.log
+  local -a files
+  if [[ -d $pattern ]]; then files=("$pattern"/*); else files=($pattern); fi
+  mkdir -p "$corpus" "build-fuzz/findings/$t"
+  # 1. every seed once: a regression test
+  if ! "$bin" -timeout=10 -rss_limit_mb=2560 -artifact_prefix="build-fuzz/findings/$t/" \
+      "${files[@]}" >"$log" 2>&1; then
+    echo "FAIL $t: a seed input fails (build-fuzz/logs/$t.log)"
+    return 1
+  fi
+  cp "${files[@]}" "$corpus/"
+  # 2. fuzzing from the seeds
+  if ! "$bin" "$corpus" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2560 \
+      -artifact_prefix="build-fuzz/findings/$t/" -print_final_stats=1 >>"$log" 2>&1; then
+    echo "FAIL $t: found $(ls "build-fuzz/findings/$t" | head -1) (build-fuzz/logs/$t.log)"
+    return 1
+  fi
+  local runs
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | tail -1 | grep -o '[0-9]*$')
+  echo "ok   $t: ${#files[@]} seeds replayed; ${runs:-?} runs in ${seconds} s; corpus $(ls "$corpus" | wc -l) inputs"
+}
+export -f fuzz_one
+
+echo "== fuzzing: ${#targets[@]} targets, ${seconds} s each, ${jobs} at a time"
+for t in "${targets[@]}"; do echo "$t ${seeds[$t]}"; done |
+  xargs -P "$jobs" -n 2 bash -c 'fuzz_one "$1" "$2" '"$seconds" _
