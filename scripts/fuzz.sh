@@ -4,12 +4,16 @@
 # fuzzes each target for FUZZ_SECONDS (default 60) from a copy of its corpus. Any crash, leak,
 # sanitizer report or timeout fails the stage and leaves the input under build-fuzz/findings/.
 # New interesting inputs stay in build-fuzz/corpus/ (add the useful ones to fuzz/corpus/).
+# FUZZ_SEED (default 1) makes a run repeatable: the same binaries and seeds try the same inputs
+# in the same order (how many depends on the machine's speed); FUZZ_SEED=0 draws a new one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${FUZZ_SECONDS:-60}
+export FUZZ_SEED=${FUZZ_SEED:-1}
 jobs=$(nproc)
 
-# target : seed files (the corpus replayed as a regression test and fuzzed from)
+# target : seed files, comma-separated folders or globs (replayed as a regression test and
+# fuzzed from); fuzz/corpus/ also keeps the inputs fuzzing has found (fixed since)
 declare -A seeds=(
   [scenario_fuzz]="fuzz/corpus/scenario"
   [csv_fuzz]="fuzz/corpus/csv"
@@ -18,7 +22,7 @@ declare -A seeds=(
   [vadere_fuzz]="fuzz/corpus/vadere"
   [overrides_fuzz]="fuzz/corpus/overrides"
   [sdf_sdf3_fuzz]="tests/sdf/data/*.xml"
-  [sdf_json_fuzz]="tests/sdf/data/*.json"
+  [sdf_json_fuzz]="tests/sdf/data/*.json,fuzz/corpus/sdf_json"
 )
 targets=(scenario_fuzz csv_fuzz steersuite_fuzz menge_fuzz vadere_fuzz overrides_fuzz sdf_sdf3_fuzz sdf_json_fuzz)
 
@@ -34,8 +38,11 @@ export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_erro
 fuzz_one() {
   local t=$1 pattern=$2 seconds=$3
   local bin=build-fuzz/fuzz/$t corpus=build-fuzz/corpus/$t log=build-fuzz/logs/$t.log
-  local -a files
-  if [[ -d $pattern ]]; then files=("$pattern"/*); else files=($pattern); fi
+  local -a files=()
+  local p
+  for p in ${pattern//,/ }; do
+    if [[ -d $p ]]; then files+=("$p"/*); else files+=($p); fi
+  done
   mkdir -p "$corpus" "build-fuzz/findings/$t"
   # 1. every seed once: a regression test
   if ! "$bin" -timeout=10 -rss_limit_mb=2560 -artifact_prefix="build-fuzz/findings/$t/" \
@@ -45,7 +52,7 @@ fuzz_one() {
   fi
   cp "${files[@]}" "$corpus/"
   # 2. fuzzing from the seeds
-  if ! "$bin" "$corpus" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2560 \
+  if ! "$bin" "$corpus" -seed="$FUZZ_SEED" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2560 \
       -artifact_prefix="build-fuzz/findings/$t/" -print_final_stats=1 >>"$log" 2>&1; then
     echo "FAIL $t: found $(ls "build-fuzz/findings/$t" | head -1) (build-fuzz/logs/$t.log)"
     return 1

@@ -13,6 +13,7 @@
 
 #include "sdf/io.hpp"
 #include "sdf/json_detail.hpp"
+#include "sdf/text.hpp"
 
 namespace sdf {
 
@@ -117,6 +118,7 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
       graph.name = s;
     } else if (at_ == At::actor) {
       if (s.empty()) fail(where() + ".name: empty");
+      if (padded(s)) fail(where() + ".name: begins or ends with white space");
       actor_names.push_back(std::move(s));
       has_name_ = true;
     } else if (at_ == At::channel && key_ != "prd" && key_ != "cns" && key_ != "delay") {
@@ -125,6 +127,7 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
       if (key_ == "dst") c.dst = std::move(s), c.has_dst = true;
       if (key_ == "name") {
         if (s.empty()) fail(where() + ".name: empty");
+        if (padded(s)) fail(where() + ".name: begins or ends with white space");
         c.name = std::move(s);
       }
     } else {
@@ -349,7 +352,7 @@ class Scanner {
     do {
       std::string_view k, v;
       if (!skip_to('{') || !string(k) || k != "name" || !skip_to(':') || !string(v) || v.empty() ||
-          !skip_to('}'))
+          padded(v) || !skip_to('}'))
         return false;
       out.actors.push_back(v);
     } while (peek_is(','));
@@ -378,7 +381,7 @@ class Scanner {
         } else if (k == "delay") {
           bit = 16, ok = number(c.delay);
         } else if (k == "name") {
-          bit = 32, ok = string(c.name) && !c.name.empty();
+          bit = 32, ok = string(c.name) && !c.name.empty() && !padded(c.name);
         } else {
           return false;
         }

@@ -15,6 +15,12 @@ inline std::string_view trim(std::string_view s) {
   return s;
 }
 
+// Names may not begin or end with white space: the SDF3 reader trims attribute values (XML
+// tools pad them), so such a name read from JSON would come back changed from SDF3.
+inline bool padded(std::string_view s) {
+  return trim(s).size() != s.size();
+}
+
 // Well-formed UTF-8 (no overlong forms, surrogates or code points above U+10FFFF): names end up
 // in JSON output, which must be valid UTF-8.
 inline bool valid_utf8(std::string_view s) {

@@ -198,6 +198,13 @@ TEST(JsonReader, NamesTheFieldOfEachMistake) {
       "f.json: channels[0].dst: unknown actor 'B'");
   EXPECT_EQ(json_error(R"({"actors":[{"name":"A"},{"name":"A"}]})"),
             "f.json: actors[1].name: duplicate actor name 'A'");
+  // Padded names would come back trimmed from SDF3 (found by the JSON fuzzer in CI).
+  EXPECT_EQ(json_error(R"({"actors":[{"name":"A"},{"name":" B"}]})"),
+            "f.json: actors[1].name: begins or ends with white space");
+  EXPECT_EQ(
+      json_error(
+          R"({"actors":[{"name":"A"}],"channels":[{"src":"A","dst":"A","prd":1,"cns":1,"name":"c\n"}]})"),
+      "f.json: channels[0].name: begins or ends with white space");
   EXPECT_EQ(json_error(R"({"actors":[{"name":"A"},{}]})"),
             "f.json: actors[1]: missing field 'name'");
   EXPECT_EQ(json_error(R"({"actors":[{"name":["A"]}]})"),
