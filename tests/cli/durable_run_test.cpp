@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "support/cli.hpp"
+#include "support/sqlite_query.hpp"
 
 extern char** environ;
 
@@ -20,19 +21,12 @@ namespace {
 
 using test::TempDir;
 
-std::vector<std::string> query(const std::filesystem::path& db, const std::string& sql) {
-  sqlite3* h = nullptr;
-  EXPECT_EQ(sqlite3_open_v2(db.c_str(), &h, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
-  std::vector<std::string> out;
-  sqlite3_exec(
-      h, sql.c_str(),
-      [](void* p, int, char** v, char**) {
-        static_cast<std::vector<std::string>*>(p)->push_back(v[0] ? v[0] : "NULL");
-        return 0;
-      },
-      &out, nullptr);
-  sqlite3_close(h);
-  return out;
+using test::query;
+
+// crowddb_run's last_tick and status, in that order.
+std::vector<std::string> last_tick_and_status(const std::filesystem::path& db) {
+  return query(db,
+               "SELECT value FROM crowddb_run WHERE key IN ('status', 'last_tick') ORDER BY key");
 }
 
 // `crowddb run SCENARIO --out OUT` in the background, its stderr to ERR.
@@ -100,8 +94,7 @@ TEST(DurableRun, CtrlCKeepsEveryFrameMarkedIncomplete) {
   EXPECT_NE(err.find("is kept in " + partial.string() + " (incomplete)"), std::string::npos) << err;
   EXPECT_FALSE(std::filesystem::exists(out));
   EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.lock"));
-  const std::vector<std::string> status_tick = query(
-      partial, "SELECT value FROM crowddb_run WHERE key IN ('status', 'last_tick') ORDER BY key");
+  const std::vector<std::string> status_tick = last_tick_and_status(partial);
   ASSERT_EQ(status_tick.size(), 2u);
   EXPECT_EQ(status_tick[1], "stopped");
   const std::string last = status_tick[0];
@@ -124,8 +117,7 @@ TEST(DurableRun, KillMinus9LosesAtMostTheOpenBatch) {
   run.signal(SIGKILL);
   run.wait();
   EXPECT_FALSE(std::filesystem::exists(out));
-  const std::vector<std::string> status_tick = query(
-      partial, "SELECT value FROM crowddb_run WHERE key IN ('status', 'last_tick') ORDER BY key");
+  const std::vector<std::string> status_tick = last_tick_and_status(partial);
   ASSERT_EQ(status_tick.size(), 2u);
   EXPECT_EQ(status_tick[1], "running");  // killed: it could not say more
   const int last = std::stoi(status_tick[0]);

@@ -6,25 +6,12 @@
 #include <algorithm>
 
 #include "support/cli.hpp"
+#include "support/sqlite_query.hpp"
 
 namespace crowddb {
 namespace {
 
-// Runs a query on an SQLite file and returns the first column of every row as text.
-std::vector<std::string> query(const std::filesystem::path& db, const std::string& sql) {
-  sqlite3* h = nullptr;
-  EXPECT_EQ(sqlite3_open_v2(db.c_str(), &h, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
-  std::vector<std::string> out;
-  sqlite3_exec(
-      h, sql.c_str(),
-      [](void* p, int, char** v, char**) {
-        static_cast<std::vector<std::string>*>(p)->push_back(v[0] ? v[0] : "NULL");
-        return 0;
-      },
-      &out, nullptr);
-  sqlite3_close(h);
-  return out;
-}
+using test::query;
 
 const char* kScenario = R"({"name": "two", "bounds": [0, 0, 100, 50], "dt": 0.5, "ticks": 10,
   "goals": [{"name": "g", "x": 90, "y": 25, "arrival_radius": 2}],
@@ -87,19 +74,24 @@ TEST(TrajectorySqlite, EveryNthFrameAndFps) {
   EXPECT_EQ(std::stod(query(db, "SELECT value FROM metadata WHERE key = 'fps'").at(0)), 0.4);
 }
 
+// Begins `w` and writes frame 0, then `ticks` ticks (frame, then metrics, as the run loop does).
+void write_ticks(io::TrajectoryWriter& w, const Scenario& sc, Simulation& sim, uint64_t ticks) {
+  w.begin(sc, sim.world());
+  w.frame(0, sim.world());
+  for (uint64_t t = 1; t <= ticks; ++t) {
+    const TickMetrics& m = sim.step();
+    w.frame(t, sim.world());
+    w.metrics(m);
+  }
+}
+
 // A stopped run keeps what it wrote, marked incomplete, under a name no finished run has.
 TEST(TrajectorySqlite, StopKeepsEverythingWrittenMarkedIncomplete) {
   test::TempDir dir;
   Scenario sc = parse_scenario(kScenario, "two.json");
   Simulation sim(std::move(sc.world), sc.config);
   auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
-  w->begin(sc, sim.world());
-  w->frame(0, sim.world());
-  for (uint64_t t = 1; t <= 3; ++t) {
-    const TickMetrics& m = sim.step();
-    w->frame(t, sim.world());
-    w->metrics(m);
-  }
+  write_ticks(*w, sc, sim, 3);
   EXPECT_EQ(w->stop(3, "interrupted at tick 3"), dir / "run.sqlite.partial");
   EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite"));
   EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.lock"));
@@ -141,13 +133,7 @@ TEST(TrajectorySqlite, BatchesAreCommittedWhileTheRunGoesOn) {
   Scenario sc = parse_scenario(kScenario, "two.json");
   Simulation sim(std::move(sc.world), sc.config);
   auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
-  w->begin(sc, sim.world());
-  w->frame(0, sim.world());
-  for (uint64_t t = 1; t <= 250; ++t) {
-    const TickMetrics& m = sim.step();
-    w->frame(t, sim.world());
-    w->metrics(m);
-  }
+  write_ticks(*w, sc, sim, 250);
   const auto db = dir / "run.sqlite.partial";
   const std::vector<std::string> seen =
       query(db, "SELECT value FROM crowddb_run WHERE key IN ('status', 'last_tick') ORDER BY key");
