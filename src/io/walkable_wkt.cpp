@@ -208,9 +208,9 @@ WalkableArea WalkableArea::parse(std::string_view wkt) {
         if (v.empty() || v.back().x != r[k].x() || v.back().y != r[k].y())
           v.push_back({r[k].x(), r[k].y()});
       if (v.size() >= 3 && v.front().x == v.back().x && v.front().y == v.back().y) v.pop_back();
-      // The exact check is quadratic; very long rings are left to Boost's validity check below.
-      if (v.size() < 3 || v.size() > 5000) return;
+      if (v.size() < 3) return;
       if (auto bad = first_self_intersection(v)) {
+        if (!bad->named) invalid("invalid walkable area: it is self-intersecting: in " + name);
         auto edge = [&](std::size_t e) {
           const Vec2 &a = v[e], &b = v[(e + 1) % v.size()];
           return "the edge from " + pt(Point(a.x, a.y)) + " to " + pt(Point(b.x, b.y));

@@ -28,31 +28,89 @@ bool segments_touch(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) 
 
 }  // namespace
 
-std::optional<std::pair<std::size_t, std::size_t>> first_self_intersection(
-    std::span<const Vec2> ring) {
+namespace {
+
+// Whether edges i < j of the ring meet in a way a simple polygon forbids.
+bool edges_meet(std::span<const Vec2> ring, std::size_t i, std::size_t j) {
   const std::size_t n = ring.size();
+  const Vec2& a = ring[i];
+  const Vec2& b = ring[(i + 1) % n];
+  const Vec2& c = ring[j];
+  const Vec2& d = ring[(j + 1) % n];
+  if (j == i + 1 || (i == 0 && j == n - 1)) {
+    // Adjacent edges share one vertex; they may not fold back onto each other.
+    const Vec2& shared = (j == i + 1) ? b : a;
+    const Vec2& p = (j == i + 1) ? a : b;
+    const Vec2& q = (j == i + 1) ? d : c;
+    return orientation(p, shared, q) == 0 &&
+           (p.x - shared.x) * (q.x - shared.x) + (p.y - shared.y) * (q.y - shared.y) > 0;
+  }
+  return segments_touch(a, b, c, d);
+}
+
+std::optional<SelfIntersection> repeated_vertex(std::span<const Vec2> ring) {
+  for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+    const Vec2& a = ring[i];
+    const Vec2& b = ring[(i + 1) % n];
+    if (a.x == b.x && a.y == b.y) return SelfIntersection{i, (i + 1) % n};
+  }
+  return std::nullopt;
+}
+
+// Every pair in (i, j) order: O(v^2), for short rings, whose messages then name the first pair.
+std::optional<SelfIntersection> scan_all_pairs(std::span<const Vec2> ring) {
+  const std::size_t n = ring.size();
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j)
+      if (edges_meet(ring, i, j)) return SelfIntersection{i, j};
+  return std::nullopt;
+}
+
+// Edges in order of their boxes' left sides; each is tested against the earlier edges whose boxes
+// it overlaps. Bounded: at most 64 v + 10^6 box tests.
+std::optional<SelfIntersection> sweep_boxes(std::span<const Vec2> ring) {
+  const std::size_t n = ring.size();
+  struct Box {
+    double xmin, xmax, ymin, ymax;
+    std::size_t edge;
+  };
+  std::vector<Box> boxes(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2& a = ring[i];
     const Vec2& b = ring[(i + 1) % n];
-    if (a.x == b.x && a.y == b.y) return std::pair{i, (i + 1) % n};  // repeated vertex
-    for (std::size_t j = i + 1; j < n; ++j) {
-      const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
-      const Vec2& c = ring[j];
-      const Vec2& d = ring[(j + 1) % n];
-      if (adjacent) {
-        // Adjacent edges share one vertex; they may not fold back onto each other.
-        const Vec2& shared = (j == i + 1) ? b : a;
-        const Vec2& p = (j == i + 1) ? a : b;
-        const Vec2& q = (j == i + 1) ? d : c;
-        if (orientation(p, shared, q) == 0 &&
-            (p.x - shared.x) * (q.x - shared.x) + (p.y - shared.y) * (q.y - shared.y) > 0)
-          return std::pair{i, j};
-        continue;
-      }
-      if (segments_touch(a, b, c, d)) return std::pair{i, j};
-    }
+    boxes[i] = {std::min(a.x, b.x), std::max(a.x, b.x), std::min(a.y, b.y), std::max(a.y, b.y), i};
   }
-  return std::nullopt;
+  std::sort(boxes.begin(), boxes.end(), [](const Box& p, const Box& q) {
+    return p.xmin != q.xmin ? p.xmin < q.xmin : p.edge < q.edge;
+  });
+  std::uint64_t budget = 64 * static_cast<std::uint64_t>(n) + 1000000;
+  std::vector<Box> active;
+  for (const Box& e : boxes) {
+    std::size_t kept = 0;
+    for (const Box& o : active) {
+      if (budget-- == 0) return SelfIntersection{0, 0, false};
+      if (o.xmax < e.xmin) continue;  // behind the sweep for good
+      active[kept++] = o;
+      if (o.ymax < e.ymin || e.ymax < o.ymin) continue;
+      const std::size_t i = std::min(o.edge, e.edge), j = std::max(o.edge, e.edge);
+      if (edges_meet(ring, i, j)) return SelfIntersection{i, j};
+    }
+    active.resize(kept);
+    active.push_back(e);
+  }
+  return SelfIntersection{0, 0, false};
+}
+
+}  // namespace
+
+std::optional<SelfIntersection> first_self_intersection(std::span<const Vec2> ring) {
+  if (ring.size() < 3) return std::nullopt;
+  if (auto dup = repeated_vertex(ring)) return dup;
+  if (is_simple_polygon(ring)) return std::nullopt;
+  // Not simple (decided exactly). Name the edges with the same doubles predicates as before; if
+  // rounding hides the crossing from them, it is reported unnamed rather than not at all.
+  const auto found = ring.size() <= kNamedCrossingLimit ? scan_all_pairs(ring) : sweep_boxes(ring);
+  return found ? *found : SelfIntersection{0, 0, false};
 }
 
 namespace {

@@ -105,8 +105,22 @@ inline bool inside_goal(const Goal& g, double px, double py) {
 // Non-convex areas: their nearest point (the edge offsets do not make their erosion).
 Vec2 goal_target(const Goal& g, double px, double py, double r = 0);
 
-// The first pair of non-adjacent edges (i, j), i < j, that touch or cross, if any. O(v^2).
-std::optional<std::pair<std::size_t, std::size_t>> first_self_intersection(
-    std::span<const Vec2> ring);
+// Whether the ring (>= 3 vertices, implicitly closed) is a simple polygon: no repeated vertex,
+// no two edges meeting except consecutive ones at their shared vertex. Exact (CGAL's sweep with
+// exact predicates), O(v log v).
+bool is_simple_polygon(std::span<const Vec2> ring);
+
+// A pair of edges (i, j), i < j, that touch or cross (or consecutive edges that fold back onto
+// each other, or a repeated vertex), if the ring is not simple; nullopt if it is. Simplicity is
+// decided by is_simple_polygon; the pair is then the first in (i, j) order for rings of up to
+// kNamedCrossingLimit vertices, else the first a bounded sweep over edge boxes finds.
+// `named == false` when that sweep ran out of its budget (O(v) box tests beyond the rings a
+// pathological star shape can make quadratic): the ring is not simple, its edges unnamed.
+struct SelfIntersection {
+  std::size_t first = 0, second = 0;
+  bool named = true;
+};
+inline constexpr std::size_t kNamedCrossingLimit = 2000;
+std::optional<SelfIntersection> first_self_intersection(std::span<const Vec2> ring);
 
 }  // namespace crowddb

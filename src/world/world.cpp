@@ -47,8 +47,10 @@ void normalize_ring(std::vector<Vec2>& ring, const char* field) {
   const double area = signed_area(ring);
   if (area == 0) throw InvalidRow(field, "polygon has zero area");
   if (auto bad = first_self_intersection(ring))
-    throw InvalidRow(field, "polygon is not simple: edges " + std::to_string(bad->first) + " and " +
-                                std::to_string(bad->second) + " intersect");
+    throw InvalidRow(field, bad->named
+                                ? "polygon is not simple: edges " + std::to_string(bad->first) +
+                                      " and " + std::to_string(bad->second) + " intersect"
+                                : "polygon is not simple: it crosses or touches itself");
   if (area < 0) std::reverse(ring.begin(), ring.end());
 }
 

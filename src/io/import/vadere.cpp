@@ -361,7 +361,7 @@ std::vector<std::vector<Vec2>> simple_pieces(const std::vector<Vec2>& ring) {
     todo.pop_back();
     if (r.size() < 3) continue;
     const auto bad = first_self_intersection(r);
-    if (!bad) {
+    if (!bad || !bad->named) {  // unnamed crossings: the world refuses the ring, naming it
       if (signed_area(r) != 0) out.push_back(std::move(r));
       continue;
     }
