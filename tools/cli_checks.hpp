@@ -11,12 +11,12 @@
 #include <sstream>
 #include <string>
 
+#include "util/plain_number.hpp"
+
 namespace crowddb::cli_checks {
 
 inline std::string plain(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
+  return plain_number(v);
 }
 
 // A whole number in [lo, hi].

@@ -146,6 +146,14 @@ struct Collider {
   friend bool operator==(Collider, Collider) = default;
 };
 
+// The ranges first-to-collide and the collision set accept. Inside them the pair arithmetic
+// (squared distances, |v|^2 t^2) stays far from overflow, so every method is exact; outside, a
+// product such as (2e160)^2 would overflow to infinity and a collision be missed, so such inputs
+// are refused (Error::Kind::input naming the row and field) rather than answered wrongly.
+// Coordinates and radii: |value| <= kMaxCoordinate (10^9 length units).
+inline constexpr double kMaxQuerySpeed = 1e9;    // |vx|, |vy| [length/tick]
+inline constexpr double kMaxQueryHorizon = 1e9;  // [ticks]
+
 struct FtcHit {
   Collider with;           // kind none: no collision within the horizon
   double time = INFINITY;  // [ticks], in [0, horizon]; 0 when already overlapping
@@ -154,7 +162,8 @@ struct FtcHit {
 
 // For each disc, the first agent or obstacle it collides with within `horizon` ticks, moving on
 // rays p + v t. Ties in time go to agents before obstacles, then the smaller id (agents) or row
-// (obstacles). Exact: every method returns the same hits.
+// (obstacles). Exact: every method returns the same hits. Inputs outside the ranges above (and a
+// horizon outside [0, kMaxQueryHorizon]) throw Error::Kind::input.
 std::vector<FtcHit> first_to_collide(const DiscView& discs, const StaticScene& scene,
                                      double horizon, std::string_view method = "auto",
                                      int threads = 1, QueryStats* stats = nullptr);
@@ -235,7 +244,8 @@ struct CollisionPairs {
   }
 };
 
-// The rows of discs that overlap another disc or an obstacle, sorted.
+// The rows of discs that overlap another disc or an obstacle, sorted. Inputs outside the ranges of
+// first-to-collide throw Error::Kind::input.
 std::vector<uint32_t> collision_set(const DiscView& discs, const StaticScene& scene,
                                     std::string_view method = "auto", int threads = 1,
                                     QueryStats* stats = nullptr);

@@ -10,6 +10,7 @@
 
 #include <libfccp/csv.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -17,6 +18,7 @@
 #include <unordered_set>
 
 #include "crowddb/error.hpp"
+#include "util/plain_number.hpp"
 #include "util/read_file.hpp"
 
 namespace crowddb::io {
@@ -47,6 +49,26 @@ void require_columns(Reader& in, const std::string& path,
       throw Error(Error::Kind::input, path + ": missing column '" + n + "' in the header");
 }
 
+// The CSV library reads fields as C strings, so a NUL byte would silently cut a field short
+// ("1\0junk" reads as 1): refuse the file, naming the line.
+void reject_nul(std::string_view text, const std::string& path) {
+  const std::size_t at = text.find('\0');
+  if (at == std::string_view::npos) return;
+  const auto line =
+      1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+  throw Error(Error::Kind::input,
+              path + ":" + std::to_string(line) + ": contains a NUL byte (not a text file?)");
+}
+
+// A number within [-limit, limit]: the ranges of crowddb/query.hpp, said with file and line.
+double parse_bounded(const char* text, const std::string& at, double limit) {
+  const double v = parse_number(text, at);
+  if (std::abs(v) > limit)
+    throw Error(Error::Kind::input,
+                at + ": must lie within +-" + plain_number(limit) + " (got " + text + ")");
+  return v;
+}
+
 }  // namespace
 
 double parse_number(const char* text, const std::string& at) {
@@ -72,6 +94,7 @@ std::vector<CircleObstacle> read_obstacles_csv(const std::filesystem::path& path
 }
 
 DiscTable parse_agents_csv(std::string_view text, const std::string& path) {
+  reject_nul(text, path);
   DiscTable t;
   try {
     ::io::CSVReader<7, ::io::trim_chars<' ', '\t'>, ::io::no_quote_escape<','>> in(
@@ -93,15 +116,16 @@ DiscTable parse_agents_csv(std::string_view text, const std::string& path) {
       if (!seen.insert(idv).second)
         throw Error(Error::Kind::input,
                     where(path, line, "id") + ": duplicate id " + std::to_string(idv));
-      const double px = parse_number(x, where(path, line, "x"));
-      const double py = parse_number(y, where(path, line, "y"));
-      const double pvx = parse_number(vx, where(path, line, "vx"));
-      const double pvy = parse_number(vy, where(path, line, "vy"));
-      const double pr = parse_number(r, where(path, line, "radius"));
+      const double px = parse_bounded(x, where(path, line, "x"), kMaxCoordinate);
+      const double py = parse_bounded(y, where(path, line, "y"), kMaxCoordinate);
+      const double pvx = parse_bounded(vx, where(path, line, "vx"), kMaxQuerySpeed);
+      const double pvy = parse_bounded(vy, where(path, line, "vy"), kMaxQuerySpeed);
+      const double pr = parse_bounded(r, where(path, line, "radius"), kMaxCoordinate);
       if (!(pr > 0))
         throw Error(Error::Kind::input,
                     where(path, line, "radius") + ": must be > 0 (got " + r + ")");
-      const double pc = has_charge ? parse_number(c, where(path, line, "charge")) : 1.0;
+      const double pc =
+          has_charge ? parse_bounded(c, where(path, line, "charge"), kMaxCoordinate) : 1.0;
       t.push_back(idv, px, py, pvx, pvy, pr, pc);
     }
   } catch (const Error&) {
@@ -113,6 +137,7 @@ DiscTable parse_agents_csv(std::string_view text, const std::string& path) {
 }
 
 std::vector<CircleObstacle> parse_obstacles_csv(std::string_view text, const std::string& path) {
+  reject_nul(text, path);
   std::vector<CircleObstacle> out;
   try {
     ::io::CSVReader<4, ::io::trim_chars<' ', '\t'>, ::io::no_quote_escape<','>> in(
@@ -124,13 +149,13 @@ std::vector<CircleObstacle> parse_obstacles_csv(std::string_view text, const std
     while (in.read_row(x, y, r, c)) {
       const unsigned line = in.get_file_line();
       CircleObstacle o;
-      o.x = parse_number(x, where(path, line, "x"));
-      o.y = parse_number(y, where(path, line, "y"));
-      o.radius = parse_number(r, where(path, line, "radius"));
+      o.x = parse_bounded(x, where(path, line, "x"), kMaxCoordinate);
+      o.y = parse_bounded(y, where(path, line, "y"), kMaxCoordinate);
+      o.radius = parse_bounded(r, where(path, line, "radius"), kMaxCoordinate);
       if (!(o.radius > 0))
         throw Error(Error::Kind::input,
                     where(path, line, "radius") + ": must be > 0 (got " + r + ")");
-      o.charge = has_charge ? parse_number(c, where(path, line, "charge")) : 1.0;
+      o.charge = has_charge ? parse_bounded(c, where(path, line, "charge"), kMaxCoordinate) : 1.0;
       out.push_back(o);
     }
   } catch (const Error&) {

@@ -23,6 +23,11 @@
 namespace crowddb {
 namespace {
 
+std::string hex4(unsigned c) {
+  const char* digits = "0123456789ABCDEF";
+  return {digits[(c >> 12) & 15], digits[(c >> 8) & 15], digits[(c >> 4) & 15], digits[c & 15]};
+}
+
 using nlohmann::json;
 
 // The document being read: its file name for messages and, for a document converted from another
@@ -133,7 +138,16 @@ class Node {
     }
     const json& v = raw(key);
     if (!v.is_string()) fail(key, "expected a string");
-    return v.get<std::string>();
+    std::string text = v.get<std::string>();
+    // "\u0000" and other control characters are valid JSON but would cut names short in C APIs
+    // and SQLite output, or end up raw in messages: refuse them (tab and line breaks are fine).
+    for (std::size_t i = 0; i < text.size(); ++i) {
+      const auto c = static_cast<unsigned char>(text[i]);
+      if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f)
+        fail(key,
+             "contains the control character U+" + hex4(c) + " at position " + std::to_string(i));
+    }
+    return text;
   }
 
   std::string choice(const std::string& key, std::initializer_list<const char*> options,

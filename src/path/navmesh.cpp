@@ -13,6 +13,7 @@
 #include <string>
 
 #include "util/executor.hpp"
+#include "util/plain_number.hpp"
 #include "util/stopwatch.hpp"
 #include "world/geometry.hpp"
 
@@ -275,16 +276,21 @@ std::unique_ptr<NavMesh> NavMesh::build(const NavGeometry& g, const NavMeshParam
   if (params.tile_size < 16 || params.tile_size > 4096) bad("tile_size must be in 16..4096");
   const Bounds& b = g.bounds;
   if (!(b.width() > 0 && b.height() > 0)) bad("the bounds are empty");
-  const int erode = static_cast<int>(std::ceil(params.radius / cs)) + kErodeMargin;
-  if (erode > 120)
-    bad("cell_size " + std::to_string(cs) + " is too small for radius " +
-        std::to_string(params.radius) + " (erosion over 120 cells): raise cell_size");
+  const double erode_cells = std::ceil(params.radius / cs) + kErodeMargin;  // may be huge
+  if (!(erode_cells <= 120))
+    throw Error(Error::Kind::input,
+                "/navigation/cell_size: " + plain_number(cs) +
+                    " is too small for agents of radius " + plain_number(params.radius) +
+                    " (the navigation mesh would erode over 120 cells): raise cell_size");
+  const int erode = static_cast<int>(erode_cells);
   const double gw = std::ceil(b.width() / cs), gh = std::ceil(b.height() / cs);
   const double tx = std::ceil(gw / params.tile_size), ty = std::ceil(gh / params.tile_size);
-  if (tx * ty > 16384)
-    bad("the world needs " + std::to_string(static_cast<long long>(tx * ty)) +
-        " tiles at cell_size " + std::to_string(cs) +
-        " (at most 16384): raise cell_size or tile_size");
+  if (!(tx * ty <= 16384))
+    throw Error(Error::Kind::input,
+                "/navigation: the navigation mesh would need " +
+                    (std::isfinite(tx * ty) ? plain_number(tx * ty) : std::string("too many")) +
+                    " tiles at cell_size " + plain_number(cs) +
+                    " (at most 16384): raise cell_size or tile_size");
   const int tiles_x = static_cast<int>(tx), tiles_y = static_cast<int>(ty);
 
   auto nm = std::unique_ptr<NavMesh>(new NavMesh());

@@ -20,7 +20,10 @@ inline double ray_disc_time(double dx, double dy, double wx, double wy, double R
   const double b = dx * wx + dy * wy;  // half the linear coefficient; < 0 when approaching
   if (!(b < 0)) return INFINITY;
   const double a = wx * wx + wy * wy;
-  const double disc = b * b - a * c;
+  // b^2 - a c, rewritten with Lagrange's identity (d.w)^2 - |d|^2 |w|^2 = -(d x w)^2 so that it
+  // does not cancel: head-on at 2e9 m the textbook form loses every digit and misses the contact.
+  const double cross = dx * wy - dy * wx;
+  const double disc = a * (R * R) - cross * cross;
   if (!(disc > 0)) return INFINITY;
   // c / (-b + sqrt(disc)) is the smaller root without the cancellation of (-b - sqrt(disc)) / a.
   const double t = c / (-b + std::sqrt(disc));

@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "crowddb/error.hpp"
 #include "plan/access_path.hpp"
+#include "util/plain_number.hpp"
 #include "util/stopwatch.hpp"
 
 namespace crowddb {
@@ -32,11 +34,66 @@ CollisionQueryShape shape_of(const DiscView& d) {
   return s;
 }
 
+[[noreturn]] void out_of_range(std::string_view query, const std::string& what, double v,
+                               double limit) {
+  std::ostringstream os;
+  const std::string l = plain_number(limit);
+  os << query << ": " << what << " = " << v << " is outside [-" << l << ", " << l
+     << "] (larger values could overflow the exact pair arithmetic)";
+  throw Error(Error::Kind::input, os.str());
+}
+
+// The input rules of first-to-collide and the collision set (query.hpp, kMaxQuerySpeed).
+void check_inputs(std::string_view query, const DiscView& d, const StaticScene& scene) {
+  const auto row = [&](std::size_t i, const char* field) {
+    return "agent " + (d.id ? "id " + std::to_string(d.id[i]) : "row " + std::to_string(i)) + " " +
+           field;
+  };
+  for (std::size_t i = 0; i < d.n; ++i) {
+    if (!(std::abs(d.x[i]) <= kMaxCoordinate))
+      out_of_range(query, row(i, "x"), d.x[i], kMaxCoordinate);
+    if (!(std::abs(d.y[i]) <= kMaxCoordinate))
+      out_of_range(query, row(i, "y"), d.y[i], kMaxCoordinate);
+    if (!(std::abs(d.vx[i]) <= kMaxQuerySpeed))
+      out_of_range(query, row(i, "vx"), d.vx[i], kMaxQuerySpeed);
+    if (!(std::abs(d.vy[i]) <= kMaxQuerySpeed))
+      out_of_range(query, row(i, "vy"), d.vy[i], kMaxQuerySpeed);
+    if (!(d.radius[i] > 0 && d.radius[i] <= kMaxCoordinate))
+      throw Error(Error::Kind::input, std::string(query) + ": " + row(i, "radius") +
+                                          " must be > 0 and <= 1e9 (got " +
+                                          std::to_string(d.radius[i]) + ")");
+  }
+  // Walls (rows >= wall_begin) lie up to three world widths out, by construction within range.
+  const auto circles = scene.circles();
+  for (std::size_t i = 0; i < circles.size(); ++i) {
+    const std::string at = "obstacle circle " + std::to_string(i);
+    if (!(std::abs(circles[i].x) <= kMaxCoordinate))
+      out_of_range(query, at + " x", circles[i].x, kMaxCoordinate);
+    if (!(std::abs(circles[i].y) <= kMaxCoordinate))
+      out_of_range(query, at + " y", circles[i].y, kMaxCoordinate);
+    if (!(std::abs(circles[i].radius) <= kMaxCoordinate))
+      out_of_range(query, at + " radius", circles[i].radius, kMaxCoordinate);
+  }
+  const auto polygons = scene.polygons();
+  for (std::size_t p = 0; p < scene.wall_begin(); ++p)
+    for (const Vec2& v : polygons[p].vertices)
+      if (!(std::abs(v.x) <= kMaxCoordinate && std::abs(v.y) <= kMaxCoordinate))
+        out_of_range(query, "obstacle polygon " + std::to_string(p) + " vertex",
+                     std::abs(v.x) > std::abs(v.y) || !std::isfinite(v.x) ? v.x : v.y,
+                     kMaxCoordinate);
+}
+
 }  // namespace
 
 std::vector<FtcHit> first_to_collide(const DiscView& discs, const StaticScene& scene,
                                      double horizon, std::string_view method, int threads,
                                      QueryStats* stats) {
+  check_inputs("first-to-collide", discs, scene);
+  if (!(horizon >= 0 && horizon <= kMaxQueryHorizon)) {
+    std::ostringstream os;
+    os << "first-to-collide: horizon must be >= 0 and <= 1e9 ticks (got " << horizon << ")";
+    throw Error(Error::Kind::input, os.str());
+  }
   const FtcMethod& m = method == "auto" ? choose_ftc_method(discs.n) : find_ftc_method(method);
   auto path = m.make();
   Executor ex(threads);
@@ -101,6 +158,7 @@ FieldColumns field_at(std::span<const Vec2> points, const DiscView& sources,
 
 std::vector<uint32_t> collision_set(const DiscView& discs, const StaticScene& scene,
                                     std::string_view method, int threads, QueryStats* stats) {
+  check_inputs("collision set", discs, scene);
   const CollisionQueryShape shape = shape_of(discs);
   const CollisionMethod& m =
       method == "auto" ? choose_collision_method(shape) : find_collision_method(method, shape);

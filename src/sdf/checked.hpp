@@ -28,6 +28,17 @@ inline uint64_t add(uint64_t a, uint64_t b, const char* what) {
   return r;
 }
 
+// tokens + k·gain on channel `name`; an overflow names the channel.
+[[noreturn]] inline void token_overflow(const std::string& name) {
+  overflow("the token count on channel '" + name + "'");
+}
+inline uint64_t add_tokens(uint64_t tokens, uint64_t k, uint64_t gain, const std::string& name) {
+  uint64_t r;
+  if (__builtin_mul_overflow(k, gain, &r) || __builtin_add_overflow(tokens, r, &r))
+    token_overflow(name);
+  return r;
+}
+
 // Saturating forms, for caps and limits where "at least 2^64 - 1" is all that matters.
 inline uint64_t mul_sat(uint64_t a, uint64_t b) {
   uint64_t r;

@@ -12,7 +12,8 @@ struct OnlineScheduler::Topology {
   std::vector<char> has_loop;  // per actor: one of its channels is a self-loop
   std::vector<uint32_t> in_off, out_off;
   std::vector<ChannelId> in, out;
-  std::vector<ActorId> out_dst;  // dst of out[i], beside it
+  std::vector<ActorId> out_dst;   // dst of out[i], beside it
+  std::vector<std::string> name;  // per channel, for messages
 };
 
 namespace {
@@ -58,6 +59,7 @@ OnlineScheduler::OnlineScheduler(const Graph& g, std::span<const uint64_t> q, On
     topo->src[c] = ch.src;
     topo->dst[c] = ch.dst;
     topo->self[c] = ch.src == ch.dst;
+    topo->name.push_back(ch.name);
     if (ch.src == ch.dst) topo->has_loop[ch.src] = 1;
     prd_[c] = ch.prd;
     cns_[c] = ch.cns;
@@ -315,7 +317,7 @@ std::optional<Run> OnlineScheduler::step(uint64_t max_firings) {
       v = tokens_[c] - k * (cns_[c] - prd_[c]);
     } else {
       const uint64_t gain = t.self[c] ? prd_[c] - cns_[c] : prd_[c];
-      v = detail::add(tokens_[c], detail::mul(k, gain, "a token count"), "a token count");
+      v = detail::add_tokens(tokens_[c], k, gain, t.name[c]);
     }
     set_tokens(c, v);
     if (!caps_.empty() && v > caps_[c] && exceeded_ < 0) exceeded_ = c;

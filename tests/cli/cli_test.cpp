@@ -36,13 +36,15 @@ TEST(Cli, BadNumbersAreUsageErrorsInPlainWords) {
   const auto agents = dir.write("a.csv", "id,x,y,vx,vy,radius\n1,0,0,0,0,1\n");
   const std::string run = "run " + sc.string() + " --no-output --quiet ";
   const std::pair<std::string, std::string> cases[] = {
-      {run + "--duration nan", "--duration: must be a finite number >= 0 and <= 1e+09 (got nan)"},
+      {run + "--duration nan", "--duration: must be a finite number >= 0 and <= 1e9 (got nan)"},
       {run + "--nudge-after inf", "--nudge-after: must be a finite number >= 0"},
       {run + "--every 0", "--every: must be a whole number >= 1 (got 0)"},
       {run + "--every 2.5", "--every: must be a whole number >= 1 (got 2.5)"},
       {run + "--threads 300", "--threads: must be a whole number from 1 to 256 (got 300)"},
       {"query ftc --agents " + agents.string() + " --horizon nan",
-       "--horizon: must be a finite number >= 0 (got nan)"},
+       "--horizon: must be a finite number >= 0 and <= 1e9 (got nan)"},
+      {"query ftc --agents " + agents.string() + " --horizon 1e12",
+       "--horizon: must be a finite number >= 0 and <= 1e9 (got 1e12)"},
       {"bench " + sc.string() + " --duration -1", "--duration: must be a finite number >= 0"},
   };
   for (const auto& [args, message] : cases) {
@@ -52,6 +54,35 @@ TEST(Cli, BadNumbersAreUsageErrorsInPlainWords) {
     EXPECT_EQ(lines(r.err), 1) << args << ": " << r.err;
   }
   EXPECT_EQ(run_cli(run + "--duration 0.5 --every 2", dir).status, 0);
+}
+
+// Errors the engine finds after loading (a navigation mesh that cannot be built) name the file
+// and the field, in validate and run alike; 1e-300 used to overflow into "-9223372036854775808
+// tiles at cell_size 0.000000".
+TEST(Cli, NavigationMeshErrorsNameFileAndField) {
+  TempDir dir;
+  const auto scenario = [&](const std::string& navigation, const std::string& size) {
+    return dir.write("nav.json", R"({"bounds": [0, 0, )" + size + ", " + size +
+                                     R"(], "duration": 1, "navigation": )" + navigation + R"(,
+      "obstacles": [{"type": "circle", "x": 50, "y": 50, "radius": 5}],
+      "goals": [{"name": "g", "x": 80, "y": 50}], "agents": [{"x": 20, "y": 50, "goal": "g"}]})");
+  };
+  const std::tuple<std::string, std::string, std::string> cases[] = {
+      {R"({"cell_size": 0.001})", "100",
+       "nav.json: /navigation/cell_size: 0.001 is too small for agents of radius 0.25"},
+      {R"({"cell_size": 1e-300})", "100", "nav.json: /navigation/cell_size: 1e-300 is too small"},
+      {R"({"cell_size": 0.01, "tile_size": 16})", "1000",
+       "nav.json: /navigation: the navigation mesh would need 39062500 tiles at cell_size 0.01"},
+  };
+  for (const auto& [navigation, size, message] : cases) {
+    const auto file = scenario(navigation, size);
+    for (const std::string command : {"validate ", "run --no-output "}) {
+      const CliResult r = run_cli(command + file.string(), dir);
+      EXPECT_EQ(r.status, 1) << command << navigation;
+      EXPECT_NE(r.err.find(message), std::string::npos) << command << navigation << ": " << r.err;
+      EXPECT_EQ(lines(r.err), 1) << r.err;
+    }
+  }
 }
 
 TEST(Cli, UnknownMethodIsAUsageError) {
@@ -72,6 +103,13 @@ TEST(Cli, BadCsvFilesExitWith1NamingFileLineAndField) {
       {"id,x,y,vx,vy,radius\n1,0,0,0,0,-1\n", ":2: field radius"},
       {"id,x,y,vx,vy,radius\n1,0,0,0,0,1\n2,inf,0,0,0,1\n", ":3: field x"},
       {"id,x,y,vx,vy,radius\n1,0,0,nan,0,1\n", ":2: field vx"},
+      // Beyond these ranges first-to-collide's arithmetic could overflow (query.hpp).
+      {"id,x,y,vx,vy,radius\n1,0,0,1e160,0,1\n", ":2: field vx: must lie within +-1e9 (got 1e160)"},
+      {"id,x,y,vx,vy,radius\n1,0,-2e9,0,0,1\n", ":2: field y: must lie within +-1e9"},
+      {"id,x,y,vx,vy,radius\n1,0,0,0,0,1e300\n", ":2: field radius: must lie within +-1e9"},
+      // A NUL byte used to cut a field short silently ("1\0junk" read as 1).
+      {std::string("id,x,y,vx,vy,radius\n1,0,0,0,0,1\n2,5,0,0,0,1\0junk\n", 49),
+       ":3: contains a NUL byte"},
       {"id,x,y,vx,vy,radius\n1,0,0,0,0\n", "line 2"},
       {"id,x,y,vx,vy\n1,0,0,0,0\n", "missing column 'radius'"},
       {"id,x,y,vx,vy,radius,mood\n1,0,0,0,0,1,happy\n", "mood"},

@@ -199,6 +199,11 @@ TEST(ScenarioJson, InvalidFieldsNameTheirPointer) {
       {head +
            R"("groups": [{"count": 500, "radius": 3, "placement": {"type": "uniform", "region": [0,0,10,10]}, "goal": "g"}]})",
        "too crowded"},
+      // Control characters would cut names short in SQLite output and end up raw in messages.
+      {R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g\u0000x", "x": 1, "y": 1}]})",
+       "/goals/0/name: contains the control character U+0000 at position 1"},
+      {R"({"walkable": "POLYGON((0 0,9 0,9 9,0 9,0 0))\u001bjunk"})",
+       "/walkable: contains the control character U+001B at position 30"},
       {R"({"bounds": [0, 0, -1, 1]})", "/bounds"},
       {R"({"bounds": [0, 0, 1, 1], "bounds": [0, 0, 2, 2]})", "duplicate key"},
       {R"({"ticks": 3})", "/bounds: missing"},

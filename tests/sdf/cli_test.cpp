@@ -42,6 +42,17 @@ TEST(SdfschedCli, InconsistentAndOverflow) {
   EXPECT_EQ(o.out, "");
   EXPECT_NE(o.err.find("does not fit in 64 bits"), std::string::npos);
   EXPECT_TRUE(one_line(o.err));
+  // A token count that overflows while scheduling names the file and the channel.
+  for (const char* policy : {"static", "online", "online-bounded"}) {
+    const test::Cli t =
+        test::sdfsched("schedule " + graph("token_overflow.json") + " --policy " + policy);
+    EXPECT_EQ(t.status, 1) << policy;
+    EXPECT_NE(t.err.find("token_overflow.json: the token count on channel 'ab' does not fit in 64 "
+                         "bits"),
+              std::string::npos)
+        << policy << ": " << t.err;
+    EXPECT_TRUE(one_line(t.err)) << t.err;
+  }
 }
 
 TEST(SdfschedCli, ScheduleStaticJson) {

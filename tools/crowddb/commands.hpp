@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "crowddb/error.hpp"
 #include "crowddb/scenario.hpp"
 
 namespace crowddb::cli {
@@ -28,6 +29,19 @@ void add_set_option(CLI::App* sub, std::vector<std::string>& overrides);
 
 // Prints a loaded scenario's warnings on stderr, one line each, naming the file.
 void print_warnings(const Scenario& sc);
+
+// Runs `work`; an input error it throws that does not yet name a file (one the engine finds
+// after loading, such as a navigation mesh that cannot be built) is said to be about `file`.
+template <class F>
+auto naming_file(const std::string& file, F&& work) -> decltype(work()) {
+  try {
+    return work();
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    if (e.kind() != Error::Kind::input || msg.rfind(file, 0) == 0) throw;
+    throw Error(Error::Kind::input, file + ": " + msg);
+  }
+}
 
 // Shortest decimal that reads back as the same double.
 std::string format_number(double v);

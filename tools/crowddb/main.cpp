@@ -37,7 +37,11 @@ int main(int argc, char** argv) {
     std::cerr << "crowddb: " << e.what() << "\n";
     return e.exit_code();
   } catch (const std::bad_alloc&) {
-    std::cerr << "crowddb: out of memory\n";
+    // Name the work that ran out: the command line holds its files.
+    std::string command = "crowddb";
+    for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+    if (command.size() > 200) command = command.substr(0, 197) + "...";
+    std::cerr << "crowddb: out of memory (in: " << command << ")\n";
     return 1;
   } catch (const std::exception& e) {
     std::cerr << "crowddb: internal error: " << e.what() << "\n";

@@ -62,7 +62,7 @@ void add_query_commands(CLI::App& app, Action& action) {
   add_common(ftc, fc);
   ftc->add_option("--horizon", horizon, "look-ahead T in ticks; collisions after T are ignored")
       ->required()
-      ->check(cli_checks::non_negative());
+      ->check(cli_checks::finite(0, kMaxQueryHorizon));
   ftc->callback([&action] {
     action = [] {
       Inputs in = load(fc, ObstacleCharges::centres);

@@ -96,7 +96,8 @@ int run(const RunOptions& o) {
     if (!dir.empty() && !std::filesystem::is_directory(dir))
       throw Error(Error::Kind::io, o.summary_json + ": no such directory");
   }
-  Simulation sim(std::move(sc.world), sc.config);
+  Simulation sim =
+      naming_file(o.scenario, [&] { return Simulation(std::move(sc.world), sc.config); });
   if (o.explain) {
     std::cout << sim.explain();
     return 0;
@@ -127,7 +128,7 @@ int run(const RunOptions& o) {
     };
   metrics::RunSummary summary;
   try {
-    summary = metrics::run_to_end(sc, sim, control);
+    summary = naming_file(o.scenario, [&] { return metrics::run_to_end(sc, sim, control); });
   } catch (...) {
     if (tty) std::fprintf(stderr, "\n");
     std::signal(SIGINT, old_int);
@@ -212,7 +213,9 @@ void add_validate_command(CLI::App& app, Action& action) {
       print_warnings(sc);
       const std::size_t agents = sc.world.agents().size(), goals = sc.world.goals().size();
       const std::size_t circles = sc.world.circles().size(), polygons = sc.world.polygons().size();
-      Simulation sim(std::move(sc.world), sc.config);  // also checks the access-path choices
+      // Also checks the access-path choices and builds the navigation meshes.
+      const Simulation sim =
+          naming_file(file, [&] { return Simulation(std::move(sc.world), sc.config); });
       std::cout << file << ": ok" << (sc.format == "crowddb" ? "" : " (" + sc.format + ")") << ": "
                 << (sc.name.empty() ? "(unnamed)" : sc.name) << ", " << agents << " agents, "
                 << goals << " goals, " << circles << " circles, " << polygons << " polygons, "

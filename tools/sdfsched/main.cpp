@@ -25,6 +25,19 @@ namespace {
 using Json = nlohmann::ordered_json;
 using sdf::Error;
 
+// The graph file a command works on: errors found after reading it (a count that overflows,
+// memory running out) name it, as parse errors do.
+std::string current_input;
+
+sdf::Graph read_graph(const std::string& path) {
+  current_input = path;
+  return sdf::read_graph_file(path);
+}
+
+std::string about_input() {
+  return current_input.empty() ? "" : current_input + ": ";
+}
+
 void print_json(const Json& j) {
   std::cout << j.dump() << "\n";
 }
@@ -161,7 +174,7 @@ void print_text_metrics(const sdf::Graph& g, const sdf::Metrics& m) {
 }
 
 int cmd_repetitions(const std::string& path, bool json) {
-  const sdf::Graph g = sdf::read_graph_file(path);
+  const sdf::Graph g = read_graph(path);
   const Consistency c = consistency(g, json);
   if (c.status) return c.status;
   if (json) {
@@ -187,7 +200,7 @@ int cmd_repetitions(const std::string& path, bool json) {
 
 int cmd_schedule(const std::string& path, const std::string& policy_text, bool json,
                  const RunFlags& flags) {
-  const sdf::Graph g = sdf::read_graph_file(path);
+  const sdf::Graph g = read_graph(path);
   const Consistency c = consistency(g, json);
   if (c.status) return c.status;
   const std::vector<uint64_t>& q = c.rep.q;
@@ -328,7 +341,7 @@ sdf::RateChange parse_rate_change(const sdf::Graph& g, const std::string& spec) 
 
 int cmd_simulate(const std::string& path, const std::string& policy_text,
                  const std::string& change_text, bool json, const RunFlags& flags) {
-  const sdf::Graph g = sdf::read_graph_file(path);
+  const sdf::Graph g = read_graph(path);
   const Consistency c = consistency(g, json);
   if (c.status) return c.status;
   const sdf::StaticSchedule st = sdf::static_schedule(g, c.rep.q);
@@ -404,7 +417,7 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
 }
 
 int cmd_convert(const std::string& path, const std::string& to, const std::string& out) {
-  const sdf::Graph g = sdf::read_graph_file(path);
+  const sdf::Graph g = read_graph(path);
   const std::string text =
       to == "json" ? sdf::write_json(g) : (to == "dot" ? sdf::write_dot(g) : sdf::write_sdf3(g));
   if (out.empty() || out == "-") {
@@ -563,10 +576,12 @@ int main(int argc, char** argv) {
   try {
     return action ? action() : 0;
   } catch (const Error& e) {
-    std::cerr << "sdfsched: " << e.what() << "\n";
+    const std::string msg = e.what();
+    const bool named = !current_input.empty() && msg.rfind(current_input, 0) == 0;
+    std::cerr << "sdfsched: " << (named ? "" : about_input()) << msg << "\n";
     return e.exit_code();
   } catch (const std::bad_alloc&) {
-    std::cerr << "sdfsched: out of memory\n";
+    std::cerr << "sdfsched: " << about_input() << "out of memory\n";
     return 1;
   } catch (const std::exception& e) {
     std::cerr << "sdfsched: internal error: " << e.what() << "\n";
