@@ -207,6 +207,17 @@ class Simulation {
   // Hash of the current committed state; equal hashes mean bit-identical states.
   uint64_t state_hash() const;
 
+  // Checkpoints. save_state(): the whole state after the last step (the agents table and slot
+  // map, the sources' random streams, path requests queued and in flight, tick and counters) as
+  // bytes. restore_state() on a Simulation built from the same scenario and configuration (any
+  // thread count) continues bit-identically: every later step gives the same state hash as the
+  // run that saved it. Throws Error(input) on bytes that are damaged or from another scenario
+  // (a fingerprint of its static tables and settings is checked), leaving this simulation
+  // unusable only if the error came after the agents were restored (then build it anew).
+  // Not saved: EXPLAIN ANALYZE's operator times, which count from the restore.
+  std::string save_state() const;
+  void restore_state(std::string_view bytes, const std::string& what = "checkpoint");
+
   // The plan the next tick will run (EXPLAIN).
   std::string explain() const;
   // The plan with rows, loops and time per operator accumulated over all ticks so far

@@ -20,6 +20,9 @@
 
 namespace crowddb {
 
+class ByteWriter;  // src/util/byte_codec.hpp
+class ByteReader;
+
 struct Vec2 {
   double x = 0;
   double y = 0;
@@ -209,6 +212,14 @@ class World {
   bool at_goal(std::size_t row) const;
 
   static void validate_spec(const AgentSpec& spec, std::size_t goal_count);
+
+  // ---- checkpoints (Simulation::save_state) ----
+  // The agents table, slot map and free list. The static tables (bounds, goals, sources,
+  // obstacles) are the scenario's and are not saved: restore into a world built from it.
+  // save_agents throws Error(usage) while changes are buffered; restore_agents throws
+  // Error(input) on data that does not make a consistent table, leaving the world unchanged.
+  void save_agents(ByteWriter& out) const;
+  void restore_agents(ByteReader& in);
 
  private:
   struct Slot {

@@ -102,14 +102,15 @@ void FeatureGrid::run(const DiscView& p, std::span<const double> reach, const St
       uint32_t count = 0;
       cand.clear();
       if (W_ > 0 && px + r >= x0_ && px - r <= x1_ && py + r >= y0_ && py - r <= y1_) {
-        auto clamp_col = [&](double x) {
-          return std::clamp<int64_t>(static_cast<int64_t>(std::floor((x - x0_) / cell_)), 0,
-                                     W_ - 1);
+        // Clamped in double before the conversion, which a far-away probe would overflow.
+        auto clamp_cell = [&](double v, int64_t n) {
+          const double k = std::floor(v / cell_);
+          return !(k > 0)                          ? int64_t{0}
+                 : k >= static_cast<double>(n - 1) ? n - 1
+                                                   : static_cast<int64_t>(k);
         };
-        auto clamp_row = [&](double y) {
-          return std::clamp<int64_t>(static_cast<int64_t>(std::floor((y - y0_) / cell_)), 0,
-                                     H_ - 1);
-        };
+        auto clamp_col = [&](double x) { return clamp_cell(x - x0_, W_); };
+        auto clamp_row = [&](double y) { return clamp_cell(y - y0_, H_); };
         // One cell of slack on each side against rounding of the box.
         const int64_t cx0 = std::max<int64_t>(0, clamp_col(px - r) - 1);
         const int64_t cx1 = std::min<int64_t>(W_ - 1, clamp_col(px + r) + 1);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "util/byte_codec.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb::path {
@@ -27,7 +28,9 @@ Navigation::~Navigation() {
 
 int Navigation::class_of(double radius) const {
   // Rounded up, with a little slack so that a radius equal to a class boundary stays in it.
-  return std::max(1, static_cast<int>(std::ceil(radius / params_.radius_step - 1e-9)));
+  // (Clamped in double: a radius of 1e9 m at a step of 0.01 m would overflow an int.)
+  const double k = std::ceil(radius / params_.radius_step - 1e-9);
+  return k >= 1e9 ? 1'000'000'000 : std::max(1, static_cast<int>(k));
 }
 
 double Navigation::class_radius(double radius) const {
@@ -35,7 +38,10 @@ double Navigation::class_radius(double radius) const {
 }
 
 const NavMesh& Navigation::mesh_for(double radius) {
-  const int k = class_of(radius);
+  return mesh_of_class(class_of(radius));
+}
+
+const NavMesh& Navigation::mesh_of_class(int k) {
   auto& slot = meshes_[k];
   if (!slot) {
     NavMeshParams p;
@@ -140,6 +146,73 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
     service_->submit(tick + latency_ticks_, std::move(jobs));
   }
   return made;
+}
+
+void Navigation::save(ByteWriter& out) const {
+  out.u64(next_ticket_);
+  for (uint64_t v : {stats_.requests, stats_.replans, stats_.dispatched, stats_.superseded,
+                     stats_.applied, stats_.failed, stats_.partial, stats_.sight_checks})
+    out.u64(v);
+  out.u64(queue_.size());
+  for (const Queued& q : queue_) {
+    out.u64(q.ticket);
+    out.u64(q.agent);
+  }
+  const auto batches = service_->pending_jobs();
+  out.u64(batches.size());
+  for (const auto& [due, jobs] : batches) {
+    out.u64(due);
+    out.u64(jobs.size());
+    for (const PathJob& j : jobs) {
+      int k = 0;
+      for (const auto& [c, m] : meshes_)
+        if (m.get() == j.mesh) k = c;
+      out.u64(j.ticket);
+      out.u64(j.agent);
+      out.u32(static_cast<uint32_t>(k));
+      for (double v : {j.start.x, j.start.y, j.goal.x, j.goal.y}) out.f64(v);
+    }
+  }
+}
+
+void Navigation::restore(ByteReader& in, uint64_t tick) {
+  next_ticket_ = in.u64();
+  for (uint64_t* v : {&stats_.requests, &stats_.replans, &stats_.dispatched, &stats_.superseded,
+                      &stats_.applied, &stats_.failed, &stats_.partial, &stats_.sight_checks})
+    *v = in.u64();
+  queue_.resize(in.count(16));
+  for (Queued& q : queue_) {
+    q.ticket = in.u64();
+    q.agent = in.u64();
+  }
+  // The searches the constructor dispatched are not this run's: start a fresh service.
+  service_ = std::make_unique<PathService>();
+  const uint64_t batches = in.count(16);
+  uint64_t last_due = 0;
+  for (uint64_t b = 0; b < batches; ++b) {
+    const uint64_t due = in.u64();
+    // Dispatched at some tick <= `tick` and not collected yet: due in (tick, tick + latency].
+    if (due < last_due || due <= tick || due - tick > latency_ticks_)
+      in.fail("path searches due at tick " + std::to_string(due) + " after tick " +
+              std::to_string(tick));
+    last_due = due;
+    std::vector<PathJob> jobs(in.count(52));
+    for (PathJob& j : jobs) {
+      j.ticket = in.u64();
+      j.agent = in.u64();
+      const uint32_t k = in.u32();
+      // A class is a multiple of radius_step no larger than the world is wide.
+      const double side = std::max(geometry_.bounds.width(), geometry_.bounds.height());
+      if (k < 1 || k * params_.radius_step > side) in.fail("bad radius class " + std::to_string(k));
+      j.mesh = &mesh_of_class(static_cast<int>(k));
+      j.start = {in.f64(), in.f64()};
+      j.goal = {in.f64(), in.f64()};
+      if (!std::isfinite(j.start.x) || !std::isfinite(j.start.y) || !std::isfinite(j.goal.x) ||
+          !std::isfinite(j.goal.y))
+        in.fail("a path search with a point that is not finite");
+    }
+    service_->submit(due, std::move(jobs));
+  }
 }
 
 NavigationStats Navigation::stats() const {

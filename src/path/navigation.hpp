@@ -68,9 +68,16 @@ class Navigation {
   std::size_t mesh_count() const { return meshes_.size(); }
   double mesh_build_seconds() const;
 
+  // Checkpoints: tickets, counters, the request queue and the searches in flight (submitted
+  // again on restore; their results depend on the job and the mesh only, so they come out the
+  // same). restore() replaces what the constructor requested; `tick` is the restored tick.
+  void save(ByteWriter& out) const;
+  void restore(ByteReader& in, uint64_t tick);
+
  private:
   int class_of(double radius) const;
   const NavMesh& mesh_for(double radius);  // builds on first use
+  const NavMesh& mesh_of_class(int k);
   // Drops the leading waypoints the agent has already passed (the one after is in sight).
   void trim_passed(World& world, std::size_t row);
 

@@ -66,6 +66,14 @@ std::size_t PathService::pending_batches() const {
   return batches_.size();
 }
 
+std::vector<std::pair<uint64_t, std::vector<PathJob>>> PathService::pending_jobs() const {
+  std::lock_guard lock(mu_);
+  std::vector<std::pair<uint64_t, std::vector<PathJob>>> out;
+  for (const auto& b : batches_)
+    out.emplace_back(b->due, b->jobs);  // jobs: read-only to the worker
+  return out;
+}
+
 PathService::Stats PathService::stats() const {
   std::lock_guard lock(mu_);
   return stats_;

@@ -17,6 +17,7 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "path/navmesh.hpp"
@@ -66,6 +67,8 @@ class PathService {
   std::vector<PathReply> collect(uint64_t tick);
   // Batches submitted and not collected yet.
   std::size_t pending_batches() const;
+  // Their due ticks and jobs, in submission order (checkpoints save them and submit them again).
+  std::vector<std::pair<uint64_t, std::vector<PathJob>>> pending_jobs() const;
   Stats stats() const;
 
  private:

@@ -14,6 +14,8 @@
 #include "sim/stages.hpp"
 #include "sim/stalemate.hpp"
 #include "steer/model.hpp"
+#include "util/byte_codec.hpp"
+#include "util/hash.hpp"
 #include "util/rng.hpp"
 #include "util/stopwatch.hpp"
 
@@ -191,7 +193,13 @@ struct Simulation::Engine {
       for (double r : w.agents().radius) rmin = std::min(rmin, r);
     if (!std::isfinite(rmin)) rmin = 1;
     if (rmin >= scene_spacing) return;
-    scene_spacing = rmin;
+    build_scene(w, cfg, rmin);
+  }
+  void build_scene(const World& w, const SimConfig& cfg, double spacing) {
+    const ThesisParams& th = cfg.steering.thesis;
+    const bool charged = cfg.steering.model == "thesis" && th.w_apf > 0 &&
+                         th.obstacle_repulsion == ThesisParams::ObstacleRepulsion::charges;
+    scene_spacing = spacing;
     scene = StaticScene({w.circles().begin(), w.circles().end()},
                         {w.polygons().begin(), w.polygons().end()}, scene_spacing,
                         charged ? th.obstacle_charges : ObstacleCharges::none,
@@ -276,6 +284,123 @@ Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 
 uint64_t Simulation::state_hash() const {
   return sim::state_hash(world_.agents(), last_.tick);
+}
+
+namespace {
+
+constexpr std::string_view kCheckpointMagic = "crowddb-checkpoint";
+constexpr uint32_t kCheckpointVersion = 1;
+
+// What a checkpoint must agree on with the simulation it is restored into: the static tables
+// and the settings that change what a tick computes (not the thread count).
+uint64_t fingerprint(const World& w, const SimConfig& cfg) {
+  StateHasher h;
+  const Bounds& b = w.bounds();
+  for (double v : {b.xmin, b.ymin, b.xmax, b.ymax, cfg.dt}) h.add(v);
+  h.add(cfg.seed);
+  for (char c : cfg.steering.model) h.add(static_cast<uint64_t>(c));
+  h.add(static_cast<uint64_t>(cfg.backoff) | static_cast<uint64_t>(cfg.walls) << 1 |
+        static_cast<uint64_t>(cfg.navigation.enabled) << 2 |
+        static_cast<uint64_t>(cfg.arrival) << 3);
+  h.add(w.goals().size());
+  for (const Goal& g : w.goals()) {
+    h.add(g.x);
+    h.add(g.y);
+    h.add(g.area.size());
+  }
+  h.add(w.circles().size());
+  for (const CircleObstacle& c : w.circles()) {
+    h.add(c.x);
+    h.add(c.y);
+    h.add(c.radius);
+  }
+  h.add(w.polygons().size());
+  for (const PolygonObstacle& p : w.polygons()) h.add(p.vertices.size());
+  h.add(w.sources().size());
+  return h.digest();
+}
+
+template <class Io, class M>
+void metrics_fields(Io&& io, M& m) {
+  io(m.tick);
+  io(m.time);
+  for (auto* v : {&m.agents, &m.active, &m.entered, &m.arrived, &m.frozen, &m.freeze_iterations,
+                  &m.overlapping_pairs, &m.obstacle_overlaps, &m.gridlocked, &m.gridlock_started,
+                  &m.longest_frozen, &m.nudged, &m.stalled, &m.queueing, &m.stall_started,
+                  &m.longest_stall, &m.yielding, &m.sidestepping})
+    io(*v);
+  io(m.seconds);
+  io(m.state_hash);
+}
+
+}  // namespace
+
+std::string Simulation::save_state() const {
+  const Engine& e = *engine_;
+  ByteWriter out;
+  out.text(kCheckpointMagic);
+  out.u32(kCheckpointVersion);
+  out.u64(fingerprint(world_, config_));
+  world_.save_agents(out);
+  metrics_fields(
+      [&](const auto& v) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(v)>, double>)
+          out.f64(v);
+        else
+          out.u64(static_cast<uint64_t>(v));
+      },
+      last_);
+  out.u64(arrived_total_);
+  out.u64(entered_total_);
+  out.u8(e.start_clean);
+  out.f64(e.scene_spacing);
+  e.sources.save(out);
+  out.u8(e.nav != nullptr);
+  if (e.nav) e.nav->save(out);
+  out.text(kCheckpointMagic);  // a trailer: the bytes ended where they should
+  out.u64(checksum(out.bytes()));
+  return out.take();
+}
+
+void Simulation::restore_state(std::string_view bytes, const std::string& what) {
+  Engine& e = *engine_;
+  if (bytes.size() < 8) ByteReader(bytes, what).fail("ends too early");
+  const std::string_view body = bytes.substr(0, bytes.size() - 8);
+  ByteReader sum(bytes.substr(body.size()), what);
+  ByteReader in(body, what);
+  if (in.text() != kCheckpointMagic) in.fail("not a crowddb checkpoint");
+  if (sum.u64() != checksum(body)) in.fail("damaged (its checksum does not match)");
+  const uint32_t version = in.u32();
+  if (version != kCheckpointVersion)
+    in.fail("checkpoint version " + std::to_string(version) + ", this build reads version " +
+            std::to_string(kCheckpointVersion));
+  if (in.u64() != fingerprint(world_, config_))
+    in.fail("the checkpoint is of another scenario or other settings");
+  world_.restore_agents(in);
+  TickMetrics m;
+  metrics_fields(
+      [&](auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, double>)
+          v = in.f64();
+        else
+          v = static_cast<T>(in.u64());
+      },
+      m);
+  if (m.tick > (uint64_t{1} << 53)) in.fail("bad tick " + std::to_string(m.tick));
+  last_ = m;
+  arrived_total_ = in.u64();
+  entered_total_ = in.u64();
+  e.start_clean = in.u8() != 0;
+  const double spacing = in.f64();
+  if (!(spacing > 0)) in.fail("bad obstacle sampling");
+  if (spacing != e.scene_spacing) e.build_scene(world_, config_, spacing);
+  e.sources.restore(in, world_);
+  const bool nav = in.u8() != 0;
+  if (nav != (e.nav != nullptr)) in.fail("navigation is on in one and off in the other");
+  if (e.nav) e.nav->restore(in, last_.tick);
+  if (in.text() != kCheckpointMagic || !in.at_end()) in.fail("trailing or damaged data");
+  if (last_.state_hash != state_hash()) in.fail("the state does not match its hash");
 }
 
 std::size_t Simulation::waiting_to_enter() const {

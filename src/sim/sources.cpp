@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "query/naive_paths.hpp"
+#include "util/byte_codec.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb::sim {
@@ -19,6 +20,27 @@ uint64_t source_total(const Source& s) {
 SourceEmitter::SourceEmitter(const World& world, uint64_t seed) {
   for (std::size_t i = 0; i < world.sources().size(); ++i)
     state_.push_back({0, Rng::stream(seed ^ 0x50a7ce5ull, i)});
+}
+
+void SourceEmitter::save(ByteWriter& out) const {
+  out.u64(state_.size());
+  for (const State& st : state_) {
+    out.u64(st.entered);
+    for (uint64_t w : st.rng.state()) out.u64(w);
+  }
+}
+
+void SourceEmitter::restore(ByteReader& in, const World& world) {
+  if (in.u64() != state_.size()) in.fail("the number of sources differs from the scenario's");
+  for (std::size_t i = 0; i < state_.size(); ++i) {
+    const uint64_t entered = in.u64();
+    if (entered > source_total(world.sources()[i]))
+      in.fail("source " + std::to_string(i) + " let in more agents than it has");
+    std::array<uint64_t, 4> rng;
+    for (uint64_t& w : rng) w = in.u64();
+    state_[i].entered = entered;
+    state_[i].rng.set_state(rng);
+  }
 }
 
 std::size_t SourceEmitter::waiting(const World& world) const {

@@ -26,6 +26,9 @@ class SourceEmitter {
   std::size_t emit(World& world, const SimConfig& cfg, const StaticScene& scene, uint64_t tick);
   // Agents still to enter (due or not).
   std::size_t waiting(const World& world) const;
+  // Checkpoints: per source, the agents let in and the random stream.
+  void save(ByteWriter& out) const;
+  void restore(ByteReader& in, const World& world);
 
  private:
   static constexpr int kTries = 20;

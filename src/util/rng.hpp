@@ -2,6 +2,7 @@
 // differs between standard libraries, and scenario generation must give the same world everywhere.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -30,6 +31,12 @@ class Rng {
   static Rng stream(uint64_t seed, uint64_t stream_id) {
     uint64_t sm = seed ^ (0xd1b54a32d192ed03ull * (stream_id + 1));
     return Rng(splitmix64(sm));
+  }
+
+  // The generator's whole state (checkpoints save it and set it back).
+  std::array<uint64_t, 4> state() const { return {s_[0], s_[1], s_[2], s_[3]}; }
+  void set_state(const std::array<uint64_t, 4>& s) {
+    for (int i = 0; i < 4; ++i) s_[i] = s[static_cast<std::size_t>(i)];
   }
 
   uint64_t next() {

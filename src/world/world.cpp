@@ -4,7 +4,9 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
+#include "util/byte_codec.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb {
@@ -25,6 +27,14 @@ void require_finite(const char* field, double v) {
 void require_positive(const char* field, double v) {
   require_finite(field, v);
   if (!(v > 0)) throw InvalidRow(field, std::string(field) + " must be > 0 (got " + fmt(v) + ")");
+}
+
+// Within +-kMaxCoordinate (positions, radii, speeds: beyond it grid cells and radius classes
+// overflow their integers).
+void require_within(const char* field, double v) {
+  require_finite(field, v);
+  if (std::abs(v) > kMaxCoordinate)
+    throw InvalidRow(field, std::string(field) + " must lie within +-1e9 (got " + fmt(v) + ")");
 }
 
 std::string missing_goal(uint32_t g, std::size_t goal_count) {
@@ -57,13 +67,15 @@ void normalize_ring(std::vector<Vec2>& ring, const char* field) {
 }  // namespace
 
 void World::validate_spec(const AgentSpec& s, std::size_t goal_count) {
-  require_finite("x", s.x);
-  require_finite("y", s.y);
-  require_finite("vx", s.vx);
-  require_finite("vy", s.vy);
+  require_within("x", s.x);
+  require_within("y", s.y);
+  require_within("vx", s.vx);
+  require_within("vy", s.vy);
   require_positive("radius", s.radius);
+  require_within("radius", s.radius);
   require_positive("pref_speed", s.pref_speed);
   require_positive("max_speed", s.max_speed);
+  require_within("max_speed", s.max_speed);
   if (s.max_speed < s.pref_speed)
     throw InvalidRow("max_speed", "max_speed must be >= pref_speed (got " + fmt(s.max_speed) +
                                       " < " + fmt(s.pref_speed) + ")");
@@ -395,6 +407,154 @@ void World::validate() const {
   }
   for (const Slot& s : slots_) live += s.row != kNoRow;
   if (live != n) throw std::logic_error("slot map and rows disagree on the agent count");
+}
+
+// ---- checkpoints ----
+
+namespace {
+
+template <class T>
+void save_nested(ByteWriter& out, const std::vector<std::vector<T>>& v) {
+  out.u64(v.size());
+  for (const auto& inner : v) {
+    if constexpr (std::is_same_v<T, Vec2>) {
+      out.u64(inner.size());
+      for (const Vec2& p : inner) {
+        out.f64(p.x);
+        out.f64(p.y);
+      }
+    } else {
+      out.vec(inner);
+    }
+  }
+}
+
+template <class T>
+void restore_nested(ByteReader& in, std::vector<std::vector<T>>& v) {
+  v.resize(in.count(8));
+  for (auto& inner : v) {
+    if constexpr (std::is_same_v<T, Vec2>) {
+      inner.resize(in.count(16));
+      for (Vec2& p : inner) {
+        p.x = in.f64();
+        p.y = in.f64();
+      }
+    } else {
+      in.vec(inner);
+    }
+  }
+}
+
+// Every column, in one order for saving and restoring.
+template <class Io, class Table>
+void columns(Io& io, Table& t) {
+  io.vec(t.x);
+  io.vec(t.y);
+  io.vec(t.vx);
+  io.vec(t.vy);
+  io.vec(t.radius);
+  io.vec(t.pref_speed);
+  io.vec(t.max_speed);
+  io.vec(t.max_accel);
+  io.vec(t.charge);
+  io.vec(t.target_x);
+  io.vec(t.target_y);
+  io.vec(t.goal);
+  io.vec(t.state);
+  io.vec(t.frozen_ticks);
+  io.vec(t.progress_best);
+  io.vec(t.stall_ticks);
+  io.vec(t.id);
+  io.vec(t.stall_action);
+  io.vec(t.stall_until);
+  io.vec(t.stall_dir_x);
+  io.vec(t.stall_dir_y);
+  io.vec(t.path_goal);
+  io.vec(t.path_ticket);
+  io.vec(t.replan_ticks);
+}
+
+}  // namespace
+
+void World::save_agents(ByteWriter& out) const {
+  if (!pending_.empty())
+    throw Error(Error::Kind::usage,
+                "checkpoint: agent changes are buffered; save before changing agents or after a "
+                "step applied them");
+  columns(out, agents_);
+  save_nested(out, agents_.route);
+  save_nested(out, agents_.then);
+  out.u64(slots_.size());
+  for (const Slot& s : slots_) {
+    out.u32(s.generation);
+    out.u32(s.row);
+  }
+  out.vec(free_slots_);
+}
+
+void World::restore_agents(ByteReader& in) {
+  AgentTable t;
+  columns(in, t);
+  restore_nested(in, t.route);
+  restore_nested(in, t.then);
+  std::vector<Slot> slots(in.count(8));
+  for (Slot& s : slots) {
+    s.generation = in.u32();
+    s.row = in.u32();
+  }
+  std::vector<uint32_t> free_slots;
+  in.vec(free_slots);
+  // The data must make a table this world could have reached: check before taking it.
+  const auto bad = [&](const std::string& why) { in.fail("agents table: " + why); };
+  World trial;  // column lengths, slot map and goal rows, by the world's own invariants
+  trial.goals_ = goals_;
+  trial.agents_ = std::move(t);
+  trial.slots_ = std::move(slots);
+  try {
+    trial.validate();
+  } catch (const std::logic_error& e) {
+    bad(e.what());
+  }
+  const AgentTable& a = trial.agents_;
+  for (std::size_t r = 0; r < a.size(); ++r) {
+    const std::string row = "row " + std::to_string(r);
+    if (static_cast<uint8_t>(a.state[r]) > 2) bad(row + ": bad state");
+    if (static_cast<uint8_t>(a.stall_action[r]) > 2) bad(row + ": bad stall action");
+    AgentSpec spec;  // the rules an inserted agent obeys
+    spec.x = a.x[r];
+    spec.y = a.y[r];
+    spec.vx = a.vx[r];
+    spec.vy = a.vy[r];
+    spec.radius = a.radius[r];
+    spec.pref_speed = a.pref_speed[r];
+    spec.max_speed = a.max_speed[r];
+    spec.max_accel = a.max_accel[r];
+    spec.charge = a.charge[r];
+    spec.goal = a.goal[r];
+    spec.then = a.then[r];
+    try {
+      validate_spec(spec, goals_.size());
+    } catch (const InvalidRow& e) {
+      bad(row + ": " + e.what());
+    }
+    if (!std::isfinite(a.target_x[r]) || !std::isfinite(a.target_y[r]))
+      bad(row + ": waypoint not finite");
+    for (const Vec2& p : a.route[r])
+      if (!(std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate))
+        bad(row + ": a route point lies beyond +-1e9");
+    if (a.path_goal[r] != AgentTable::kNoPath && a.path_goal[r] >= goals_.size())
+      bad(row + ": bad planned goal");
+  }
+  std::vector<uint8_t> seen(trial.slots_.size(), 0);
+  for (uint32_t f : free_slots) {
+    if (f >= trial.slots_.size() || trial.slots_[f].row != kNoRow || seen[f])
+      bad("free slot " + std::to_string(f) + " is not a free slot");
+    seen[f] = 1;
+  }
+  agents_ = std::move(trial.agents_);
+  slots_ = std::move(trial.slots_);
+  free_slots_ = std::move(free_slots);
+  pending_.clear();
 }
 
 }  // namespace crowddb
