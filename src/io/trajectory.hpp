@@ -7,7 +7,8 @@
 // killed outright (kill -9, power aside) loses at most one batch, and a run stopped by a
 // signal or an error keeps PATH.partial with what it wrote, marked incomplete (SQLite:
 // crowddb_run keys status, last_tick and stop_reason). While a run writes PATH it holds
-// PATH.lock (io/output_lock.hpp); an earlier run's PATH.partial is never overwritten.
+// PATH.lock (io/output_lock.hpp); an earlier run's PATH.partial is never overwritten. With
+// checkpoints (SQLite only) `crowddb resume` continues PATH.partial where the run stopped.
 #pragma once
 
 #include <filesystem>
@@ -46,6 +47,11 @@ class TrajectoryWriter {
   virtual void metrics(const TickMetrics& m) = 0;
   // Flushes, closes and renames PATH.partial to PATH.
   virtual void finish(const RunInfo& info) = 0;
+  // A checkpoint after `tick` (whose frame and metrics are written): the simulation's state
+  // and the run's, committed at once with every frame up to it. Only the SQLite writer keeps
+  // them (table crowddb_checkpoint, latest only); the CSV writer ignores them.
+  virtual void checkpoint(uint64_t /*tick*/, const std::string& /*engine*/,
+                          const std::string& /*run*/) {}
   // Stops an unfinished run: keeps everything written so far in PATH.partial, marked incomplete
   // up to `tick` because of `reason`, and releases the lock. Returns the file kept, or an empty
   // path when nothing was begun. Safe to call at any time, never throws.
@@ -56,6 +62,24 @@ std::unique_ptr<TrajectoryWriter> make_sqlite_writer(const std::filesystem::path
                                                      uint32_t every);
 std::unique_ptr<TrajectoryWriter> make_csv_writer(const std::filesystem::path& path,
                                                   uint32_t every);
+
+// An interrupted run's PATH.partial as `crowddb resume` needs it: the crowddb_run keys and the
+// latest checkpoint. Throws Error(input) naming the file when it is not a crowddb SQLite output,
+// is complete, or has no checkpoint.
+struct PartialRun {
+  std::filesystem::path path;  // the final PATH the run writes (PATH.partial until it finishes)
+  std::vector<std::pair<std::string, std::string>> run;  // crowddb_run
+  std::string value(const std::string& key) const;       // "" when absent
+  uint64_t tick = 0;                                     // of the checkpoint
+  std::string engine, progress;                          // Simulation and run_to_end state
+};
+PartialRun read_partial_run(const std::filesystem::path& file);
+
+// Reopens PATH.partial to continue a run from its checkpoint at `tick`: takes the lock, drops the
+// frames and metrics written after `tick` (the resumed run writes them again) and marks the
+// run as running.
+std::unique_ptr<TrajectoryWriter> resume_sqlite_writer(const PartialRun& partial, double dt,
+                                                       const std::string& format);
 
 inline std::unique_ptr<TrajectoryWriter> make_writer(const OutputSpec& out) {
   return out.format == OutputSpec::Format::csv ? make_csv_writer(out.path, out.every)

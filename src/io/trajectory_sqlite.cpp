@@ -7,7 +7,10 @@
 //                        overlapping_pairs, obstacle_overlaps, gridlocked, stalled, queueing,
 //                        longest_stall, tick_seconds, state_hash)
 //   crowddb_run(key, value): scenario name and text, seed, threads, ticks, final state hash;
-//                            status (running, complete, stopped), last_tick, stop_reason
+//                            status (running, complete, stopped), last_tick, stop_reason;
+//                            resume_options (the command line's settings, for crowddb resume)
+//   crowddb_checkpoint(tick, engine, progress): the latest checkpoint of an unfinished run
+//                            (Simulation::save_state and the run's counters; emptied at finish)
 // WAL journal, frames committed in batches (io/trajectory.hpp); renamed into place at the end.
 #include <sqlite3.h>
 
@@ -15,6 +18,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "io/output_lock.hpp"
@@ -58,6 +62,24 @@ class Statement {
  private:
   sqlite3_stmt* s_ = nullptr;
 };
+
+// The settings a run took from its command line rather than its document: `crowddb resume`
+// applies them again to the stored document.
+std::string resume_options(const Scenario& sc) {
+  nlohmann::json j;
+  j["ticks"] = sc.ticks;
+  j["stop_when_all_arrived"] = sc.stop_when_all_arrived;
+  j["format"] = sc.format;
+  j["threads"] = sc.config.threads;
+  j["model"] = sc.config.steering.model;
+  j["backoff"] = sc.config.backoff;
+  j["nudge_after"] = sc.config.nudge_after;
+  j["navigation"] = sc.config.navigation.enabled;
+  j["ftc"] = sc.config.access.ftc;
+  j["field"] = sc.config.access.field;
+  j["collisions"] = sc.config.access.collisions;
+  return j.dump();
+}
 
 class SqliteWriter final : public TrajectoryWriter {
  public:
@@ -108,6 +130,9 @@ class SqliteWriter final : public TrajectoryWriter {
         "NULL, state_hash TEXT NOT NULL)");
     exec("CREATE TABLE crowddb_run (key TEXT NOT NULL UNIQUE PRIMARY KEY, value TEXT NOT NULL)");
     exec(
+        "CREATE TABLE crowddb_checkpoint (tick INTEGER PRIMARY KEY, engine BLOB NOT NULL, "
+        "progress BLOB NOT NULL)");
+    exec(
         "CREATE TABLE crowddb_goals (goal INTEGER PRIMARY KEY, name TEXT NOT NULL, x REAL NOT "
         "NULL, "
         "y REAL NOT NULL, arrival_radius REAL NOT NULL)");
@@ -129,6 +154,7 @@ class SqliteWriter final : public TrajectoryWriter {
                                {"seed", std::to_string(sc.config.seed)},
                                {"dt", num(sc.config.dt)},
                                {"frame_every", std::to_string(every_)},
+                               {"resume_options", resume_options(sc)},
                                {"status", "running"},
                                {"last_tick", "0"}})
       insert_text(run, k, v);
@@ -148,6 +174,11 @@ class SqliteWriter final : public TrajectoryWriter {
       sqlite3_bind_double(goals.get(), 5, g.arrival_radius);
       step(goals);
     }
+    prepare();
+    batch_start_ = std::chrono::steady_clock::now();
+  }
+
+  void prepare() {
     traj_ = Statement(db_, "INSERT INTO trajectory_data VALUES (?, ?, ?, ?)", path_.string());
     state_ = Statement(db_, "INSERT INTO crowddb_agent_state VALUES (?, ?, ?, ?, ?, ?, ?)",
                        path_.string());
@@ -157,7 +188,6 @@ class SqliteWriter final : public TrajectoryWriter {
         "INSERT INTO crowddb_tick_metrics VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
         path_.string());
     set_run_ = Statement(db_, "INSERT OR REPLACE INTO crowddb_run VALUES (?, ?)", path_.string());
-    batch_start_ = std::chrono::steady_clock::now();
   }
 
   void frame(uint64_t tick, const World& world) override {
@@ -219,7 +249,60 @@ class SqliteWriter final : public TrajectoryWriter {
     }
   }
 
+  void checkpoint(uint64_t tick, const std::string& engine, const std::string& run) override {
+    exec("DELETE FROM crowddb_checkpoint");
+    Statement cp(db_, "INSERT INTO crowddb_checkpoint VALUES (?, ?, ?)", path_.string());
+    sqlite3_bind_int64(cp.get(), 1, static_cast<int64_t>(tick));
+    sqlite3_bind_blob64(cp.get(), 2, engine.data(), engine.size(), SQLITE_STATIC);
+    sqlite3_bind_blob64(cp.get(), 3, run.data(), run.size(), SQLITE_STATIC);
+    step(cp);
+    insert_text(set_run_, "last_tick", std::to_string(last_tick_));
+    exec("COMMIT");
+    exec("BEGIN");
+    frames_in_batch_ = 0;
+    batch_start_ = std::chrono::steady_clock::now();
+  }
+
+  // Continues PATH.partial after `tick` (resume_sqlite_writer).
+  void reopen(uint64_t tick, double dt, const std::string& format) {
+    dt_ = dt;
+    format_ = format;
+    lock_.emplace(path_);
+    if (sqlite3_open_v2(partial_.c_str(), &db_, SQLITE_OPEN_READWRITE, nullptr) != SQLITE_OK) {
+      const std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
+      sqlite3_close(db_);
+      db_ = nullptr;
+      throw Error(Error::Kind::io, partial_ + ": cannot open (" + msg + ")");
+    }
+    exec("PRAGMA journal_mode=WAL");
+    exec("PRAGMA synchronous=NORMAL");
+    exec("BEGIN");
+    {
+      Statement g(db_, "SELECT hash, wkt FROM geometry LIMIT 1", path_.string());
+      if (sqlite3_step(g.get()) != SQLITE_ROW)
+        throw Error(Error::Kind::input, partial_ + ": no geometry row");
+      geometry_hash_ = sqlite3_column_int64(g.get(), 0);
+    }
+    const std::string frame = std::to_string(tick / every_);
+    const std::string t = std::to_string(tick);
+    for (const std::string& sql :
+         {"DELETE FROM trajectory_data WHERE frame > " + frame,
+          "DELETE FROM crowddb_agent_state WHERE frame > " + frame,
+          "DELETE FROM frame_data WHERE frame > " + frame,
+          "DELETE FROM crowddb_tick_metrics WHERE tick > " + t,
+          std::string("DELETE FROM crowddb_run WHERE key = 'stop_reason'")})
+      exec(sql.c_str());
+    prepare();
+    insert_text(set_run_, "status", "running");
+    insert_text(set_run_, "last_tick", t);
+    last_tick_ = tick;
+    exec("COMMIT");
+    exec("BEGIN");
+    batch_start_ = std::chrono::steady_clock::now();
+  }
+
   void finish(const RunInfo& info) override {
+    exec("DELETE FROM crowddb_checkpoint");  // a finished run has nothing to resume
     {
       Statement run(db_, "INSERT INTO crowddb_run VALUES (?, ?)", path_.string());
       for (const auto& [k, v] :
@@ -349,6 +432,91 @@ class SqliteWriter final : public TrajectoryWriter {
 std::unique_ptr<TrajectoryWriter> make_sqlite_writer(const std::filesystem::path& path,
                                                      uint32_t every) {
   return std::make_unique<SqliteWriter>(path, every);
+}
+
+std::string PartialRun::value(const std::string& key) const {
+  for (const auto& [k, v] : run)
+    if (k == key) return v;
+  return {};
+}
+
+PartialRun read_partial_run(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  PartialRun p;
+  const std::string suffix = ".partial";
+  std::filesystem::path partial = file;
+  if (name.size() > suffix.size() &&
+      name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+    p.path = name.substr(0, name.size() - suffix.size());
+  } else {
+    p.path = file;
+    partial = name + suffix;
+  }
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(partial, ec)) {
+    if (std::filesystem::exists(p.path, ec))
+      throw Error(Error::Kind::input, p.path.string() + ": nothing to resume (no " +
+                                          partial.string() +
+                                          ": the run finished, or it is not a run's output)");
+    throw Error(Error::Kind::io, partial.string() + ": no such file");
+  }
+  sqlite3* db = nullptr;
+  const auto close = [&] { sqlite3_close(db); };
+  const std::string where = partial.string();
+  if (sqlite3_open_v2(where.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+    close();
+    throw Error(Error::Kind::input, where + ": not a readable SQLite file");
+  }
+  try {
+    {
+      Statement q(db, "SELECT key, value FROM crowddb_run", where);
+      int rc;
+      while ((rc = sqlite3_step(q.get())) == SQLITE_ROW) {
+        const auto* k = reinterpret_cast<const char*>(sqlite3_column_text(q.get(), 0));
+        const auto* v = reinterpret_cast<const char*>(sqlite3_column_text(q.get(), 1));
+        p.run.emplace_back(k ? k : "", v ? v : "");
+      }
+      if (rc != SQLITE_DONE) throw Error(Error::Kind::input, where + ": " + sqlite3_errmsg(db));
+    }
+    if (p.value("status") == "complete")
+      throw Error(Error::Kind::input, where + ": this run is complete");
+    if (p.value("resume_options").empty())
+      throw Error(Error::Kind::input,
+                  where + ": written by a crowddb without checkpoints; it cannot be resumed");
+    Statement q(db, "SELECT tick, engine, progress FROM crowddb_checkpoint", where);
+    if (sqlite3_step(q.get()) != SQLITE_ROW)
+      throw Error(Error::Kind::input,
+                  where + ": no checkpoint yet (the run stopped before its first; run it again)");
+    p.tick = static_cast<uint64_t>(sqlite3_column_int64(q.get(), 0));
+    const auto blob = [&](int col) {
+      const auto* b = static_cast<const char*>(sqlite3_column_blob(q.get(), col));
+      return std::string(b ? b : "", static_cast<std::size_t>(sqlite3_column_bytes(q.get(), col)));
+    };
+    p.engine = blob(1);
+    p.progress = blob(2);
+  } catch (const Error& e) {
+    close();
+    const std::string msg = e.what();
+    if (msg.rfind(where, 0) == 0) throw;
+    throw Error(Error::Kind::input, where + ": not an interrupted crowddb run (" + msg + ")");
+  }
+  close();
+  return p;
+}
+
+std::unique_ptr<TrajectoryWriter> resume_sqlite_writer(const PartialRun& partial, double dt,
+                                                       const std::string& format) {
+  uint64_t every = 1;
+  try {
+    every = std::stoull(partial.value("frame_every"));
+  } catch (const std::exception&) {
+    throw Error(Error::Kind::input, partial.path.string() + ".partial: bad frame_every");
+  }
+  if (every < 1 || every > 1u << 30)
+    throw Error(Error::Kind::input, partial.path.string() + ".partial: bad frame_every");
+  auto w = std::make_unique<SqliteWriter>(partial.path, static_cast<uint32_t>(every));
+  w->reopen(partial.tick, dt, format);
+  return w;
 }
 
 }  // namespace crowddb::io

@@ -8,6 +8,7 @@
 
 #include "crowddb/error.hpp"
 #include "io/trajectory.hpp"
+#include "util/byte_codec.hpp"
 #include "util/stopwatch.hpp"
 
 namespace crowddb::metrics {
@@ -36,6 +37,57 @@ std::string hex(uint64_t v) {
   return buf;
 }
 
+namespace {
+
+// What a run accumulates besides the simulation: saved with each checkpoint.
+struct Progress {
+  RunSummary* s;
+  SteerBench* bench;
+  std::vector<double>* tick_seconds;
+  uint64_t* last_arrival;
+  std::size_t *longest_frozen, *longest_stall;
+  double* wall_before;  // [s] spent before the resume
+
+  template <class F>
+  void counters(F&& f) const {
+    for (std::size_t* v :
+         {&s->agents_at_start, &s->max_overlapping_pairs, &s->max_obstacle_overlaps,
+          &s->frozen_agent_ticks, &s->freeze_iterations_total, &s->freeze_iterations_max,
+          &s->gridlocked_max, &s->gridlock_streaks, &s->nudged, &s->stall_streaks, &s->stalled_max,
+          &s->yields, &s->sidesteps, longest_frozen, longest_stall})
+      f(*v);
+  }
+  std::string save(double wall_now) const {
+    ByteWriter out;
+    out.text("crowddb-run-progress");
+    out.u64(s->ticks);
+    counters([&](std::size_t& v) { out.u64(v); });
+    out.u64(*last_arrival);
+    out.f64(wall_now);
+    out.vec(*tick_seconds);
+    bench->save(out);
+    out.u64(checksum(out.bytes()));
+    return out.take();
+  }
+  void restore(std::string_view bytes) const {
+    if (bytes.size() < 8) ByteReader(bytes, "checkpoint").fail("run progress ends too early");
+    const std::string_view body = bytes.substr(0, bytes.size() - 8);
+    ByteReader sum(bytes.substr(body.size()), "checkpoint");
+    ByteReader in(body, "checkpoint");
+    if (in.text() != "crowddb-run-progress" || sum.u64() != checksum(body))
+      in.fail("run progress damaged");
+    s->ticks = in.u64();
+    counters([&](std::size_t& v) { v = in.u64(); });
+    *last_arrival = in.u64();
+    *wall_before = in.f64();
+    in.vec(*tick_seconds);
+    bench->restore(in);
+    if (!in.at_end()) in.fail("run progress: trailing data");
+  }
+};
+
+}  // namespace
+
 RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& control,
                       std::vector<AgentScore>* scores) {
   RunSummary s;
@@ -49,18 +101,36 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
   s.agents_at_start = sim.world().agents().size();
   const double dt = s.dt;
   SteerBench bench(dt, sim.config().walls);
-  bench.start(sim.world());
   std::vector<double> tick_seconds;
-  tick_seconds.reserve(std::min<uint64_t>(sc.ticks, 1u << 20));
   uint64_t last_arrival = 0;
   std::size_t longest_frozen = 0, longest_stall = 0;
-  Stopwatch clock;
+  double wall_before = 0;
+  const Progress progress{
+      &s, &bench, &tick_seconds, &last_arrival, &longest_frozen, &longest_stall, &wall_before};
+  if (control.resume_from) {
+    progress.restore(*control.resume_from);
+    if (s.ticks != sim.ticks())
+      throw Error(Error::Kind::input, "checkpoint: the run's progress is of tick " +
+                                          std::to_string(s.ticks) + ", the simulation's of tick " +
+                                          std::to_string(sim.ticks()));
+  } else {
+    bench.start(sim.world());
+  }
+  tick_seconds.reserve(std::min<uint64_t>(sc.ticks, 1u << 20));
+  Stopwatch clock, since_checkpoint;
   io::TrajectoryWriter* w = control.writer;
+  const auto checkpoint = [&] {
+    if (w && control.checkpoint_every >= 0)
+      w->checkpoint(s.ticks, sim.save_state(), progress.save(wall_before + clock.seconds()));
+    since_checkpoint.restart();
+  };
   try {
-    if (w) w->frame(0, sim.world());
-    for (uint64_t t = 1; t <= sc.ticks; ++t) {
-      if (control.interrupted && control.interrupted())
+    if (w && !control.resume_from) w->frame(0, sim.world());
+    for (uint64_t t = s.ticks + 1; t <= sc.ticks; ++t) {
+      if (control.interrupted && control.interrupted()) {
+        checkpoint();  // the state after tick t - 1 is whole: a resume continues from it
         throw Error(Error::Kind::io, "interrupted at tick " + std::to_string(t - 1));
+      }
       const TickMetrics& m = sim.step();
       tick_seconds.push_back(m.seconds);
       bench.tick(sim.world(), m);
@@ -83,6 +153,9 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
       if (w) {
         w->frame(t, sim.world());  // the writer keeps every n-th frame
         w->metrics(m);
+        if (control.checkpoint_every >= 0 && t < sc.ticks &&
+            since_checkpoint.seconds() >= control.checkpoint_every)
+          checkpoint();
       }
       if (control.on_tick) control.on_tick(sim, m, sc.ticks);
       if (sc.stop_when_all_arrived && m.active == 0 && sim.waiting_to_enter() == 0) {
@@ -90,7 +163,7 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
         break;
       }
     }
-    s.wall_seconds = clock.seconds();
+    s.wall_seconds = wall_before + clock.seconds();
     s.state_hash = sim.state_hash();
     s.steerbench = bench.totals();
     if (w) {

@@ -22,7 +22,7 @@ struct RunSummary {
   std::string name, source, format, model;
   double dt = 0;
   int threads = 1;
-  uint64_t ticks = 0;         // ticks run
+  uint64_t ticks = 0;          // ticks run
   uint64_t ticks_planned = 0;  // the scenario's (or the command line's) tick count
   double sim_seconds = 0;
   bool stopped_when_all_arrived = false;  // ended before ticks_planned: everyone had arrived
@@ -55,10 +55,17 @@ struct RunControl {
   std::function<bool()> interrupted;
   // After each tick (progress lines).
   std::function<void(const Simulation&, const TickMetrics&, uint64_t ticks_planned)> on_tick;
+  // [s] of wall time between checkpoints written to the writer (one also when interrupted);
+  // negative: none. Checkpoints go with a batch of frames: resuming from one loses nothing.
+  double checkpoint_every = -1;
+  // Resuming: `sim` was restored from a checkpoint, and this is the run's own state from the
+  // same checkpoint (summary counters, SteerBench, tick times).
+  const std::string* resume_from = nullptr;
 };
 
 // Runs `sim` (built from `sc`) for sc.ticks ticks, or until everyone has arrived when
-// sc.stop_when_all_arrived. On an exception the writer is aborted (no partial file is left).
+// sc.stop_when_all_arrived. On an exception the writer is stopped: what it wrote is kept in
+// PATH.partial, marked incomplete.
 RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& control,
                       std::vector<AgentScore>* scores = nullptr);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "util/byte_codec.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb::metrics {
@@ -117,11 +118,9 @@ void SteerBench::collisions(const World& world) {
       const auto polys = world.polygons();
       for (std::size_t k = 0; k < polys.size(); ++k) {
         const auto& v = polys[k].vertices;
-        const double pen = point_in_polygon(v, x, y)
-                               ? r
-                               : r - std::sqrt(dist2_to_boundary(v, x, y));
-        if (pen > kCollision)
-          obstacles.insert({t.id[i], static_cast<int64_t>(circles.size() + k)});
+        const double pen =
+            point_in_polygon(v, x, y) ? r : r - std::sqrt(dist2_to_boundary(v, x, y));
+        if (pen > kCollision) obstacles.insert({t.id[i], static_cast<int64_t>(circles.size() + k)});
       }
       if (walls_) {
         const Bounds& b = world.bounds();
@@ -168,6 +167,78 @@ SteerBenchTotals SteerBench::totals() const {
   s.composite01 = 50 * s.avg_collisions + s.avg_time + s.avg_energy;
   s.composite02 = s.composite01 + s.avg_acceleration;
   return s;
+}
+
+void SteerBench::save(ByteWriter& out) const {
+  out.u64(tick_);
+  out.u64(scores_.size());
+  for (const AgentScore& a : scores_) {
+    out.u64(a.id);
+    out.u64(a.collisions);
+    for (double v : {a.time, a.path_length, a.energy, a.acceleration}) out.f64(v);
+    out.u8(a.arrived);
+  }
+  // Hash containers in key order, so equal states save equal bytes.
+  std::vector<uint64_t> ids;
+  for (const auto& [id, tr] : active_) ids.push_back(id);
+  std::sort(ids.begin(), ids.end());
+  out.u64(ids.size());
+  for (uint64_t id : ids) {
+    const Track& tr = active_.at(id);
+    out.u64(id);
+    out.u64(tr.score);
+    for (double v : {tr.x, tr.y, tr.vx, tr.vy}) out.f64(v);
+    out.u8(tr.has_v);
+    out.u64(tr.seen);
+  }
+  std::vector<uint64_t> known(known_.begin(), known_.end());
+  std::sort(known.begin(), known.end());
+  out.vec(known);
+  out.u64(open_pairs_.size());
+  for (const auto& [a, b] : open_pairs_) {
+    out.u64(a);
+    out.u64(b);
+  }
+  out.u64(open_obstacles_.size());
+  for (const auto& [a, o] : open_obstacles_) {
+    out.u64(a);
+    out.u64(static_cast<uint64_t>(o));
+  }
+}
+
+void SteerBench::restore(ByteReader& in) {
+  tick_ = in.u64();
+  scores_.resize(in.count(49));
+  for (AgentScore& a : scores_) {
+    a.id = in.u64();
+    a.collisions = in.u64();
+    for (double* v : {&a.time, &a.path_length, &a.energy, &a.acceleration}) *v = in.f64();
+    a.arrived = in.u8() != 0;
+  }
+  active_.clear();
+  for (uint64_t k = 0, n = in.count(57); k < n; ++k) {
+    const uint64_t id = in.u64();
+    Track tr{};
+    tr.score = in.u64();
+    if (tr.score >= scores_.size()) in.fail("steerbench: a track without its score");
+    for (double* v : {&tr.x, &tr.y, &tr.vx, &tr.vy}) *v = in.f64();
+    tr.has_v = in.u8() != 0;
+    tr.seen = in.u64();
+    active_[id] = tr;
+  }
+  std::vector<uint64_t> known;
+  in.vec(known);
+  known_ = {known.begin(), known.end()};
+  open_pairs_.clear();
+  for (uint64_t k = 0, n = in.count(16); k < n; ++k) {
+    const uint64_t a = in.u64();
+    open_pairs_.insert({a, in.u64()});
+  }
+  open_obstacles_.clear();
+  for (uint64_t k = 0, n = in.count(16); k < n; ++k) {
+    const uint64_t a = in.u64();
+    open_obstacles_.insert({a, static_cast<int64_t>(in.u64())});
+  }
 }
 
 }  // namespace crowddb::metrics

@@ -60,6 +60,9 @@ class SteerBench {
   // In order of first appearance.
   const std::vector<AgentScore>& scores() const { return scores_; }
   SteerBenchTotals totals() const;
+  // Checkpoints (a resumed run's scores equal the uninterrupted run's).
+  void save(ByteWriter& out) const;
+  void restore(ByteReader& in);
 
  private:
   struct Track {
@@ -74,9 +77,9 @@ class SteerBench {
   bool walls_;
   uint64_t tick_ = 0;
   std::vector<AgentScore> scores_;
-  std::unordered_map<uint64_t, Track> active_;  // by agent id
-  std::unordered_set<uint64_t> known_;          // every id measured so far
-  std::set<std::pair<uint64_t, uint64_t>> open_pairs_;      // agent ids, smaller first
+  std::unordered_map<uint64_t, Track> active_;             // by agent id
+  std::unordered_set<uint64_t> known_;                     // every id measured so far
+  std::set<std::pair<uint64_t, uint64_t>> open_pairs_;     // agent ids, smaller first
   std::set<std::pair<uint64_t, int64_t>> open_obstacles_;  // id, obstacle (-1..-4: walls)
 };
 

@@ -17,6 +17,7 @@ using Action = std::function<int()>;
 
 void add_query_commands(CLI::App& app, Action& action);
 void add_run_command(CLI::App& app, Action& action);
+void add_resume_command(CLI::App& app, Action& action);
 void add_validate_command(CLI::App& app, Action& action);
 void add_experiment_command(CLI::App& app, Action& action);
 void add_fit_kernel_command(CLI::App& app, Action& action);

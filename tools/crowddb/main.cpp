@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "crowddb 0.1.0");
   crowddb::cli::Action action;
   crowddb::cli::add_run_command(app, action);
+  crowddb::cli::add_resume_command(app, action);
   crowddb::cli::add_validate_command(app, action);
   crowddb::cli::add_query_commands(app, action);
   crowddb::cli::add_experiment_command(app, action);

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "cli_checks.hpp"
@@ -41,6 +42,7 @@ struct RunOptions {
   std::string ftc, field, collisions;
   std::string behavior, summary_json;
   std::vector<std::string> overrides;
+  double checkpoint_every = 60;  // [s] of wall time; SQLite output only
 };
 
 }  // namespace
@@ -86,6 +88,9 @@ void apply_overrides(Scenario& sc, const RunOptions& o) {
   if (o.no_output) sc.output.path.clear();
 }
 
+int execute(const Scenario& sc, Simulation& sim, io::TrajectoryWriter* writer, const RunOptions& o,
+            const std::string& file, const std::string* resume_from);
+
 int run(const RunOptions& o) {
   Scenario sc = load_scenario(o.scenario, LoadOptions{o.behavior, o.overrides});
   apply_overrides(sc, o);
@@ -107,12 +112,20 @@ int run(const RunOptions& o) {
     writer = io::make_writer(sc.output);
     writer->begin(sc, sim.world());
   }
+  return execute(sc, sim, writer.get(), o, o.scenario, nullptr);
+}
+
+// Runs a built (or restored) simulation to its end: signals, progress line, summary.
+int execute(const Scenario& sc, Simulation& sim, io::TrajectoryWriter* writer, const RunOptions& o,
+            const std::string& file, const std::string* resume_from) {
   g_interrupted = false;
   auto old_int = std::signal(SIGINT, on_interrupt);
   auto old_term = std::signal(SIGTERM, on_interrupt);
   const bool tty = isatty(STDERR_FILENO) && !o.quiet;
   metrics::RunControl control;
-  control.writer = writer.get();
+  control.writer = writer;
+  control.checkpoint_every = o.checkpoint_every;
+  control.resume_from = resume_from;
   control.interrupted = [] { return g_interrupted.load(); };
   Stopwatch clock, progress_clock;
   if (tty)
@@ -128,7 +141,7 @@ int run(const RunOptions& o) {
     };
   metrics::RunSummary summary;
   try {
-    summary = naming_file(o.scenario, [&] { return metrics::run_to_end(sc, sim, control); });
+    summary = naming_file(file, [&] { return metrics::run_to_end(sc, sim, control); });
   } catch (...) {
     if (tty) std::fprintf(stderr, "\n");
     std::signal(SIGINT, old_int);
@@ -138,7 +151,7 @@ int run(const RunOptions& o) {
   if (tty) std::fprintf(stderr, "\n");
   std::signal(SIGINT, old_int);
   std::signal(SIGTERM, old_term);
-  if (summary.name.empty()) summary.name = o.scenario;
+  if (summary.name.empty()) summary.name = file;
   std::string text = summary.text(sim.config());
   if (writer)
     text += "  trajectories: " + sc.output.path + " (" +
@@ -153,7 +166,67 @@ int run(const RunOptions& o) {
   return 0;
 }
 
+// `crowddb resume FILE`: an interrupted run's PATH.partial, continued from its checkpoint.
+int resume(const std::string& file, const RunOptions& o) {
+  const io::PartialRun p = io::read_partial_run(file);
+  const std::string partial = p.path.string() + ".partial";
+  Scenario sc = naming_file(partial, [&] {
+    return parse_scenario(p.value("scenario_json"), p.value("scenario_source"));
+  });
+  try {
+    const nlohmann::json opt = nlohmann::json::parse(p.value("resume_options"));
+    sc.ticks = opt.at("ticks").get<uint64_t>();
+    sc.stop_when_all_arrived = opt.at("stop_when_all_arrived").get<bool>();
+    sc.format = opt.at("format").get<std::string>();
+    sc.config.threads = opt.at("threads").get<int>();
+    sc.config.steering.model = opt.at("model").get<std::string>();
+    sc.config.backoff = opt.at("backoff").get<bool>();
+    sc.config.nudge_after = opt.at("nudge_after").get<double>();
+    sc.config.navigation.enabled = opt.at("navigation").get<bool>();
+    sc.config.access.ftc = opt.at("ftc").get<std::string>();
+    sc.config.access.field = opt.at("field").get<std::string>();
+    sc.config.access.collisions = opt.at("collisions").get<std::string>();
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(Error::Kind::input, partial + ": bad resume_options (" + e.what() + ")");
+  }
+  if (sc.config.threads < 1 || sc.config.threads > 256)
+    throw Error(Error::Kind::input, partial + ": bad resume_options (threads)");
+  if (o.threads > 0) sc.config.threads = o.threads;
+  sc.output.path = p.path.string();
+  sc.output.format = OutputSpec::Format::sqlite;
+  Simulation sim = naming_file(partial, [&] {
+    Simulation s(std::move(sc.world), sc.config);
+    s.restore_state(p.engine, partial + ": checkpoint");
+    return s;
+  });
+  if (p.tick >= sc.ticks)
+    throw Error(Error::Kind::input, partial + ": the checkpoint is at the run's last tick");
+  auto writer = io::resume_sqlite_writer(p, sc.config.dt, sc.format);
+  if (!o.quiet)
+    std::cerr << "crowddb: resuming " << (sc.name.empty() ? p.value("scenario_source") : sc.name)
+              << " at tick " << p.tick << " of " << sc.ticks << " (" << partial << ")\n";
+  return execute(sc, sim, writer.get(), o, p.value("scenario_source"), &p.progress);
+}
+
 }  // namespace
+
+void add_resume_command(CLI::App& app, Action& action) {
+  static RunOptions o;
+  static std::string file;
+  auto* sub = app.add_subcommand(
+      "resume", "continue an interrupted run from its last checkpoint (its PATH.partial)");
+  sub->add_option("file", file, "the interrupted run's output: PATH.partial (or PATH)")->required();
+  sub->add_option("--threads", o.threads,
+                  "threads (default: the run's; results do not depend on it)")
+      ->check(cli_checks::whole(1, 256));
+  sub->add_option("--checkpoint-every", o.checkpoint_every,
+                  "seconds of wall time between checkpoints (default 60)")
+      ->check(cli_checks::finite(0, 1e9));
+  sub->add_option("--summary-json", o.summary_json,
+                  "write the run's summary as JSON to FILE (\"-\": standard output)");
+  sub->add_flag("--quiet", o.quiet, "no progress line");
+  sub->callback([&action] { action = [] { return resume(file, o); }; });
+}
 
 void add_run_command(CLI::App& app, Action& action) {
   static RunOptions o;
@@ -197,6 +270,10 @@ void add_run_command(CLI::App& app, Action& action) {
   sub->add_option("--field", o.field, "potential-field access path (auto, naive, ...)");
   sub->add_option("--collisions", o.collisions, "collision-set access path (auto, naive, ...)");
   sub->add_flag("--quiet", o.quiet, "no progress line");
+  sub->add_option("--checkpoint-every", o.checkpoint_every,
+                  "seconds of wall time between checkpoints in SQLite output, so `crowddb resume` "
+                  "can continue an interrupted run (default 60; 0: at every batch of frames)")
+      ->check(cli_checks::finite(0, 1e9));
   sub->callback([&action] { action = [] { return run(o); }; });
 }
 
