@@ -258,7 +258,17 @@ class DiscGrid {
     ys_.push_back(y);
     rs_.push_back(r);
     rmax_ = std::max(rmax_, r);
-    cells_[key(cell_of(x), cell_of(y))].push_back(i);
+    // An intrusive list per cell (head in the map, links in next_): no allocation per cell.
+    auto [it, fresh] = head_.try_emplace(key(cell_of(x), cell_of(y)), i);
+    next_.push_back(fresh ? kEnd : it->second);
+    it->second = i;
+  }
+  void reserve(std::size_t n) {
+    xs_.reserve(n);
+    ys_.reserve(n);
+    rs_.reserve(n);
+    next_.reserve(n);
+    head_.reserve(n);
   }
   // Does a placed disc overlap (x, y, r) with the extra gap? A window wider than the discs are
   // many (a huge gap) scans the discs instead of the cells: work stays bounded by the input.
@@ -274,9 +284,9 @@ class DiscGrid {
     const int64_t y0 = cell_of(y - reach), y1 = cell_of(y + reach);
     for (int64_t cx = x0; cx <= x1; ++cx)
       for (int64_t cy = y0; cy <= y1; ++cy) {
-        auto it = cells_.find(key(cx, cy));
-        if (it == cells_.end()) continue;
-        for (std::size_t j : it->second)
+        auto it = head_.find(key(cx, cy));
+        if (it == head_.end()) continue;
+        for (std::size_t j = it->second; j != kEnd; j = next_[j])
           if (discs_overlap(xs_[j] - x, ys_[j] - y, rs_[j] + r + gap)) return true;
       }
     return false;
@@ -295,9 +305,9 @@ class DiscGrid {
       std::size_t first_j = SIZE_MAX;
       for (int64_t cx = cell_of(xs_[i] - reach); cx <= cell_of(xs_[i] + reach); ++cx)
         for (int64_t cy = cell_of(ys_[i] - reach); cy <= cell_of(ys_[i] + reach); ++cy) {
-          auto it = cells_.find(key(cx, cy));
-          if (it == cells_.end()) continue;
-          for (std::size_t j : it->second)
+          auto it = head_.find(key(cx, cy));
+          if (it == head_.end()) continue;
+          for (std::size_t j = it->second; j != kEnd; j = next_[j])
             if (j > i && discs_overlap(xs_[j] - xs_[i], ys_[j] - ys_[i], rs_[i] + rs_[j])) {
               first_j = std::min(first_j, j);
               if (++out.count >= cap) out.capped = true;
@@ -325,7 +335,9 @@ class DiscGrid {
   double cell_;
   double rmax_ = 0;
   std::vector<double> xs_, ys_, rs_;
-  std::unordered_map<uint64_t, std::vector<std::size_t>> cells_;
+  static constexpr std::size_t kEnd = SIZE_MAX;
+  std::unordered_map<uint64_t, std::size_t> head_;  // cell -> its newest disc
+  std::vector<std::size_t> next_;                   // disc -> the next older disc in its cell
 };
 
 struct Loader {
@@ -846,6 +858,7 @@ struct Loader {
     double rmax = 0;
     for (const AgentSpec& s : agents) rmax = std::max(rmax, s.radius);
     DiscGrid all(2 * rmax);
+    all.reserve(agents.size());
     for (const AgentSpec& s : agents) all.add(s.x, s.y, s.radius);
     const DiscGrid::PairCount pairs = all.count_pairs(kOverlapCountCap);
     if (pairs.found)
