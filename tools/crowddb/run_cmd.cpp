@@ -272,7 +272,7 @@ void add_run_command(CLI::App& app, Action& action) {
   sub->add_flag("--quiet", o.quiet, "no progress line");
   sub->add_option("--checkpoint-every", o.checkpoint_every,
                   "seconds of wall time between checkpoints in SQLite output, so `crowddb resume` "
-                  "can continue an interrupted run (default 60; 0: at every batch of frames)")
+                  "can continue an interrupted run (default 60; 0: after every tick)")
       ->check(cli_checks::finite(0, 1e9));
   sub->callback([&action] { action = [] { return run(o); }; });
 }
