@@ -469,6 +469,21 @@ PartialRun read_partial_run(const std::filesystem::path& file) {
   }
   try {
     {
+      // A run killed while creating its file leaves it without tables: say so rather than
+      // "no such table".
+      Statement t(db, "SELECT count(*), sum(name = 'crowddb_run') FROM sqlite_master", where);
+      if (sqlite3_step(t.get()) != SQLITE_ROW)
+        throw Error(Error::Kind::input, where + ": " + sqlite3_errmsg(db));
+      if (sqlite3_column_int64(t.get(), 0) == 0)
+        throw Error(Error::Kind::input,
+                    where +
+                        ": no checkpoint yet (the run stopped before writing anything; run it "
+                        "again)");
+      if (sqlite3_column_int64(t.get(), 1) == 0)
+        throw Error(Error::Kind::input,
+                    where + ": not a crowddb run's output (no crowddb_run table)");
+    }
+    {
       Statement q(db, "SELECT key, value FROM crowddb_run", where);
       int rc;
       while ((rc = sqlite3_step(q.get())) == SQLITE_ROW) {

@@ -105,10 +105,17 @@ TEST(Resume, KillMinus9AtRandomTicksThenResumeEndsAsTheUninterruptedRun) {
     int status = 0;
     waitpid(pid, &status, 0);
     if (std::filesystem::exists(out)) continue;  // it finished first: not a trial
+    // Killed before its first checkpoint (on a loaded machine, even before creating the file or
+    // its tables): nothing to resume, and resume says so.
+    if (!std::filesystem::exists(partial)) {
+      const std::string err = test::run_cli("resume " + partial.string(), dir).err;
+      EXPECT_NE(err.find("no such file"), std::string::npos) << err;
+      continue;
+    }
     const auto checkpoint = query(partial, "SELECT tick FROM crowddb_checkpoint");
-    if (checkpoint.empty()) {  // killed before its first checkpoint: nothing to resume
-      EXPECT_NE(test::run_cli("resume " + partial.string(), dir).err.find("no checkpoint yet"),
-                std::string::npos);
+    if (checkpoint.empty()) {
+      const std::string err = test::run_cli("resume " + partial.string(), dir).err;
+      EXPECT_NE(err.find("no checkpoint yet"), std::string::npos) << err;
       continue;
     }
     killed_at.push_back(std::stoull(checkpoint[0]));
@@ -170,6 +177,20 @@ TEST(Resume, WhatCannotBeResumedSaysWhy) {
   const test::CliResult r = test::run_cli("resume " + junk.string(), dir);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find(junk.string()), std::string::npos) << r.err;
+  // An empty file (a run killed while creating it) and an SQLite file of something else.
+  const auto empty = dir / "empty.sqlite.partial";
+  std::fclose(std::fopen(empty.c_str(), "w"));
+  EXPECT_NE(test::run_cli("resume " + empty.string(), dir).err.find("no checkpoint yet"),
+            std::string::npos);
+  const auto other = dir / "other.sqlite.partial";
+  {
+    sqlite3* h = nullptr;
+    ASSERT_EQ(sqlite3_open(other.c_str(), &h), SQLITE_OK);
+    sqlite3_exec(h, "CREATE TABLE t(x)", nullptr, nullptr, nullptr);
+    sqlite3_close(h);
+  }
+  EXPECT_NE(test::run_cli("resume " + other.string(), dir).err.find("not a crowddb run's output"),
+            std::string::npos);
 }
 
 }  // namespace
