@@ -582,6 +582,9 @@ struct Loader {
   void read_agents(Node& root) {
     if (!root.has("agents")) return;
     const json& arr = root.array("agents");
+    if (arr.size() > kMaxScenarioAgents)
+      root.fail("agents", std::to_string(arr.size()) + " agents; a scenario places at most " +
+                              std::to_string(kMaxScenarioAgents));
     for (std::size_t i = 0; i < arr.size(); ++i) {
       Node a = root.element(arr, "agents", i);
       AgentSpec s;
@@ -610,7 +613,12 @@ struct Loader {
       Node g = root.element(arr, "groups", gi);
       Rng rng = Rng::stream(sc.config.seed, gi);
       g.string("name", std::string());
-      const uint64_t count = g.integer("count", std::nullopt, 10'000'000);
+      const uint64_t count = g.integer("count");
+      if (count > kMaxScenarioAgents - std::min(kMaxScenarioAgents, agents.size()))
+        g.fail("count", std::to_string(count) + " agents would make " +
+                            std::to_string(agents.size() + count) + "; a scenario places at most " +
+                            std::to_string(kMaxScenarioAgents) +
+                            " at load time (explicit agents and groups together)");
       const auto radius = g.range("radius", {0.25, 0.25});
       if (!(radius.first > 0)) g.fail("radius", "must be > 0");
       const auto speed = g.range("speed", {0, 0});

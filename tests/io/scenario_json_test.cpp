@@ -305,6 +305,25 @@ TEST(ScenarioJson, HugePilesAndGapsStayCheap) {
       EXPECT_GE(std::hypot(t.x[i] - t.x[j], t.y[i] - t.y[j]), 30.5);
 }
 
+// The documented limit on agents placed at load time is checked before any agent is placed, so
+// a 200-byte file asking for 10^7 agents is refused at once instead of taking GBs and minutes.
+TEST(ScenarioJson, AgentsPlacedAtLoadAreLimited) {
+  const std::string head =
+      R"({"bounds": [0, 0, 100000, 100000], "goals": [{"name": "g", "x": 5, "y": 5}], )";
+  const std::string uniform =
+      R"(, "goal": "g", "placement": {"type": "uniform", "region": [0, 0, 100000, 100000]}})";
+  std::string e = error_of(head + R"("groups": [{"count": 10000000)" + uniform + "]}");
+  EXPECT_NE(e.find("/groups/0/count: 10000000 agents would make 10000000; a scenario places at "
+                   "most 2000000 at load time"),
+            std::string::npos)
+      << e;
+  // Explicit agents count too: one explicit agent and a group of exactly the limit pass it.
+  e = error_of(head + R"("agents": [{"x": 1, "y": 1, "goal": "g"}], "groups": [{"count": 2000000)" +
+               uniform + "]}");
+  EXPECT_NE(e.find("/groups/0/count: 2000000 agents would make 2000001"), std::string::npos) << e;
+  EXPECT_EQ(kMaxScenarioAgents, 2'000'000u);
+}
+
 TEST(ScenarioJson, ShippedScenariosLoadWithoutWarnings) {
   for (const char* name : {"airport", "circle", "crossing", "bottleneck"}) {
     const Scenario sc =

@@ -29,7 +29,7 @@ struct ProjectSettings {
   uint64_t sub_steps = 0;      // the project's subSteps (dt = time_step / (1 + subSteps))
   double duration = 400;       // [s] Menge's default
   uint64_t seed = 0;           // `random`; 0 (Menge: a time-based seed) gives seed 1
-  std::size_t max_agents = 10'000'000;  // more agents than this is an error (fuzzing lowers it)
+  std::size_t max_agents = kMaxScenarioAgents;  // more is an error (fuzzing lowers it)
 };
 
 // The in-memory entry (fuzzing, tests): a scene and a behaviour text with the names used in

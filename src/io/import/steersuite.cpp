@@ -24,7 +24,7 @@ constexpr double kDefaultSpeed = 1.3;   // EXAMPLE.xml's recommendation
 constexpr double kDt = 0.05;            // SteerSuite's default clock: 20 frames per second
 constexpr double kDuration = 600;       // SteerSuite runs until every agent is done
 constexpr int kAttempts = 10000;        // SteerSuite gives up placing after 10,000 tries
-constexpr std::size_t kMaxAgents = 10'000'000;
+constexpr std::size_t kMaxAgents = kMaxScenarioAgents;
 
 struct Xyz {
   double x = 0, y = 0, z = 0;

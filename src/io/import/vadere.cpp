@@ -1233,6 +1233,9 @@ class Reader {
           }
         }
       }
+      if (++explicit_ > kMaxScenarioAgents)
+        fail(p, "more than " + std::to_string(kMaxScenarioAgents) +
+                    " pedestrians placed at the start (crowddb's limit per scenario)");
       if (++agents_ > kMaxAgents) fail(p, "more than 10^7 agents");
       b_.agent(std::move(row), where(p));
       b_.occupy(x, y, a.radius);
@@ -1582,6 +1585,7 @@ class Reader {
   std::map<int64_t, std::vector<std::size_t>> target_ids_;  // id -> targets (ids may repeat)
   std::set<std::string> speed_warned_;                      // attribute objects warned about
   double agents_ = 0;              // explicit and spawned, for the 10^7 bound
+  std::size_t explicit_ = 0;       // placed at the start, for kMaxScenarioAgents
   double removed_ = 0, idle_ = 0;  // agents whose last target is absorbing / not
   std::optional<Val> removed_at_, idle_at_;
 };

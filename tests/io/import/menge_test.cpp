@@ -898,15 +898,15 @@ TEST(MengeErrors, TooManyAgents) {
   std::string s = scene(group(R"(    <Generator type="rect_grid" anchor_x="0" anchor_y="0"
         offset_x="1" offset_y="1" count_x="10000" count_y="10000" />
 )"));
-  expect_error(s, kStand, at("s.xml", s, "rect_grid", "Generator"), "more than 10000000");
+  expect_error(s, kStand, at("s.xml", s, "rect_grid", "Generator"), "more than 2000000");
   s = scene(group(R"(    <Generator type="hex_lattice" anchor_x="0" anchor_y="0"
         alignment="center" row_direction="x" density="1" width="10" population="20000000" />
 )"));
-  expect_error(s, kStand, at("s.xml", s, "hex_lattice", "Generator"), "more than 10000000");
+  expect_error(s, kStand, at("s.xml", s, "hex_lattice", "Generator"), "more than 2000000");
   s = scene(group(R"(    <Generator type="hex_lattice" anchor_x="0" anchor_y="0"
         alignment="center" row_direction="y" density="1" width="1e12" population="1" />
 )"));
-  expect_error(s, kStand, at("s.xml", s, "hex_lattice", "Generator"), "more than 10000000");
+  expect_error(s, kStand, at("s.xml", s, "hex_lattice", "Generator"), "more than 2000000");
   io::ProjectSettings small;
   small.max_agents = 3;
   s = scene(group(agents({{0, 0}, {1, 0}, {2, 0}, {3, 0}})));
