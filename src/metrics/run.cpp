@@ -39,6 +39,8 @@ std::string hex(uint64_t v) {
 
 namespace {
 
+constexpr std::string_view kProgressMagic = "crowddb-run-progress";
+
 // What a run accumulates besides the simulation: saved with each checkpoint.
 struct Progress {
   RunSummary* s;
@@ -58,24 +60,18 @@ struct Progress {
       f(*v);
   }
   std::string save(double wall_now) const {
-    ByteWriter out;
-    out.text("crowddb-run-progress");
+    ByteWriter out(kProgressMagic);
     out.u64(s->ticks);
     counters([&](std::size_t& v) { out.u64(v); });
     out.u64(*last_arrival);
     out.f64(wall_now);
     out.vec(*tick_seconds);
     bench->save(out);
-    out.u64(checksum(out.bytes()));
-    return out.take();
+    return out.seal();
   }
   void restore(std::string_view bytes) const {
-    if (bytes.size() < 8) ByteReader(bytes, "checkpoint").fail("run progress ends too early");
-    const std::string_view body = bytes.substr(0, bytes.size() - 8);
-    ByteReader sum(bytes.substr(body.size()), "checkpoint");
-    ByteReader in(body, "checkpoint");
-    if (in.text() != "crowddb-run-progress" || sum.u64() != checksum(body))
-      in.fail("run progress damaged");
+    ByteReader in = ByteReader::open_sealed(bytes, kProgressMagic, "run's progress record",
+                                            "checkpoint: run progress");
     s->ticks = in.u64();
     counters([&](std::size_t& v) { v = in.u64(); });
     *last_arrival = in.u64();

@@ -337,8 +337,7 @@ void metrics_fields(Io&& io, M& m) {
 
 std::string Simulation::save_state() const {
   const Engine& e = *engine_;
-  ByteWriter out;
-  out.text(kCheckpointMagic);
+  ByteWriter out(kCheckpointMagic);
   out.u32(kCheckpointVersion);
   out.u64(fingerprint(world_, config_));
   world_.save_agents(out);
@@ -358,18 +357,12 @@ std::string Simulation::save_state() const {
   out.u8(e.nav != nullptr);
   if (e.nav) e.nav->save(out);
   out.text(kCheckpointMagic);  // a trailer: the bytes ended where they should
-  out.u64(checksum(out.bytes()));
-  return out.take();
+  return out.seal();
 }
 
 void Simulation::restore_state(std::string_view bytes, const std::string& what) {
   Engine& e = *engine_;
-  if (bytes.size() < 8) ByteReader(bytes, what).fail("ends too early");
-  const std::string_view body = bytes.substr(0, bytes.size() - 8);
-  ByteReader sum(bytes.substr(body.size()), what);
-  ByteReader in(body, what);
-  if (in.text() != kCheckpointMagic) in.fail("not a crowddb checkpoint");
-  if (sum.u64() != checksum(body)) in.fail("damaged (its checksum does not match)");
+  ByteReader in = ByteReader::open_sealed(bytes, kCheckpointMagic, "crowddb checkpoint", what);
   const uint32_t version = in.u32();
   if (version != kCheckpointVersion)
     in.fail("checkpoint version " + std::to_string(version) + ", this build reads version " +

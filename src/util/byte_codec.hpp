@@ -38,13 +38,13 @@ inline uint64_t checksum(std::string_view bytes) {
 
 class ByteWriter {
  public:
+  // A sealed record starts with `magic` and ends with seal(): ByteReader::open_sealed checks both.
+  explicit ByteWriter(std::string_view magic = {}) {
+    if (!magic.empty()) text(magic);
+  }
   void u8(uint8_t v) { out_.push_back(static_cast<char>(v)); }
-  void u32(uint32_t v) {
-    for (int i = 0; i < 4; ++i) u8(static_cast<uint8_t>(v >> (8 * i)));
-  }
-  void u64(uint64_t v) {
-    for (int i = 0; i < 8; ++i) u8(static_cast<uint8_t>(v >> (8 * i)));
-  }
+  void u32(uint32_t v) { uint_le(v); }
+  void u64(uint64_t v) { uint_le(v); }
   void f64(double v) { u64(std::bit_cast<uint64_t>(v)); }
   void text(std::string_view s) {
     u64(s.size());
@@ -58,8 +58,17 @@ class ByteWriter {
   }
   const std::string& bytes() const { return out_; }
   std::string take() { return std::move(out_); }
+  // The record with the checksum of every byte before it appended.
+  std::string seal() {
+    u64(checksum(out_));
+    return take();
+  }
 
  private:
+  template <class U>
+  void uint_le(U v) {
+    for (std::size_t i = 0; i < sizeof(U); ++i) u8(static_cast<uint8_t>(v >> (8 * i)));
+  }
   template <class T>
   void one(T x) {
     if constexpr (std::is_same_v<T, double>) {
@@ -83,24 +92,25 @@ class ByteReader {
   // `what` names the data in messages ("run.sqlite.partial: checkpoint").
   ByteReader(std::string_view bytes, std::string what) : in_(bytes), what_(std::move(what)) {}
 
+  // A reader over the body of a record written by ByteWriter(magic) ... seal(), after checking its
+  // magic ("not a <kind>") and its checksum ("damaged"), before anything else is parsed.
+  static ByteReader open_sealed(std::string_view bytes, std::string_view magic,
+                                const std::string& kind, std::string what) {
+    if (bytes.size() < 8) ByteReader(bytes, what).fail("ends too early");
+    const std::string_view body = bytes.substr(0, bytes.size() - 8);
+    const uint64_t sum = ByteReader(bytes.substr(body.size()), what).u64();
+    ByteReader in(body, std::move(what));
+    if (in.text() != magic) in.fail("not a " + kind);
+    if (sum != checksum(body)) in.fail("damaged (its checksum does not match)");
+    return in;
+  }
+
   uint8_t u8() {
     need(1);
     return static_cast<uint8_t>(in_[pos_++]);
   }
-  uint32_t u32() {
-    need(4);
-    uint32_t v = 0;
-    for (int i = 0; i < 4; ++i)
-      v |= static_cast<uint32_t>(static_cast<uint8_t>(in_[pos_++])) << (8 * i);
-    return v;
-  }
-  uint64_t u64() {
-    need(8);
-    uint64_t v = 0;
-    for (int i = 0; i < 8; ++i)
-      v |= static_cast<uint64_t>(static_cast<uint8_t>(in_[pos_++])) << (8 * i);
-    return v;
-  }
+  uint32_t u32() { return uint_le<uint32_t>(); }
+  uint64_t u64() { return uint_le<uint64_t>(); }
   double f64() { return std::bit_cast<double>(u64()); }
   std::string text() {
     const uint64_t n = count(1);
@@ -130,6 +140,14 @@ class ByteReader {
  private:
   void need(std::size_t n) {
     if (in_.size() - pos_ < n) fail("ends too early");
+  }
+  template <class U>
+  U uint_le() {
+    need(sizeof(U));
+    U v = 0;
+    for (std::size_t i = 0; i < sizeof(U); ++i)
+      v |= static_cast<U>(static_cast<U>(static_cast<uint8_t>(in_[pos_++])) << (8 * i));
+    return v;
   }
   template <class T>
   T one() {
