@@ -7,22 +7,6 @@
 #include "world/geometry.hpp"
 
 namespace crowddb::io {
-namespace {
-
-uint64_t cell_key(int64_t cx, int64_t cy) {
-  return (static_cast<uint64_t>(cx) << 32) ^ static_cast<uint64_t>(cy & 0xffffffff);
-}
-
-// The grid cell of a coordinate, clamped so that any double (a file may say 1e53; the loader
-// refuses it later, naming the field) converts without overflow.
-int64_t cell_of(double v, double cell) {
-  constexpr double kLimit = 1e15;
-  const double c = std::floor(v / cell);
-  return static_cast<int64_t>(std::isnan(c) ? 0.0 : std::clamp(c, -kLimit, kLimit));
-}
-
-}  // namespace
-
 std::string fmt(double v) {
   std::ostringstream os;
   os.precision(15);
@@ -113,31 +97,11 @@ bool DocBuilder::free(double x, double y, double r, bool agents) const {
     if (discs_overlap(c.x - x, c.y - y, c.r + r)) return false;
   for (const auto& p : polygons_)
     if (disc_overlaps_polygon(p, x, y, r)) return false;
-  if (!agents) return true;
-  const double reach = r + rmax_;
-  const int64_t c0x = cell_of(x - reach, kCell), c1x = cell_of(x + reach, kCell);
-  const int64_t c0y = cell_of(y - reach, kCell), c1y = cell_of(y + reach, kCell);
-  // A window of more cells than there are occupied ones (huge radii): scan the occupied cells.
-  const double window = (static_cast<double>(c1x - c0x) + 1) * (static_cast<double>(c1y - c0y) + 1);
-  if (window > static_cast<double>(discs_.size())) {
-    for (const auto& [key, cell] : discs_)
-      for (const Disc& d : cell)
-        if (discs_overlap(d.x - x, d.y - y, d.r + r)) return false;
-    return true;
-  }
-  for (int64_t cx = c0x; cx <= c1x; ++cx)
-    for (int64_t cy = c0y; cy <= c1y; ++cy) {
-      const auto it = discs_.find(cell_key(cx, cy));
-      if (it == discs_.end()) continue;
-      for (const Disc& d : it->second)
-        if (discs_overlap(d.x - x, d.y - y, d.r + r)) return false;
-    }
-  return true;
+  return !agents || !agents_.any_overlap(x, y, r, 0);
 }
 
 void DocBuilder::occupy(double x, double y, double r) {
-  rmax_ = std::max(rmax_, r);
-  discs_[cell_key(cell_of(x, kCell), cell_of(y, kCell))].push_back({x, y, r});
+  agents_.add(x, y, r);
 }
 
 Imported DocBuilder::finish() {

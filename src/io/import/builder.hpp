@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "crowddb/world.hpp"
+#include "io/disc_grid.hpp"
 #include "io/import/importer.hpp"
 #include "util/rng.hpp"
 
@@ -82,10 +83,7 @@ class DocBuilder {
   Box extent_;
   std::vector<std::vector<Vec2>> polygons_;
   std::vector<Disc> circles_;
-  // Agent discs in a hash grid of cell kCell.
-  static constexpr double kCell = 2.0;
-  std::unordered_map<uint64_t, std::vector<Disc>> discs_;
-  double rmax_ = 0;
+  DiscGrid agents_{2.0};  // agent discs (cells of 2 m: agents are 0.2-0.5 m)
 };
 
 // Distance formatting for messages: shortest form.

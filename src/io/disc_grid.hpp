@@ -1,0 +1,107 @@
+// A spatial hash of discs for placing agents without overlaps: the scenario reader's groups and
+// the importers' random placement. Exact (the same predicate as the engine's overlap test) and
+// bounded: a query window wider than the discs are many scans the discs instead of the cells.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "world/geometry.hpp"
+
+namespace crowddb::io {
+
+class DiscGrid {
+ public:
+  explicit DiscGrid(double cell) : cell_(cell > 0 ? cell : 1) {}
+  void add(double x, double y, double r) {
+    const std::size_t i = xs_.size();
+    xs_.push_back(x);
+    ys_.push_back(y);
+    rs_.push_back(r);
+    rmax_ = std::max(rmax_, r);
+    // An intrusive list per cell (head in the map, links in next_): no allocation per cell.
+    auto [it, fresh] = head_.try_emplace(key(cell_of(x), cell_of(y)), i);
+    next_.push_back(fresh ? kEnd : it->second);
+    it->second = i;
+  }
+  void reserve(std::size_t n) {
+    xs_.reserve(n);
+    ys_.reserve(n);
+    rs_.reserve(n);
+    next_.reserve(n);
+    head_.reserve(n);
+  }
+  // Does a placed disc overlap (x, y, r) with the extra gap? A window wider than the discs are
+  // many (a huge gap) scans the discs instead of the cells: work stays bounded by the input.
+  bool any_overlap(double x, double y, double r, double gap) const {
+    const double reach = r + rmax_ + gap;
+    const double side = 2 * reach / cell_ + 2;  // cells per side of the window
+    if (!(side * side <= static_cast<double>(xs_.size()))) {
+      for (std::size_t j = 0; j < xs_.size(); ++j)
+        if (discs_overlap(xs_[j] - x, ys_[j] - y, rs_[j] + r + gap)) return true;
+      return false;
+    }
+    const int64_t x0 = cell_of(x - reach), x1 = cell_of(x + reach);
+    const int64_t y0 = cell_of(y - reach), y1 = cell_of(y + reach);
+    for (int64_t cx = x0; cx <= x1; ++cx)
+      for (int64_t cy = y0; cy <= y1; ++cy) {
+        auto it = head_.find(key(cx, cy));
+        if (it == head_.end()) continue;
+        for (std::size_t j = it->second; j != kEnd; j = next_[j])
+          if (discs_overlap(xs_[j] - x, ys_[j] - y, rs_[j] + r + gap)) return true;
+      }
+    return false;
+  }
+  // Overlapping pairs (i < j) among the placed discs: how many (counting stops at `cap`, so a
+  // pile of 10^5 discs on one spot costs no more than the cap) and the first in (i, j) order.
+  struct PairCount {
+    uint64_t count = 0;
+    bool capped = false, found = false;
+    std::size_t first_i = 0, first_j = 0;
+  };
+  PairCount count_pairs(uint64_t cap) const {
+    PairCount out;
+    for (std::size_t i = 0; i < xs_.size() && !out.capped; ++i) {
+      const double reach = rs_[i] + rmax_;
+      std::size_t first_j = SIZE_MAX;
+      for (int64_t cx = cell_of(xs_[i] - reach); cx <= cell_of(xs_[i] + reach); ++cx)
+        for (int64_t cy = cell_of(ys_[i] - reach); cy <= cell_of(ys_[i] + reach); ++cy) {
+          auto it = head_.find(key(cx, cy));
+          if (it == head_.end()) continue;
+          for (std::size_t j = it->second; j != kEnd; j = next_[j])
+            if (j > i && discs_overlap(xs_[j] - xs_[i], ys_[j] - ys_[i], rs_[i] + rs_[j])) {
+              first_j = std::min(first_j, j);
+              if (++out.count >= cap) out.capped = true;
+            }
+        }
+      if (first_j != SIZE_MAX && !out.found) {
+        out.found = true;
+        out.first_i = i;
+        out.first_j = first_j;
+      }
+    }
+    return out;
+  }
+
+ private:
+  // Clamped: a cell number beyond int64 (positions near 1e308) would be undefined behaviour.
+  int64_t cell_of(double v) const {
+    const double c = std::floor(v / cell_);
+    if (!(c > -0x1p62)) return c == c ? -(int64_t{1} << 62) : 0;
+    return c < 0x1p62 ? static_cast<int64_t>(c) : int64_t{1} << 62;
+  }
+  static uint64_t key(int64_t cx, int64_t cy) {
+    return (static_cast<uint64_t>(cx) * 0x9e3779b97f4a7c15ull) ^ static_cast<uint64_t>(cy);
+  }
+  double cell_;
+  double rmax_ = 0;
+  std::vector<double> xs_, ys_, rs_;
+  static constexpr std::size_t kEnd = SIZE_MAX;
+  std::unordered_map<uint64_t, std::size_t> head_;  // cell -> its newest disc
+  std::vector<std::size_t> next_;                   // disc -> the next older disc in its cell
+};
+
+}  // namespace crowddb::io
