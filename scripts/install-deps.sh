@@ -13,6 +13,9 @@ packages=(
   libpugixml-dev                               # SDF3 XML
   gnuplot-nox graphviz                         # experiment plots, DOT rendering
   clang libclang-rt-14-dev                     # libFuzzer targets (scripts/fuzz.sh)
+  python3-dev pybind11-dev python3-numpy       # the Python module
+  python3-pytest python3-matplotlib            # its tests and the plotting example
+  pkg-config                                   # the install test (crowddb.pc)
 )
 missing=()
 for p in "${packages[@]}"; do

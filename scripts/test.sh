@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The whole test suite: a Release build with every test, then the same tests built with
+# The whole test suite: a Release build with every test (C++, the Python module's pytest suite,
+# the install and the example built against it), then the C++ tests built with
 # AddressSanitizer + UndefinedBehaviorSanitizer, then every parser's libFuzzer target (clang):
 # its seed corpus replayed and FUZZ_SECONDS (default 60) of fuzzing (scripts/fuzz.sh). Tests
 # labelled `slow` run only with CROWDDB_SLOW_TESTS=1. Exits non-zero on the first failure.
@@ -13,11 +14,13 @@ echo "== Release build and tests"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DCROWDDB_WERROR=ON >/dev/null
 cmake --build build -j "$jobs"
 ctest --test-dir build "${ctest_args[@]}"
+echo "== install, and the C++ example built against the installed package"
+bash scripts/test-install.sh build
 
 echo "== ASan+UBSan build and tests"
 # -g1 (line tables only): sanitizer reports keep file:line, and the build is much lighter than -g.
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" \
-  -DCROWDDB_SANITIZE=ON -DCROWDDB_WERROR=ON -DCROWDDB_BUILD_BENCHMARKS=OFF >/dev/null
+  -DCROWDDB_SANITIZE=ON -DCROWDDB_WERROR=ON -DCROWDDB_BUILD_BENCHMARKS=OFF -DCROWDDB_BUILD_PYTHON=OFF >/dev/null
 cmake --build build-asan -j "$jobs"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-asan "${ctest_args[@]}" -LE "slow|nosan"
