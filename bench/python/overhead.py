@@ -22,7 +22,7 @@ import crowddb
 def scenario(n: int) -> dict:
     side = (n / 0.5) ** 0.5  # 0.5 agents per m^2
     return {"name": f"uniform-{n}", "bounds": [0, 0, side, side], "seed": 3,
-            "goals": [{"name": f"g{k}", "x": x, "y": y, "radius": 2}
+            "goals": [{"name": f"g{k}", "x": x, "y": y, "arrival_radius": 2}
                       for k, (x, y) in enumerate([(2, 2), (side - 2, 2), (2, side - 2),
                                                   (side - 2, side - 2)])],
             "groups": [{"count": n, "radius": 0.25,
