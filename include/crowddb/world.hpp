@@ -158,8 +158,9 @@ struct AgentTable {
 
 class World {
  public:
+  // A world without bounds (nothing is outside it), or one inside `bounds` (set_bounds' checks).
   World() = default;
-  explicit World(Bounds bounds) : bounds_(bounds) {}
+  explicit World(Bounds bounds) { set_bounds(bounds); }
 
   // ---- static tables; validated, applied immediately ----
   // Throws InvalidRow naming the field (a polygon goal that is not simple, a duplicate name).
@@ -170,9 +171,16 @@ class World {
   // Throws InvalidRow unless xmin < xmax, ymin < ymax and every coordinate lies within
   // ±kMaxCoordinate (beyond it, distances and navigation meshes lose all precision or overflow).
   void set_bounds(Bounds bounds);
+  // Whether the bounds are solid walls (SimConfig::walls, default true; Simulation sets it from
+  // its configuration). With walls, an agent's centre must lie within the bounds. Throws
+  // InvalidRow when turning walls on leaves an agent (or a pending insert) outside.
+  void set_walls(bool walls);
+  bool walls() const { return walls_; }
 
   // ---- agent changes: validated now, applied by apply_pending() (start of the next tick) ----
-  // Throws InvalidRow naming the field; nothing stored changes.
+  // Throws InvalidRow naming the field; nothing stored changes. An agent whose centre lies
+  // outside the walkable area (outside the bounds with walls, or strictly inside an obstacle)
+  // is refused too (field "x").
   AgentId insert(const AgentSpec& spec);
   // Throws Error(input) when the id is not alive or pending.
   void erase(AgentId id);
@@ -212,6 +220,9 @@ class World {
   bool at_goal(std::size_t row) const;
 
   static void validate_spec(const AgentSpec& spec, std::size_t goal_count);
+  // Throws InvalidRow("x") when (x, y) lies outside the walkable area: outside the bounds with
+  // walls, or strictly inside an obstacle (on its boundary is walkable).
+  void check_walkable(double x, double y) const;
 
   // ---- checkpoints (Simulation::save_state) ----
   // The agents table, slot map and free list. The static tables (bounds, goals, sources,
@@ -240,6 +251,9 @@ class World {
   void push_row(AgentId id, const AgentSpec& spec);
 
   Bounds bounds_{};
+  bool has_bounds_ = false;
+  bool walls_ = true;
+  std::vector<Bounds> polygon_boxes_;  // of polygons_, to skip most polygons in check_walkable
   AgentTable agents_;
   std::vector<Goal> goals_;
   std::vector<Source> sources_;

@@ -108,6 +108,13 @@ def test_errors_are_typed_and_name_the_field(tmp_path):
         w.insert_agents([1.0], [1.0], "h")
     with pytest.raises(ValueError, match="3 values for 2 agents"):
         w.insert_agents([1.0, 2.0], [1.0, 2.0, 3.0], "g")
+    w.add_circle(8, 8, 1)
+    for x, y, where in [(-1.0, 5.0, "outside the bounds"), (8.2, 8.2, "inside circle obstacle 0")]:
+        with pytest.raises(crowddb.InvalidRow, match=where) as e:
+            w.insert_agents([x], [y], "g")
+        assert e.value.field == "x"
+    with pytest.raises(crowddb.InvalidRow, match="duplicate goal name 'g'"):
+        w.add_goal("g", x=1, y=1)
     with pytest.raises(crowddb.InputError):
         crowddb.World((10, 0, 0, 10))  # inverted bounds
     with pytest.raises(crowddb.InputError):

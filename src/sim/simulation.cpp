@@ -251,6 +251,7 @@ struct Simulation::Engine {
 Simulation::Simulation(World world, SimConfig config)
     : world_(std::move(world)), config_(std::move(config)) {
   config_.validate();
+  world_.set_walls(config_.walls);
   for (const Source& s : world_.sources())
     for (uint32_t g : s.goals)
       if (g >= world_.goals().size())

@@ -146,6 +146,14 @@ uint32_t World::add_obstacle(const CircleObstacle& c) {
 uint32_t World::add_obstacle(PolygonObstacle p) {
   require_finite("charge", p.charge);
   normalize_ring(p.vertices, "vertices");
+  Bounds box{INFINITY, INFINITY, -INFINITY, -INFINITY};
+  for (const Vec2& v : p.vertices) {
+    box.xmin = std::min(box.xmin, v.x);
+    box.ymin = std::min(box.ymin, v.y);
+    box.xmax = std::max(box.xmax, v.x);
+    box.ymax = std::max(box.ymax, v.y);
+  }
+  polygon_boxes_.push_back(box);
   polygons_.push_back(std::move(p));
   return static_cast<uint32_t>(polygons_.size() - 1);
 }
@@ -164,6 +172,38 @@ void World::set_bounds(Bounds b) {
       throw InvalidRow("bounds", os.str());
     }
   bounds_ = b;
+  has_bounds_ = true;
+}
+
+void World::set_walls(bool walls) {
+  walls_ = walls;
+  if (!walls) return;
+  try {
+    for (std::size_t i = 0; i < agents_.size(); ++i) check_walkable(agents_.x[i], agents_.y[i]);
+    for (const Change& c : pending_)
+      if (c.kind == Change::Kind::insert) check_walkable(c.spec.x, c.spec.y);
+  } catch (const InvalidRow&) {
+    walls_ = false;
+    throw;
+  }
+}
+
+void World::check_walkable(double x, double y) const {
+  const auto at = [&] { return "the agent at (" + fmt(x) + ", " + fmt(y) + ") lies "; };
+  const Bounds& b = bounds_;
+  if (walls_ && has_bounds_ && !(x >= b.xmin && x <= b.xmax && y >= b.ymin && y <= b.ymax))
+    throw InvalidRow("x", at() + "outside the bounds [" + fmt(b.xmin) + ", " + fmt(b.xmax) +
+                              "] x [" + fmt(b.ymin) + ", " + fmt(b.ymax) + "] (the walls)");
+  for (std::size_t k = 0; k < circles_.size(); ++k)
+    if (std::hypot(circles_[k].x - x, circles_[k].y - y) < circles_[k].radius)
+      throw InvalidRow("x", at() + "inside circle obstacle " + std::to_string(k));
+  for (std::size_t k = 0; k < polygons_.size(); ++k) {
+    const Bounds& box = polygon_boxes_[k];
+    if (x <= box.xmin || x >= box.xmax || y <= box.ymin || y >= box.ymax) continue;
+    const auto& ring = polygons_[k].vertices;
+    if (point_in_polygon(ring, x, y) && dist2_to_boundary(ring, x, y) > 0)
+      throw InvalidRow("x", at() + "inside polygon obstacle " + std::to_string(k));
+  }
 }
 
 const World::Slot* World::live_slot(AgentId id) const {
@@ -176,6 +216,7 @@ const World::Slot* World::live_slot(AgentId id) const {
 
 AgentId World::insert(const AgentSpec& spec) {
   validate_spec(spec, goals_.size());
+  check_walkable(spec.x, spec.y);
   AgentId id;
   if (!free_slots_.empty()) {
     id.index = free_slots_.back();

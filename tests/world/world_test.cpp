@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "crowddb/simulation.hpp"
 #include "support/configs.hpp"
 
 namespace crowddb {
@@ -165,6 +166,69 @@ TEST(World, InvalidStaticRowsAreRejected) {
   EXPECT_EQ(w.goals().size(), 2u);
   EXPECT_TRUE(w.circles().empty());
   EXPECT_TRUE(w.polygons().empty());
+}
+
+// The API refuses what the scenario reader refuses: bounds that are inverted or not finite (in
+// the constructor too), a duplicate goal name, and agents whose centre is outside the walkable
+// area: outside the walls, or strictly inside an obstacle (its boundary is walkable).
+TEST(World, ApiRefusesBadBoundsDuplicateGoalsAndAgentsOutsideTheWalkableArea) {
+  const auto field_of = [](auto&& f) -> std::string {
+    try {
+      f();
+    } catch (const InvalidRow& e) {
+      return e.field() + ": " + e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_EQ(field_of([] { World w(Bounds{10, 0, 0, 10}); }).rfind("bounds: ", 0), 0u);
+  EXPECT_EQ(field_of([] { World w(Bounds{0, 0, kNaN, 10}); }).rfind("bounds: ", 0), 0u);
+  EXPECT_EQ(field_of([] { World w(Bounds{0, 0, 1e300, 10}); }).rfind("bounds: ", 0), 0u);
+  World w = world_with_goals();
+  EXPECT_EQ(field_of([&] {
+              w.add_goal({"g0", 1, 1, 1, 1, {}});
+            }),
+            "name: duplicate goal name 'g0'");
+
+  w.add_obstacle(CircleObstacle{50, 50, 5, 1});
+  w.add_obstacle(PolygonObstacle{{{20, 20}, {30, 20}, {30, 30}, {20, 30}}, 1});
+  EXPECT_EQ(field_of([&] { w.insert(spec_at(-1, 50)); }),
+            "x: the agent at (-1, 50) lies outside the bounds [0, 100] x [0, 100] (the walls)");
+  EXPECT_EQ(field_of([&] { w.insert(spec_at(50, 100.5)); }).rfind("x: ", 0), 0u);
+  EXPECT_EQ(field_of([&] { w.insert(spec_at(52, 51)); }),
+            "x: the agent at (52, 51) lies inside circle obstacle 0");
+  EXPECT_EQ(field_of([&] { w.insert(spec_at(25, 29.9)); }),
+            "x: the agent at (25, 29.899999999999999) lies inside polygon obstacle 0");
+  EXPECT_EQ(w.pending_changes(), 0u);  // nothing was stored
+  // The boundary is walkable (an agent may stand against a wall or obstacle), and so is every
+  // point of the bounds.
+  for (const auto& [x, y] : std::vector<std::pair<double, double>>{
+           {55, 50}, {20, 25}, {30, 30}, {0, 0}, {100, 100}, {31, 25}, {10, 90}})
+    EXPECT_EQ(field_of([&] { w.insert(spec_at(x, y)); }), "accepted") << x << ", " << y;
+
+  // Without walls the bounds do not bound agents; turning walls on checks the agents there.
+  World open = world_with_goals();
+  open.set_walls(false);
+  open.insert(spec_at(150, 50));
+  EXPECT_EQ(field_of([&] { open.set_walls(true); }).rfind("x: the agent at (150, 50)", 0), 0u);
+  EXPECT_FALSE(open.walls());
+  // A world without bounds has no outside.
+  World unbounded;
+  unbounded.add_goal({"g", 0, 0, 1, 1, {}});
+  EXPECT_EQ(field_of([&] { unbounded.insert(spec_at(1e6, -1e6)); }), "accepted");
+}
+
+// Simulation takes SimConfig::walls: an agent outside the bounds is fine without walls and an
+// error with them.
+TEST(World, SimulationChecksTheWorldAgainstItsWalls) {
+  World w = world_with_goals();
+  w.set_walls(false);
+  w.insert(spec_at(120, 5));
+  SimConfig walled;
+  EXPECT_THROW(Simulation(World(w), walled), InvalidRow);
+  SimConfig open = walled;
+  open.walls = false;
+  Simulation sim(std::move(w), open);
+  EXPECT_EQ(sim.world().agents().size(), 1u);
 }
 
 TEST(World, PolygonsAreStoredCounterClockwiseAndClosingVertexDropped) {
