@@ -6,6 +6,7 @@
 #include "bindings.hpp"
 #include "crowddb/error.hpp"
 #include "crowddb/query.hpp"
+#include "crowddb/world.hpp"
 
 namespace py = pybind11;
 using namespace pybind11::literals;
@@ -41,13 +42,33 @@ DiscTable discs_of(const Doubles& x, const Doubles& y, const Doubles& vx, const 
   return t;
 }
 
-StaticScene scene_of(const std::vector<std::tuple<double, double, double>>& circles) {
-  std::vector<CircleObstacle> c;
-  for (const auto& [x, y, r] : circles) {
-    if (!(r > 0)) throw Error(Error::Kind::input, "circles: a radius must be > 0");
-    c.push_back({x, y, r, 1});
+using Circles = std::vector<std::tuple<double, double, double>>;
+using Polygons = std::vector<Doubles>;
+
+// Obstacles: circles (x, y, r) and simple polygons ((n, 2) vertices), validated as the World
+// validates them (errors name the obstacle).
+StaticScene scene_of(const Circles& circles, const Polygons& polygons) {
+  World w;
+  for (std::size_t k = 0; k < circles.size(); ++k) try {
+      const auto& [x, y, r] = circles[k];
+      w.add_obstacle(CircleObstacle{x, y, r, 1});
+    } catch (const InvalidRow& e) {
+      throw InvalidRow(e.field(), "circles[" + std::to_string(k) + "]: " + e.what());
+    }
+  for (std::size_t k = 0; k < polygons.size(); ++k) {
+    const Doubles& v = polygons[k];
+    if (v.ndim() != 2 || v.shape(1) != 2)
+      throw py::value_error("polygons[" + std::to_string(k) + "]: expected an (n, 2) array");
+    PolygonObstacle p;
+    for (py::ssize_t i = 0; i < v.shape(0); ++i) p.vertices.push_back({v.at(i, 0), v.at(i, 1)});
+    try {
+      w.add_obstacle(std::move(p));
+    } catch (const InvalidRow& e) {
+      throw InvalidRow(e.field(), "polygons[" + std::to_string(k) + "]: " + e.what());
+    }
   }
-  return StaticScene(std::move(c), {}, 1.0, ObstacleCharges::centres);
+  return StaticScene({w.circles().begin(), w.circles().end()},
+                     {w.polygons().begin(), w.polygons().end()}, 1.0, ObstacleCharges::centres);
 }
 
 }  // namespace
@@ -56,11 +77,10 @@ void bind_queries(py::module_& m) {
   m.def(
       "ftc",
       [](const Doubles& x, const Doubles& y, const Doubles& vx, const Doubles& vy,
-         const Doubles& radius, double horizon,
-         const std::vector<std::tuple<double, double, double>>& circles, const std::string& method,
-         int threads) {
+         const Doubles& radius, double horizon, const Circles& circles, const Polygons& polygons,
+         const std::string& method, int threads) {
         const DiscTable t = discs_of(x, y, vx, vy, radius, scalar(1.0));
-        const StaticScene scene = scene_of(circles);
+        const StaticScene scene = scene_of(circles, polygons);
         std::vector<FtcHit> hits;
         {
           py::gil_scoped_release release;
@@ -77,12 +97,12 @@ void bind_queries(py::module_& m) {
         }
         return py::dict("kind"_a = kind, "row"_a = with, "time"_a = time);
       },
-      "x"_a, "y"_a, "vx"_a, "vy"_a, "radius"_a, "horizon"_a, py::kw_only(),
-      "circles"_a = std::vector<std::tuple<double, double, double>>{}, "method"_a = "auto",
-      "threads"_a = 1,
-      "First-to-collide: for each disc moving on p + v t, the first disc or circle obstacle "
-      "(x, y, r) it meets within `horizon` (time in the velocities' unit). Returns {'kind': "
-      "0 none / 1 agent / 2 circle, 'row': the other's row or -1, 'time': inf when none}.");
+      "x"_a, "y"_a, "vx"_a, "vy"_a, "radius"_a, "horizon"_a, py::kw_only(), "circles"_a = Circles{},
+      "polygons"_a = Polygons{}, "method"_a = "auto", "threads"_a = 1,
+      "First-to-collide: for each disc moving on p + v t, the first disc or obstacle (circles "
+      "(x, y, r), polygons (n, 2)) it meets within `horizon` (time in the velocities' unit). "
+      "Returns {'kind': 0 none / 1 agent / 2 circle / 3 polygon, 'row': the other's row or -1, "
+      "'time': inf when none}.");
 
   m.def(
       "field",
@@ -116,11 +136,10 @@ void bind_queries(py::module_& m) {
 
   m.def(
       "collisions",
-      [](const Doubles& x, const Doubles& y, const Doubles& radius,
-         const std::vector<std::tuple<double, double, double>>& circles, const std::string& method,
-         int threads) {
+      [](const Doubles& x, const Doubles& y, const Doubles& radius, const Circles& circles,
+         const Polygons& polygons, const std::string& method, int threads) {
         const DiscTable t = discs_of(x, y, scalar(0.0), scalar(0.0), radius, scalar(1.0));
-        const StaticScene scene = scene_of(circles);
+        const StaticScene scene = scene_of(circles, polygons);
         std::vector<uint32_t> rows;
         {
           py::gil_scoped_release release;
@@ -128,10 +147,9 @@ void bind_queries(py::module_& m) {
         }
         return py::array_t<uint32_t>(rows.size(), rows.data());
       },
-      "x"_a, "y"_a, "radius"_a, py::kw_only(),
-      "circles"_a = std::vector<std::tuple<double, double, double>>{}, "method"_a = "auto",
-      "threads"_a = 1,
-      "The rows of discs that overlap another disc or a circle obstacle, sorted (uint32).");
+      "x"_a, "y"_a, "radius"_a, py::kw_only(), "circles"_a = Circles{}, "polygons"_a = Polygons{},
+      "method"_a = "auto", "threads"_a = 1,
+      "The rows of discs that overlap another disc or an obstacle, sorted (uint32).");
 
   m.def(
       "methods",

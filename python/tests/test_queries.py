@@ -15,7 +15,8 @@ def discs(n, seed):
 def test_ftc_methods_agree(seed):
     x, y, vx, vy, r = discs(300, seed)
     circles = [(25.0, 25.0, 3.0), (10.0, 40.0, 1.0)]
-    answers = [crowddb.ftc(x, y, vx, vy, r, 20.0, circles=circles, method=m)
+    polygons = [np.array([[40.0, 5.0], [45.0, 5.0], [42.0, 12.0]])]
+    answers = [crowddb.ftc(x, y, vx, vy, r, 20.0, circles=circles, polygons=polygons, method=m)
                for m in crowddb.methods()["ftc"]]
     assert len(answers) >= 2
     for a in answers[1:]:
@@ -23,6 +24,7 @@ def test_ftc_methods_agree(seed):
             np.testing.assert_array_equal(a[key], answers[0][key])
     hit = answers[0]["kind"] == 1
     assert hit.any() and (answers[0]["time"][hit] <= 20).all()
+    assert set(answers[0]["kind"].tolist()) == {0, 1, 2, 3}
     assert np.isinf(answers[0]["time"][answers[0]["kind"] == 0]).all()
 
 
@@ -61,6 +63,10 @@ def test_field_methods_agree():
 
 
 def test_query_errors():
+    with pytest.raises(crowddb.InvalidRow, match=r"polygons\[0\]: .*not simple"):
+        crowddb.collisions([0.0], [0.0], [1.0], polygons=[[[0, 0], [4, 2], [4, 0], [0, 3]]])
+    with pytest.raises(crowddb.InvalidRow, match=r"circles\[1\]"):
+        crowddb.collisions([0.0], [0.0], [1.0], circles=[(5, 5, 1), (1, 1, -1)])
     with pytest.raises(crowddb.InputError):
         crowddb.ftc([0.0], [0.0], [1e300], [0.0], [1.0], 10.0)
     with pytest.raises(ValueError, match="expected 2 values"):
