@@ -12,6 +12,11 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/crowddb ${PROJECT_SOURCE_DIR}/in
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 if(CROWDDB_BUILD_TOOLS)
   install(TARGETS crowddb_cli sdfsched_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  # With shared libraries the installed commands find them relative to themselves.
+  if(BUILD_SHARED_LIBS)
+    file(RELATIVE_PATH bin_to_lib /prefix/${CMAKE_INSTALL_BINDIR} /prefix/${CMAKE_INSTALL_LIBDIR})
+    set_target_properties(crowddb_cli sdfsched_cli PROPERTIES INSTALL_RPATH "$ORIGIN/${bin_to_lib}")
+  endif()
 endif()
 
 set(crowddb_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/crowddb)
