@@ -29,7 +29,9 @@ struct OutputSpec {
   enum class Format { sqlite, csv };
   std::string path;  // empty: no trajectory output
   Format format = Format::sqlite;
-  uint32_t every = 1;  // write every n-th frame (frame 0 and the last are always written)
+  // Write the state after every n-th tick: frame k holds tick k * every (JuPedSim frames are
+  // evenly spaced, so a last tick that is not a multiple of `every` is not written).
+  uint32_t every = 1;
 };
 
 struct Scenario {
