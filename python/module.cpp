@@ -38,31 +38,6 @@ py::array column(const std::vector<T>& v, py::handle owner) {
   return column(v.data(), v.size(), owner);
 }
 
-using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-// A 1-D array argument of n values, or a scalar (or 1-element array) used for every one of them.
-class Broadcast {
- public:
-  Broadcast(const Doubles& a, std::size_t n, const char* name) : a_(a) {
-    if (a.ndim() > 1)
-      throw py::value_error(std::string(name) + ": expected a 1-D array or a number");
-    if (a.size() != 1 && static_cast<std::size_t>(a.size()) != n)
-      throw py::value_error(std::string(name) + ": " + std::to_string(a.size()) + " values for " +
-                            std::to_string(n) + " agents");
-    one_ = a.size() == 1;
-  }
-  double operator[](std::size_t i) const { return a_.data()[one_ ? 0 : i]; }
-
- private:
-  const Doubles& a_;
-  bool one_ = false;
-};
-
-std::size_t length_of(const Doubles& a, const char* name) {
-  if (a.ndim() != 1) throw py::value_error(std::string(name) + ": expected a 1-D array");
-  return static_cast<std::size_t>(a.size());
-}
-
 // ---------------------------------------------------------------- settings
 
 ArrivalPolicy arrival_of(const std::string& s) {

@@ -14,8 +14,6 @@ using namespace pybind11::literals;
 namespace crowddb::python {
 namespace {
 
-using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
 // A one-element array (Doubles(v) would be an array of v elements).
 Doubles scalar(double v) {
   Doubles a(1);
@@ -26,19 +24,12 @@ Doubles scalar(double v) {
 // Disc columns from arrays; scalars (or 1-element arrays) apply to every disc.
 DiscTable discs_of(const Doubles& x, const Doubles& y, const Doubles& vx, const Doubles& vy,
                    const Doubles& radius, const Doubles& charge) {
-  if (x.ndim() != 1) throw py::value_error("x: expected a 1-D array");
-  const auto n = static_cast<std::size_t>(x.size());
-  const auto at = [n](const Doubles& a, const char* name) {
-    if (a.ndim() > 1 || (a.size() != 1 && static_cast<std::size_t>(a.size()) != n))
-      throw py::value_error(std::string(name) + ": expected " + std::to_string(n) +
-                            " values or one number");
-    return [&a](std::size_t i) { return a.data()[a.size() == 1 ? 0 : i]; };
-  };
-  const auto fy = at(y, "y"), fvx = at(vx, "vx"), fvy = at(vy, "vy"), fr = at(radius, "radius"),
-             fc = at(charge, "charge");
+  const std::size_t n = length_of(x, "x");
+  const Broadcast fy(y, n, "y"), fvx(vx, n, "vx"), fvy(vy, n, "vy"), fr(radius, n, "radius"),
+      fc(charge, n, "charge");
   DiscTable t;
   for (std::size_t i = 0; i < n; ++i)
-    t.push_back(i, x.data()[i], fy(i), fvx(i), fvy(i), fr(i), fc(i));
+    t.push_back(i, x.data()[i], fy[i], fvx[i], fvy[i], fr[i], fc[i]);
   return t;
 }
 
