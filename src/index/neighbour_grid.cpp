@@ -105,14 +105,22 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         const auto base = static_cast<std::size_t>(cy * W_);
         const uint32_t lo = S[base + static_cast<std::size_t>(cx0)];
         const uint32_t hi = S[base + static_cast<std::size_t>(cx1) + 1];
-        // Candidates beyond the k-th best (ties may still win on id) never reach offer().
-        double limit = std::min(r2, best.bound());
+        // Candidates beyond the k-th best (ties may still win on id) never reach offer(). The
+        // captured values are copied into locals: offer() stores doubles, which could alias
+        // them and force a reload of each one per candidate.
+        const double x = px, y = py, rr = r2;
+        const double* const xs = X;
+        const double* const ys = Y;
+        const uint32_t* const rs = R;
+        const uint64_t* const is = I;
+        const std::size_t self = i;
+        double limit = std::min(rr, best.bound());
         for (uint32_t a = lo; a < hi; ++a) {
-          const double dx = X[a] - px, dy = Y[a] - py;
+          const double dx = xs[a] - x, dy = ys[a] - y;
           const double d2 = dx * dx + dy * dy;
-          if (d2 < r2 && d2 <= limit && R[a] != i) {
-            best.offer(R[a], I[a], d2);
-            limit = std::min(r2, best.bound());
+          if (d2 < rr && d2 <= limit && rs[a] != self) {
+            best.offer(rs[a], is[a], d2);
+            limit = std::min(rr, best.bound());
           }
         }
         tests[c] += hi - lo;
@@ -141,15 +149,26 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         auto scan_cell = [&](int64_t cx, int64_t cy) {
           if (!cell_far(cx, cy)) scan(cy, cx, cx);
         };
-        const int64_t max_ring = std::max({qx, W_ - 1 - qx, qy, H_ - 1 - qy});
-        for (int64_t rho = 0; rho <= max_ring; ++rho) {
+        // Rings 0 and 1 first, as three runs of adjacent cells (contiguous in the arrays).
+        const int64_t bx0 = std::max<int64_t>(0, qx - 1), bx1 = std::min(W_ - 1, qx + 1);
+        const int64_t by0 = std::max<int64_t>(0, qy - 1), by1 = std::min(H_ - 1, qy + 1);
+        for (int64_t cy = by0; cy <= by1; ++cy) scan(cy, bx0, bx1);
+        rings[c] += 2;
+        // Every disc outside the block is at least `gap` away (a side on the grid's edge has
+        // nothing beyond it); done when the k-th best, or the range, is strictly nearer.
+        double gap = INFINITY;
+        if (bx0 > 0) gap = std::min(gap, px - (x0_ + static_cast<double>(bx0) * cell_));
+        if (bx1 < W_ - 1) gap = std::min(gap, x0_ + static_cast<double>(bx1 + 1) * cell_ - px);
+        if (by0 > 0) gap = std::min(gap, py - (y0_ + static_cast<double>(by0) * cell_));
+        if (by1 < H_ - 1) gap = std::min(gap, y0_ + static_cast<double>(by1 + 1) * cell_ - py);
+        gap -= slack;
+        const bool done =
+            gap > 0 && (gap * gap >= r2 || (best.full() && best.bound() < gap * gap));
+        const int64_t max_ring = done ? 1 : std::max({qx, W_ - 1 - qx, qy, H_ - 1 - qy});
+        for (int64_t rho = 2; rho <= max_ring; ++rho) {
           const double reach = static_cast<double>(rho - 1) * cell_ * (1 - 1e-9);
-          if (rho >= 2 && (reach >= range || (best.full() && best.bound() < reach * reach))) break;
+          if (reach >= range || (best.full() && best.bound() < reach * reach)) break;
           ++rings[c];
-          if (rho == 0) {
-            scan(qy, qx, qx);
-            continue;
-          }
           const int64_t cx0 = std::max<int64_t>(0, qx - rho), cx1 = std::min(W_ - 1, qx + rho);
           for (int64_t cx = cx0; cx <= cx1; ++cx) {
             if (qy - rho >= 0) scan_cell(cx, qy - rho);  // bottom row of the ring

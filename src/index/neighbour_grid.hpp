@@ -1,7 +1,10 @@
 // The indexed neighbour query: a uniform grid over disc centres, rebuilt each tick (counting
 // sort, O(n)), with a ring-by-ring k-nearest search.
 //
-// Search: the rings of cells around the query's cell are visited outwards. Every disc in ring
+// Search: the 3 x 3 block around the query's cell is scanned first, as three runs of adjacent
+// cells; when the k-th best so far (or the range) is strictly nearer than the block's nearest
+// outside edge, nothing beyond can contribute. Otherwise the rings beyond are visited outwards:
+// every disc in ring
 // rho (Chebyshev cell distance rho) is at least (rho - 1) * cell away from the query, so once the
 // list holds k entries whose worst distance is below that bound, or the bound reaches the range,
 // no further ring can contribute; within a ring, a cell whose nearest point is farther than the
