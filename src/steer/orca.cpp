@@ -190,16 +190,19 @@ class OrcaModel final : public Model {
     }
     const std::size_t chunks = (n + kGrain - 1) / kGrain;
     infeasible_.assign(chunks, 0);
-    // Priority: the agent with less of its path left goes first; idle agents come last.
-    remaining_.resize(n);
-    rank_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      remaining_[i] = t.state[i] == AgentState::arrived ? INFINITY : sim::path_left(t, in.goals, i);
-      uint64_t h = in.cfg.seed ^ (t.id[i] * 0x9e3779b97f4a7c15ull);
-      rank_[i] = splitmix64(h);
-    }
     const double hi_share = p.first_share;
     log.timed("ORCA linear programs", n, [&] {
+      // Priority: the agent with less of its path left goes first; idle agents come last.
+      remaining_.resize(n);
+      rank_.resize(n);
+      ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+          remaining_[i] =
+              t.state[i] == AgentState::arrived ? INFINITY : sim::path_left(t, in.goals, i);
+          uint64_t h = in.cfg.seed ^ (t.id[i] * 0x9e3779b97f4a7c15ull);
+          rank_[i] = splitmix64(h);
+        }
+      });
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
         std::vector<HalfPlane> planes;
         for (std::size_t i = b; i < e; ++i) {
