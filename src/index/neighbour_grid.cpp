@@ -162,8 +162,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         if (by0 > 0) gap = std::min(gap, py - (y0_ + static_cast<double>(by0) * cell_));
         if (by1 < H_ - 1) gap = std::min(gap, y0_ + static_cast<double>(by1 + 1) * cell_ - py);
         gap -= slack;
-        const bool done =
-            gap > 0 && (gap * gap >= r2 || (best.full() && best.bound() < gap * gap));
+        const bool done = gap > 0 && (gap * gap >= r2 || (best.full() && best.bound() < gap * gap));
         const int64_t max_ring = done ? 1 : std::max({qx, W_ - 1 - qx, qy, H_ - 1 - qy});
         for (int64_t rho = 2; rho <= max_ring; ++rho) {
           const double reach = static_cast<double>(rho - 1) * cell_ * (1 - 1e-9);
