@@ -2,6 +2,7 @@
 // order the operators first ran (fixed by the plan, so the report's order is deterministic).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -18,9 +19,15 @@ struct OperatorStats {
   uint64_t rows = 0;
   double seconds = 0;
   QueryStats query;
-  // A model-specific count shown beside the operator ("3-D fallbacks 12").
+  // An operator-specific count shown beside it ("infeasible (3-D fallback) 12"), in total and
+  // the most in one loop.
   std::string events_name;
-  uint64_t events = 0;
+  uint64_t events = 0, events_max = 0;
+  void count(const char* name, uint64_t k) {
+    events_name = name;
+    events += k;
+    events_max = std::max(events_max, k);
+  }
 };
 
 class OpLog {

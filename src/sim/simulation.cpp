@@ -466,6 +466,7 @@ const TickMetrics& Simulation::step() {
   log.timed(backoff_name, n, [&] {
     if (cfg.backoff) {
       overlaps = sim::backoff(t, e.next, e.scene, cpath, e.ex, bop.query, m.freeze_iterations);
+      bop.count("rounds (1: nothing to undo)", m.freeze_iterations);
     } else {
       overlaps = sim::find_overlaps(t, e.next, e.scene, cpath, e.ex, bop.query);
     }
@@ -680,8 +681,10 @@ std::string Simulation::explain_analyze() const {
       os << line;
     }
     if (!s.events_name.empty()) {
-      std::snprintf(line, sizeof line, "  %-22s %s %llu\n", "", s.events_name.c_str(),
-                    static_cast<unsigned long long>(s.events));
+      std::snprintf(line, sizeof line, "  %-22s %s %llu (%.2f per loop, at most %llu)\n", "",
+                    s.events_name.c_str(), static_cast<unsigned long long>(s.events),
+                    static_cast<double>(s.events) / static_cast<double>(s.loops),
+                    static_cast<unsigned long long>(s.events_max));
       os << line;
     }
   }

@@ -255,8 +255,7 @@ class OrcaModel final : public Model {
     uint64_t fallback = 0;
     for (uint64_t c : infeasible_) fallback += c;
     sim::OperatorStats& lp = log.at("ORCA linear programs");
-    lp.events_name = "infeasible (3-D fallback)";
-    lp.events += fallback;
+    lp.count("infeasible (3-D fallback)", fallback);
   }
 
   void explain(std::ostream& os, const TickInput& in, int& step) const override {

@@ -1,0 +1,271 @@
+// The whole tick's speed on named scenarios, per steering model and thread count: median and
+// minimum ms per tick, agent-ticks per second, the tick's drift over the run (median of the first
+// and of the last tenth of the ticks), peak resident memory, the machine's load, and the final
+// state hash (which must not depend on the thread count; a difference fails the run).
+//
+// Each case runs in a child process of its own, so that its peak memory is its own
+// (getrusage of the child) and one case's allocations do not slow the next.
+//
+//   build/bench/tick_speed                          # every case but airport-1m
+//   build/bench/tick_speed --cases airport-20k --models orca --threads 1,2 --ticks 100
+//   build/bench/tick_speed --cases all --csv docs/bench/tick_speed.csv
+//
+// Cases (docs/benchmarks.md): airport-1k/20k/100k/1m are the agents of bench/rvo2_side_by_side
+// (uniform at 0.5 people/m^2 in a walled square, radius 0.25 m, 1.3 m/s, four goals on the
+// walls, round robin, dt 0.1 s), so their figures compare with RVO2's; ring-1k is 1,000 people
+// on a circle of radius 100 m swapping with the point opposite (RVO2's Circle in metres);
+// bottleneck-2k empties a 40 x 40 m room of 2,000 people through a 2.4 m door (navigation on).
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "crowddb/scenario.hpp"
+#include "crowddb/simulation.hpp"
+
+using namespace crowddb;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+struct Case {
+  const char* name;
+  uint64_t ticks;  // default ticks per run
+  std::string (*doc)(const std::string& model, int threads);
+};
+
+std::string airport(std::size_t agents, const std::string& model, int threads) {
+  const double side = std::sqrt(static_cast<double>(agents) / 0.5);
+  char doc[2048];
+  std::snprintf(doc, sizeof doc, R"({"bounds": [0, 0, %.17g, %.17g], "dt": 0.1, "seed": 3,
+    "threads": %d, "steering": {"model": "%s", "orca": {"neighbor_dist": 5, "max_neighbors": 10,
+    "time_horizon": 2, "time_horizon_obst": 0.5}},
+    "goals": [{"name": "S", "x": %.17g, "y": 1}, {"name": "E", "x": %.17g, "y": %.17g},
+              {"name": "W", "x": 1, "y": %.17g}, {"name": "N", "x": %.17g, "y": %.17g}],
+    "groups": [{"count": %zu, "placement": {"type": "uniform", "region": [0, 0, %.17g, %.17g],
+                "gap": 0.02}, "radius": 0.25, "pref_speed": 1.3, "goals": {"assign": "round_robin"}}]})",
+                side, side, threads, model.c_str(), side / 2, side - 1, side / 2, side / 2,
+                side / 2, side - 1, agents, side, side);
+  return doc;
+}
+
+std::string ring(const std::string& model, int threads) {
+  char doc[1024];
+  std::snprintf(doc, sizeof doc, R"({"bounds": [-110, -110, 110, 110], "dt": 0.1, "seed": 7,
+    "threads": %d, "steering": {"model": "%s"}, "arrival": "idle",
+    "groups": [{"count": 1000, "placement": {"type": "circle", "center": [0, 0], "radius": 100},
+                "radius": 0.25, "pref_speed": 1.34,
+                "goals": {"assign": "antipodal", "arrival_radius": 0.3}}]})",
+                threads, model.c_str());
+  return doc;
+}
+
+std::string bottleneck(const std::string& model, int threads) {
+  char doc[1536];
+  std::snprintf(doc, sizeof doc, R"({"bounds": [0, 0, 50, 40], "dt": 0.1, "seed": 11,
+    "threads": %d, "steering": {"model": "%s"}, "arrival": "remove", "navigation": {},
+    "obstacles": [{"type": "polygon", "vertices": [[40, 0], [40.3, 0], [40.3, 18.8], [40, 18.8]]},
+                  {"type": "polygon", "vertices": [[40, 21.2], [40.3, 21.2], [40.3, 40], [40, 40]]}],
+    "goals": [{"name": "out", "area": [[48, 0], [50, 0], [50, 40], [48, 40]]}],
+    "groups": [{"count": 2000, "placement": {"type": "uniform", "region": [0.3, 0.3, 39.7, 39.7],
+                "gap": 0.05}, "radius": [0.2, 0.25], "pref_speed": [1.1, 1.5], "goal": "out"}]})",
+                threads, model.c_str());
+  return doc;
+}
+
+const Case kCases[] = {
+    {"airport-1k", 200, [](const std::string& m, int t) { return airport(1000, m, t); }},
+    {"airport-20k", 100, [](const std::string& m, int t) { return airport(20000, m, t); }},
+    {"airport-100k", 30, [](const std::string& m, int t) { return airport(100000, m, t); }},
+    {"airport-1m", 8, [](const std::string& m, int t) { return airport(1000000, m, t); }},
+    {"ring-1k", 1200, ring},
+    {"bottleneck-2k", 600, bottleneck},
+};
+
+// What a child sends back through its pipe.
+struct Result {
+  uint64_t ticks = 0;
+  double agents = 0;  // mean rows per tick
+  double median_ms = 0, min_ms = 0, first_ms = 0, last_ms = 0, seconds = 0;
+  uint64_t hash = 0;
+  char error[256] = {};
+};
+
+double load_average() {
+  std::ifstream f("/proc/loadavg");
+  double l = -1;
+  f >> l;
+  return l;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+Result run_case(const Case& c, const std::string& model, int threads, uint64_t ticks) {
+  Result r;
+  try {
+    Scenario sc = parse_scenario(c.doc(model, threads), c.name);
+    Simulation sim(std::move(sc.world), sc.config);
+    std::vector<double> ms;
+    double rows = 0;
+    for (uint64_t k = 0; k < ticks; ++k) {
+      rows += static_cast<double>(sim.world().agents().size());
+      const auto a = Clock::now();
+      r.hash = sim.step().state_hash;
+      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - a).count());
+    }
+    const std::size_t tenth = std::max<std::size_t>(1, ms.size() / 10);
+    r.ticks = ms.size();
+    r.agents = rows / static_cast<double>(ms.size());
+    r.median_ms = median(ms);
+    r.min_ms = *std::min_element(ms.begin(), ms.end());
+    r.first_ms = median({ms.begin(), ms.begin() + static_cast<std::ptrdiff_t>(tenth)});
+    r.last_ms = median({ms.end() - static_cast<std::ptrdiff_t>(tenth), ms.end()});
+    for (double v : ms) r.seconds += v / 1e3;
+  } catch (const std::exception& e) {
+    std::snprintf(r.error, sizeof r.error, "%s", e.what());
+  }
+  return r;
+}
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::size_t a = 0;
+  while (a <= s.size()) {
+    const std::size_t b = std::min(s.find(',', a), s.size());
+    if (b > a) out.push_back(s.substr(a, b - a));
+    a = b + 1;
+  }
+  return out;
+}
+
+int usage(const char* why) {
+  std::fprintf(
+      stderr,
+      "tick_speed: %s\nusage: tick_speed [--cases all|NAME,...] [--models orca,cfsm,thesis] "
+      "[--threads 1,2] [--ticks N] [--csv FILE]\ncases:",
+      why);
+  for (const Case& c : kCases) std::fprintf(stderr, " %s", c.name);
+  std::fprintf(stderr, "\n");
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> cases, models = {"orca", "cfsm", "thesis"};
+  std::vector<int> thread_counts = {1, 2};
+  uint64_t ticks = 0;
+  std::string csv;
+  for (int a = 1; a < argc; a += 2) {
+    const std::string k = argv[a];
+    if (a + 1 >= argc) return usage(("missing value after " + k).c_str());
+    const std::string v = argv[a + 1];
+    if (k == "--cases") {
+      cases = split(v);
+    } else if (k == "--models") {
+      models = split(v);
+    } else if (k == "--threads") {
+      thread_counts.clear();
+      for (const std::string& t : split(v)) thread_counts.push_back(std::atoi(t.c_str()));
+    } else if (k == "--ticks") {
+      ticks = std::strtoull(v.c_str(), nullptr, 10);
+      if (ticks == 0) return usage("--ticks must be a positive number");
+    } else if (k == "--csv") {
+      csv = v;
+    } else {
+      return usage(("unknown option " + k).c_str());
+    }
+  }
+  std::vector<const Case*> chosen;
+  for (const Case& c : kCases) {
+    const bool named = std::find(cases.begin(), cases.end(), c.name) != cases.end();
+    const bool all = std::find(cases.begin(), cases.end(), "all") != cases.end();
+    if (named || all || (cases.empty() && std::strcmp(c.name, "airport-1m") != 0))
+      chosen.push_back(&c);
+  }
+  for (const std::string& n : cases)
+    if (n != "all" && std::none_of(std::begin(kCases), std::end(kCases),
+                                   [&](const Case& c) { return n == c.name; }))
+      return usage(("no case named " + n).c_str());
+  for (int t : thread_counts)
+    if (t < 1) return usage("--threads takes positive counts");
+
+  std::FILE* out = csv.empty() ? nullptr : std::fopen(csv.c_str(), "w");
+  if (!csv.empty() && !out) return usage(("cannot write " + csv).c_str());
+  if (out)
+    std::fprintf(out,
+                 "case,model,threads,agents,ticks,median_ms,min_ms,first_tenth_ms,last_tenth_ms,"
+                 "agent_ticks_per_s,peak_mb,load_before,load_after,state_hash\n");
+  std::printf("%-14s %-7s %3s %9s %6s %10s %10s %10s %10s %12s %8s %11s  %s\n", "case", "model",
+              "thr", "agents", "ticks", "median ms", "min ms", "first 1/10", "last 1/10",
+              "agent-t/s", "peak MB", "load", "state hash");
+  int status = 0;
+  std::map<std::string, uint64_t> hash_of;  // case/model -> hash of the first thread count
+  for (const Case* c : chosen) {
+    for (const std::string& model : models) {
+      for (int threads : thread_counts) {
+        const uint64_t n = ticks ? ticks : c->ticks;
+        int fd[2];
+        if (pipe(fd) != 0) return usage("pipe failed");
+        const double load_before = load_average();
+        const pid_t pid = fork();
+        if (pid == 0) {
+          close(fd[0]);
+          const Result r = run_case(*c, model, threads, n);
+          const ssize_t w = write(fd[1], &r, sizeof r);
+          _exit(w == static_cast<ssize_t>(sizeof r) ? 0 : 1);
+        }
+        close(fd[1]);
+        Result r;
+        const bool got = read(fd[0], &r, sizeof r) == static_cast<ssize_t>(sizeof r);
+        close(fd[0]);
+        int wstatus = 0;
+        rusage ru{};
+        wait4(pid, &wstatus, 0, &ru);
+        const double load_after = load_average();
+        if (!got || r.error[0]) {
+          std::printf("%-14s %-7s %3d  failed: %s\n", c->name, model.c_str(), threads,
+                      got ? r.error : "the child process died");
+          status = 1;
+          continue;
+        }
+        const double peak_mb = static_cast<double>(ru.ru_maxrss) / 1024.0;
+        const double rate = r.agents * static_cast<double>(r.ticks) / r.seconds;
+        char hash[17];
+        std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(r.hash));
+        const std::string key = std::string(c->name) + "/" + model;
+        const auto [it, first] = hash_of.emplace(key, r.hash);
+        const bool same = first || it->second == r.hash;
+        std::printf(
+            "%-14s %-7s %3d %9.0f %6llu %10.2f %10.2f %10.2f %10.2f %12.3g %8.0f %5.2f-%5.2f  "
+            "%s%s\n",
+            c->name, model.c_str(), threads, r.agents, static_cast<unsigned long long>(r.ticks),
+            r.median_ms, r.min_ms, r.first_ms, r.last_ms, rate, peak_mb, load_before, load_after,
+            hash, same ? "" : "  DIFFERS FROM THE FIRST THREAD COUNT");
+        std::fflush(stdout);
+        if (!same) status = 1;
+        if (out)
+          std::fprintf(out, "%s,%s,%d,%.0f,%llu,%.3f,%.3f,%.3f,%.3f,%.4g,%.0f,%.2f,%.2f,%s\n",
+                       c->name, model.c_str(), threads, r.agents,
+                       static_cast<unsigned long long>(r.ticks), r.median_ms, r.min_ms, r.first_ms,
+                       r.last_ms, rate, peak_mb, load_before, load_after, hash);
+      }
+    }
+  }
+  if (out) std::fclose(out);
+  return status;
+}
