@@ -152,7 +152,11 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         // Rings 0 and 1 first, as three runs of adjacent cells (contiguous in the arrays).
         const int64_t bx0 = std::max<int64_t>(0, qx - 1), bx1 = std::min(W_ - 1, qx + 1);
         const int64_t by0 = std::max<int64_t>(0, qy - 1), by1 = std::min(H_ - 1, qy + 1);
-        for (int64_t cy = by0; cy <= by1; ++cy) scan(cy, bx0, bx1);
+        // The query's own row of cells first: its candidates are the likeliest nearest, so the
+        // k-th best bound tightens early and more of the other rows' candidates are cut at once.
+        scan(qy, bx0, bx1);
+        if (by0 < qy) scan(by0, bx0, bx1);
+        if (by1 > qy) scan(by1, bx0, bx1);
         rings[c] += 2;
         // Every disc outside the block is at least `gap` away (a side on the grid's edge has
         // nothing beyond it); done when the k-th best, or the range, is strictly nearer.
