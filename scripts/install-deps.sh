@@ -16,6 +16,7 @@ packages=(
   python3-dev pybind11-dev python3-numpy       # the Python module
   python3-pytest python3-matplotlib            # its tests and the plotting example
   pkg-config                                   # the install test (crowddb.pc)
+  libcairo2-dev                                # crowddb render: pictures of runs
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,253 @@
+#include "view/run_file.hpp"
+
+#include <sqlite3.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "crowddb/error.hpp"
+#include "io/walkable_wkt.hpp"
+
+namespace crowddb::view {
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw Error(Error::Kind::input, path + ": " + what);
+}
+
+std::string text_of(sqlite3_stmt* st, int col) {
+  const auto* p = reinterpret_cast<const char*>(sqlite3_column_text(st, col));
+  return p ? std::string(p, static_cast<std::size_t>(sqlite3_column_bytes(st, col))) : "";
+}
+
+Shade shade_of(const std::string& s) {
+  if (s == "active") return Shade::active;
+  if (s == "frozen") return Shade::frozen;
+  if (s == "arrived") return Shade::arrived;
+  return Shade::unknown;
+}
+
+// Goal areas from the scenario document a crowddb run keeps; anything unexpected in it (an
+// imported scenario's own format, a hand-edited file) leaves the goals out, it never fails.
+std::vector<GoalShape> goals_of(const std::string& doc) {
+  std::vector<GoalShape> out;
+  const nlohmann::json j = nlohmann::json::parse(doc, nullptr, false);
+  if (!j.is_object() || !j.contains("goals") || !j["goals"].is_array()) return out;
+  for (const auto& g : j["goals"]) {
+    if (!g.is_object()) return {};
+    GoalShape s;
+    if (g.contains("name") && g["name"].is_string()) s.name = g["name"].get<std::string>();
+    if (g.contains("area") && g["area"].is_array()) {
+      for (const auto& p : g["area"]) {
+        if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number()) return {};
+        s.ring.push_back({p[0].get<double>(), p[1].get<double>()});
+      }
+      if (s.ring.size() < 3) return {};
+    } else if (g.contains("x") && g.contains("y") && g["x"].is_number() && g["y"].is_number()) {
+      s.x = g["x"].get<double>();
+      s.y = g["y"].get<double>();
+      s.radius = g.contains("arrival_radius") && g["arrival_radius"].is_number()
+                     ? g["arrival_radius"].get<double>()
+                     : 0.5;
+    } else {
+      return {};
+    }
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+}  // namespace
+
+struct RunFile::Db {
+  sqlite3* h = nullptr;
+  ~Db() { sqlite3_close(h); }
+
+  // Prepares `sql`; a failure names the file and SQLite's reason.
+  sqlite3_stmt* prepare(const std::string& path, const char* sql) const {
+    sqlite3_stmt* st = nullptr;
+    if (sqlite3_prepare_v2(h, sql, -1, &st, nullptr) != SQLITE_OK) {
+      const std::string why = sqlite3_errmsg(h);
+      sqlite3_finalize(st);
+      fail(path, why);
+    }
+    return st;
+  }
+  bool has_table(const std::string& path, const char* name) const {
+    sqlite3_stmt* st =
+        prepare(path, "SELECT 1 FROM sqlite_master WHERE type IN ('table', 'view') AND name = ?");
+    sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
+    const bool yes = sqlite3_step(st) == SQLITE_ROW;
+    sqlite3_finalize(st);
+    return yes;
+  }
+  // The value of `key` in a (key, value) table, or "" when absent.
+  std::string value(const std::string& path, const char* table, const char* key) const {
+    const std::string sql = std::string("SELECT value FROM ") + table + " WHERE key = ?";
+    sqlite3_stmt* st = prepare(path, sql.c_str());
+    sqlite3_bind_text(st, 1, key, -1, SQLITE_STATIC);
+    std::string v = sqlite3_step(st) == SQLITE_ROW ? text_of(st, 0) : "";
+    sqlite3_finalize(st);
+    return v;
+  }
+};
+
+RunFile::~RunFile() = default;
+RunFile::RunFile(RunFile&&) noexcept = default;
+RunFile& RunFile::operator=(RunFile&&) noexcept = default;
+
+RunFile RunFile::open(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) throw Error(Error::Kind::io, path + ": no such file");
+  if (!std::filesystem::is_regular_file(status))
+    throw Error(Error::Kind::io, path + ": not a regular file");
+  RunFile f;
+  f.path_ = path;
+  f.db_ = std::make_unique<Db>();
+  if (sqlite3_open_v2(path.c_str(), &f.db_->h, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK)
+    fail(path, std::string("cannot open: ") + sqlite3_errmsg(f.db_->h));
+  // The first read tells whether it is a database at all.
+  {
+    sqlite3_stmt* st = nullptr;
+    const int rc =
+        sqlite3_prepare_v2(f.db_->h, "SELECT count(*) FROM sqlite_master", -1, &st, nullptr);
+    const int step = rc == SQLITE_OK ? sqlite3_step(st) : rc;
+    sqlite3_finalize(st);
+    if (step == SQLITE_NOTADB || rc == SQLITE_NOTADB)
+      fail(path, "not an SQLite file (a crowddb run's output or a JuPedSim trajectory is)");
+    if (step != SQLITE_ROW) fail(path, std::string("cannot read: ") + sqlite3_errmsg(f.db_->h));
+  }
+  if (!f.db_->has_table(path, "trajectory_data"))
+    fail(path,
+         "not a trajectory file: no table trajectory_data (a crowddb run's output or a JuPedSim "
+         "trajectory is)");
+  f.crowddb_ =
+      f.db_->has_table(path, "crowddb_agent_state") && f.db_->has_table(path, "crowddb_run");
+
+  {
+    sqlite3_stmt* st = f.db_->prepare(
+        path,
+        "SELECT min(frame), max(frame), min(pos_x), min(pos_y), max(pos_x), max(pos_y) FROM "
+        "trajectory_data");
+    if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_type(st, 0) != SQLITE_NULL) {
+      f.first_ = sqlite3_column_int64(st, 0);
+      f.last_ = sqlite3_column_int64(st, 1);
+      f.bounds_ = {sqlite3_column_double(st, 2), sqlite3_column_double(st, 3),
+                   sqlite3_column_double(st, 4), sqlite3_column_double(st, 5)};
+    } else {
+      f.first_ = 0;
+      f.last_ = -1;
+    }
+    sqlite3_finalize(st);
+  }
+
+  const bool meta = f.db_->has_table(path, "metadata");
+  if (meta) {
+    const std::string fps = f.db_->value(path, "metadata", "fps");
+    if (!fps.empty()) {
+      char* end = nullptr;
+      const double v = std::strtod(fps.c_str(), &end);
+      if (end == fps.c_str() || *end || !(v > 0) || !std::isfinite(v))
+        fail(path, "metadata fps: '" + fps + "' is not a positive number");
+      f.fps_ = v;
+    }
+  }
+  if (f.db_->has_table(path, "geometry")) {
+    sqlite3_stmt* st = f.db_->prepare(path, "SELECT wkt FROM geometry LIMIT 1");
+    if (sqlite3_step(st) == SQLITE_ROW) f.wkt_ = text_of(st, 0);
+    sqlite3_finalize(st);
+    if (!f.wkt_.empty()) {
+      try {
+        const Bounds e = io::WalkableArea::parse(f.wkt_).envelope();
+        f.bounds_ = e;
+      } catch (const Error& e) {
+        fail(path, std::string("geometry: ") + e.what());
+      }
+    }
+  }
+  if (meta) {  // crowddb's own bounds (the walls) win over the envelopes
+    double b[4];
+    bool all = true;
+    const char* keys[4] = {"xmin", "ymin", "xmax", "ymax"};
+    for (int k = 0; k < 4; ++k) {
+      const std::string v = f.db_->value(path, "metadata", keys[k]);
+      char* end = nullptr;
+      b[k] = std::strtod(v.c_str(), &end);
+      all = all && !v.empty() && !*end && std::isfinite(b[k]);
+    }
+    if (all && b[0] < b[2] && b[1] < b[3]) f.bounds_ = {b[0], b[1], b[2], b[3]};
+  }
+  if (!(f.bounds_.width() > 0) || !(f.bounds_.height() > 0)) {  // one agent, or none: 10 m
+    const double cx = (f.bounds_.xmin + f.bounds_.xmax) / 2,
+                 cy = (f.bounds_.ymin + f.bounds_.ymax) / 2;
+    const double h = std::max({f.bounds_.width(), f.bounds_.height(), 10.0}) / 2;
+    f.bounds_ = {cx - h, cy - h, cx + h, cy + h};
+  }
+  if (!std::isfinite(f.bounds_.xmin + f.bounds_.xmax + f.bounds_.ymin + f.bounds_.ymax))
+    fail(path, "the positions or bounds are not finite numbers");
+
+  f.name_ = std::filesystem::path(path).stem().string();
+  if (f.crowddb_) {
+    const std::string n = f.db_->value(path, "crowddb_run", "scenario_name");
+    if (!n.empty()) f.name_ = n;
+    f.goals_ = goals_of(f.db_->value(path, "crowddb_run", "scenario_json"));
+  }
+  return f;
+}
+
+std::vector<FrameAgent> RunFile::frame(int64_t k) const {
+  if (k < first_ || k > last_)
+    throw Error(Error::Kind::usage,
+                path_ + ": no frame " + std::to_string(k) +
+                    (last_ < first_ ? " (the file has no frames)"
+                                    : " (frames " + std::to_string(first_) + " to " +
+                                          std::to_string(last_) + ")"));
+  std::vector<FrameAgent> out;
+  {
+    sqlite3_stmt* st = db_->prepare(
+        path_, "SELECT id, pos_x, pos_y FROM trajectory_data WHERE frame = ? ORDER BY id");
+    sqlite3_bind_int64(st, 1, k);
+    while (sqlite3_step(st) == SQLITE_ROW) {
+      FrameAgent a;
+      a.id = sqlite3_column_int64(st, 0);
+      a.x = sqlite3_column_double(st, 1);
+      a.y = sqlite3_column_double(st, 2);
+      a.radius = kDefaultRadius;
+      if (!std::isfinite(a.x) || !std::isfinite(a.y)) {
+        sqlite3_finalize(st);
+        fail(path_, "frame " + std::to_string(k) + ", agent " + std::to_string(a.id) +
+                        ": position is not a finite number");
+      }
+      out.push_back(a);
+    }
+    sqlite3_finalize(st);
+  }
+  if (!crowddb_) return out;
+  sqlite3_stmt* st = db_->prepare(path_,
+                                  "SELECT id, vel_x, vel_y, radius, state, goal FROM "
+                                  "crowddb_agent_state WHERE frame = ? ORDER BY id");
+  sqlite3_bind_int64(st, 1, k);
+  std::size_t at = 0;  // both lists are sorted by id: merge
+  while (sqlite3_step(st) == SQLITE_ROW) {
+    const int64_t id = sqlite3_column_int64(st, 0);
+    while (at < out.size() && out[at].id < id) ++at;
+    if (at == out.size() || out[at].id != id) continue;
+    FrameAgent& a = out[at];
+    const double vx = sqlite3_column_double(st, 1), vy = sqlite3_column_double(st, 2);
+    const double r = sqlite3_column_double(st, 3);
+    if (std::isfinite(vx) && std::isfinite(vy)) {
+      a.vx = vx;
+      a.vy = vy;
+    }
+    if (r > 0 && std::isfinite(r)) a.radius = r;
+    a.shade = shade_of(text_of(st, 4));
+    const int64_t g = sqlite3_column_int64(st, 5);
+    a.goal = g >= 0 && static_cast<std::size_t>(g) < goals_.size() ? g : -1;
+  }
+  sqlite3_finalize(st);
+  return out;
+}
+
+}  // namespace crowddb::view
