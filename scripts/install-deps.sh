@@ -17,7 +17,11 @@ packages=(
   python3-pytest python3-matplotlib            # its tests and the plotting example
   pkg-config                                   # the install test (crowddb.pc)
   libcairo2-dev                                # crowddb render: pictures of runs
+  libcpp-httplib-dev                           # crowddb view: the local web server
+  chromium                                     # the viewer's browser test (headless)
 )
+# The viewer's page is bundled with npm packages; Debian's Node.js when the machine has none.
+command -v npm > /dev/null || packages+=(nodejs npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -29,3 +33,6 @@ if ((${#missing[@]})); then
   $sudo apt-get update -qq
   $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
+# The viewer's npm packages (esbuild to bundle the page, uPlot for its chart, playwright-core to
+# drive Chromium in its test), at the versions package-lock.json records; no browser download.
+npm ci --prefix "$(dirname "$0")/../viewer" --no-audit --no-fund --loglevel=error

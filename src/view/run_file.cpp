@@ -2,6 +2,7 @@
 
 #include <sqlite3.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -206,9 +207,19 @@ std::vector<FrameAgent> RunFile::frame(int64_t k) const {
                                           std::to_string(last_) + ")"));
   std::vector<FrameAgent> out;
   {
-    sqlite3_stmt* st = db_->prepare(
-        path_, "SELECT id, pos_x, pos_y FROM trajectory_data WHERE frame = ? ORDER BY id");
-    sqlite3_bind_int64(st, 1, k);
+    sqlite3_stmt* st = nullptr;
+    if (const auto it = traj_rows_.find(k); it != traj_rows_.end()) {
+      st = db_->prepare(path_,
+                        "SELECT id, pos_x, pos_y FROM trajectory_data WHERE rowid BETWEEN ? AND ? "
+                        "AND frame = ? ORDER BY id");
+      sqlite3_bind_int64(st, 1, it->second.first);
+      sqlite3_bind_int64(st, 2, it->second.last);
+      sqlite3_bind_int64(st, 3, k);
+    } else {
+      st = db_->prepare(path_,
+                        "SELECT id, pos_x, pos_y FROM trajectory_data WHERE frame = ? ORDER BY id");
+      sqlite3_bind_int64(st, 1, k);
+    }
     while (sqlite3_step(st) == SQLITE_ROW) {
       FrameAgent a;
       a.id = sqlite3_column_int64(st, 0);
@@ -225,10 +236,20 @@ std::vector<FrameAgent> RunFile::frame(int64_t k) const {
     sqlite3_finalize(st);
   }
   if (!crowddb_) return out;
-  sqlite3_stmt* st = db_->prepare(path_,
-                                  "SELECT id, vel_x, vel_y, radius, state, goal FROM "
-                                  "crowddb_agent_state WHERE frame = ? ORDER BY id");
-  sqlite3_bind_int64(st, 1, k);
+  sqlite3_stmt* st = nullptr;
+  if (const auto it = state_rows_.find(k); it != state_rows_.end()) {
+    st = db_->prepare(path_,
+                      "SELECT id, vel_x, vel_y, radius, state, goal FROM crowddb_agent_state "
+                      "WHERE rowid BETWEEN ? AND ? AND frame = ? ORDER BY id");
+    sqlite3_bind_int64(st, 1, it->second.first);
+    sqlite3_bind_int64(st, 2, it->second.last);
+    sqlite3_bind_int64(st, 3, k);
+  } else {
+    st = db_->prepare(path_,
+                      "SELECT id, vel_x, vel_y, radius, state, goal FROM crowddb_agent_state "
+                      "WHERE frame = ? ORDER BY id");
+    sqlite3_bind_int64(st, 1, k);
+  }
   std::size_t at = 0;  // both lists are sorted by id: merge
   while (sqlite3_step(st) == SQLITE_ROW) {
     const int64_t id = sqlite3_column_int64(st, 0);
@@ -248,6 +269,89 @@ std::vector<FrameAgent> RunFile::frame(int64_t k) const {
   }
   sqlite3_finalize(st);
   return out;
+}
+
+namespace {
+
+// One pass over a table: each frame's least and greatest rowid, when every frame's rows come in
+// one run (else nothing: the reader scans); a reader still filters by frame within the range.
+// Also the largest frame's row count.
+template <class Rows>
+bool row_ranges(sqlite3* h, const char* table, std::unordered_map<int64_t, Rows>& out,
+                std::size_t& most) {
+  out.clear();
+  const std::string sql = std::string("SELECT rowid, frame FROM ") + table;
+  sqlite3_stmt* st = nullptr;
+  if (sqlite3_prepare_v2(h, sql.c_str(), -1, &st, nullptr) != SQLITE_OK) {
+    sqlite3_finalize(st);
+    return false;
+  }
+  bool ok = true, any = false;
+  int64_t frame = 0;
+  std::size_t count = 0;
+  Rows cur;
+  while (sqlite3_step(st) == SQLITE_ROW) {
+    const int64_t rowid = sqlite3_column_int64(st, 0), f = sqlite3_column_int64(st, 1);
+    if (!any || f != frame) {
+      if (any) {
+        if (!out.emplace(frame, cur).second) ok = false;  // the frame came back later
+        most = std::max(most, count);
+      }
+      if (out.count(f)) ok = false;
+      any = true;
+      frame = f;
+      cur = {rowid, rowid};
+      count = 0;
+    }
+    cur.first = std::min(cur.first, rowid);  // an index on frame returns a frame's rows by id
+    cur.last = std::max(cur.last, rowid);
+    ++count;
+    if (!ok) break;
+  }
+  sqlite3_finalize(st);
+  if (any && ok) {
+    ok = out.emplace(frame, cur).second;
+    most = std::max(most, count);
+  }
+  if (!ok) out.clear();
+  return ok;
+}
+
+}  // namespace
+
+void RunFile::index_frames() {
+  std::size_t most = 0;
+  if (!row_ranges(db_->h, "trajectory_data", traj_rows_, most)) {
+    // Rows not stored frame by frame: count the largest frame the slow way.
+    sqlite3_stmt* st = db_->prepare(
+        path_, "SELECT max(c) FROM (SELECT count(*) AS c FROM trajectory_data GROUP BY frame)");
+    if (sqlite3_step(st) == SQLITE_ROW)
+      most = static_cast<std::size_t>(sqlite3_column_int64(st, 0));
+    sqlite3_finalize(st);
+  }
+  max_agents_ = most;
+  if (crowddb_) {
+    std::size_t ignored = 0;
+    row_ranges(db_->h, "crowddb_agent_state", state_rows_, ignored);
+  }
+}
+
+RunFile::Metrics RunFile::metrics() const {
+  Metrics m;
+  if (!crowddb_ || !db_->has_table(path_, "crowddb_tick_metrics")) return m;
+  sqlite3_stmt* st = db_->prepare(path_,
+                                  "SELECT time, arrived, frozen, stalled, overlapping_pairs, "
+                                  "tick_seconds FROM crowddb_tick_metrics ORDER BY tick");
+  while (sqlite3_step(st) == SQLITE_ROW) {
+    m.time.push_back(sqlite3_column_double(st, 0));
+    m.arrived.push_back(sqlite3_column_double(st, 1));
+    m.frozen.push_back(sqlite3_column_double(st, 2));
+    m.stalled.push_back(sqlite3_column_double(st, 3));
+    m.overlaps.push_back(sqlite3_column_double(st, 4));
+    m.ms.push_back(sqlite3_column_double(st, 5) * 1e3);
+  }
+  sqlite3_finalize(st);
+  return m;
 }
 
 }  // namespace crowddb::view

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "crowddb/world.hpp"
@@ -57,6 +58,18 @@ class RunFile {
   // The agents of frame k, by id. Throws Error(usage) outside [first_frame, last_frame].
   std::vector<FrameAgent> frame(int64_t k) const;
 
+  // Reads where each frame's rows lie (one scan of the file), so that frame() reads only them
+  // instead of scanning: for files stored frame by frame, as crowddb's and JuPedSim's writers
+  // store them (others keep working, by scanning). Also counts max_agents().
+  void index_frames();
+  std::size_t max_agents() const { return max_agents_; }
+
+  // Per-tick metrics of a crowddb run (empty otherwise), in tick order.
+  struct Metrics {
+    std::vector<double> time, arrived, frozen, stalled, overlaps, ms;
+  };
+  Metrics metrics() const;
+
  private:
   struct Db;
   RunFile() = default;
@@ -67,6 +80,11 @@ class RunFile {
   Bounds bounds_;
   std::vector<GoalShape> goals_;
   std::unique_ptr<Db> db_;
+  struct Rows {
+    int64_t first = 0, last = -1;  // rowids
+  };
+  std::unordered_map<int64_t, Rows> traj_rows_, state_rows_;  // by frame; empty: scan
+  std::size_t max_agents_ = 0;
 };
 
 }  // namespace crowddb::view

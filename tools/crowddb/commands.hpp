@@ -25,6 +25,7 @@ void add_verify_command(CLI::App& app, Action& action);
 void add_convert_command(CLI::App& app, Action& action);
 void add_bench_command(CLI::App& app, Action& action);
 void add_render_command(CLI::App& app, Action& action);
+void add_view_command(CLI::App& app, Action& action);
 
 // The --set KEY=VALUE option (LoadOptions::overrides) of the commands that load scenarios.
 void add_set_option(CLI::App* sub, std::vector<std::string>& overrides);

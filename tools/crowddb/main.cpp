@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   crowddb::cli::add_convert_command(app, action);
   crowddb::cli::add_bench_command(app, action);
   crowddb::cli::add_render_command(app, action);
+  crowddb::cli::add_view_command(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
