@@ -23,6 +23,7 @@ cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_REL
   -DCROWDDB_SANITIZE=ON -DCROWDDB_WERROR=ON -DCROWDDB_BUILD_BENCHMARKS=OFF -DCROWDDB_BUILD_PYTHON=OFF >/dev/null
 cmake --build build-asan -j "$jobs"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp" \
   ctest --test-dir build-asan "${ctest_args[@]}" -LE "slow|nosan"
 echo "== fuzzing (clang, libFuzzer, ASan+UBSan)"
 bash scripts/fuzz.sh

@@ -33,6 +33,20 @@ struct RunInfo {
   const std::vector<metrics::AgentScore>* scores = nullptr;  // SteerBench, per agent
 };
 
+// The state a frame records for agent row i: "arrived", "frozen" (put back by the backoff in the
+// tick), "stalled" (active, but without progress for longer than the stall watch's `after`,
+// given in ticks; an agent waiting in a queue is not stalled), else "active".
+inline const char* agent_state_name(const AgentTable& t, std::size_t i, uint64_t stall_after) {
+  switch (t.state[i]) {
+    case AgentState::arrived:
+      return "arrived";
+    case AgentState::frozen:
+      return "frozen";
+    default:
+      return t.stall_ticks[i] > stall_after ? "stalled" : "active";
+  }
+}
+
 class TrajectoryWriter {
  public:
   virtual ~TrajectoryWriter() = default;
@@ -79,6 +93,7 @@ PartialRun read_partial_run(const std::filesystem::path& file);
 // frames and metrics written after `tick` (the resumed run writes them again) and marks the
 // run as running.
 std::unique_ptr<TrajectoryWriter> resume_sqlite_writer(const PartialRun& partial, double dt,
+                                                       uint64_t stall_after,
                                                        const std::string& format);
 
 inline std::unique_ptr<TrajectoryWriter> make_writer(const OutputSpec& out) {

@@ -29,6 +29,7 @@ class CsvWriter final : public TrajectoryWriter {
 
   void begin(const Scenario& sc, const World&) override {
     dt_ = sc.config.dt;
+    stall_after_ = sc.config.ticks_for(sc.config.stall.after);
     lock_.emplace(path_);
     for (const auto* p : {&path_, &metrics_path_, &steerbench_path_}) {
       std::error_code ec;
@@ -48,14 +49,13 @@ class CsvWriter final : public TrajectoryWriter {
     if (tick % every_ != 0) return;
     const uint64_t frame = tick / every_;
     const AgentTable& t = world.agents();
-    static const char* states[] = {"active", "frozen", "arrived"};
     std::string line;
     for (std::size_t i = 0; i < t.size(); ++i) {
       line.clear();
       line += std::to_string(frame) + "," + std::to_string(t.id[i]);
       for (double v : {t.x[i], t.y[i], t.vx[i], t.vy[i], t.radius[i]}) line += "," + num(v);
       line += ",";
-      line += states[static_cast<int>(t.state[i])];
+      line += agent_state_name(t, i, stall_after_);
       line += "," + std::to_string(t.goal[i]) + "\n";
       traj_ << line;
     }
@@ -116,7 +116,8 @@ class CsvWriter final : public TrajectoryWriter {
   }
 
  private:
-  double dt_ = 1;  // [s] per tick, for the metrics in seconds
+  double dt_ = 1;                      // [s] per tick, for the metrics in seconds
+  uint64_t stall_after_ = UINT64_MAX;  // [ticks] the stall watch's threshold, for the states
   static std::filesystem::path partial(const std::filesystem::path& p) {
     return p.string() + ".partial";
   }

@@ -2,7 +2,8 @@
 //   trajectory_data(frame, id, pos_x, pos_y), metadata(key, value) with version and fps,
 //   geometry(hash, wkt), frame_data(frame, geometry_hash)
 // and crowddb's own tables beside them:
-//   crowddb_agent_state(frame, id, vel_x, vel_y, radius, state, goal)
+//   crowddb_agent_state(frame, id, vel_x, vel_y, radius, state, goal): state active, frozen,
+//                            stalled or arrived (agent_state_name)
 //   crowddb_tick_metrics(tick, time, agents, entered, arrived, frozen, freeze_iterations,
 //                        overlapping_pairs, obstacle_overlaps, gridlocked, stalled, queueing,
 //                        longest_stall, tick_seconds, state_hash)
@@ -92,6 +93,7 @@ class SqliteWriter final : public TrajectoryWriter {
 
   void begin(const Scenario& sc, const World& world) override {
     dt_ = sc.config.dt;
+    stall_after_ = sc.config.ticks_for(sc.config.stall.after);
     format_ = sc.format;
     lock_.emplace(path_);
     std::error_code ec;
@@ -194,7 +196,6 @@ class SqliteWriter final : public TrajectoryWriter {
     if (tick % every_ != 0) return;
     const auto frame = static_cast<int64_t>(tick / every_);
     const AgentTable& t = world.agents();
-    static const char* states[] = {"active", "frozen", "arrived"};
     for (std::size_t i = 0; i < t.size(); ++i) {
       const auto id = static_cast<int64_t>(t.id[i]);
       sqlite3_bind_int64(traj_.get(), 1, frame);
@@ -207,7 +208,7 @@ class SqliteWriter final : public TrajectoryWriter {
       sqlite3_bind_double(state_.get(), 3, t.vx[i]);
       sqlite3_bind_double(state_.get(), 4, t.vy[i]);
       sqlite3_bind_double(state_.get(), 5, t.radius[i]);
-      sqlite3_bind_text(state_.get(), 6, states[static_cast<int>(t.state[i])], -1, SQLITE_STATIC);
+      sqlite3_bind_text(state_.get(), 6, agent_state_name(t, i, stall_after_), -1, SQLITE_STATIC);
       sqlite3_bind_int64(state_.get(), 7, t.goal[i]);
       step(state_);
     }
@@ -264,8 +265,9 @@ class SqliteWriter final : public TrajectoryWriter {
   }
 
   // Continues PATH.partial after `tick` (resume_sqlite_writer).
-  void reopen(uint64_t tick, double dt, const std::string& format) {
+  void reopen(uint64_t tick, double dt, uint64_t stall_after, const std::string& format) {
     dt_ = dt;
+    stall_after_ = stall_after;
     format_ = format;
     lock_.emplace(path_);
     if (sqlite3_open_v2(partial_.c_str(), &db_, SQLITE_OPEN_READWRITE, nullptr) != SQLITE_OK) {
@@ -381,7 +383,8 @@ class SqliteWriter final : public TrajectoryWriter {
   }
 
  private:
-  double dt_ = 1;  // [s] per tick, for the metrics in seconds
+  double dt_ = 1;                      // [s] per tick, for the metrics in seconds
+  uint64_t stall_after_ = UINT64_MAX;  // [ticks] the stall watch's threshold, for the states
   std::string format_;
   static std::string num(double v) {
     char buf[32];
@@ -520,6 +523,7 @@ PartialRun read_partial_run(const std::filesystem::path& file) {
 }
 
 std::unique_ptr<TrajectoryWriter> resume_sqlite_writer(const PartialRun& partial, double dt,
+                                                       uint64_t stall_after,
                                                        const std::string& format) {
   uint64_t every = 1;
   try {
@@ -530,7 +534,7 @@ std::unique_ptr<TrajectoryWriter> resume_sqlite_writer(const PartialRun& partial
   if (every < 1 || every > 1u << 30)
     throw Error(Error::Kind::input, partial.path.string() + ".partial: bad frame_every");
   auto w = std::make_unique<SqliteWriter>(partial.path, static_cast<uint32_t>(every));
-  w->reopen(partial.tick, dt, format);
+  w->reopen(partial.tick, dt, stall_after, format);
   return w;
 }
 

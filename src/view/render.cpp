@@ -9,7 +9,6 @@
 #include <memory>
 
 #include "crowddb/error.hpp"
-#include "io/walkable_wkt.hpp"
 
 namespace crowddb::view {
 namespace {
@@ -42,6 +41,8 @@ uint32_t shade_colour(Shade s) {
       return colour::kFrozen;
     case Shade::arrived:
       return colour::kArrived;
+    case Shade::stalled:
+      return colour::kStalled;
     default:
       return colour::kActive;
   }
@@ -115,12 +116,10 @@ void render_png(const RunFile& run, int64_t frame, const RenderOptions& opt,
   set_rgb(cr, colour::kFloor);
   cairo_rectangle(cr, v.px(b.xmin), v.py(b.ymax), b.width() * v.scale, b.height() * v.scale);
   cairo_fill(cr);
-  if (!run.geometry_wkt().empty()) {
-    set_rgb(cr, colour::kBlocked);
-    for (const auto& piece : io::WalkableArea::parse(run.geometry_wkt()).blocked_pieces(b)) {
-      ring_path(cr, v, piece);
-      cairo_fill(cr);
-    }
+  set_rgb(cr, colour::kBlocked);
+  for (const auto& piece : run.blocked()) {
+    ring_path(cr, v, piece);
+    cairo_fill(cr);
   }
   set_rgb(cr, colour::kBlocked);
   cairo_set_line_width(cr, 1);
@@ -161,7 +160,7 @@ void render_png(const RunFile& run, int64_t frame, const RenderOptions& opt,
   if (!(top > 0))
     for (const FrameAgent& a : agents) top = std::max(top, std::hypot(a.vx, a.vy));
   top = std::max(top, 0.1);
-  std::size_t count[4] = {0, 0, 0, 0};
+  std::size_t count[5] = {0, 0, 0, 0, 0};
   cairo_set_line_width(cr, std::clamp(0.08 * v.scale, 0.3, 1.0));
   for (const FrameAgent& a : agents) {
     ++count[static_cast<int>(a.shade)];
@@ -206,6 +205,7 @@ void render_png(const RunFile& run, int64_t frame, const RenderOptions& opt,
       key(speed_colour(s / 4.0), fixed(top * s / 4, 2) + (s == 4 ? " m/s" : ""));
   } else if (run.crowddb()) {
     key(colour::kActive, "active " + std::to_string(count[0] + count[3]));
+    key(colour::kStalled, "stalled " + std::to_string(count[4]));
     key(colour::kFrozen, "frozen " + std::to_string(count[1]));
     key(colour::kArrived, "arrived " + std::to_string(count[2]));
   } else {
@@ -219,6 +219,9 @@ void render_png(const RunFile& run, int64_t frame, const RenderOptions& opt,
   cairo_show_text(cr, scale_label.c_str());
 
   cairo_surface_flush(pic.s);
+  if (cairo_status(cr) != CAIRO_STATUS_SUCCESS)
+    throw Error(Error::Kind::io, out + ": cannot draw the picture (" +
+                                     cairo_status_to_string(cairo_status(cr)) + ")");
   const std::string tmp = out + ".tmp";
   const cairo_status_t st = cairo_surface_write_to_png(pic.s, tmp.c_str());
   if (st != CAIRO_STATUS_SUCCESS) {

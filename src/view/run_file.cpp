@@ -22,10 +22,34 @@ std::string text_of(sqlite3_stmt* st, int col) {
   return p ? std::string(p, static_cast<std::size_t>(sqlite3_column_bytes(st, col))) : "";
 }
 
+constexpr double kMaxCoordinate = 1e9;  // [m] as for scenarios (World::set_bounds)
+
+// `s` with every byte that is not part of valid UTF-8 replaced by '?' (names end up in JSON and
+// in pictures, both of which need valid text).
+std::string valid_utf8(std::string s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    const std::size_t n = c < 0x80         ? 1
+                          : (c >> 5) == 6  ? 2
+                          : (c >> 4) == 14 ? 3
+                          : (c >> 3) == 30 ? 4
+                                           : 0;
+    bool ok = n > 0 && i + n <= s.size();
+    for (std::size_t k = 1; ok && k < n; ++k) ok = (static_cast<unsigned char>(s[i + k]) >> 6) == 2;
+    if (!ok) {
+      s[i++] = '?';
+      continue;
+    }
+    i += n;
+  }
+  return s;
+}
+
 Shade shade_of(const std::string& s) {
   if (s == "active") return Shade::active;
   if (s == "frozen") return Shade::frozen;
   if (s == "arrived") return Shade::arrived;
+  if (s == "stalled") return Shade::stalled;
   return Shade::unknown;
 }
 
@@ -77,9 +101,29 @@ struct RunFile::Db {
   }
   bool has_table(const std::string& path, const char* name) const {
     sqlite3_stmt* st =
-        prepare(path, "SELECT 1 FROM sqlite_master WHERE type IN ('table', 'view') AND name = ?");
+        prepare(path, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?");
     sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
-    const bool yes = sqlite3_step(st) == SQLITE_ROW;
+    const bool yes = step(path, st);
+    sqlite3_finalize(st);
+    return yes;
+  }
+  // Steps `st`: true on a row, false when done; an error (a damaged file, a lock held by a
+  // writer beyond the busy timeout) finalizes it and names the file.
+  bool step(const std::string& path, sqlite3_stmt* st) const {
+    const int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    const std::string why = sqlite3_errmsg(h);
+    sqlite3_finalize(st);
+    fail(path, "cannot read: " + why);
+  }
+  // Whether `table` has a column of this name (one that would shadow SQLite's rowid).
+  bool has_column(const std::string& path, const char* table, const char* column) const {
+    const std::string sql = std::string("SELECT 1 FROM pragma_table_info('") + table +
+                            "') WHERE lower(name) = lower(?)";
+    sqlite3_stmt* st = prepare(path, sql.c_str());
+    sqlite3_bind_text(st, 1, column, -1, SQLITE_STATIC);
+    const bool yes = step(path, st);
     sqlite3_finalize(st);
     return yes;
   }
@@ -88,7 +132,7 @@ struct RunFile::Db {
     const std::string sql = std::string("SELECT value FROM ") + table + " WHERE key = ?";
     sqlite3_stmt* st = prepare(path, sql.c_str());
     sqlite3_bind_text(st, 1, key, -1, SQLITE_STATIC);
-    std::string v = sqlite3_step(st) == SQLITE_ROW ? text_of(st, 0) : "";
+    std::string v = step(path, st) ? text_of(st, 0) : "";
     sqlite3_finalize(st);
     return v;
   }
@@ -107,8 +151,14 @@ RunFile RunFile::open(const std::string& path) {
   RunFile f;
   f.path_ = path;
   f.db_ = std::make_unique<Db>();
-  if (sqlite3_open_v2(path.c_str(), &f.db_->h, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK)
+  if (sqlite3_open_v2(path.c_str(), &f.db_->h, SQLITE_OPEN_READONLY | SQLITE_OPEN_FULLMUTEX,
+                      nullptr) != SQLITE_OK)
     fail(path, std::string("cannot open: ") + sqlite3_errmsg(f.db_->h));
+  // A file from elsewhere is data, never code: no triggers or functions from its schema, no
+  // writes through it, and a writer's lock is waited for a while, not failed at once.
+  sqlite3_db_config(f.db_->h, SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, nullptr);
+  sqlite3_db_config(f.db_->h, SQLITE_DBCONFIG_DEFENSIVE, 1, nullptr);
+  sqlite3_busy_timeout(f.db_->h, 2000);
   // The first read tells whether it is a database at all.
   {
     sqlite3_stmt* st = nullptr;
@@ -128,15 +178,49 @@ RunFile RunFile::open(const std::string& path) {
       f.db_->has_table(path, "crowddb_agent_state") && f.db_->has_table(path, "crowddb_run");
 
   {
+    // Every row's types, once: integer frames and ids, numeric positions (anything else would
+    // read as 0 or drop out of its frame silently).
+    sqlite3_stmt* st = f.db_->prepare(
+        path,
+        "SELECT frame, id, typeof(frame), typeof(id), typeof(pos_x), typeof(pos_y) FROM "
+        "trajectory_data WHERE typeof(frame) <> 'integer' OR typeof(id) <> 'integer' OR "
+        "typeof(pos_x) NOT IN ('integer', 'real') OR typeof(pos_y) NOT IN ('integer', 'real') "
+        "LIMIT 1");
+    if (f.db_->step(path, st)) {
+      const std::string where = "trajectory_data: the row of frame " + text_of(st, 0) + ", id " +
+                                text_of(st, 1) + " holds ";
+      const std::string types[4] = {text_of(st, 2), text_of(st, 3), text_of(st, 4), text_of(st, 5)};
+      sqlite3_finalize(st);
+      const char* cols[4] = {"frame", "id", "pos_x", "pos_y"};
+      for (int c = 0; c < 4; ++c)
+        if ((c < 2 && types[c] != "integer") ||
+            (c >= 2 && types[c] != "integer" && types[c] != "real"))
+          fail(path, where + types[c] + " in " + cols[c] + " (" +
+                         (c < 2 ? "an integer" : "a number") + " is expected)");
+    }
+    sqlite3_finalize(st);
+  }
+  {
     sqlite3_stmt* st = f.db_->prepare(
         path,
         "SELECT min(frame), max(frame), min(pos_x), min(pos_y), max(pos_x), max(pos_y) FROM "
         "trajectory_data");
-    if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_type(st, 0) != SQLITE_NULL) {
+    if (f.db_->step(path, st) && sqlite3_column_type(st, 0) != SQLITE_NULL) {
       f.first_ = sqlite3_column_int64(st, 0);
       f.last_ = sqlite3_column_int64(st, 1);
       f.bounds_ = {sqlite3_column_double(st, 2), sqlite3_column_double(st, 3),
                    sqlite3_column_double(st, 4), sqlite3_column_double(st, 5)};
+      if (f.first_ < 0 || f.last_ > INT32_MAX) {
+        sqlite3_finalize(st);
+        fail(path, "trajectory_data: frame numbers " + std::to_string(f.first_) + " to " +
+                       std::to_string(f.last_) + " lie outside 0 to 2147483647");
+      }
+      for (double v : {f.bounds_.xmin, f.bounds_.ymin, f.bounds_.xmax, f.bounds_.ymax})
+        if (!(std::abs(v) <= kMaxCoordinate)) {
+          sqlite3_finalize(st);
+          fail(path, "trajectory_data: positions must lie within +-1e9 m (got " +
+                         std::to_string(v) + ")");
+        }
     } else {
       f.first_ = 0;
       f.last_ = -1;
@@ -157,15 +241,15 @@ RunFile RunFile::open(const std::string& path) {
   }
   if (f.db_->has_table(path, "geometry")) {
     sqlite3_stmt* st = f.db_->prepare(path, "SELECT wkt FROM geometry LIMIT 1");
-    if (sqlite3_step(st) == SQLITE_ROW) f.wkt_ = text_of(st, 0);
+    if (f.db_->step(path, st)) f.wkt_ = text_of(st, 0);
     sqlite3_finalize(st);
     if (!f.wkt_.empty()) {
       try {
-        const Bounds e = io::WalkableArea::parse(f.wkt_).envelope();
-        f.bounds_ = e;
+        f.bounds_ = io::WalkableArea::parse(f.wkt_).envelope();
       } catch (const Error& e) {
         fail(path, std::string("geometry: ") + e.what());
       }
+      f.has_geometry_ = true;
     }
   }
   if (meta) {  // crowddb's own bounds (the walls) win over the envelopes
@@ -189,12 +273,44 @@ RunFile RunFile::open(const std::string& path) {
   if (!std::isfinite(f.bounds_.xmin + f.bounds_.xmax + f.bounds_.ymin + f.bounds_.ymax))
     fail(path, "the positions or bounds are not finite numbers");
 
+  if (f.has_geometry_) {  // what is not walkable within the drawing area, once
+    try {
+      f.blocked_ = io::WalkableArea::parse(f.wkt_).blocked_pieces(f.bounds_);
+    } catch (const Error& e) {
+      fail(path, std::string("geometry: ") + e.what());
+    }
+  }
   f.name_ = std::filesystem::path(path).stem().string();
   if (f.crowddb_) {
     const std::string n = f.db_->value(path, "crowddb_run", "scenario_name");
     if (!n.empty()) f.name_ = n;
     f.goals_ = goals_of(f.db_->value(path, "crowddb_run", "scenario_json"));
+    // Every goal by its row (also those a group made, antipodal or per-agent targets): the
+    // table the writer keeps; the areas' outlines come from the scenario, by name.
+    if (f.db_->has_table(path, "crowddb_goals")) {
+      std::vector<GoalShape> rows;
+      sqlite3_stmt* st = f.db_->prepare(
+          path, "SELECT goal, name, x, y, arrival_radius FROM crowddb_goals ORDER BY goal");
+      while (f.db_->step(path, st)) {
+        if (sqlite3_column_int64(st, 0) != static_cast<int64_t>(rows.size())) break;
+        GoalShape g;
+        g.name = text_of(st, 1);
+        g.x = sqlite3_column_double(st, 2);
+        g.y = sqlite3_column_double(st, 3);
+        g.radius = sqlite3_column_double(st, 4);
+        if (!(std::abs(g.x) <= kMaxCoordinate && std::abs(g.y) <= kMaxCoordinate && g.radius >= 0 &&
+              g.radius <= kMaxCoordinate))
+          break;
+        for (const GoalShape& area : f.goals_)
+          if (area.name == g.name && !area.ring.empty()) g.ring = area.ring;
+        rows.push_back(std::move(g));
+      }
+      sqlite3_finalize(st);
+      if (!rows.empty()) f.goals_ = std::move(rows);
+    }
   }
+  f.name_ = valid_utf8(f.name_);
+  for (GoalShape& g : f.goals_) g.name = valid_utf8(g.name);
   return f;
 }
 
@@ -206,6 +322,8 @@ std::vector<FrameAgent> RunFile::frame(int64_t k) const {
                                     : " (frames " + std::to_string(first_) + " to " +
                                           std::to_string(last_) + ")"));
   std::vector<FrameAgent> out;
+  // Indexed: a frame without rows (a gap in the numbering) is empty, without a scan.
+  if (indexed_ && !traj_rows_.count(k)) return out;
   {
     sqlite3_stmt* st = nullptr;
     if (const auto it = traj_rows_.find(k); it != traj_rows_.end()) {
@@ -220,7 +338,7 @@ std::vector<FrameAgent> RunFile::frame(int64_t k) const {
                         "SELECT id, pos_x, pos_y FROM trajectory_data WHERE frame = ? ORDER BY id");
       sqlite3_bind_int64(st, 1, k);
     }
-    while (sqlite3_step(st) == SQLITE_ROW) {
+    while (db_->step(path_, st)) {
       FrameAgent a;
       a.id = sqlite3_column_int64(st, 0);
       a.x = sqlite3_column_double(st, 1);
@@ -251,20 +369,22 @@ std::vector<FrameAgent> RunFile::frame(int64_t k) const {
     sqlite3_bind_int64(st, 1, k);
   }
   std::size_t at = 0;  // both lists are sorted by id: merge
-  while (sqlite3_step(st) == SQLITE_ROW) {
+  while (db_->step(path_, st)) {
     const int64_t id = sqlite3_column_int64(st, 0);
     while (at < out.size() && out[at].id < id) ++at;
     if (at == out.size() || out[at].id != id) continue;
     FrameAgent& a = out[at];
     const double vx = sqlite3_column_double(st, 1), vy = sqlite3_column_double(st, 2);
     const double r = sqlite3_column_double(st, 3);
-    if (std::isfinite(vx) && std::isfinite(vy)) {
+    // Values beyond any pedestrian's are left at their defaults (0, 0.2 m) rather than drawn.
+    if (std::abs(vx) <= kMaxCoordinate && std::abs(vy) <= kMaxCoordinate) {
       a.vx = vx;
       a.vy = vy;
     }
-    if (r > 0 && std::isfinite(r)) a.radius = r;
+    if (r > 0 && r <= kMaxCoordinate) a.radius = r;
     a.shade = shade_of(text_of(st, 4));
-    const int64_t g = sqlite3_column_int64(st, 5);
+    const int64_t g =
+        sqlite3_column_type(st, 5) == SQLITE_INTEGER ? sqlite3_column_int64(st, 5) : -1;
     a.goal = g >= 0 && static_cast<std::size_t>(g) < goals_.size() ? g : -1;
   }
   sqlite3_finalize(st);
@@ -290,7 +410,8 @@ bool row_ranges(sqlite3* h, const char* table, std::unordered_map<int64_t, Rows>
   int64_t frame = 0;
   std::size_t count = 0;
   Rows cur;
-  while (sqlite3_step(st) == SQLITE_ROW) {
+  int rc = SQLITE_ROW;
+  while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
     const int64_t rowid = sqlite3_column_int64(st, 0), f = sqlite3_column_int64(st, 1);
     if (!any || f != frame) {
       if (any) {
@@ -309,6 +430,7 @@ bool row_ranges(sqlite3* h, const char* table, std::unordered_map<int64_t, Rows>
     if (!ok) break;
   }
   sqlite3_finalize(st);
+  if (ok && rc != SQLITE_DONE) ok = false;  // a read error part-way: no ranges from half a scan
   if (any && ok) {
     ok = out.emplace(frame, cur).second;
     most = std::max(most, count);
@@ -320,17 +442,25 @@ bool row_ranges(sqlite3* h, const char* table, std::unordered_map<int64_t, Rows>
 }  // namespace
 
 void RunFile::index_frames() {
+  // A column of the table's own named like SQLite's row id would be read instead of it.
+  auto shadowed = [&](const char* table) {
+    for (const char* c : {"rowid", "oid", "_rowid_"})
+      if (db_->has_column(path_, table, c)) return true;
+    return false;
+  };
   std::size_t most = 0;
-  if (!row_ranges(db_->h, "trajectory_data", traj_rows_, most)) {
+  indexed_ =
+      !shadowed("trajectory_data") && row_ranges(db_->h, "trajectory_data", traj_rows_, most);
+  if (!indexed_) {
+    traj_rows_.clear();
     // Rows not stored frame by frame: count the largest frame the slow way.
     sqlite3_stmt* st = db_->prepare(
         path_, "SELECT max(c) FROM (SELECT count(*) AS c FROM trajectory_data GROUP BY frame)");
-    if (sqlite3_step(st) == SQLITE_ROW)
-      most = static_cast<std::size_t>(sqlite3_column_int64(st, 0));
+    if (db_->step(path_, st)) most = static_cast<std::size_t>(sqlite3_column_int64(st, 0));
     sqlite3_finalize(st);
   }
   max_agents_ = most;
-  if (crowddb_) {
+  if (crowddb_ && !shadowed("crowddb_agent_state")) {
     std::size_t ignored = 0;
     row_ranges(db_->h, "crowddb_agent_state", state_rows_, ignored);
   }
@@ -342,7 +472,7 @@ RunFile::Metrics RunFile::metrics() const {
   sqlite3_stmt* st = db_->prepare(path_,
                                   "SELECT time, arrived, frozen, stalled, overlapping_pairs, "
                                   "tick_seconds FROM crowddb_tick_metrics ORDER BY tick");
-  while (sqlite3_step(st) == SQLITE_ROW) {
+  while (db_->step(path_, st)) {
     m.time.push_back(sqlite3_column_double(st, 0));
     m.arrived.push_back(sqlite3_column_double(st, 1));
     m.frozen.push_back(sqlite3_column_double(st, 2));

@@ -14,7 +14,8 @@
 
 namespace crowddb::view {
 
-enum class Shade : uint8_t { active, frozen, arrived, unknown };
+// Codes fixed by the viewer's frame layout (src/view/server.hpp).
+enum class Shade : uint8_t { active = 0, frozen = 1, arrived = 2, unknown = 3, stalled = 4 };
 
 struct FrameAgent {
   int64_t id = 0;
@@ -54,6 +55,8 @@ class RunFile {
   // the positions' envelope.
   const Bounds& bounds() const { return bounds_; }
   const std::string& geometry_wkt() const { return wkt_; }  // empty when the file has none
+  // Everything within bounds() that is not walkable, as simple polygons (none without geometry).
+  const std::vector<std::vector<Vec2>>& blocked() const { return blocked_; }
   const std::vector<GoalShape>& goals() const { return goals_; }
   // The agents of frame k, by id. Throws Error(usage) outside [first_frame, last_frame].
   std::vector<FrameAgent> frame(int64_t k) const;
@@ -63,6 +66,7 @@ class RunFile {
   // store them (others keep working, by scanning). Also counts max_agents().
   void index_frames();
   std::size_t max_agents() const { return max_agents_; }
+  bool indexed() const { return indexed_; }  // frames are read by row ranges
 
   // Per-tick metrics of a crowddb run (empty otherwise), in tick order.
   struct Metrics {
@@ -79,12 +83,15 @@ class RunFile {
   double fps_ = 0;
   Bounds bounds_;
   std::vector<GoalShape> goals_;
+  bool has_geometry_ = false;
+  std::vector<std::vector<Vec2>> blocked_;
   std::unique_ptr<Db> db_;
   struct Rows {
     int64_t first = 0, last = -1;  // rowids
   };
   std::unordered_map<int64_t, Rows> traj_rows_, state_rows_;  // by frame; empty: scan
   std::size_t max_agents_ = 0;
+  bool indexed_ = false;
 };
 
 }  // namespace crowddb::view

@@ -6,7 +6,8 @@
 //   GET /api/frames?from=K&count=N frames K .. K+N-1 (at most 1000), binary, little-endian:
 //     u32 0x46424443 ("CDBF"), u32 frames; per frame: i32 frame, u32 n, then f64 id[n],
 //     f32 x[n], f32 y[n], f32 radius[n], f32 speed[n], i32 goal[n] (-1: none), u8 state[n]
-//     (0 active, 1 frozen, 2 arrived, 3 unknown), zero padding to a multiple of 8 bytes.
+//     (0 active, 1 frozen, 2 arrived, 3 unknown, 4 stalled), zero padding to a multiple of 8
+//     bytes.
 #pragma once
 
 #include <functional>

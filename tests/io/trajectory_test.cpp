@@ -4,6 +4,7 @@
 #include <sqlite3.h>
 
 #include <algorithm>
+#include <sstream>
 
 #include "support/cli.hpp"
 #include "support/sqlite_query.hpp"
@@ -207,3 +208,44 @@ TEST(TrajectoryCsv, RoundTripsExactly) {
 
 }  // namespace
 }  // namespace crowddb
+
+namespace crowddb::io {
+namespace {
+
+// Frames record "stalled" for an active agent past the stall watch's threshold (not for one
+// held exactly at it, as queueing agents are), and never for frozen or arrived ones.
+TEST(TrajectoryStates, StalledActiveFrozenArrived) {
+  AgentTable t;  // the two columns the state is read from
+  t.state = {AgentState::active, AgentState::active, AgentState::active, AgentState::frozen,
+             AgentState::arrived};
+  t.stall_ticks = {0, 40, 41, 90, 90};
+  const char* want[] = {"active", "active", "stalled", "frozen", "arrived"};
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_STREQ(agent_state_name(t, i, 40), want[i]) << i;
+}
+
+// A real run: the bottleneck's stalls show in the frames, never more per frame than the tick's
+// metrics count as stalled.
+TEST(TrajectoryStates, TheBottlenecksStallsAreInTheFrames) {
+  test::TempDir dir;
+  const auto out = dir / "bn.sqlite";
+  ASSERT_EQ(test::run_cli("run " + test::source_path("scenarios/bottleneck.json") +
+                              " --ticks 300 --quiet --out " + out.string(),
+                          dir)
+                .status,
+            0);
+  const auto rows = test::query(
+      out,
+      "SELECT s.frame || ' ' || s.n || ' ' || m.stalled FROM (SELECT frame, count(*) AS n FROM "
+      "crowddb_agent_state WHERE state = 'stalled' GROUP BY frame) s JOIN crowddb_tick_metrics m "
+      "ON m.tick = s.frame");
+  ASSERT_FALSE(rows.empty());
+  for (const std::string& r : rows) {
+    std::istringstream in(r);
+    uint64_t frame = 0, n = 0, stalled = 0;
+    in >> frame >> n >> stalled;
+    EXPECT_LE(n, stalled) << "frame " << frame;
+  }
+}
+
+}  // namespace
+}  // namespace crowddb::io

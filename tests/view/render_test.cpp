@@ -86,7 +86,7 @@ TEST(RunFile, ReadsACrowddbRun) {
       EXPECT_EQ(agents[i].x, xs[i]);
       EXPECT_GE(agents[i].radius, 0.2);
       EXPECT_LE(agents[i].radius, 0.25);
-      EXPECT_EQ(agents[i].shade, Shade::active);
+      EXPECT_TRUE(agents[i].shade == Shade::active || agents[i].shade == Shade::stalled);
       EXPECT_EQ(agents[i].goal, 0);
     }
   }
@@ -118,7 +118,9 @@ TEST(Render, DrawsEveryAgentWhereTheFileSaysOnTwoFrames) {
     EXPECT_EQ(pic.height(), v.height);
     const auto agents = run.frame(k);
     for (const FrameAgent& a : agents)
-      EXPECT_EQ(pic.at(v.px(a.x), v.py(a.y)), colour::kActive) << "agent " << a.id;
+      EXPECT_EQ(pic.at(v.px(a.x), v.py(a.y)),
+                a.shade == Shade::stalled ? colour::kStalled : colour::kActive)
+          << "agent " << a.id;
     EXPECT_EQ(pic.at(v.px(10.15), v.py(2.2)), colour::kBlocked);  // the door's lower wall
     // Open floor: the room's corner, where nobody stands at these frames.
     bool clear = true;
@@ -205,13 +207,39 @@ TEST(Render, BadFilesAndArgumentsGiveOneLine) {
     ASSERT_EQ(sqlite3_exec(h, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sql;
     sqlite3_close(h);
   }
+  const auto text_pos = dir / "textpos.sqlite";
+  const auto huge_frame = dir / "hugeframe.sqlite";
+  const auto a_view = dir / "view.sqlite";
+  const auto far = dir / "far.sqlite";
+  for (const auto& [path, sql] : std::vector<std::pair<std::filesystem::path, std::string>>{
+           {text_pos,
+            "CREATE TABLE trajectory_data (frame, id, pos_x, pos_y);"
+            "INSERT INTO trajectory_data VALUES (0, 1, 1, 1), (0, 2, 'left', 1);"},
+           {huge_frame,
+            "CREATE TABLE trajectory_data (frame, id, pos_x, pos_y);"
+            "INSERT INTO trajectory_data VALUES (0, 1, 1, 1), (4294967296, 1, 1, 1);"},
+           {a_view,
+            "CREATE TABLE t (frame, id, pos_x, pos_y);"
+            "CREATE VIEW trajectory_data AS SELECT * FROM t;"},
+           {far,
+            "CREATE TABLE trajectory_data (frame, id, pos_x, pos_y);"
+            "INSERT INTO trajectory_data VALUES (0, 1, 1, 1), (0, 2, 1e300, 1);"}}) {
+    sqlite3* h = nullptr;
+    ASSERT_EQ(sqlite3_open(path.c_str(), &h), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(h, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sql;
+    sqlite3_close(h);
+  }
   const std::pair<std::string, std::string> cases[] = {
+      {text_pos.string(), "the row of frame 0, id 2 holds text in pos_x (a number is expected)"},
+      {huge_frame.string(), "frame numbers 0 to 4294967296 lie outside 0 to 2147483647"},
+      {a_view.string(), "no table trajectory_data"},
+      {far.string(), "positions must lie within +-1e9 m"},
       {(dir / "missing.sqlite").string(), "no such file"},
       {dir.path().string(), "not a regular file"},
       {text.string(), "not an SQLite file"},
       {other.string(), "no table trajectory_data"},
       {badgeo.string(), "geometry:"},
-      {nan.string(), "not finite"},
+      {nan.string(), "positions must lie within +-1e9 m"},
   };
   for (const auto& [file, message] : cases) {
     const test::CliResult r =
@@ -228,17 +256,30 @@ TEST(Render, BadFilesAndArgumentsGiveOneLine) {
       {"--width 50", "--width: 50 pixels"},
       {"--color pink", "--color"},
       {"--time -1", "--time"},
+      {"--time 1000", "--time 1000 s is after the last frame (0.5 s)"},
+      {"--frame -3", "no frame -3 (frames 0 to 5)"},
   };
   for (const auto& [args, message] : usage) {
     const test::CliResult r = test::run_cli("render " + run.string() + " " + args, dir);
     EXPECT_EQ(r.status, 2) << args;
     EXPECT_NE(r.err.find(message), std::string::npos) << args << ": " << r.err;
   }
-  // The default output sits beside the run, named after it; --time picks the nearest frame.
-  const test::CliResult ok = test::run_cli("render " + run.string() + " --time 0.3", dir);
+  // The default output sits beside the run, named after it; --time picks the nearest frame
+  // (frame k at k / fps): the same picture as that frame's.
+  const test::CliResult ok = test::run_cli("render " + run.string() + " --time 0.31", dir);
   EXPECT_EQ(ok.status, 0) << ok.err;
   EXPECT_TRUE(std::filesystem::exists(dir / "bn.png"));
   EXPECT_FALSE(std::filesystem::exists(dir / "bn.png.tmp"));
+  ASSERT_EQ(
+      test::run_cli("render " + run.string() + " --frame 3 --out " + (dir / "f3.png").string(), dir)
+          .status,
+      0);
+  ASSERT_EQ(
+      test::run_cli("render " + run.string() + " --frame 2 --out " + (dir / "f2.png").string(), dir)
+          .status,
+      0);
+  EXPECT_EQ(test::slurp(dir / "bn.png"), test::slurp(dir / "f3.png"));
+  EXPECT_NE(test::slurp(dir / "f2.png"), test::slurp(dir / "f3.png"));
 }
 
 }  // namespace

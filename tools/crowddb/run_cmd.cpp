@@ -201,7 +201,8 @@ int resume(const std::string& file, const RunOptions& o) {
   });
   if (p.tick >= sc.ticks)
     throw Error(Error::Kind::input, partial + ": the checkpoint is at the run's last tick");
-  auto writer = io::resume_sqlite_writer(p, sc.config.dt, sc.format);
+  auto writer = io::resume_sqlite_writer(p, sc.config.dt,
+                                         sc.config.ticks_for(sc.config.stall.after), sc.format);
   if (!o.quiet)
     std::cerr << "crowddb: resuming " << (sc.name.empty() ? p.value("scenario_source") : sc.name)
               << " at tick " << p.tick << " of " << sc.ticks << " (" << partial << ")\n";

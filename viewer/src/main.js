@@ -6,8 +6,8 @@ import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
 import './style.css';
 
-const SHADES = ['active', 'frozen', 'arrived', 'unknown'];
-const COLOURS = { active: '#1f77b4', frozen: '#ff7f0e', arrived: '#9e9e9e', unknown: '#1f77b4' };
+const SHADES = ['active', 'frozen', 'arrived', 'unknown', 'stalled'];  // codes of the frame layout
+const COLOURS = { active: '#1f77b4', frozen: '#ff7f0e', arrived: '#9e9e9e', unknown: '#1f77b4', stalled: '#9467bd' };
 const FLOOR = '#f3efe6', BLOCKED = '#4d4d4d';
 const VIRIDIS = [[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]];
 const MAX_WINDOWS = 6;
@@ -29,7 +29,8 @@ const st = {
   colour: 'state',
   density: false,
   view: { cx: 0, cy: 0, s: 1 },
-  hover: null,
+  hover: null, // the hovered agent's index in the frame on show, and its id
+  hoverId: null,
   chart: null,
   lastChart: 0,
 };
@@ -149,7 +150,7 @@ function polygon(ring) {
 }
 
 function speedColour(f) {
-  f = Math.max(0, Math.min(1, f)) * 4;
+  f = Number.isFinite(f) ? Math.max(0, Math.min(1, f)) * 4 : 0;
   const i = Math.min(3, Math.floor(f)), t = f - i;
   const c = VIRIDIS[i].map((a, j) => Math.round(a + t * (VIRIDIS[i + 1][j] - a)));
   return `rgb(${c[0]},${c[1]},${c[2]})`;
@@ -157,7 +158,7 @@ function speedColour(f) {
 
 function topSpeed(d) {
   let top = 0.1;
-  for (let i = 0; i < d.n; ++i) top = Math.max(top, d.v[i]);
+  for (let i = 0; i < d.n; ++i) if (Number.isFinite(d.v[i])) top = Math.max(top, d.v[i]);
   return top;
 }
 
@@ -223,7 +224,7 @@ function draw() {
     } else {
       drawSquares(d, colourOf);
     }
-    if (st.hover !== null && st.hover < d.n) {
+    if (st.hover !== null && st.hover < d.n && d.id[st.hover] === st.hoverId) {
       const [px, py] = toScreen(d.x[st.hover], d.y[st.hover]);
       ctx.beginPath();
       ctx.arc(px, py, Math.max(d.r[st.hover] * st.view.s, 3) + 2, 0, 2 * Math.PI);
@@ -280,11 +281,12 @@ function drawSquares(d, colourOf) {
 function drawDensity(d) {
   const b = st.run.bounds, cells = new Map();
   for (let i = 0; i < d.n; ++i) {
-    const key = Math.floor(d.x[i] - b[0]) * 1048576 + Math.floor(d.y[i] - b[1]);
+    const key = `${Math.floor(d.x[i] - b[0])},${Math.floor(d.y[i] - b[1])}`;
     cells.set(key, (cells.get(key) || 0) + 1);
   }
   for (const [key, count] of cells) {
-    const cx = Math.floor(key / 1048576) + b[0], cy = (key % 1048576) + b[1];
+    const [ix, iy] = key.split(',').map(Number);
+    const cx = ix + b[0], cy = iy + b[1];
     const [px, py] = toScreen(cx, cy + 1);
     // People per m^2 in 1 m cells; full red at 4 /m^2 and above.
     ctx.fillStyle = `rgba(214,39,40,${Math.min(1, count / 4) * 0.6})`;
@@ -302,10 +304,11 @@ function legend() {
       html += `<span class="key" style="background:${speedColour(s / 4)}"></span>${(top * s / 4).toFixed(2)}`;
     html += ' m/s';
   } else {
-    const count = [0, 0, 0, 0];
+    const count = [0, 0, 0, 0, 0];
     for (let i = 0; i < d.n; ++i) ++count[d.shade[i]];
     if (st.run.crowddb)
       html += `<span class="key" style="background:${COLOURS.active}"></span>active ${count[0] + count[3]}` +
+        `<span class="key" style="background:${COLOURS.stalled}"></span>stalled ${count[4]}` +
         `<span class="key" style="background:${COLOURS.frozen}"></span>frozen ${count[1]}` +
         `<span class="key" style="background:${COLOURS.arrived}"></span>arrived ${count[2]}`;
     else html += `<span class="key" style="background:${COLOURS.unknown}"></span>${d.n} agents (radius 0.2 m: not in the file)`;
@@ -335,10 +338,10 @@ function status(text) {
 let last = null;
 function tick(ts) {
   if (st.playing && last !== null) {
-    const k = st.run.first_frame + Math.floor(st.time * fps());
+    const k = Math.max(st.run.first_frame, Math.floor(st.time * fps()));
     if (frameData(k)) {  // hold the playhead while a window is on its way
       st.time += ((ts - last) / 1000) * st.speed;
-      const next = Math.min(st.run.last_frame, st.run.first_frame + Math.floor(st.time * fps()));
+      const next = Math.min(st.run.last_frame, Math.max(st.run.first_frame, Math.floor(st.time * fps())));
       if (next !== st.frame) {
         showFrame(next);
         draw();
@@ -353,14 +356,15 @@ function tick(ts) {
 function setPlaying(on) {
   st.playing = on;
   if (on && st.frame >= st.run.last_frame) {
-    st.time = 0;
+    st.time = st.run.first_frame / fps();
     showFrame(st.run.first_frame);
   }
   $('play').innerHTML = on ? '&#10074;&#10074;' : '&#9654;';
 }
 
 function seek(k) {
-  st.time = (k - st.run.first_frame) / fps();
+  k = Math.max(st.run.first_frame, Math.min(st.run.last_frame, k));
+  st.time = k / fps();  // frame k is at time k / fps
   showFrame(k);
   draw();
 }
@@ -383,6 +387,7 @@ function hoverAt(mx, my) {
       st.hover = i;
     }
   }
+  st.hoverId = st.hover === null ? null : d.id[st.hover];
   if (st.hover === null) {
     tip.hidden = true;
   } else {
@@ -453,6 +458,7 @@ function wire() {
   });
   canvas.addEventListener('mouseleave', () => {
     st.hover = null;
+    st.hoverId = null;
     $('tip').hidden = true;
     draw();
   });
@@ -556,7 +562,7 @@ window.crowddbViewer = {
     }
     return out;
   },
-  hovered: () => (st.hover === null || !st.shown ? null : st.shown.id[st.hover]),
+  hovered: () => st.hoverId,
   // Milliseconds per redraw of the current frame (the median of n), for the frame-rate figure.
   drawMs: (n = 20) => {
     const t = [];

@@ -90,8 +90,8 @@ try {
       check(held.length === want.length && held.every(([id, x, y], i) => id === want[i].id &&
         Math.abs(x - want[i].x) < 1e-4 && Math.abs(y - want[i].y) < 1e-4),
         `frame ${k}: the page holds the file's ${want.length} agents at the file's positions`);
-      const coloured = new Set([0x1f77b4, 0xff7f0e, 0x9e9e9e]);
-      const bad = probes.filter((p) => p.inside && !coloured.has(p.rgb));
+      const coloured = new Set([0x1f77b4, 0xff7f0e, 0x9e9e9e, 0x9467bd]);
+      const bad = probes.filter((p) => !p.inside || !coloured.has(p.rgb));  // fitted: all inside
       check(want.length > 0 && bad.length === 0,
         `frame ${k}: a disc under each of the ${probes.length} agents' positions` +
         (bad.length ? ` (${bad.length} missing, e.g. agent ${bad[0].id}: #${bad[0].rgb.toString(16)})` : ''));
