@@ -24,9 +24,10 @@ declare -A seeds=(
   [sdf_sdf3_fuzz]="tests/sdf/data/*.xml"
   [sdf_json_fuzz]="tests/sdf/data/*.json,fuzz/corpus/sdf_json"
   [checkpoint_fuzz]="fuzz/corpus/checkpoint"
+  [runfile_fuzz]="fuzz/corpus/runfile"
 )
 targets=(scenario_fuzz csv_fuzz steersuite_fuzz menge_fuzz vadere_fuzz overrides_fuzz sdf_sdf3_fuzz sdf_json_fuzz
-  checkpoint_fuzz)
+  checkpoint_fuzz runfile_fuzz)
 
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCROWDDB_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCROWDDB_BUILD_TESTS=OFF \

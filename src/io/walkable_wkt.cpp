@@ -8,6 +8,10 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
 #include <algorithm>
+// Boost.Geometry's default rescaling to integers overflows long long (undefined behaviour) on
+// rings whose coordinates differ by many orders of magnitude (found by fuzzing trajectory
+// files' WKT): floating point throughout instead, as Boost.Geometry does by default since 1.77.
+#define BOOST_GEOMETRY_NO_ROBUSTNESS
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/multi_polygon.hpp>
 #include <boost/geometry/geometries/point_xy.hpp>

@@ -13,8 +13,13 @@
 namespace crowddb::view {
 namespace {
 
-[[noreturn]] void fail(const std::string& path, const std::string& what) {
-  throw Error(Error::Kind::input, path + ": " + what);
+std::string valid_utf8(std::string s);
+
+// Errors are one line: SQLite's messages quote names from the file, which may hold anything.
+[[noreturn]] void fail(const std::string& path, std::string what) {
+  for (char& c : what)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
+  throw Error(Error::Kind::input, path + ": " + valid_utf8(std::move(what)));
 }
 
 std::string text_of(sqlite3_stmt* st, int col) {
