@@ -257,7 +257,8 @@ RunFile RunFile::open(const std::string& path) {
       f.has_geometry_ = true;
     }
   }
-  if (meta) {  // crowddb's own bounds (the walls) win over the envelopes
+  if (meta && f.crowddb_) {  // crowddb's own bounds (the walls) win over the envelopes (in
+                             // JuPedSim's files these keys are the positions' envelope)
     double b[4];
     bool all = true;
     const char* keys[4] = {"xmin", "ymin", "xmax", "ymax"};

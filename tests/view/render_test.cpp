@@ -137,8 +137,10 @@ TEST(Render, DrawsEveryAgentWhereTheFileSaysOnTwoFrames) {
   EXPECT_TRUE(moved);
 }
 
-// A JuPedSim trajectory file written by other software: positions and a walkable area with a
-// hole, no radii or states (drawn at the default radius), the frame rate from its metadata.
+// A JuPedSim trajectory file written by other software (the layout of JuPedSim's writer,
+// version 3): positions and a walkable area with a hole, no radii or states (drawn at the
+// default radius), the frame rate from its metadata. (PedPy's test files of JuPedSim versions
+// 1 and 2 were opened and drawn by hand; they are not in this repository.)
 TEST(Render, OpensAJuPedSimFileWithoutCrowddbTables) {
   TempDir dir;
   const auto file = dir / "jps.sqlite";
@@ -149,7 +151,8 @@ TEST(Render, OpensAJuPedSimFileWithoutCrowddbTables) {
                    "CREATE TABLE trajectory_data (frame INTEGER, id INTEGER, pos_x REAL, "
                    "pos_y REAL, ori_x REAL, ori_y REAL);"
                    "CREATE TABLE metadata (key TEXT, value TEXT);"
-                   "INSERT INTO metadata VALUES ('version', '3'), ('fps', '8');"
+                   "INSERT INTO metadata VALUES ('version', '3'), ('fps', '8'), ('xmin', '2'), "
+                   "('xmax', '15'), ('ymin', '2'), ('ymax', '8');"
                    "CREATE TABLE geometry (hash INTEGER, wkt TEXT);"
                    "INSERT INTO geometry VALUES (1, 'POLYGON ((0 0, 20 0, 20 10, 0 10, 0 0), "
                    "(8 3, 12 3, 12 7, 8 7, 8 3))');"
@@ -163,7 +166,10 @@ TEST(Render, OpensAJuPedSimFileWithoutCrowddbTables) {
   EXPECT_FALSE(run.crowddb());
   EXPECT_EQ(run.name(), "jps");
   EXPECT_DOUBLE_EQ(run.fps(), 8);
+  // The drawing area is the geometry's envelope: JuPedSim's metadata bounds are the positions'.
+  EXPECT_EQ(run.bounds().xmin, 0);
   EXPECT_EQ(run.bounds().xmax, 20);
+  EXPECT_EQ(run.bounds().ymax, 10);
   EXPECT_EQ(run.last_frame(), 1);
   const auto agents = run.frame(1);
   ASSERT_EQ(agents.size(), 2u);
