@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "airport_scenario.hpp"
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
 
@@ -69,17 +70,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rvo2_side_by_side: options must be positive\n");
     return 2;
   }
-  const double side = std::sqrt(agents / density);
-  char doc[2048];
-  std::snprintf(doc, sizeof doc, R"({"bounds": [0, 0, %.17g, %.17g], "dt": 0.1, "seed": 3,
-    "threads": %d, "steering": {"model": "orca", "orca": {"neighbor_dist": 5, "max_neighbors": 10,
-    "time_horizon": 2, "time_horizon_obst": 0.5}},
-    "goals": [{"name": "S", "x": %.17g, "y": 1}, {"name": "E", "x": %.17g, "y": %.17g},
-              {"name": "W", "x": 1, "y": %.17g}, {"name": "N", "x": %.17g, "y": %.17g}],
-    "groups": [{"count": %d, "placement": {"type": "uniform", "region": [0, 0, %.17g, %.17g],
-                "gap": 0.02}, "radius": 0.25, "pref_speed": 1.3, "goals": {"assign": "round_robin"}}]})",
-                side, side, threads, side / 2, side - 1, side / 2, side / 2, side / 2, side - 1,
-                agents, side, side);
+  const double side = bench::airport_side(static_cast<std::size_t>(agents), density);
+  const std::string doc =
+      bench::airport_scenario(static_cast<std::size_t>(agents), "orca", threads, density);
   Scenario sc = parse_scenario(doc, "side-by-side");
   const AgentTable& t = sc.world.agents();
 

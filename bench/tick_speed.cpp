@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "airport_scenario.hpp"
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
 
@@ -45,18 +46,7 @@ struct Case {
 };
 
 std::string airport(std::size_t agents, const std::string& model, int threads) {
-  const double side = std::sqrt(static_cast<double>(agents) / 0.5);
-  char doc[2048];
-  std::snprintf(doc, sizeof doc, R"({"bounds": [0, 0, %.17g, %.17g], "dt": 0.1, "seed": 3,
-    "threads": %d, "steering": {"model": "%s", "orca": {"neighbor_dist": 5, "max_neighbors": 10,
-    "time_horizon": 2, "time_horizon_obst": 0.5}},
-    "goals": [{"name": "S", "x": %.17g, "y": 1}, {"name": "E", "x": %.17g, "y": %.17g},
-              {"name": "W", "x": 1, "y": %.17g}, {"name": "N", "x": %.17g, "y": %.17g}],
-    "groups": [{"count": %zu, "placement": {"type": "uniform", "region": [0, 0, %.17g, %.17g],
-                "gap": 0.02}, "radius": 0.25, "pref_speed": 1.3, "goals": {"assign": "round_robin"}}]})",
-                side, side, threads, model.c_str(), side / 2, side - 1, side / 2, side / 2,
-                side / 2, side - 1, agents, side, side);
-  return doc;
+  return bench::airport_scenario(agents, model, threads);
 }
 
 std::string ring(const std::string& model, int threads) {

@@ -320,6 +320,22 @@ RunFile RunFile::open(const std::string& path) {
   return f;
 }
 
+sqlite3_stmt* RunFile::frame_rows(const char* what, const std::unordered_map<int64_t, Rows>& rows,
+                                  int64_t k) const {
+  const auto it = rows.find(k);
+  const std::string sql = std::string("SELECT ") + what + " WHERE " +
+                          (it != rows.end() ? "rowid BETWEEN ? AND ? AND " : "") +
+                          "frame = ? ORDER BY id";
+  sqlite3_stmt* st = db_->prepare(path_, sql.c_str());
+  int at = 1;
+  if (it != rows.end()) {
+    sqlite3_bind_int64(st, at++, it->second.first);
+    sqlite3_bind_int64(st, at++, it->second.last);
+  }
+  sqlite3_bind_int64(st, at, k);
+  return st;
+}
+
 std::vector<FrameAgent> RunFile::frame(int64_t k) const {
   if (k < first_ || k > last_)
     throw Error(Error::Kind::usage,
@@ -331,19 +347,7 @@ std::vector<FrameAgent> RunFile::frame(int64_t k) const {
   // Indexed: a frame without rows (a gap in the numbering) is empty, without a scan.
   if (indexed_ && !traj_rows_.count(k)) return out;
   {
-    sqlite3_stmt* st = nullptr;
-    if (const auto it = traj_rows_.find(k); it != traj_rows_.end()) {
-      st = db_->prepare(path_,
-                        "SELECT id, pos_x, pos_y FROM trajectory_data WHERE rowid BETWEEN ? AND ? "
-                        "AND frame = ? ORDER BY id");
-      sqlite3_bind_int64(st, 1, it->second.first);
-      sqlite3_bind_int64(st, 2, it->second.last);
-      sqlite3_bind_int64(st, 3, k);
-    } else {
-      st = db_->prepare(path_,
-                        "SELECT id, pos_x, pos_y FROM trajectory_data WHERE frame = ? ORDER BY id");
-      sqlite3_bind_int64(st, 1, k);
-    }
+    sqlite3_stmt* st = frame_rows("id, pos_x, pos_y FROM trajectory_data", traj_rows_, k);
     while (db_->step(path_, st)) {
       FrameAgent a;
       a.id = sqlite3_column_int64(st, 0);
@@ -360,20 +364,8 @@ std::vector<FrameAgent> RunFile::frame(int64_t k) const {
     sqlite3_finalize(st);
   }
   if (!crowddb_) return out;
-  sqlite3_stmt* st = nullptr;
-  if (const auto it = state_rows_.find(k); it != state_rows_.end()) {
-    st = db_->prepare(path_,
-                      "SELECT id, vel_x, vel_y, radius, state, goal FROM crowddb_agent_state "
-                      "WHERE rowid BETWEEN ? AND ? AND frame = ? ORDER BY id");
-    sqlite3_bind_int64(st, 1, it->second.first);
-    sqlite3_bind_int64(st, 2, it->second.last);
-    sqlite3_bind_int64(st, 3, k);
-  } else {
-    st = db_->prepare(path_,
-                      "SELECT id, vel_x, vel_y, radius, state, goal FROM crowddb_agent_state "
-                      "WHERE frame = ? ORDER BY id");
-    sqlite3_bind_int64(st, 1, k);
-  }
+  sqlite3_stmt* st =
+      frame_rows("id, vel_x, vel_y, radius, state, goal FROM crowddb_agent_state", state_rows_, k);
   std::size_t at = 0;  // both lists are sorted by id: merge
   while (db_->step(path_, st)) {
     const int64_t id = sqlite3_column_int64(st, 0);

@@ -12,6 +12,8 @@
 
 #include "crowddb/world.hpp"
 
+struct sqlite3_stmt;
+
 namespace crowddb::view {
 
 // Codes fixed by the viewer's frame layout (src/view/server.hpp).
@@ -90,6 +92,9 @@ class RunFile {
     int64_t first = 0, last = -1;  // rowids
   };
   std::unordered_map<int64_t, Rows> traj_rows_, state_rows_;  // by frame; empty: scan
+  // "SELECT what WHERE frame = k ORDER BY id", within the frame's row range when known.
+  sqlite3_stmt* frame_rows(const char* what, const std::unordered_map<int64_t, Rows>& rows,
+                           int64_t k) const;
   std::size_t max_agents_ = 0;
   bool indexed_ = false;
 };

@@ -13,6 +13,7 @@
 #include "crowddb/error.hpp"
 #include "support/cli.hpp"
 #include "support/sqlite_query.hpp"
+#include "view/runs.hpp"
 
 namespace crowddb::view {
 namespace {
@@ -39,15 +40,7 @@ class Png {
   cairo_surface_t* s_;
 };
 
-std::filesystem::path bottleneck_run(const TempDir& dir, int ticks) {
-  const auto out = dir / "bn.sqlite";
-  const test::CliResult r =
-      test::run_cli("run " + test::source_path("scenarios/bottleneck.json") + " --ticks " +
-                        std::to_string(ticks) + " --quiet --out " + out.string(),
-                    dir);
-  EXPECT_EQ(r.status, 0) << r.err;
-  return out;
-}
+using test::bottleneck_run;
 
 TEST(RunFile, ReadsACrowddbRun) {
   TempDir dir;

@@ -22,21 +22,14 @@
 
 #include "crowddb/error.hpp"
 #include "support/cli.hpp"
+#include "view/runs.hpp"
 
 namespace crowddb::view {
 namespace {
 
 using test::TempDir;
 
-std::filesystem::path bottleneck_run(const TempDir& dir, int ticks) {
-  const auto out = dir / "bn.sqlite";
-  const test::CliResult r =
-      test::run_cli("run " + test::source_path("scenarios/bottleneck.json") + " --ticks " +
-                        std::to_string(ticks) + " --quiet --out " + out.string(),
-                    dir);
-  EXPECT_EQ(r.status, 0) << r.err;
-  return out;
-}
+using test::bottleneck_run;
 
 template <class T>
 T get(const std::string& b, std::size_t& at) {
