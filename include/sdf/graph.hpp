@@ -88,6 +88,18 @@ class Graph {
   // the graph without regrowing its arrays and hash tables. Changes nothing else.
   void reserve(size_t actors, size_t channels);
 
+  // Actor annotations, kept so that a graph read and written again loses nothing. The type is
+  // SDF3's actor `type` (empty: unset; writers then use the name). The execution time is a
+  // non-negative integer in the graph's time unit (SDF3 <executionTime time=...>, the JSON
+  // form's "time"), needed by the timed analyses (throughput, latency); unset by default.
+  const std::string& actor_type(ActorId a) const;
+  void set_actor_type(ActorId a, std::string actor_type);
+  std::optional<uint64_t> actor_time(ActorId a) const;
+  // Throws Error(input) for times of 2^63 or more (sums of times must stay exact).
+  void set_actor_time(ActorId a, std::optional<uint64_t> time);
+  bool has_actor_times() const { return !actor_times_.empty(); }
+  bool has_actor_types() const { return !actor_types_.empty(); }
+
   std::optional<ActorId> find_actor(std::string_view name) const;
   std::optional<ChannelId> find_channel(std::string_view name) const;
   // find_actor for many names at once: ids[i] is the id of names[i] or -1. The probes of later
@@ -99,9 +111,18 @@ class Graph {
   std::vector<uint64_t> delays() const;
 
   std::string name;  // the graph's name (SDF3 `sdf name=`), may be empty
+  std::string type;  // the graph's type (SDF3 `sdf type=`); empty: writers use the name
+  // The SDF3 <sdfProperties> element as read (XML text), so that its processors, memories,
+  // channel and graph properties survive a conversion. The writers merge the actors' execution
+  // times into it (docs/sdf.md, "Execution times"). Empty when the graph had none.
+  std::string sdf3_properties;
 
  private:
   std::vector<std::string> actor_names_;
+  // Sized to the actors only once one is set, so graphs without annotations pay nothing.
+  std::vector<std::string> actor_types_;
+  std::vector<uint64_t> actor_times_;  // kNoTime = unset
+  static constexpr uint64_t kNoTime = UINT64_MAX;
   std::vector<Channel> channels_;
   // Flat open-addressing tables of ids (the names live in actor_names_ / channels_): no node
   // per entry, so a 10^6-actor graph loads without millions of small allocations. A slot holds

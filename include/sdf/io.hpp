@@ -2,16 +2,18 @@
 // (write) for Graphviz.
 //
 // SDF3 subset read: <sdf3 type="sdf"> / <applicationGraph> / <sdf name=...> holding <actor
-// name=...> elements with <port name=... type="in|out" rate=N/> children and <channel name=...
-// srcActor=... srcPort=... dstActor=... dstPort=... [initialTokens=N]/> elements. Other
-// elements (sdfProperties, ...) and attributes are ignored. Every port must be connected to
-// exactly one channel of the right direction; CSDF rate lists are rejected. Written files carry
-// the same elements plus an empty <sdfProperties/>, so SDF3 tools can read them.
+// name=... type=...> elements with <port name=... type="in|out" rate=N/> children and <channel
+// name=... srcActor=... srcPort=... dstActor=... dstPort=... [initialTokens=N]/> elements. Every
+// port must be connected to exactly one channel of the right direction; CSDF rate lists are
+// rejected. <sdfProperties> gives the actors' execution times (SDF3's rule: the last <processor>
+// carrying a `default` attribute) and is kept whole as text; written files carry it back with the
+// graph's times merged in.
 //
-// JSON form: {"actors":[{"name":"A"},...], "channels":[{"src":"A","dst":"B","prd":2,"cns":3,
-// "delay":0},...]}. "delay" defaults to 0; a channel may carry an optional "name" (written only
-// when it differs from the default `src->dst#k`), the top level an optional "name". Unknown
-// fields are errors (they are usually typos).
+// JSON form: {"actors":[{"name":"A","time":3},...], "channels":[{"src":"A","dst":"B","prd":2,
+// "cns":3,"delay":0},...]}; optional "type" (graph, actor), "time" (actor), "src_port"/"dst_port"
+// (channel) and "sdf3_properties" (docs/sdf.md). "delay" defaults to 0; a channel may carry an
+// optional "name" (written only when it differs from the default `src->dst#k`), the top level an
+// optional "name". Unknown fields are errors (they are usually typos).
 //
 // Errors: Error(input) whose what() is one line "FILE:LINE: message" (XML; JSON syntax errors)
 // or "FILE: channels[3].prd: message" (JSON fields). Loading is O(size) for both formats: names

@@ -292,6 +292,31 @@ void Graph::set_rates(ChannelId c, uint64_t prd, uint64_t cns) {
   channels_[c].cns = cns;
 }
 
+const std::string& Graph::actor_type(ActorId a) const {
+  static const std::string kNone;
+  return a < actor_types_.size() ? actor_types_[a] : kNone;
+}
+
+void Graph::set_actor_type(ActorId a, std::string actor_type) {
+  if (a >= actor_count()) throw Error(Error::Kind::input, "set_actor_type: unknown actor");
+  if (actor_types_.size() < actor_count()) actor_types_.resize(actor_count());
+  actor_types_[a] = std::move(actor_type);
+}
+
+std::optional<uint64_t> Graph::actor_time(ActorId a) const {
+  if (a >= actor_times_.size() || actor_times_[a] == kNoTime) return std::nullopt;
+  return actor_times_[a];
+}
+
+void Graph::set_actor_time(ActorId a, std::optional<uint64_t> time) {
+  if (a >= actor_count()) throw Error(Error::Kind::input, "set_actor_time: unknown actor");
+  if (time && *time >= (uint64_t{1} << 63))
+    throw Error(Error::Kind::input, "execution time of actor '" + actor_names_[a] +
+                                        "' must be below 2^63 (got " + std::to_string(*time) + ")");
+  if (actor_times_.size() < actor_count()) actor_times_.resize(actor_count(), kNoTime);
+  actor_times_[a] = time ? *time : kNoTime;
+}
+
 void Graph::set_port_names(ChannelId c, std::string src_port, std::string dst_port) {
   channels_[c].src_port = std::move(src_port);
   channels_[c].dst_port = std::move(dst_port);

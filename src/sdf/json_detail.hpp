@@ -16,4 +16,9 @@ Graph read_json_sax(std::string_view text, const std::string& source);
 // reader.
 std::optional<Graph> read_json_plain(std::string_view text, const std::string& source);
 
+// The JSON form's "sdf3_properties": an <sdfProperties> element as text, checked and read as
+// the SDF3 reader does (execution times for the actors that have no "time"; unknown actors are
+// errors); kept in g.sdf3_properties. Errors: Error(input) "SOURCE: sdf3_properties: ...".
+void read_sdf3_properties(Graph& g, std::string_view xml, const std::string& source);
+
 }  // namespace sdf::detail

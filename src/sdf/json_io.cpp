@@ -10,6 +10,7 @@
 // because the "channels" array may come before "actors".
 #include <nlohmann/json.hpp>
 #include <set>
+#include <tuple>
 
 #include "sdf/io.hpp"
 #include "sdf/json_detail.hpp"
@@ -19,8 +20,11 @@ namespace sdf {
 
 namespace {
 
+constexpr uint64_t kNoTime = UINT64_MAX;
+constexpr uint64_t kTimeLimit = uint64_t{1} << 63;
+
 struct PendingChannel {
-  std::string src, dst, name;
+  std::string src, dst, name, src_port, dst_port;
   uint64_t prd = 0, cns = 0, delay = 0;
   bool has_src = false, has_dst = false, has_prd = false, has_cns = false;
 };
@@ -31,6 +35,9 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
   Graph graph;
   std::vector<PendingChannel> channels;
   std::vector<std::string> actor_names;
+  std::vector<std::string> actor_types;  // "" = unset
+  std::vector<uint64_t> actor_times;     // kNoTime = unset
+  std::string sdf3_properties;
 
   // Structure: top-level object; "actors" and "channels" arrays of flat objects.
   enum class At { start, top, actors, actor, channels, channel, done };
@@ -44,6 +51,9 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
         if (!key_.empty()) break;
         at_ = At::actor;
         has_name_ = false;
+        actor_fields_ = 0;
+        actor_types.emplace_back();
+        actor_times.push_back(kNoTime);
         return true;
       case At::channels:
         if (!key_.empty()) break;
@@ -101,14 +111,21 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
   bool key(string_t& k) override {
     key_ = k;
     if (at_ == At::top) {
-      if (k == "actors" || k == "channels" || k == "name") {
+      if (k == "actors" || k == "channels" || k == "name" || k == "type" ||
+          k == "sdf3_properties") {
         if (!seen_top_.insert(k).second) fail("duplicate field '" + k + "'");
         return true;
       }
     } else if (at_ == At::actor) {
-      if (k == "name") return true;
+      const unsigned bit = k == "name" ? 1 : k == "type" ? 2 : k == "time" ? 4 : 0;
+      if (bit != 0) {
+        if (actor_fields_ & bit) fail(where() + ": duplicate field '" + k + "'");
+        actor_fields_ |= bit;
+        return true;
+      }
     } else if (at_ == At::channel) {
-      if (k == "src" || k == "dst" || k == "prd" || k == "cns" || k == "delay" || k == "name")
+      if (k == "src" || k == "dst" || k == "prd" || k == "cns" || k == "delay" || k == "name" ||
+          k == "src_port" || k == "dst_port")
         return true;
     }
     fail(where() + ": unknown field '" + k + "'");
@@ -116,7 +133,13 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
   bool string(string_t& s) override {
     if (at_ == At::top && key_ == "name") {
       graph.name = s;
-    } else if (at_ == At::actor) {
+    } else if (at_ == At::top && key_ == "type") {
+      graph.type = s;
+    } else if (at_ == At::top && key_ == "sdf3_properties") {
+      sdf3_properties = std::move(s);
+    } else if (at_ == At::actor && key_ == "type") {
+      actor_types.back() = std::move(s);
+    } else if (at_ == At::actor && key_ == "name") {
       if (s.empty()) fail(where() + ".name: empty");
       if (padded(s)) fail(where() + ".name: begins or ends with white space");
       actor_names.push_back(std::move(s));
@@ -125,10 +148,10 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
       PendingChannel& c = channels.back();
       if (key_ == "src") c.src = std::move(s), c.has_src = true;
       if (key_ == "dst") c.dst = std::move(s), c.has_dst = true;
-      if (key_ == "name") {
-        if (s.empty()) fail(where() + ".name: empty");
-        if (padded(s)) fail(where() + ".name: begins or ends with white space");
-        c.name = std::move(s);
+      if (key_ == "name" || key_ == "src_port" || key_ == "dst_port") {
+        if (s.empty()) fail(where() + "." + key_ + ": empty");
+        if (padded(s)) fail(where() + "." + key_ + ": begins or ends with white space");
+        (key_ == "name" ? c.name : key_ == "src_port" ? c.src_port : c.dst_port) = std::move(s);
       }
     } else {
       unexpected("a string");
@@ -136,6 +159,11 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
     return true;
   }
   bool number_unsigned(number_unsigned_t v) override {
+    if (at_ == At::actor && key_ == "time") {
+      if (v >= kTimeLimit) fail(where() + ".time: must be below 2^63");
+      actor_times.back() = v;
+      return true;
+    }
     if (at_ != At::channel || (key_ != "prd" && key_ != "cns" && key_ != "delay"))
       unexpected("a number");
     PendingChannel& c = channels.back();
@@ -147,12 +175,15 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
   }
   bool number_integer(number_integer_t v) override {
     if (v >= 0) return number_unsigned(static_cast<number_unsigned_t>(v));
-    if (at_ == At::channel) fail(where() + "." + key_ + ": must not be negative");
+    if (at_ == At::channel || (at_ == At::actor && key_ == "time"))
+      fail(where() + "." + key_ + ": must not be negative");
     unexpected("a number");
   }
   bool number_float(number_float_t, const string_t& s) override {
     if (at_ == At::channel)
       fail(where() + "." + key_ + ": '" + s + "' is not an integer below 2^64");
+    if (at_ == At::actor && key_ == "time")
+      fail(where() + ".time: '" + s + "' is not an integer below 2^63");
     unexpected("a number");
   }
   bool null() override { unexpected("null"); }
@@ -189,6 +220,7 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
   std::string key_;
   size_t index_ = 0;
   bool has_name_ = false;
+  unsigned actor_fields_ = 0;  // name, type, time seen in the current actor
   std::set<std::string> seen_top_;
 };
 
@@ -197,13 +229,18 @@ class JsonReader : public nlohmann::json_sax<nlohmann::json> {
 namespace {
 
 struct ChannelView {
-  std::string_view src, dst, name;
+  std::string_view src, dst, name, src_port, dst_port;
   uint64_t prd = 0, cns = 0, delay = 0;
 };
 
 struct Parsed {
   std::string graph_name;
+  std::string graph_type;
+  std::string sdf3_properties;
   std::vector<std::string_view> actors;
+  // Parallel to actors, or empty when no actor has one.
+  std::vector<std::string_view> actor_types;  // "" = unset
+  std::vector<uint64_t> actor_times;          // kNoTime = unset
   std::vector<ChannelView> channels;
 };
 
@@ -213,10 +250,16 @@ Graph build(Parsed& p, const std::string& source) {
   auto fail = [&](const std::string& msg) { throw Error(Error::Kind::input, source + ": " + msg); };
   Graph g;
   g.name = std::move(p.graph_name);
+  g.type = std::move(p.graph_type);
   g.reserve(p.actors.size(), p.channels.size());
   if (const size_t i = g.add_actors(p.actors); i < p.actors.size())
     fail("actors[" + std::to_string(i) + "].name: duplicate actor name '" +
          std::string(p.actors[i]) + "'");
+  for (size_t a = 0; a < p.actor_types.size(); ++a)
+    if (!p.actor_types[a].empty())
+      g.set_actor_type(static_cast<ActorId>(a), std::string(p.actor_types[a]));
+  for (size_t a = 0; a < p.actor_times.size(); ++a)
+    if (p.actor_times[a] != kNoTime) g.set_actor_time(static_cast<ActorId>(a), p.actor_times[a]);
   // A block at a time: resolve the names (Graph::find_actors overlaps the probes), add the
   // channels before the first unknown name, then report the first failure in file order.
   constexpr size_t kBlock = 4096;
@@ -240,6 +283,12 @@ Graph build(Parsed& p, const std::string& source) {
                        static_cast<ActorId>(ids[2 * (i - b) + 1]), c.prd, c.cns, c.delay, c.name});
     }
     const size_t added = g.add_channels(batch);
+    for (size_t k = 0; k < added; ++k) {
+      const ChannelView& c = p.channels[b + k];
+      if (!c.src_port.empty() || !c.dst_port.empty())
+        g.set_port_names(static_cast<ChannelId>(b + k), std::string(c.src_port),
+                         std::string(c.dst_port));
+    }
     const size_t i = b + added;
     if (i == end) continue;
     const ChannelView& c = p.channels[i];
@@ -254,6 +303,18 @@ Graph build(Parsed& p, const std::string& source) {
     if (ids[2 * (i - b)] < 0)
       fail("channels[" + std::to_string(i) + "].src: unknown actor '" + std::string(c.src) + "'");
     fail("channels[" + std::to_string(i) + "].dst: unknown actor '" + std::string(c.dst) + "'");
+  }
+  if (!p.sdf3_properties.empty()) detail::read_sdf3_properties(g, p.sdf3_properties, source);
+  // A port belongs to one channel: the names given must be unique per actor (SDF3 would refuse
+  // the file written from them).
+  std::set<std::pair<ActorId, std::string_view>> ports;
+  for (size_t i = 0; i < p.channels.size(); ++i) {
+    const Channel& c = g.channel(static_cast<ChannelId>(i));
+    for (const auto& [actor, port, field] : {std::tuple{c.src, p.channels[i].src_port, "src_port"},
+                                             std::tuple{c.dst, p.channels[i].dst_port, "dst_port"}})
+      if (!port.empty() && !ports.insert({actor, port}).second)
+        fail("channels[" + std::to_string(i) + "]." + field + ": actor '" + g.actor_name(actor) +
+             "' already has a port '" + std::string(port) + "'");
   }
   return g;
 }
@@ -346,15 +407,42 @@ class Scanner {
     out = v;
     return true;
   }
+  // Actor objects: "name" with an optional "type" and "time", in any order.
   bool actors(Parsed& out) {
     if (!skip_to('[')) return false;
     if (peek_is(']')) return true;
     do {
-      std::string_view k, v;
-      if (!skip_to('{') || !string(k) || k != "name" || !skip_to(':') || !string(v) || v.empty() ||
-          padded(v) || !skip_to('}'))
-        return false;
-      out.actors.push_back(v);
+      if (!skip_to('{')) return false;
+      std::string_view name, type;
+      uint64_t time = kNoTime;
+      unsigned seen = 0;
+      do {
+        std::string_view k;
+        if (!string(k) || !skip_to(':')) return false;
+        unsigned bit;
+        bool ok;
+        if (k == "name") {
+          bit = 1, ok = string(name) && !name.empty() && !padded(name);
+        } else if (k == "type") {
+          bit = 2, ok = string(type);
+        } else if (k == "time") {
+          bit = 4, ok = number(time) && time < kTimeLimit;
+        } else {
+          return false;
+        }
+        if (!ok || (seen & bit)) return false;
+        seen |= bit;
+      } while (peek_is(','));
+      if (!(seen & 1) || !skip_to('}')) return false;
+      out.actors.push_back(name);
+      if (seen & 2) {
+        out.actor_types.resize(out.actors.size());
+        out.actor_types.back() = type;
+      }
+      if (seen & 4) {
+        out.actor_times.resize(out.actors.size(), kNoTime);
+        out.actor_times.back() = time;
+      }
     } while (peek_is(','));
     return skip_to(']');
   }
@@ -382,6 +470,10 @@ class Scanner {
           bit = 16, ok = number(c.delay);
         } else if (k == "name") {
           bit = 32, ok = string(c.name) && !c.name.empty() && !padded(c.name);
+        } else if (k == "src_port") {
+          bit = 64, ok = string(c.src_port) && !c.src_port.empty() && !padded(c.src_port);
+        } else if (k == "dst_port") {
+          bit = 128, ok = string(c.dst_port) && !c.dst_port.empty() && !padded(c.dst_port);
         } else {
           return false;
         }
@@ -408,10 +500,14 @@ Graph read_json_sax(std::string_view text, const std::string& source) {
   if (!r.saw_actors()) r.fail("top level: missing field 'actors'");
   Parsed p;
   p.graph_name = std::move(r.graph.name);
+  p.graph_type = std::move(r.graph.type);
+  p.sdf3_properties = std::move(r.sdf3_properties);
   p.actors.assign(r.actor_names.begin(), r.actor_names.end());
+  p.actor_types.assign(r.actor_types.begin(), r.actor_types.end());
+  p.actor_times = std::move(r.actor_times);
   p.channels.reserve(r.channels.size());
   for (const PendingChannel& c : r.channels)
-    p.channels.push_back({c.src, c.dst, c.name, c.prd, c.cns, c.delay});
+    p.channels.push_back({c.src, c.dst, c.name, c.src_port, c.dst_port, c.prd, c.cns, c.delay});
   return build(p, source);
 }
 
@@ -435,8 +531,14 @@ Graph read_json(std::string_view text, const std::string& source) {
 std::string write_json(const Graph& g) {
   nlohmann::ordered_json j;
   if (!g.name.empty()) j["name"] = g.name;
+  if (!g.type.empty() && g.type != g.name) j["type"] = g.type;
   auto& actors = j["actors"] = nlohmann::ordered_json::array();
-  for (ActorId a = 0; a < g.actor_count(); ++a) actors.push_back({{"name", g.actor_name(a)}});
+  for (ActorId a = 0; a < g.actor_count(); ++a) {
+    nlohmann::ordered_json e = {{"name", g.actor_name(a)}};
+    if (!g.actor_type(a).empty()) e["type"] = g.actor_type(a);
+    if (const auto t = g.actor_time(a)) e["time"] = *t;
+    actors.push_back(std::move(e));
+  }
   auto& channels = j["channels"] = nlohmann::ordered_json::array();
   std::unordered_map<uint64_t, uint32_t> parallel;
   for (const Channel& c : g.channels()) {
@@ -448,8 +550,12 @@ std::string write_json(const Graph& g) {
     const uint32_t k = parallel[(static_cast<uint64_t>(c.src) << 32) | c.dst]++;
     if (c.name != g.actor_name(c.src) + "->" + g.actor_name(c.dst) + "#" + std::to_string(k))
       e["name"] = c.name;
+    if (!c.src_port.empty()) e["src_port"] = c.src_port;
+    if (!c.dst_port.empty()) e["dst_port"] = c.dst_port;
     channels.push_back(std::move(e));
   }
+  // Last: adding a key to an ordered_json moves its members (the references above).
+  if (!g.sdf3_properties.empty()) j["sdf3_properties"] = g.sdf3_properties;
   return j.dump(1) + "\n";
 }
 

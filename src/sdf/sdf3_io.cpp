@@ -7,6 +7,7 @@
 #include <charconv>
 #include <pugixml.hpp>
 #include <sstream>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "sdf/io.hpp"
@@ -15,6 +16,34 @@
 namespace sdf {
 
 namespace {
+
+// Execution times by SDF3's rule: in an actor's <actorProperties>, the last <processor> that
+// carries a `default` attribute (whatever its value) gives <executionTime time=...>. Actors
+// that already have a time keep it when `keep_times`. The element itself is kept as text for
+// the writers. fail(node, message) does not return; number(node, attr) reads a count.
+template <class Fail, class Number>
+void apply_properties(Graph& g, pugi::xml_node props, Fail&& fail, Number&& number,
+                      bool keep_times) {
+  for (pugi::xml_node ap : props.children("actorProperties")) {
+    const std::string_view name = trim(ap.attribute("actor").value());
+    const auto a = g.find_actor(name);
+    if (!a) fail(ap, "<actorProperties> names an unknown actor '" + std::string(name) + "'");
+    pugi::xml_node chosen;
+    for (pugi::xml_node proc : ap.children("processor"))
+      if (proc.attribute("default")) chosen = proc;
+    if (!chosen) continue;
+    const pugi::xml_node et = chosen.child("executionTime");
+    if (!et || (keep_times && g.actor_time(*a))) continue;
+    const uint64_t t = number(et, "time");
+    if (t >= (uint64_t{1} << 63))
+      fail(et, "execution time " + std::to_string(t) + " is 2^63 or more");
+    g.set_actor_time(*a, t);
+  }
+  std::ostringstream out;
+  props.print(out, "", pugi::format_raw, pugi::encoding_utf8);
+  g.sdf3_properties = out.str();
+  if (!valid_utf8(g.sdf3_properties)) fail(props, "<sdfProperties> is not valid UTF-8");
+}
 
 struct Port {
   ActorId actor;
@@ -45,6 +74,8 @@ class Sdf3Reader {
     Graph g;
     g.name = sdf.attribute("name").value();
     if (!valid_utf8(g.name)) fail(sdf, "attribute 'name' is not valid UTF-8");
+    g.type = sdf.attribute("type").value();
+    if (!valid_utf8(g.type)) fail(sdf, "attribute 'type' is not valid UTF-8");
     for (pugi::xml_node actor : sdf.children("actor")) read_actor(g, actor);
     std::sort(ports_.begin(), ports_.end(), [](const Port& a, const Port& b) {
       return a.actor != b.actor ? a.actor < b.actor : a.name < b.name;
@@ -62,6 +93,7 @@ class Sdf3Reader {
       if (p.channel < 0)
         fail(p.offset, "port '" + std::string(p.name) + "' of actor '" + g.actor_name(p.actor) +
                            "' is not connected to a channel");
+    if (const pugi::xml_node props = app.child("sdfProperties")) read_properties(g, props);
     return g;
   }
 
@@ -107,6 +139,10 @@ class Sdf3Reader {
     } catch (const Error& e) {
       fail(actor, e.what());
     }
+    if (const pugi::xml_attribute type = actor.attribute("type")) {
+      if (!valid_utf8(type.value())) fail(actor, "attribute 'type' is not valid UTF-8");
+      g.set_actor_type(id, type.value());
+    }
     for (pugi::xml_node port : actor.children("port")) {
       Port p;
       p.actor = id;
@@ -119,6 +155,15 @@ class Sdf3Reader {
       p.offset = static_cast<size_t>(std::max<ptrdiff_t>(0, port.offset_debug()));
       ports_.push_back(p);
     }
+  }
+
+  void read_properties(Graph& g, pugi::xml_node props) {
+    apply_properties(
+        g, props, [&](pugi::xml_node n, const std::string& m) { fail(n, m); },
+        [&](pugi::xml_node n, const char* attr) {
+          return number(n, attr, required(n, attr), false);
+        },
+        false);
   }
 
   Port& find_port(const Graph& g, pugi::xml_node ch, ActorId actor, std::string_view name) {
@@ -198,7 +243,76 @@ std::vector<std::pair<std::string, std::string>> port_names(const Graph& g) {
   return names;
 }
 
+// <sdfProperties>: the element as read, with every actor's execution time merged in (the graph's
+// time wins; it goes into the processor SDF3 would read it from, or a new default processor).
+void write_properties(const Graph& g, pugi::xml_node app) {
+  pugi::xml_document kept;
+  pugi::xml_node props;
+  if (!g.sdf3_properties.empty() &&
+      kept.load_buffer(g.sdf3_properties.data(), g.sdf3_properties.size(), pugi::parse_default,
+                       pugi::encoding_utf8) &&
+      kept.child("sdfProperties"))
+    props = app.append_copy(kept.child("sdfProperties"));
+  else
+    props = app.append_child("sdfProperties");
+  if (!g.has_actor_times()) return;
+  std::unordered_map<std::string_view, pugi::xml_node> by_actor;
+  for (pugi::xml_node ap : props.children("actorProperties"))
+    by_actor[ap.attribute("actor").value()] = ap;
+  for (ActorId a = 0; a < g.actor_count(); ++a) {
+    const std::optional<uint64_t> t = g.actor_time(a);
+    if (!t) continue;
+    pugi::xml_node ap;
+    if (auto it = by_actor.find(g.actor_name(a)); it != by_actor.end()) {
+      ap = it->second;
+    } else {
+      ap = props.append_child("actorProperties");
+      ap.append_attribute("actor") = g.actor_name(a).c_str();
+    }
+    pugi::xml_node chosen;
+    for (pugi::xml_node proc : ap.children("processor"))
+      if (proc.attribute("default")) chosen = proc;
+    if (!chosen) {
+      chosen = ap.append_child("processor");
+      chosen.append_attribute("type") = "default";
+      chosen.append_attribute("default") = "true";
+    }
+    pugi::xml_node et = chosen.child("executionTime");
+    if (!et) et = chosen.prepend_child("executionTime");
+    pugi::xml_attribute time = et.attribute("time");
+    if (!time) time = et.append_attribute("time");
+    time = static_cast<unsigned long long>(*t);
+  }
+}
+
 }  // namespace
+
+namespace detail {
+
+void read_sdf3_properties(Graph& g, std::string_view xml, const std::string& source) {
+  auto fail = [&](pugi::xml_node, const std::string& msg) {
+    throw Error(Error::Kind::input, source + ": sdf3_properties: " + msg);
+  };
+  pugi::xml_document doc;
+  const pugi::xml_parse_result res =
+      doc.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
+  if (!res) fail({}, std::string("XML: ") + res.description());
+  const pugi::xml_node props = doc.first_child();
+  if (std::string_view(props.name()) != "sdfProperties" || props.next_sibling())
+    fail({}, "is not one <sdfProperties> element");
+  auto number = [&](pugi::xml_node n, const char* attr) {
+    const std::string_view v = trim(n.attribute(attr).value());
+    uint64_t x = 0;
+    const auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+    if (v.empty() || ec != std::errc() || ptr != v.data() + v.size())
+      fail(n, "attribute " + std::string(attr) + "='" + std::string(v) +
+                  "' is not a non-negative 64-bit integer");
+    return x;
+  };
+  apply_properties(g, props, fail, number, true);
+}
+
+}  // namespace detail
 
 Graph read_sdf3(std::string_view text, const std::string& source) {
   Sdf3Reader reader(text, source);
@@ -220,11 +334,12 @@ std::string write_sdf3(const Graph& g) {
   app.append_attribute("name") = name.c_str();
   pugi::xml_node sdf = app.append_child("sdf");
   sdf.append_attribute("name") = name.c_str();
-  sdf.append_attribute("type") = name.c_str();
+  sdf.append_attribute("type") = (g.type.empty() ? name : g.type).c_str();
   for (ActorId a = 0; a < g.actor_count(); ++a) {
     pugi::xml_node actor = sdf.append_child("actor");
     actor.append_attribute("name") = g.actor_name(a).c_str();
-    actor.append_attribute("type") = g.actor_name(a).c_str();
+    const std::string& type = g.actor_type(a);
+    actor.append_attribute("type") = (type.empty() ? g.actor_name(a) : type).c_str();
     for (ChannelId c : adj.inputs(a)) {
       pugi::xml_node p = actor.append_child("port");
       p.append_attribute("name") = ports[c].second.c_str();
@@ -249,7 +364,7 @@ std::string write_sdf3(const Graph& g) {
     if (ch.delay != 0)
       e.append_attribute("initialTokens") = static_cast<unsigned long long>(ch.delay);
   }
-  app.append_child("sdfProperties");
+  write_properties(g, app);
   std::ostringstream out;
   doc.save(out, "  ", pugi::format_default, pugi::encoding_utf8);
   return out.str();

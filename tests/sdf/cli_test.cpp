@@ -163,6 +163,47 @@ TEST(SdfschedCli, ConvertRoundTrips) {
   EXPECT_NE(d.out.find("\"A\" -> \"B\""), std::string::npos);
 }
 
+TEST(SdfschedCli, ThroughputAndHsdf) {
+  const test::Cli j = test::sdfsched("throughput " + graph("timed_modem.xml") + " --json");
+  ASSERT_EQ(j.status, 0) << j.err;
+  const json t = json::parse(j.out);
+  EXPECT_EQ(t["throughput"], "1/4");
+  EXPECT_EQ(t["critical_cycle"].dump(), R"(["filt_0","filt_1","sink_0","src_0"])");
+  EXPECT_EQ(t["cycle_time"], 8);
+  EXPECT_EQ(t["cycle_tokens"], 2);
+  const test::Cli text = test::sdfsched("throughput " + graph("timed_modem.xml"));
+  EXPECT_EQ(text.out.substr(0, text.out.find('\n')),
+            "throughput: 1/4 iterations per time unit (0.25; one iteration every 4)");
+  for (const char* m : {"state-space", "mcm"})
+    EXPECT_EQ(json::parse(
+                  test::sdfsched("throughput " + graph("timed_modem.xml") + " --json --method " + m)
+                      .out)["throughput"],
+              "1/4");
+  // cd2dat has one time: the others need a default.
+  const test::Cli missing = test::sdfsched("throughput " + graph("cd2dat.xml"));
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_TRUE(one_line(missing.err));
+  EXPECT_NE(missing.err.find("actor 'B' has no execution time"), std::string::npos) << missing.err;
+  // An acyclic chain is unbounded; a deadlock is 0 and names the cycle without tokens.
+  EXPECT_EQ(
+      json::parse(test::sdfsched("throughput " + graph("cd2dat.xml") + " --json --default-time 1")
+                      .out)["throughput"],
+      "unbounded");
+  const json d = json::parse(
+      test::sdfsched("throughput " + graph("deadlock.json") + " --json --default-time 1").out);
+  EXPECT_EQ(d["throughput"], "0");
+  EXPECT_FALSE(d["deadlock_cycle"].empty());
+  // The expansion: one actor per firing, consistent with q = 1 everywhere.
+  const std::string out = test::temp_path("h.json");
+  ASSERT_EQ(
+      test::sdfsched("convert " + graph("timed_modem.xml") + " --to hsdf -o '" + out + "'").status,
+      0);
+  const test::Cli q = test::sdfsched("repetitions '" + out + "' --json");
+  std::remove(out.c_str());
+  EXPECT_EQ(json::parse(q.out)["repetitions"].dump(),
+            R"({"filt_0":1,"filt_1":1,"sink_0":1,"src_0":1})");
+}
+
 TEST(SdfschedCli, BadInputAndUsage) {
   struct Case {
     std::string args;

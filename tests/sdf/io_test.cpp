@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -47,7 +48,9 @@ std::string json_error(const std::string& text) {
 bool same_graph(const Graph& a, const Graph& b) {
   if (a.actor_count() != b.actor_count() || a.channel_count() != b.channel_count()) return false;
   for (ActorId x = 0; x < a.actor_count(); ++x)
-    if (a.actor_name(x) != b.actor_name(x)) return false;
+    if (a.actor_name(x) != b.actor_name(x) || a.actor_time(x) != b.actor_time(x) ||
+        (!a.actor_type(x).empty() && a.actor_type(x) != b.actor_type(x)))
+      return false;
   for (ChannelId c = 0; c < a.channel_count(); ++c) {
     const Channel &p = a.channel(c), &q = b.channel(c);
     if (p.src != q.src || p.dst != q.dst || p.prd != q.prd || p.cns != q.cns ||
@@ -231,10 +234,14 @@ std::string outcome(const std::function<Graph()>& read) {
     const Graph g = read();
     std::string out = "graph '" + g.name + "':";
     for (ActorId a = 0; a < g.actor_count(); ++a) out += " " + g.actor_name(a);
+    for (ActorId a = 0; a < g.actor_count(); ++a)
+      out += " " + g.actor_name(a) + ":" + g.actor_type(a) + ":" +
+             (g.actor_time(a) ? std::to_string(*g.actor_time(a)) : "-");
     for (const Channel& c : g.channels())
       out += " [" + std::to_string(c.src) + ">" + std::to_string(c.dst) + " " +
              std::to_string(c.prd) + "/" + std::to_string(c.cns) + "+" + std::to_string(c.delay) +
-             " " + c.name + "]";
+             " " + c.name + " " + c.src_port + " " + c.dst_port + "]";
+    out += " props " + g.sdf3_properties;
     return out;
   } catch (const Error& e) {
     return std::string("error: ") + e.what();
@@ -316,6 +323,113 @@ TEST(Writers, RoundTripRandomGraphsThroughBothFormats) {
     // Port names invented on the first write are kept by the second.
     EXPECT_EQ(write_sdf3(x), write_sdf3(read_sdf3(write_sdf3(x)))) << i;
   }
+}
+
+// Everything read comes back: names, ports, actor types, execution times and the rest of
+// <sdfProperties>, through SDF3, JSON and JSON-then-SDF3, for every graph file of the tests.
+TEST(Writers, ConvertLosesNothingOnEveryDataFile) {
+  int files = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(test::data(""))) {
+    const std::string ext = entry.path().extension().string();
+    if (ext != ".xml" && ext != ".json") continue;
+    Graph g;
+    try {
+      g = read_graph_file(entry.path().string());
+    } catch (const Error&) {
+      continue;  // the files of the error tests
+    }
+    ++files;
+    const std::string name = entry.path().filename().string();
+    auto check = [&](const Graph& back, const char* route) {
+      EXPECT_TRUE(same_graph(g, back)) << name << " via " << route;
+      if (!g.name.empty()) {  // SDF3 needs a name: an unnamed graph is written as "graph"
+        EXPECT_EQ(g.name, back.name) << name << " via " << route;
+        EXPECT_EQ(g.type.empty() ? g.name : g.type, back.type.empty() ? back.name : back.type)
+            << name << " via " << route;
+      }
+      for (ChannelId c = 0; c < g.channel_count(); ++c) {
+        if (g.channel(c).src_port.empty()) continue;  // invented on write
+        EXPECT_EQ(g.channel(c).src_port, back.channel(c).src_port) << name << " via " << route;
+        EXPECT_EQ(g.channel(c).dst_port, back.channel(c).dst_port) << name << " via " << route;
+      }
+      if (!g.sdf3_properties.empty()) {
+        EXPECT_EQ(g.sdf3_properties, back.sdf3_properties) << name << " via " << route;
+      }
+    };
+    check(read_sdf3(write_sdf3(g)), "sdf3");
+    check(read_json(write_json(g)), "json");
+    check(read_sdf3(write_sdf3(read_json(write_json(g)))), "json, sdf3");
+    const std::string x = write_sdf3(g);
+    EXPECT_EQ(x, write_sdf3(read_sdf3(x))) << name;
+  }
+  EXPECT_GE(files, 10);
+}
+
+TEST(Sdf3Reader, ReadsExecutionTimesBySdf3sRule) {
+  const Graph g = read_graph_file(test::data("timed_modem.xml"));
+  // src: its only processor is the default; filt: default='false' still counts (the attribute
+  // is there); sink: the last of two defaults.
+  EXPECT_EQ(g.actor_time(*g.find_actor("src")), 3u);
+  EXPECT_EQ(g.actor_time(*g.find_actor("filt")), 2u);
+  EXPECT_EQ(g.actor_time(*g.find_actor("sink")), 1u);
+  EXPECT_EQ(g.actor_type(*g.find_actor("filt")), "Filter");
+  EXPECT_NE(g.sdf3_properties.find("<tokenSize sz=\"32\""), std::string::npos);
+  // Without a processor carrying `default`, no time.
+  const Graph h = read_sdf3(
+      "<sdf3 type='sdf'><applicationGraph><sdf name='g'><actor name='A'/></sdf><sdfProperties>"
+      "<actorProperties actor='A'><processor type='p'><executionTime time='4'/></processor>"
+      "</actorProperties></sdfProperties></applicationGraph></sdf3>");
+  EXPECT_FALSE(h.actor_time(0));
+  // A time written into a graph that had none goes where SDF3 reads it.
+  Graph k = h;
+  k.set_actor_time(0, 9);
+  EXPECT_EQ(read_sdf3(write_sdf3(k)).actor_time(0), 9u);
+  EXPECT_EQ(
+      sdf3_error("<sdf3 type='sdf'><applicationGraph><sdf name='g'><actor name='A'/></sdf>"
+                 "<sdfProperties><actorProperties actor='Z'/></sdfProperties></applicationGraph>"
+                 "</sdf3>"),
+      "f.xml:1: <actorProperties> names an unknown actor 'Z'");
+  EXPECT_EQ(sdf3_error("<sdf3 type='sdf'><applicationGraph><sdf name='g'><actor name='A'/></sdf>"
+                       "<sdfProperties><actorProperties actor='A'><processor default='1'>"
+                       "<executionTime time='-1'/></processor></actorProperties>"
+                       "</sdfProperties></applicationGraph></sdf3>"),
+            "f.xml:1: attribute time='-1' is not a non-negative 64-bit integer");
+}
+
+TEST(JsonReader, ReadsTimesTypesAndPorts) {
+  const Graph g = read_json(
+      R"({"actors": [{"time": 3, "name": "A", "type": "fir"}, {"name": "B"}],
+          "channels": [{"src": "A", "dst": "B", "prd": 1, "cns": 1, "src_port": "o"}]})");
+  EXPECT_EQ(g.actor_time(0), 3u);
+  EXPECT_FALSE(g.actor_time(1));
+  EXPECT_EQ(g.actor_type(0), "fir");
+  EXPECT_EQ(g.channel(0).src_port, "o");
+  // sdf3_properties: times for actors without "time", by SDF3's rule; "time" wins.
+  const Graph p = read_json(
+      R"({"actors": [{"name": "A", "time": 3}, {"name": "B"}], "sdf3_properties":
+          "<sdfProperties><actorProperties actor='A'><processor default='1'><executionTime time='8'/></processor></actorProperties><actorProperties actor='B'><processor default='1'><executionTime time='6'/></processor></actorProperties></sdfProperties>"})");
+  EXPECT_EQ(p.actor_time(0), 3u);
+  EXPECT_EQ(p.actor_time(1), 6u);
+  EXPECT_EQ(read_sdf3(write_sdf3(p)).actor_time(0), 3u);
+  EXPECT_EQ(json_error(R"({"actors": [{"name": "A"}], "sdf3_properties": "<sdfProperties>"})"),
+            "f.json: sdf3_properties: XML: Start-end tags mismatch");
+  EXPECT_EQ(json_error(R"({"actors": [{"name": "A"}], "sdf3_properties": "<x/>"})"),
+            "f.json: sdf3_properties: is not one <sdfProperties> element");
+  EXPECT_EQ(json_error(R"({"actors": [{"name": "A"}], "sdf3_properties":
+                 "<sdfProperties><actorProperties actor='Q'/></sdfProperties>"})"),
+            "f.json: sdf3_properties: <actorProperties> names an unknown actor 'Q'");
+  EXPECT_EQ(json_error(R"({"actors": [{"name": "A", "time": -2}]})"),
+            "f.json: actors[0].time: must not be negative");
+  EXPECT_EQ(json_error(R"({"actors": [{"name": "A", "time": 1.5}]})"),
+            "f.json: actors[0].time: '1.5' is not an integer below 2^63");
+  EXPECT_EQ(json_error(R"({"actors": [{"name": "A", "time": 9223372036854775808}]})"),
+            "f.json: actors[0].time: must be below 2^63");
+  EXPECT_EQ(json_error(R"({"actors": [{"name": "A", "name": "B"}]})"),
+            "f.json: actors[0]: duplicate field 'name'");
+  EXPECT_EQ(json_error(R"({"actors": [{"name": "A"}, {"name": "B"}], "channels": [
+              {"src": "A", "dst": "B", "prd": 1, "cns": 1, "src_port": "o"},
+              {"src": "A", "dst": "B", "prd": 1, "cns": 1, "src_port": "o"}]})"),
+            "f.json: channels[1].src_port: actor 'A' already has a port 'o'");
 }
 
 TEST(Writers, KeepsSdf3NamesAndWritesDot) {

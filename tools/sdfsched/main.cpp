@@ -19,6 +19,7 @@
 #include "sdf/rates.hpp"
 #include "sdf/repetitions.hpp"
 #include "sdf/schedule.hpp"
+#include "sdf/throughput.hpp"
 
 namespace {
 
@@ -416,10 +417,73 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
   return status;
 }
 
+int cmd_throughput(const std::string& path, const std::string& method,
+                   std::optional<uint64_t> default_time, bool json) {
+  const sdf::Graph g = read_graph(path);
+  const Consistency c = consistency(g, json);
+  if (c.status) return c.status;
+  // The state space gives the value (SDF3's method); the cycle-ratio analysis names the
+  // critical cycle and, under auto, checks the value.
+  std::optional<sdf::Throughput> ss, mcm;
+  if (method != "mcm") ss = sdf::throughput_state_space(g, default_time);
+  if (method != "state-space") {
+    try {
+      mcm = sdf::throughput_mcm(g, default_time);
+    } catch (const Error& e) {
+      if (method == "mcm" || e.kind() == Error::Kind::overflow) throw;
+      std::cerr << "sdfsched: note: no critical cycle: " << e.what() << "\n";
+    }
+  }
+  if (ss && mcm && ss->str() != mcm->str())
+    throw std::logic_error("throughput: the state space gives " + ss->str() +
+                           " but the cycle ratio " + mcm->str());
+  const sdf::Throughput& t = ss ? *ss : *mcm;
+  if (json) {
+    Json j;
+    j["throughput"] = t.str();
+    j["critical_cycle"] =
+        mcm && !mcm->critical_cycle.empty() ? Json(mcm->critical_cycle) : Json(nullptr);
+    if (mcm && !mcm->critical_cycle.empty()) {
+      j["cycle_time"] = mcm->cycle_time;
+      j["cycle_tokens"] = mcm->cycle_tokens;
+    }
+    if (mcm && !mcm->deadlock_cycle.empty()) j["deadlock_cycle"] = mcm->deadlock_cycle;
+    if (ss) j["states"] = ss->states;
+    print_json(j);
+    return 0;
+  }
+  std::cout << "throughput: " << t.str();
+  if (!t.unbounded && t.num != 0)
+    std::cout << " iterations per time unit ("
+              << static_cast<double>(t.num) / static_cast<double>(t.den) << "; one iteration every "
+              << static_cast<double>(t.den) / static_cast<double>(t.num) << ")";
+  if (t.unbounded) std::cout << " (no cycle with execution time constrains the graph)";
+  if (!t.unbounded && t.num == 0) std::cout << " (the graph deadlocks)";
+  std::cout << "\n";
+  auto chain = [](const std::vector<std::string>& v) {
+    std::string s;
+    for (const std::string& f : v) s += f + " -> ";
+    return s + (v.empty() ? "" : v.front());
+  };
+  if (mcm && !mcm->critical_cycle.empty())
+    std::cout << "critical cycle: " << chain(mcm->critical_cycle) << " (time " << mcm->cycle_time
+              << ", tokens " << mcm->cycle_tokens << ")\n";
+  if (mcm && !mcm->deadlock_cycle.empty())
+    std::cout << "cycle without tokens: " << chain(mcm->deadlock_cycle) << "\n";
+  if (ss) std::cout << "states explored: " << ss->states << "\n";
+  return 0;
+}
+
 int cmd_convert(const std::string& path, const std::string& to, const std::string& out) {
   const sdf::Graph g = read_graph(path);
-  const std::string text =
-      to == "json" ? sdf::write_json(g) : (to == "dot" ? sdf::write_dot(g) : sdf::write_sdf3(g));
+  auto by_output = [&](const sdf::Graph& h) {
+    const bool as_json = out.size() >= 5 && out.compare(out.size() - 5, 5, ".json") == 0;
+    return as_json ? sdf::write_json(h) : sdf::write_sdf3(h);
+  };
+  const std::string text = to == "json"   ? sdf::write_json(g)
+                           : to == "dot"  ? sdf::write_dot(g)
+                           : to == "hsdf" ? by_output(sdf::to_hsdf(g))
+                                          : sdf::write_sdf3(g);
   if (out.empty() || out == "-") {
     std::cout << text;
     return 0;
@@ -543,11 +607,28 @@ int main(int argc, char** argv) {
 
   auto* conv = app.add_subcommand("convert", "write the graph as SDF3 XML, JSON or DOT");
   conv->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
-  conv->add_option("--to", to, "sdf3, json or dot")
+  conv->add_option("--to", to,
+                   "sdf3, json, dot, or hsdf (the homogeneous expansion, as SDF3 XML or as JSON "
+                   "when the output file ends in .json)")
       ->required()
-      ->check(CLI::IsMember({"sdf3", "json", "dot"}));
+      ->check(CLI::IsMember({"sdf3", "json", "dot", "hsdf"}));
   conv->add_option("-o,--output", out, "output file (default: standard output)");
   conv->callback([&] { action = [&] { return cmd_convert(graph, to, out); }; });
+
+  std::string method = "auto";
+  std::optional<uint64_t> default_time;
+  auto* thr = app.add_subcommand(
+      "throughput", "iterations per time unit of self-timed execution, and a critical cycle");
+  thr->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph with execution times")
+      ->required();
+  thr->add_option("--method", method,
+                  "state-space (SDF3's), mcm (maximum cycle ratio of the HSDF expansion) or auto "
+                  "(both; they must agree)")
+      ->check(CLI::IsMember({"auto", "state-space", "mcm"}));
+  thr->add_option("--default-time", default_time, "execution time of actors that have none");
+  thr->add_flag("--json", json, "JSON output");
+  thr->callback(
+      [&] { action = [&] { return cmd_throughput(graph, method, default_time, json); }; });
 
   uint64_t graphs = 100, seed = 1;
   std::string save;

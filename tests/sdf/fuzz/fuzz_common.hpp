@@ -12,17 +12,21 @@
 #include "sdf/online.hpp"
 #include "sdf/repetitions.hpp"
 #include "sdf/schedule.hpp"
+#include "sdf/throughput.hpp"
 
 namespace sdf::fuzz {
 
 inline bool same(const Graph& a, const Graph& b) {
   if (a.actor_count() != b.actor_count() || a.channel_count() != b.channel_count()) return false;
   for (ActorId x = 0; x < a.actor_count(); ++x)
-    if (a.actor_name(x) != b.actor_name(x)) return false;
+    if (a.actor_name(x) != b.actor_name(x) || a.actor_time(x) != b.actor_time(x) ||
+        (!a.actor_type(x).empty() && a.actor_type(x) != b.actor_type(x)))
+      return false;
   for (ChannelId c = 0; c < a.channel_count(); ++c) {
     const Channel &p = a.channel(c), &q = b.channel(c);
     if (p.src != q.src || p.dst != q.dst || p.prd != q.prd || p.cns != q.cns ||
-        p.delay != q.delay || p.name != q.name)
+        p.delay != q.delay || p.name != q.name ||
+        (!p.src_port.empty() && (p.src_port != q.src_port || p.dst_port != q.dst_port)))
       return false;
   }
   return true;
@@ -39,6 +43,27 @@ inline void exercise(Graph (*read)(std::string_view, const std::string&), std::s
   if (!same(g, read_json(write_json(g), "json")) || !same(g, read_sdf3(write_sdf3(g), "sdf3")))
     std::abort();
   (void)write_dot(g);
+  // Timed analyses on small graphs, with a default time for actors without one: the two
+  // throughput methods must agree.
+  try {
+    if (g.actor_count() <= 16) {
+      ThroughputLimits lim;
+      lim.max_states = 20000;
+      lim.max_hsdf_size = 5000;
+      lim.max_token_graph = 1'000'000;
+      std::string ss, mcm;
+      try {
+        ss = throughput_state_space(g, 1, lim).str();
+      } catch (const Error&) {
+      }
+      try {
+        mcm = throughput_mcm(g, 1, lim).str();
+      } catch (const Error&) {
+      }
+      if (!ss.empty() && !mcm.empty() && ss != mcm) std::abort();
+    }
+  } catch (const Error&) {
+  }
   try {
     const Repetitions r = compute_repetitions(g);
     if (!r.consistent || g.actor_count() > 64) return;
