@@ -149,6 +149,27 @@ TEST(SdfschedCli, SimulateRateChange) {
   EXPECT_EQ(json::parse(inc.out)["consistent_after"], false);
 }
 
+// After a deadlock the text says there is no period, as the JSON form says null.
+TEST(SdfschedCli, SimulateTextAgreesWithJsonAfterADeadlock) {
+  const std::string g = test::temp_path("cyc.json");
+  {
+    std::ofstream f(g);
+    f << R"({"actors": [{"name": "A"}, {"name": "B"}], "channels": [{"src": "A", "dst": "B",
+          "prd": 1, "cns": 1}, {"src": "B", "dst": "A", "prd": 1, "cns": 1, "delay": 1}]})";
+  }
+  const test::Cli j = test::sdfsched("simulate '" + g + "' --rate-change A:2/2@0 --json");
+  const test::Cli t = test::sdfsched("simulate '" + g + "' --rate-change A:2/2@0");
+  std::remove(g.c_str());
+  EXPECT_EQ(j.status, 1);
+  EXPECT_EQ(t.status, 1);
+  const json r = json::parse(j.out);
+  EXPECT_EQ(r["outcome"], "deadlock");
+  EXPECT_TRUE(r["firings_until_periodic"].is_null());
+  EXPECT_NE(t.out.find("firings until periodic again: none (not periodic)\nperiod after: none\n"),
+            std::string::npos)
+      << t.out;
+}
+
 TEST(SdfschedCli, ConvertRoundTrips) {
   const std::string out = test::temp_path("g.xml");
   const test::Cli x =

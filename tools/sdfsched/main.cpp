@@ -388,9 +388,16 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
       std::cout << "stuck:" << stuck << "\n";
     }
     if (r.channel) std::cout << "growing channel: " << describe_channel(g2, *r.channel) << "\n";
-    std::cout << "firings until periodic again: " << r.firings_until_periodic
-              << "\nperiod after: " << r.period_firings << " firings ("
-              << (r.period_valid ? "valid" : "not valid or not checked") << ")\nbuffers:";
+    // As in the JSON form: the transient and period exist only when the run became periodic.
+    const bool periodic = r.outcome == sdf::Outcome::returns || r.outcome == sdf::Outcome::periodic;
+    if (periodic)
+      std::cout << "firings until periodic again: " << r.firings_until_periodic
+                << "\nperiod after: " << r.period_firings << " firings ("
+                << (r.period_checked ? (r.period_valid ? "valid" : "NOT VALID") : "not checked")
+                << ")\n";
+    else
+      std::cout << "firings until periodic again: none (not periodic)\nperiod after: none\n";
+    std::cout << "buffers:";
     for (sdf::ChannelId ch = 0; ch < g.channel_count(); ++ch) {
       std::cout << " " << g.channel(ch).name << "=" << r.buffers_before[ch] << "->";
       std::cout << (r.buffers_after.empty() ? std::string("?")
