@@ -407,34 +407,40 @@ class Scanner {
     out = v;
     return true;
   }
-  // Actor objects: "name" with an optional "type" and "time", in any order.
+  // One object of known fields in any order, each at most once: field(key) reads the value and
+  // returns the field's bit, 0 for an unknown key or a value outside the plain form.
+  template <class Field>
+  bool object(Field&& field, unsigned& seen) {
+    if (!skip_to('{')) return false;
+    seen = 0;
+    do {
+      std::string_view k;
+      if (!string(k) || !skip_to(':')) return false;
+      const unsigned bit = field(k);
+      if (bit == 0 || (seen & bit)) return false;
+      seen |= bit;
+    } while (peek_is(','));
+    return skip_to('}');
+  }
+  // A name as the plain form has it: not empty, no white space at either end.
+  bool name(std::string_view& out) { return string(out) && !out.empty() && !padded(out); }
+
+  // Actor objects: "name" with an optional "type" and "time".
   bool actors(Parsed& out) {
     if (!skip_to('[')) return false;
     if (peek_is(']')) return true;
     do {
-      if (!skip_to('{')) return false;
-      std::string_view name, type;
+      std::string_view actor, type;
       uint64_t time = kNoTime;
-      unsigned seen = 0;
-      do {
-        std::string_view k;
-        if (!string(k) || !skip_to(':')) return false;
-        unsigned bit;
-        bool ok;
-        if (k == "name") {
-          bit = 1, ok = string(name) && !name.empty() && !padded(name);
-        } else if (k == "type") {
-          bit = 2, ok = string(type);
-        } else if (k == "time") {
-          bit = 4, ok = number(time) && time < kTimeLimit;
-        } else {
-          return false;
-        }
-        if (!ok || (seen & bit)) return false;
-        seen |= bit;
-      } while (peek_is(','));
-      if (!(seen & 1) || !skip_to('}')) return false;
-      out.actors.push_back(name);
+      unsigned seen;
+      auto field = [&](std::string_view k) -> unsigned {
+        if (k == "name") return name(actor) ? 1 : 0;
+        if (k == "type") return string(type) ? 2 : 0;
+        if (k == "time") return number(time) && time < kTimeLimit ? 4 : 0;
+        return 0;
+      };
+      if (!object(field, seen) || !(seen & 1)) return false;
+      out.actors.push_back(actor);
       if (seen & 2) {
         out.actor_types.resize(out.actors.size());
         out.actor_types.back() = type;
@@ -450,37 +456,20 @@ class Scanner {
     if (!skip_to('[')) return false;
     if (peek_is(']')) return true;
     do {
-      if (!skip_to('{')) return false;
       ChannelView c;
-      unsigned seen = 0;
-      do {
-        std::string_view k;
-        if (!string(k) || !skip_to(':')) return false;
-        unsigned bit;
-        bool ok;
-        if (k == "src") {
-          bit = 1, ok = string(c.src);
-        } else if (k == "dst") {
-          bit = 2, ok = string(c.dst);
-        } else if (k == "prd") {
-          bit = 4, ok = number(c.prd) && c.prd != 0;
-        } else if (k == "cns") {
-          bit = 8, ok = number(c.cns) && c.cns != 0;
-        } else if (k == "delay") {
-          bit = 16, ok = number(c.delay);
-        } else if (k == "name") {
-          bit = 32, ok = string(c.name) && !c.name.empty() && !padded(c.name);
-        } else if (k == "src_port") {
-          bit = 64, ok = string(c.src_port) && !c.src_port.empty() && !padded(c.src_port);
-        } else if (k == "dst_port") {
-          bit = 128, ok = string(c.dst_port) && !c.dst_port.empty() && !padded(c.dst_port);
-        } else {
-          return false;
-        }
-        if (!ok || (seen & bit)) return false;
-        seen |= bit;
-      } while (peek_is(','));
-      if ((seen & 15) != 15 || !skip_to('}')) return false;
+      unsigned seen;
+      auto field = [&](std::string_view k) -> unsigned {
+        if (k == "src") return string(c.src) ? 1 : 0;
+        if (k == "dst") return string(c.dst) ? 2 : 0;
+        if (k == "prd") return number(c.prd) && c.prd != 0 ? 4 : 0;
+        if (k == "cns") return number(c.cns) && c.cns != 0 ? 8 : 0;
+        if (k == "delay") return number(c.delay) ? 16 : 0;
+        if (k == "name") return name(c.name) ? 32 : 0;
+        if (k == "src_port") return name(c.src_port) ? 64 : 0;
+        if (k == "dst_port") return name(c.dst_port) ? 128 : 0;
+        return 0;
+      };
+      if (!object(field, seen) || (seen & 15) != 15) return false;
       out.channels.push_back(c);
     } while (peek_is(','));
     return skip_to(']');
