@@ -65,13 +65,22 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
       double px = 0, py = 0;  // preferred velocity
       if (idle(t, i)) {
         const Goal& g = goals[t.goal[i]];
-        if (!demand.empty() && demand[t.goal[i]] > 0) {
-          // Standing on (or touching) a goal area others still need: step off it.
-          const bool on =
-              g.is_polygon()
-                  ? inside_goal(g, t.x[i], t.y[i]) ||
-                        dist2_to_boundary(g.area, t.x[i], t.y[i]) < t.radius[i] * t.radius[i]
-                  : std::hypot(g.x - t.x[i], g.y - t.y[i]) < g.arrival_radius + t.radius[i];
+        if (!demand.empty() && demand[t.goal[i]] > 0 && g.is_polygon()) {
+          // An area others still head for: walk on into it, towards its inner point (where the
+          // disc fits nearest to it), so that its edge stays free for those coming. Stepping off
+          // the area instead put the first arrivals in the doorway the others came through
+          // (Menge's maze example: 8 of 30 locked out for good).
+          const Vec2 aim = goal_target(g, g.x, g.y, t.radius[i]);
+          const double dx = aim.x - t.x[i], dy = aim.y - t.y[i];
+          const double len = std::sqrt(dx * dx + dy * dy);
+          if (len > t.radius[i]) {
+            const double s = std::min(0.5 * t.pref_speed[i], len / dt);
+            px = s * dx / len;
+            py = s * dy / len;
+          }
+        } else if (!demand.empty() && demand[t.goal[i]] > 0) {
+          // Standing on (or touching) a goal disc others still need: step off it.
+          const bool on = std::hypot(g.x - t.x[i], g.y - t.y[i]) < g.arrival_radius + t.radius[i];
           if (on) {
             double dx = t.x[i] - g.x, dy = t.y[i] - g.y;
             double len = std::sqrt(dx * dx + dy * dy);

@@ -43,9 +43,10 @@ double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i
 // - a stalemate action in progress (yield or sidestep: StallAction) replaces the direction;
 // - an agent frozen nudge_after seconds in a row turns it by a seeded 45-90 degrees;
 // - a tiny seeded perturbation (steering.perturbation) breaks exact symmetries.
-// Idle (arrived) agents prefer to stand still, unless they stand on a goal area that `demand`
-// (active agents per goal row; empty when arrivals do not idle) says others still head for:
-// then they step off it, away from the goal's point, at half their preferred speed.
+// Idle (arrived) agents prefer to stand still, unless `demand` (active agents per goal row;
+// empty when arrivals do not idle) says others still head for their goal: at a polygon goal they
+// walk on into the area towards its inner point (its edge stays free for those coming), at a
+// disc goal they step off the disc, away from its centre; both at half their preferred speed.
 // Waypoint following: with `nav` (and skip_visible, every sight interval per agent), an agent whose
 // waypoint after the current one is in sight steers at that one and records the skip.
 void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,

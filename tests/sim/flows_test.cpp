@@ -63,6 +63,24 @@ TEST(Goals, IdleArrivalsMakeRoomAndLaterOnesJoinThem) {
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a.state[i], AgentState::arrived);
 }
 
+TEST(Goals, IdleArrivalsWalkIntoAnAreaAndKeepItsEdgeFree) {
+  // A box goal 1 m beyond a 1 m gap in a wall. Arrivals that stepped off the box stood in the
+  // strip between the gap and the box and locked the later ones out (14 of 30 arrived when
+  // measured); walking on into the box they leave its edge free and everyone gets in.
+  Loaded r(R"({"bounds": [0, 0, 30, 30], "duration": 120, "arrival": "idle",
+    "obstacles": [{"type": "polygon", "vertices": [[0, 8], [14.5, 8], [14.5, 10], [0, 10]]},
+                  {"type": "polygon", "vertices": [[15.5, 8], [30, 8], [30, 10], [15.5, 10]]}],
+    "navigation": {"enabled": true},
+    "goals": [{"name": "box", "area": [[12, 11], [18, 11], [18, 16], [12, 16]]}],
+    "groups": [{"count": 30, "radius": 0.25, "goal": "box",
+                "placement": {"type": "uniform", "region": [1, 1, 29, 7], "gap": 0.1}}]})");
+  for (uint64_t t = 0; t < r.sc.ticks; ++t) EXPECT_EQ(r.sim->step().overlapping_pairs, 0u);
+  EXPECT_EQ(r.sim->arrived_total(), 30u);
+  // Nobody idles in the gap itself.
+  const AgentTable& a = r.sim->world().agents();
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_FALSE(a.y[i] < 10 && a.y[i] > 8);
+}
+
 TEST(Sources, LetAgentsInAtTheirRateUntilCountOrEnd) {
   Loaded r(R"({"bounds": [0, 0, 60, 20], "duration": 30,
     "goals": [{"name": "out", "area": [[59, 0], [60, 0], [60, 20], [59, 20]]}, {"name": "b", "x": 50, "y": 10}],

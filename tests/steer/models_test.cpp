@@ -161,6 +161,29 @@ TEST(Orca, AWalkerIsNotSweptBackwardsByAGroup) {
   EXPECT_LT(on.arrival_tick, off.arrival_tick);
 }
 
+// 80 discs of radius 0.5 m head for one point and leave there (SteerSuite's squeeze cases in
+// small). With the full 2 s horizon they stood in a ring around the point, each kept out by the
+// people across the ring it would only meet after arriving: the last arrived after 132 s, with
+// 479 stalls. The arrival horizon lets them walk in one after another.
+TEST(Orca, ACrowdConvergingOnAPointThatRemovesArrivalsKeepsFlowing) {
+  const std::string text = R"({"bounds": [0, 0, 40, 30], "duration": 240, "arrival": "remove",
+    "goals": [{"name": "exit", "x": 5, "y": 15, "arrival_radius": 0.5}],
+    "groups": [{"count": 80, "radius": 0.5, "pref_speed": 1.3, "goal": "exit",
+                "placement": {"type": "uniform", "region": [15, 5, 35, 25], "gap": 0.1}}]})";
+  Scenario sc = parse_scenario(text, "t.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  uint64_t tick = 0, stalled = 0;
+  while (!sim.world().agents().empty() && tick < sc.ticks) {
+    const TickMetrics& m = sim.step();
+    EXPECT_EQ(m.overlapping_pairs, 0u);
+    stalled += m.stalled;
+    ++tick;
+  }
+  EXPECT_EQ(sim.arrived_total(), 80u);
+  EXPECT_LT(static_cast<double>(tick) * sc.config.dt, 70.0);  // measured: 48.4 s
+  EXPECT_LT(stalled, 50u);                                     // measured: 0 agent-ticks
+}
+
 // ORCA's contact planes keep the crowd overlap-free by themselves: the backoff finds nothing.
 TEST(Orca, TheBackoffHasNothingToDoAndEveryoneArrives) {
   std::size_t frozen = 0, arrived = 0;
