@@ -116,8 +116,10 @@ struct Bounds {
 // What a stalled agent is doing about it (src/sim/stalemate.hpp).
 enum class StallAction : uint8_t {
   none = 0,
-  yield = 1,     // steps aside for a neighbour of higher priority
-  sidestep = 2,  // walks off at an angle, no neighbour to yield to (or it has priority)
+  yield = 1,        // steps aside for a neighbour of higher priority
+  sidestep = 2,     // walks off at an angle, no neighbour to yield to (or it has priority)
+  yield_ahead = 3,  // yields in a jam of people going its way (src/sim/stalemate.hpp): steps
+                    // back as `yield` does, and goes first in orca so the people behind make room
 };
 
 // The agents table: structure-of-arrays columns, one entry per dense row. Columns are public

@@ -119,7 +119,7 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
         py = s * dy / dist;
       }
       if (t.stall_action[i] != StallAction::none && tick < t.stall_until[i]) {
-        const double s = t.pref_speed[i] * (t.stall_action[i] == StallAction::yield ? 0.5 : 1.0);
+        const double s = t.pref_speed[i] * (t.stall_action[i] == StallAction::sidestep ? 1.0 : 0.5);
         px = s * t.stall_dir_x[i];
         py = s * t.stall_dir_y[i];
       }

@@ -64,6 +64,15 @@
 // yield still steps back. Measured (docs/steering.md): the verification cases' longest stall
 // 21.5 -> 13.9 s, airport-5000's 22.9 -> 17.2 s, not-simple-obstacle-example's 86 -> 11 s.
 //
+// Yielding goes first (ours): the stalemate stage (src/sim/stalemate.hpp) resolves two stalled
+// agents blocking each other by having one step back for a moment. That step needs room, and
+// in a packed crowd the room is behind the yielding agent, where the people often had the right
+// of way over it and stood their ground: the yield went nowhere, and an arch in front of a door
+// stood for good (SteerSuite's bottleneck-evacuation, 200 people heading through one door for
+// ten goals: 20 got through). So an agent yielding goes first against everyone who is not: the
+// people behind it make way as they would for anyone going first, and the room travels back
+// through the crowd. With it 191 of the 200 get through in the 600 s.
+//
 // Arrival horizon (ours): the planes assume each velocity is kept for time_horizon, but an agent
 // that reaches its last goal within that time stops there or leaves. Agents converging on one
 // goal point stood in a ring around it for minutes, each forbidden to walk in by the people on
@@ -201,14 +210,18 @@ class OrcaModel final : public Model {
     infeasible_.assign(chunks, 0);
     const double hi_share = p.first_share;
     log.timed("ORCA linear programs", n, [&] {
-      // Priority: the agent with less of its path left goes first; idle agents come last.
+      // Priority: agents yielding to a stalemate first, then the one with less of its path left;
+      // idle agents come last.
       remaining_.resize(n);
       arrive_.resize(n);
+      yielding_.resize(n);
       rank_.resize(n);
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
           remaining_[i] =
               t.state[i] == AgentState::arrived ? INFINITY : sim::path_left(t, in.goals, i);
+          yielding_[i] =
+              t.stall_action[i] == StallAction::yield_ahead && in.tick < t.stall_until[i];
           arrive_[i] = arrival_time(in, i);
           uint64_t h = in.cfg.seed ^ (t.id[i] * 0x9e3779b97f4a7c15ull);
           rank_[i] = splitmix64(h);
@@ -392,8 +405,10 @@ class OrcaModel final : public Model {
     return d / t.pref_speed[i];
   }
 
-  // Does i go before j? Less path left, then the seeded rank.
+  // Does i go before j? An agent yielding to a stalemate (see the top), then less path left, then
+  // the seeded rank.
   bool first(std::size_t i, std::size_t j) const {
+    if (yielding_[i] != yielding_[j]) return yielding_[i];
     return remaining_[i] < remaining_[j] || (remaining_[i] == remaining_[j] && rank_[i] > rank_[j]);
   }
   NeighbourLists nb_;
@@ -401,6 +416,7 @@ class OrcaModel final : public Model {
   std::vector<double> reach_;
   std::vector<double> remaining_;
   std::vector<double> arrive_;
+  std::vector<uint8_t> yielding_;
   std::vector<uint64_t> rank_;
   std::vector<uint64_t> infeasible_;
   std::map<std::string, std::unique_ptr<NeighbourPath>> neighbour_paths_;

@@ -560,7 +560,7 @@ void World::restore_agents(ByteReader& in) {
   for (std::size_t r = 0; r < a.size(); ++r) {
     const std::string row = "row " + std::to_string(r);
     if (static_cast<uint8_t>(a.state[r]) > 2) bad(row + ": bad state");
-    if (static_cast<uint8_t>(a.stall_action[r]) > 2) bad(row + ": bad stall action");
+    if (static_cast<uint8_t>(a.stall_action[r]) > 3) bad(row + ": bad stall action");
     AgentSpec spec;  // the rules an inserted agent obeys
     spec.x = a.x[r];
     spec.y = a.y[r];
