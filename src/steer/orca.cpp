@@ -71,7 +71,7 @@
 // stood for good (SteerSuite's bottleneck-evacuation, 200 people heading through one door for
 // ten goals: 20 got through). So an agent yielding goes first against everyone who is not: the
 // people behind it make way as they would for anyone going first, and the room travels back
-// through the crowd. With it 191 of the 200 get through in the 600 s.
+// through the crowd. With it 195 of the 200 get through in the 600 s.
 //
 // Arrival horizon (ours): the planes assume each velocity is kept for time_horizon, but an agent
 // that reaches its last goal within that time stops there or leaves. Agents converging on one
