@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "sdf/checked.hpp"
+#include "sdf/throughput.hpp"
 
 namespace sdf::naive {
 
@@ -240,6 +241,104 @@ NaiveOnline online(const Graph& g, std::span<const uint64_t> q, const OnlineRunO
       }
     }
   }
+}
+
+namespace {
+
+// Calls f(d) for every distribution of the given size with d[c] ≥ floor[c] (default: the delay
+// of c).
+template <class F>
+void for_each_distribution(const Graph& g, uint64_t size, std::span<const uint64_t> floor_of,
+                           F&& f) {
+  const size_t m = g.channel_count();
+  std::vector<uint64_t> d(m), base(m);
+  uint64_t floor = 0;
+  for (ChannelId c = 0; c < m; ++c)
+    floor += d[c] = base[c] = floor_of.empty() ? g.channel(c).delay : floor_of[c];
+  if (size < floor) return;
+  if (m == 0) {
+    if (size == 0) f(d);
+    return;
+  }
+  // Spread `left` over channels c.. (the last takes the rest).
+  auto spread = [&](auto& self, size_t c, uint64_t left) -> void {
+    if (c + 1 == m) {
+      d[c] = base[c] + left;
+      f(d);
+      return;
+    }
+    for (uint64_t x = 0; x <= left; ++x) {
+      d[c] = base[c] + x;
+      self(self, c + 1, left - x);
+    }
+  };
+  spread(spread, 0, size - floor);
+}
+
+uint64_t floor_sum(const Graph& g, std::span<const uint64_t> floor) {
+  uint64_t s = 0;
+  for (ChannelId c = 0; c < g.channel_count(); ++c)
+    s += floor.empty() ? g.channel(c).delay : floor[c];
+  return s;
+}
+
+}  // namespace
+
+StorageSearch minimal_storage(const Graph& g, uint64_t max_size) {
+  const Repetitions rep = compute_repetitions(g);
+  StorageSearch r;
+  if (!rep.consistent) return r;
+  for (uint64_t size = floor_sum(g, {}); size <= max_size; ++size) {
+    for_each_distribution(g, size, {}, [&](const std::vector<uint64_t>& d) {
+      ++r.explored;
+      if (static_schedule(bounded_graph(g, d), rep.q).complete) r.distributions.push_back(d);
+    });
+    if (!r.distributions.empty()) {
+      r.size = size;
+      std::sort(r.distributions.begin(), r.distributions.end());
+      return r;
+    }
+  }
+  return r;
+}
+
+ParetoSearch pareto(const Graph& g, uint64_t max_size, std::span<const uint64_t> floor) {
+  ParetoSearch r;
+  r.max_throughput = throughput_mcm(g);
+  auto less = [](const Throughput& a, const Throughput& b) {
+    if (a.unbounded || b.unbounded) return !a.unbounded && b.unbounded;
+    return detail::compare_fractions(a.num, a.den, b.num, b.den) < 0;
+  };
+  Throughput best;
+  for (uint64_t size = floor_sum(g, floor); size <= max_size; ++size) {
+    std::vector<std::pair<std::vector<uint64_t>, Throughput>> all;
+    Throughput top;
+    for_each_distribution(g, size, floor, [&](const std::vector<uint64_t>& d) {
+      ++r.explored;
+      const Graph b = bounded_graph(g, d);
+      const Throughput ss = throughput_state_space(b), mcm = throughput_mcm(b);
+      if (ss.str() != mcm.str())
+        throw std::logic_error("naive pareto: the two methods disagree: " + ss.str() + " and " +
+                               mcm.str());
+      all.push_back({d, ss});
+      if (less(top, ss)) top = ss;
+    });
+    if (!less(best, top)) continue;
+    ParetoPoint p;
+    p.size = size;
+    p.throughput = top;
+    p.throughput.states = 0;
+    for (const auto& [d, t] : all)
+      if (!less(t, top)) p.distributions.push_back(d);
+    std::sort(p.distributions.begin(), p.distributions.end());
+    r.points.push_back(std::move(p));
+    best = top;
+    if (!less(best, r.max_throughput)) {
+      r.complete = true;
+      return r;
+    }
+  }
+  return r;
 }
 
 }  // namespace sdf::naive

@@ -7,6 +7,11 @@
 // naive_online: the online rules recomputed from scratch every decision (every key, every
 // eligibility, the argmax by scanning), with every state stored in a map for exact repeat
 // detection. Same outcome rules and caps as run_online.
+//
+// minimal_storage / pareto: every storage distribution (each capacity at least its channel's
+// delay, nothing else assumed: no lower bound, no dependencies) in order of size, each judged on
+// the explicit bounded_graph — deadlock-free when static_schedule completes an iteration there,
+// throughput by throughput_state_space and throughput_mcm of it, which must agree.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +19,7 @@
 #include <span>
 #include <vector>
 
+#include "sdf/buffers.hpp"
 #include "sdf/graph.hpp"
 #include "sdf/online.hpp"
 #include "sdf/repetitions.hpp"
@@ -38,5 +44,16 @@ struct NaiveOnline {
 };
 
 NaiveOnline online(const Graph& g, std::span<const uint64_t> q, const OnlineRunOptions& options);
+
+// The deadlock-free distributions of the smallest size (sorted), or size 0 and none when there
+// is none of size at most max_size.
+StorageSearch minimal_storage(const Graph& g, uint64_t max_size);
+
+// Points as storage_throughput_pareto's; `complete` when the graph's throughput (with unbounded
+// channels, by throughput_mcm) is reached at a size of at most max_size. Needs execution times.
+// Capacities start at `floor` (default: the delays). The tests pass the lower bounds, which
+// enumeration from the delays checks on its own (MinimalStorageMatchesEnumeration): below them
+// every distribution deadlocks, and the count of distributions to try shrinks a hundredfold.
+ParetoSearch pareto(const Graph& g, uint64_t max_size, std::span<const uint64_t> floor = {});
 
 }  // namespace sdf::naive

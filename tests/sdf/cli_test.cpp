@@ -225,6 +225,55 @@ TEST(SdfschedCli, ThroughputAndHsdf) {
             R"({"filt_0":1,"filt_1":1,"sink_0":1,"src_0":1})");
 }
 
+TEST(SdfschedCli, BuffersAndMinBufferSchedule) {
+  // CD-to-DAT: a chain, where every channel's lower bound p + c − gcd(p, c) suffices.
+  const test::Cli m = test::sdfsched("buffers " + graph("cd2dat.json") + " --json");
+  ASSERT_EQ(m.status, 0) << m.err;
+  const json j = json::parse(m.out);
+  EXPECT_EQ(j["lower_bound_size"], 32);
+  EXPECT_EQ(j["size"], 32);
+  EXPECT_EQ(j["distributions"].dump(),
+            R"([{"A->B#0":1,"B->C#0":4,"C->D#0":8,"D->E#0":14,"E->F#0":5}])");
+  // The trade-off of the timed modem rises to its throughput with unbounded channels.
+  const test::Cli p = test::sdfsched("buffers " + graph("timed_modem.xml") + " --pareto --json");
+  ASSERT_EQ(p.status, 0) << p.err;
+  const json k = json::parse(p.out);
+  EXPECT_EQ(k["max_throughput"], "1/4");
+  EXPECT_EQ(k["complete"], true);
+  EXPECT_EQ(k["points"].back()["throughput"], "1/4");
+  EXPECT_EQ(k["points"][0]["size"], 12);
+  // A limit stops the search: the points so far, `complete` false, exit 3.
+  const test::Cli lim = test::sdfsched("buffers " + graph("timed_modem.xml") +
+                                       " --pareto --max-distributions 2 --json");
+  EXPECT_EQ(lim.status, 3);
+  const json l = json::parse(lim.out);
+  EXPECT_EQ(l["complete"], false);
+  EXPECT_NE(l["stopped"].get<std::string>().find("more than 2 storage distributions"),
+            std::string::npos);
+  EXPECT_EQ(l["points"].size(), 2u);
+  // The schedule within the minimal distribution: valid, buffers within it, 32 in all.
+  const test::Cli s =
+      test::sdfsched("schedule " + graph("cd2dat.json") + " --policy min-buffer --json");
+  ASSERT_EQ(s.status, 0) << s.err;
+  const json t = json::parse(s.out);
+  EXPECT_EQ(t["policy"], "min-buffer");
+  EXPECT_EQ(t["valid"], true);
+  EXPECT_EQ(t["capacities"].dump(), j["distributions"][0].dump());
+  uint64_t sum = 0;
+  for (const auto& [name, v] : t["buffers"].items()) sum += v.get<uint64_t>();
+  EXPECT_EQ(sum, 32u);
+  // A graph that deadlocks whatever the capacities, and one without execution times.
+  const test::Cli d = test::sdfsched("buffers " + graph("deadlock.json"));
+  EXPECT_EQ(d.status, 1);
+  EXPECT_TRUE(one_line(d.err));
+  EXPECT_NE(d.err.find("deadlocks whatever the capacities (stuck: 'P', 'Q', 'R')"),
+            std::string::npos)
+      << d.err;
+  const test::Cli u = test::sdfsched("buffers " + graph("cd2dat.xml") + " --pareto");
+  EXPECT_EQ(u.status, 1);
+  EXPECT_NE(u.err.find("actor 'B' has no execution time"), std::string::npos) << u.err;
+}
+
 TEST(SdfschedCli, BadInputAndUsage) {
   struct Case {
     std::string args;
@@ -245,6 +294,9 @@ TEST(SdfschedCli, BadInputAndUsage) {
       {"simulate " + graph("cd2dat.json") + " --rate-change C:0/3@1", 2, "not a positive integer"},
       {"simulate " + graph("cd2dat.json") + " --rate-change Z:1/3@1", 1, "unknown actor 'Z'"},
       {"convert " + graph("cd2dat.json") + " --to png", 2, "--to"},
+      {"buffers " + graph("cd2dat.json") + " --max-size -1", 2, "--max-size"},
+      {"buffers " + graph("cd2dat.json") + " --max-distributions 0", 2, "--max-distributions"},
+      {"buffers " + graph("inconsistent.json"), 1, "inconsistent graph"},
   };
   for (const Case& c : cases) {
     const test::Cli r = test::sdfsched(c.args);

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_checks.hpp"
+#include "sdf/buffers.hpp"
 #include "sdf/checker.hpp"
 #include "sdf/claims.hpp"
 #include "sdf/graph.hpp"
@@ -219,32 +220,46 @@ int cmd_schedule(const std::string& path, const std::string& policy_text, bool j
   const std::vector<uint64_t>& q = c.rep.q;
   const sdf::StaticSchedule st = sdf::static_schedule(g, q);
   if (!st.complete) return report_deadlock(g, st, json);
-  const sdf::Policy policy = parse_policy(policy_text);
-  Json j;
-  j["policy"] = sdf::policy_name(policy);
-  if (policy == sdf::Policy::static_order) {
-    const sdf::CheckResult check = sdf::check_period(g, q, st.runs);
-    const sdf::Metrics m = sdf::measure(g, q, sdf::Eligibility::owing, st.runs);
+  // The two single-period schedules: the ready queue, and the ready queue within a minimal
+  // deadlock-free storage distribution (min-buffer).
+  if (policy_text == "static" || policy_text == "min-buffer") {
+    std::vector<uint64_t> capacity;
+    const std::vector<sdf::Run> runs =
+        policy_text == "static" ? st.runs : sdf::min_buffer_schedule(g, &capacity);
+    const sdf::CheckResult check = sdf::check_period(g, q, runs);
+    const sdf::Metrics m = sdf::measure(g, q, sdf::Eligibility::owing, runs);
     if (!json) {
       std::cout << "outcome: returns ("
                 << (check.valid ? "valid period" : "INVALID: " + check.reason)
-                << ")\nperiod: " << sdf::total_firings(st.runs) << " firings in " << st.runs.size()
-                << " decisions\nschedule: " << sdf::run_length_form(g, st.runs) << "\n";
+                << ")\nperiod: " << sdf::total_firings(runs) << " firings in " << runs.size()
+                << " decisions\nschedule: " << sdf::run_length_form(g, runs) << "\n";
+      if (!capacity.empty()) {
+        std::cout << "within capacities:";
+        for (sdf::ChannelId ch = 0; ch < g.channel_count(); ++ch)
+          std::cout << " " << g.channel(ch).name << "=" << capacity[ch];
+        std::cout << "\n";
+      }
       print_text_metrics(g, m);
       return check.valid ? 0 : 1;
     }
+    Json j;
+    j["policy"] = policy_text;
     j["outcome"] = "returns";
     j["valid"] = check.valid;
     j["repetitions"] = per_actor(g, q);
-    j["decisions"] = st.runs.size();
-    j["period_firings"] = sdf::total_firings(st.runs);
-    j["firings"] = firings(g, st.runs, flags.max_list);
-    j["runs"] = st.runs.size() <= flags.max_list ? run_list(g, st.runs) : Json(nullptr);
+    j["decisions"] = runs.size();
+    j["period_firings"] = sdf::total_firings(runs);
+    j["firings"] = firings(g, runs, flags.max_list);
+    j["runs"] = runs.size() <= flags.max_list ? run_list(g, runs) : Json(nullptr);
+    if (!capacity.empty()) j["capacities"] = per_channel(g, capacity);
     j["buffers"] = per_channel(g, m.buffers);
     j["fairness"] = {{"max", m.fairness.max}, {"mean", m.fairness.mean}};
     print_json(j);
     return check.valid ? 0 : 1;
   }
+  const sdf::Policy policy = parse_policy(policy_text);
+  Json j;
+  j["policy"] = sdf::policy_name(policy);
   const sdf::OnlineRunOptions opt = flags.options(policy == sdf::Policy::online_bounded);
   const sdf::OnlineRun run = sdf::run_online(g, q, opt);
   const std::span<const sdf::Run> runs(run.runs);
@@ -493,6 +508,81 @@ int cmd_throughput(const std::string& path, const std::string& method,
   return 0;
 }
 
+Json distribution_list(const sdf::Graph& g, const std::vector<std::vector<uint64_t>>& ds) {
+  Json j = Json::array();
+  for (const auto& d : ds) j.push_back(per_channel(g, d));
+  return j;
+}
+
+void print_distribution(const sdf::Graph& g, const std::vector<uint64_t>& d) {
+  std::cout << " ";
+  for (sdf::ChannelId c = 0; c < g.channel_count(); ++c)
+    std::cout << " " << g.channel(c).name << "=" << d[c];
+  std::cout << "\n";
+}
+
+int cmd_buffers(const std::string& path, bool pareto, std::optional<uint64_t> default_time,
+                const sdf::BufferLimits& limits, bool json) {
+  const sdf::Graph g = read_graph(path);
+  const Consistency c = consistency(g, json);
+  if (c.status) return c.status;
+  const std::vector<uint64_t> lb = sdf::buffer_lower_bounds(g);
+  uint64_t lb_size = 0;
+  for (uint64_t v : lb) lb_size = lb_size + v < lb_size ? UINT64_MAX : lb_size + v;
+  Json j;
+  j["lower_bounds"] = per_channel(g, lb);
+  j["lower_bound_size"] = lb_size;
+  if (!pareto) {
+    const sdf::StorageSearch s = sdf::minimal_storage(g, limits);
+    if (json) {
+      j["size"] = s.size;
+      j["distributions"] = distribution_list(g, s.distributions);
+      j["explored"] = s.explored;
+      print_json(j);
+      return 0;
+    }
+    std::cout << "lower bounds: " << lb_size << " in total\n";
+    print_distribution(g, lb);
+    std::cout << "minimal deadlock-free storage: " << s.size << " (" << s.distributions.size()
+              << (s.distributions.size() == 1 ? " distribution" : " distributions") << "; "
+              << s.explored << " explored)\n";
+    for (const auto& d : s.distributions) print_distribution(g, d);
+    return 0;
+  }
+  const sdf::ParetoSearch s = sdf::storage_throughput_pareto(g, default_time, limits);
+  const int status = s.complete ? 0 : 3;
+  if (json) {
+    j["max_throughput"] = s.max_throughput.str();
+    Json points = Json::array();
+    for (const sdf::ParetoPoint& p : s.points)
+      points.push_back({{"size", p.size},
+                        {"throughput", p.throughput.str()},
+                        {"distributions", distribution_list(g, p.distributions)}});
+    j["points"] = std::move(points);
+    j["complete"] = s.complete;
+    if (!s.complete) j["stopped"] = s.stopped;
+    j["explored"] = s.explored;
+    j["states"] = s.states;
+    print_json(j);
+    return status;
+  }
+  std::cout << "lower bounds: " << lb_size
+            << " in total\nthroughput with unbounded channels: " << s.max_throughput.str() << "\n";
+  for (const sdf::ParetoPoint& p : s.points) {
+    std::cout << "size " << p.size << ": throughput " << p.throughput.str() << " ("
+              << p.distributions.size()
+              << (p.distributions.size() == 1 ? " distribution)" : " distributions)") << "\n";
+    for (const auto& d : p.distributions) print_distribution(g, d);
+  }
+  if (s.complete)
+    std::cout << "complete: the last point reaches the throughput with unbounded channels ("
+              << s.explored << " distributions explored, " << s.states << " states)\n";
+  else
+    std::cout << "INCOMPLETE: " << s.stopped << " (" << s.explored << " distributions explored, "
+              << s.states << " states)\n";
+  return status;
+}
+
 int cmd_convert(const std::string& path, const std::string& to, const std::string& out) {
   const sdf::Graph g = read_graph(path);
   auto by_output = [&](const sdf::Graph& h) {
@@ -609,8 +699,10 @@ int main(int argc, char** argv) {
 
   auto* sch = app.add_subcommand("schedule", "one period by the static or an online scheduler");
   sch->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
-  sch->add_option("--policy", policy, "static, online or online-bounded")
-      ->check(CLI::IsMember({"static", "online", "online-bounded"}));
+  sch->add_option("--policy", policy,
+                  "static, min-buffer (the ready queue within a minimal deadlock-free storage "
+                  "distribution), online or online-bounded")
+      ->check(CLI::IsMember({"static", "min-buffer", "online", "online-bounded"}));
   sch->add_flag("--json", json, "JSON output");
   flags.add(sch);
   sch->callback([&] { action = [&] { return cmd_schedule(graph, policy, json, flags); }; });
@@ -648,6 +740,27 @@ int main(int argc, char** argv) {
   thr->add_flag("--json", json, "JSON output");
   thr->callback(
       [&] { action = [&] { return cmd_throughput(graph, method, default_time, json); }; });
+
+  bool pareto = false;
+  sdf::BufferLimits limits;
+  auto* buf = app.add_subcommand(
+      "buffers", "minimal deadlock-free storage per channel, or the storage-throughput trade-off");
+  buf->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
+  buf->add_flag("--pareto", pareto,
+                "every size at which the best throughput grows, up to the throughput with "
+                "unbounded channels (needs execution times)");
+  buf->add_option("--default-time", default_time, "execution time of actors that have none");
+  buf->add_option("--max-distributions", limits.max_distributions,
+                  "stop after exploring this many storage distributions")
+      ->check(crowddb::cli_checks::whole_at_least(1));
+  buf->add_option("--max-states", limits.max_states,
+                  "stop after storing this many states over all explorations")
+      ->check(crowddb::cli_checks::whole_at_least(1));
+  buf->add_option("--max-size", limits.max_size, "--pareto: explore no distribution larger")
+      ->check(crowddb::cli_checks::whole_at_least(0));
+  buf->add_flag("--json", json, "JSON output");
+  buf->callback(
+      [&] { action = [&] { return cmd_buffers(graph, pareto, default_time, limits, json); }; });
 
   uint64_t graphs = 100, seed = 1;
   std::string save;

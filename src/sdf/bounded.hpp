@@ -1,0 +1,58 @@
+// Execution of a graph whose channels have capacities (the model of include/sdf/buffers.hpp),
+// without building the bounded graph: each channel keeps its tokens and its free places.
+//
+// live(): untimed. The ready-queue run of static_schedule, each actor capped at q: by
+// persistence it completes an iteration exactly when the bounded graph is live. If it does not,
+// the run continues without the cap until nothing can fire (a connected bounded graph that is
+// not live comes to a complete standstill; every count stays within the capacities of its
+// channels from the stuck ones), and the waits of that state give the storage dependencies.
+//
+// run(): self-timed, as throughput_state_space but over the whole (connected) graph. The state
+// (tokens and the remaining times of the firings in progress; free places follow from them) is
+// stored each time the reference actor (smallest q, lowest id) completes another multiple of
+// its count; the first repeat closes the period, F firings of it in T time units giving
+// F / (q·T) iterations per time unit. For the dependencies the run then goes through that period
+// once more, recording for each batch of firings that starts at an instant which channels
+// could not have supplied its tokens or places without what arrived at that instant: the batch
+// waited for the actor that delivered them. A channel whose places were waited for, with both
+// ends in one strongly connected component of those waits, has a storage dependency.
+//
+// Thread-safety: a BoundedModel is immutable after construction; run() and live() are const.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "sdf/graph.hpp"
+
+namespace sdf::detail {
+
+struct BoundedRun {
+  bool unbounded = false;        // every actor takes no time and the graph is live
+  uint64_t num = 0, den = 1;     // iterations per time unit (num = 0: deadlock)
+  std::vector<char> dependency;  // per channel, when asked for
+  uint64_t states = 0;
+};
+
+class BoundedModel {
+ public:
+  // g: consistent and connected; q: its repetitions vector; times: per actor (empty: live() only).
+  BoundedModel(const Graph& g, std::vector<uint64_t> q, std::vector<uint64_t> times);
+
+  // cap ≥ delay on every channel. When not live and `dependency` is given, it receives the
+  // storage dependencies of the deadlock.
+  bool live(std::span<const uint64_t> cap, std::vector<char>* dependency = nullptr) const;
+
+  // Throws Error(input) when more than max_states states would be stored.
+  BoundedRun run(std::span<const uint64_t> cap, bool dependencies, uint64_t max_states) const;
+
+ private:
+  const Graph& g_;
+  Adjacency adj_;
+  std::vector<uint64_t> q_, times_;
+  ActorId reference_ = 0;
+  bool all_untimed_ = true;
+};
+
+}  // namespace sdf::detail

@@ -1,0 +1,116 @@
+// Buffer sizing: hand-worked lower bounds, minima and Pareto points; then the randomized checks
+// of buffer_checks.hpp on a few hundred small graphs (thousands in buffers_slow_test.cpp).
+#include "sdf/buffers.hpp"
+
+#include <gtest/gtest.h>
+
+#include <iostream>
+#include <numeric>
+
+#include "buffer_checks.hpp"
+#include "helpers.hpp"
+#include "sdf/checker.hpp"
+#include "sdf/generate.hpp"
+#include "sdf/io.hpp"
+#include "sdf/metrics.hpp"
+#include "sdf/naive.hpp"
+#include "sdf/repetitions.hpp"
+
+namespace sdf {
+namespace {
+
+using test::make;
+
+Graph timed(Graph g, std::vector<uint64_t> times) {
+  for (ActorId a = 0; a < g.actor_count(); ++a) g.set_actor_time(a, times[a]);
+  return g;
+}
+
+TEST(Buffers, LowerBoundsByHand) {
+  const Graph g = make({"A", "B"}, {{"A", "B", 2, 3, 0},
+                                    {"A", "B", 2, 4, 1},
+                                    {"A", "B", 2, 4, 7},
+                                    {"B", "A", 6, 4, 3},
+                                    {"A", "A", 1, 1, 1},
+                                    {"B", "B", 2, 2, 5}});
+  // 2+3−1; 2+4−2 + 1 mod 2; at least the 7 tokens; 6+4−2 + 3 mod 2; self-loops p + max(c, d).
+  EXPECT_EQ(buffer_lower_bounds(g), (std::vector<uint64_t>{4, 5, 7, 9, 2, 7}));
+}
+
+TEST(Buffers, MinimalStorageByHand) {
+  // A → B with 2:3: the classic p + c − gcd = 4 places (tokens 0, 2, 4→1, 3→0, 2, 4→1 ...).
+  const StorageSearch s = minimal_storage(make({"A", "B"}, {{"A", "B", 2, 3, 0}}));
+  EXPECT_EQ(s.size, 4u);
+  EXPECT_EQ(s.distributions, (std::vector<std::vector<uint64_t>>{{4}}));
+  // A cycle, q = (3, 2), whose back channel holds one period of A's tokens (6): the search and
+  // enumeration agree.
+  const Graph c = make({"A", "B"}, {{"A", "B", 2, 3, 0}, {"B", "A", 3, 2, 6}});
+  const StorageSearch sc = minimal_storage(c);
+  const StorageSearch nc = naive::minimal_storage(c, 40);
+  EXPECT_EQ(sc.size, nc.size);
+  EXPECT_EQ(sc.distributions, nc.distributions);
+  EXPECT_THROW(minimal_storage(make({"A", "B"}, {{"A", "B", 1, 1, 0}, {"B", "A", 1, 1, 0}})),
+               Error);                                         // deadlocks whatever the capacities
+  EXPECT_THROW(minimal_storage(make({"A", "B"}, {})), Error);  // not connected
+}
+
+TEST(Buffers, ParetoByHand) {
+  // A (1) → B (2), each sequential (self-loops). One place on A → B: A waits for B to free it,
+  // one iteration every 3; two places: B never waits, one every 2, the graph's throughput.
+  const Graph g = timed(
+      make({"A", "B"}, {{"A", "B", 1, 1, 0}, {"A", "A", 1, 1, 1}, {"B", "B", 1, 1, 1}}), {1, 2});
+  const ParetoSearch s = storage_throughput_pareto(g);
+  ASSERT_TRUE(s.complete);
+  ASSERT_EQ(s.points.size(), 2u);
+  EXPECT_EQ(s.points[0].size, 5u);
+  EXPECT_EQ(s.points[0].throughput.str(), "1/3");
+  EXPECT_EQ(s.points[0].distributions, (std::vector<std::vector<uint64_t>>{{1, 2, 2}}));
+  EXPECT_EQ(s.points[1].size, 6u);
+  EXPECT_EQ(s.points[1].throughput.str(), "1/2");
+  EXPECT_EQ(s.points[1].distributions, (std::vector<std::vector<uint64_t>>{{2, 2, 2}}));
+}
+
+TEST(Buffers, BoundedGraphAddsReverseChannels) {
+  const Graph g = make({"A", "B"}, {{"A", "B", 2, 3, 1}});
+  const Graph b = bounded_graph(g, std::vector<uint64_t>{5});
+  ASSERT_EQ(b.channel_count(), 2u);
+  EXPECT_EQ(b.channel(1).src, 1u);
+  EXPECT_EQ(b.channel(1).prd, 3u);
+  EXPECT_EQ(b.channel(1).cns, 2u);
+  EXPECT_EQ(b.channel(1).delay, 4u);
+  EXPECT_EQ(b.channel(1).name, "A->B#0#space");
+  EXPECT_THROW(bounded_graph(g, std::vector<uint64_t>{0}), Error);  // below the delay
+}
+
+TEST(Buffers, BoundedThroughputAgreesWithBothMethods) {
+  test::bounded_throughput_agrees(7001, 300);
+}
+
+TEST(Buffers, MinimalStorageMatchesEnumeration) {
+  test::minimal_storage_matches(7002, 200);
+}
+
+TEST(Buffers, ParetoMatchesEnumeration) {
+  test::pareto_matches(7003, 60);
+}
+
+TEST(Buffers, MinBufferScheduleIsValidAndMinimal) {
+  test::min_buffer_schedule_minimal(7004, 300);
+}
+
+TEST(Buffers, ParetoOfTimedModem) {
+  // The repository's small timed modem: the points rise to the unbounded graph's throughput.
+  const Graph g = read_graph_file(test::data("timed_modem.xml"));
+  const ParetoSearch s = storage_throughput_pareto(g);
+  ASSERT_TRUE(s.complete);
+  EXPECT_EQ(s.points.back().throughput.str(), throughput_state_space(g).str());
+  EXPECT_EQ(s.points.front().size, minimal_storage(g).size);
+  for (size_t k = 1; k < s.points.size(); ++k) {
+    EXPECT_LT(s.points[k - 1].size, s.points[k].size);
+    for (const auto& d : s.points[k].distributions)
+      EXPECT_EQ(bounded_throughput(g, d).str(), s.points[k].throughput.str());
+  }
+}
+
+}  // namespace
+}  // namespace sdf
