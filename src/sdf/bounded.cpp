@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <deque>
 #include <numeric>
+#include <queue>
 #include <string>
 #include <unordered_map>
 
@@ -64,7 +65,20 @@ std::vector<char> standstill_dependencies(const Graph& g, std::span<const uint64
 }  // namespace
 
 BoundedModel::BoundedModel(const Graph& g, std::vector<uint64_t> q, std::vector<uint64_t> times)
-    : g_(g), adj_(g), q_(std::move(q)), times_(std::move(times)) {
+    : g_(g), q_(std::move(q)), times_(std::move(times)) {
+  const Adjacency adj(g);
+  const auto n = static_cast<ActorId>(g.actor_count());
+  in_off_.assign(n + 1, 0);
+  out_off_.assign(n + 1, 0);
+  for (ActorId a = 0; a < n; ++a) {
+    for (ChannelId c : adj.inputs(a)) ports_.push_back({c, g.channel(c).src, g.channel(c).cns});
+    in_off_[a + 1] = static_cast<uint32_t>(ports_.size());
+  }
+  out_off_[0] = static_cast<uint32_t>(ports_.size());
+  for (ActorId a = 0; a < n; ++a) {
+    for (ChannelId c : adj.outputs(a)) ports_.push_back({c, g.channel(c).dst, g.channel(c).prd});
+    out_off_[a + 1] = static_cast<uint32_t>(ports_.size());
+  }
   for (ActorId a = 1; a < g.actor_count(); ++a)
     if (q_[a] < q_[reference_]) reference_ = a;
   for (uint64_t t : times_) all_untimed_ = all_untimed_ && t == 0;
@@ -81,19 +95,19 @@ bool BoundedModel::live(std::span<const uint64_t> cap, std::vector<char>* depend
   // is in both lists and gets its tokens and places back after each firing.
   auto can_fire = [&](ActorId a, uint64_t limit) {
     uint64_t k = limit;
-    for (ChannelId c : adj_.inputs(a)) k = std::min(k, tokens[c] / g_.channel(c).cns);
-    for (ChannelId c : adj_.outputs(a)) k = std::min(k, space[c] / g_.channel(c).prd);
+    for (const Port& p : inputs(a)) k = std::min(k, tokens[p.channel] / p.rate);
+    for (const Port& p : outputs(a)) k = std::min(k, space[p.channel] / p.rate);
     return k;
   };
   // tokens + places = capacity on every channel between firings, so nothing overflows.
   auto fire = [&](ActorId a, uint64_t k) {
-    for (ChannelId c : adj_.inputs(a)) {
-      tokens[c] -= k * g_.channel(c).cns;
-      space[c] += k * g_.channel(c).cns;
+    for (const Port& p : inputs(a)) {
+      tokens[p.channel] -= k * p.rate;
+      space[p.channel] += k * p.rate;
     }
-    for (ChannelId c : adj_.outputs(a)) {
-      space[c] -= k * g_.channel(c).prd;
-      tokens[c] += k * g_.channel(c).prd;
+    for (const Port& p : outputs(a)) {
+      space[p.channel] -= k * p.rate;
+      tokens[p.channel] += k * p.rate;
     }
     fired[a] += k;
   };
@@ -119,8 +133,8 @@ bool BoundedModel::live(std::span<const uint64_t> cap, std::vector<char>* depend
       if (k == UINT64_MAX || ++steps > (uint64_t{1} << 40))
         throw std::logic_error("bounded execution: a run without a standstill");
       fire(a, k);
-      for (ChannelId c : adj_.outputs(a)) offer(g_.channel(c).dst);
-      for (ChannelId c : adj_.inputs(a)) offer(g_.channel(c).src);  // places freed
+      for (const Port& p : outputs(a)) offer(p.other);
+      for (const Port& p : inputs(a)) offer(p.other);  // places freed
       offer(a);
     }
   };
@@ -154,8 +168,12 @@ BoundedRun BoundedModel::run(std::span<const uint64_t> cap, bool dependencies,
     tokens[c] = g_.channel(c).delay;
     space[c] = cap[c] - tokens[c];
   }
-  // Firings in progress per actor: (end time, count), sorted by end time.
+  // Firings in progress per actor: (end time, count), sorted by end time; one entry of `ends`
+  // per (end time, actor), earliest first.
   std::vector<std::vector<std::pair<uint64_t, uint64_t>>> running(n);
+  std::priority_queue<std::pair<uint64_t, ActorId>, std::vector<std::pair<uint64_t, ActorId>>,
+                      std::greater<>>
+      ends;
   uint64_t now = 0, busy = 0, done_ref = 0;
   bool track = false;
   // What arrived at the current instant (while tracking): tokens and places per channel.
@@ -163,16 +181,26 @@ BoundedRun BoundedModel::run(std::span<const uint64_t> cap, bool dependencies,
   std::vector<ChannelId> touched;
   Waits waits(m);
 
+  // Actors that may be able to start: only a firing's end can enable one (a start takes tokens
+  // and places that no other actor uses), so after the first instant only the neighbours of
+  // the actors whose firings ended are looked at.
+  std::vector<ActorId> todo;
+  std::vector<char> queued(n, 0);
+  auto offer = [&](ActorId a) {
+    if (!queued[a]) queued[a] = 1, todo.push_back(a);
+  };
   auto complete = [&](ActorId a, uint64_t k) {
-    for (ChannelId c : adj_.outputs(a)) {
-      const uint64_t more = k * g_.channel(c).prd;  // ≤ the places claimed ≤ capacity
-      tokens[c] += more;
-      if (track) got_tokens[c] += more, touched.push_back(c);
+    for (const Port& p : outputs(a)) {
+      const uint64_t more = k * p.rate;  // ≤ the places claimed ≤ capacity
+      tokens[p.channel] += more;
+      if (track) got_tokens[p.channel] += more, touched.push_back(p.channel);
+      offer(p.other);
     }
-    for (ChannelId c : adj_.inputs(a)) {
-      const uint64_t more = k * g_.channel(c).cns;
-      space[c] += more;
-      if (track) got_space[c] += more, touched.push_back(c);
+    for (const Port& p : inputs(a)) {
+      const uint64_t more = k * p.rate;
+      space[p.channel] += more;
+      if (track) got_space[p.channel] += more, touched.push_back(p.channel);
+      offer(p.other);
     }
     if (a == reference_) done_ref = add(done_ref, k, "the firings of the bounded exploration");
   };
@@ -180,51 +208,54 @@ BoundedRun BoundedModel::run(std::span<const uint64_t> cap, bool dependencies,
   // Starts every firing that can start now; firings without time end at once. In a connected
   // bounded graph with some timed actor this ends (every count is tied to that actor's, which
   // starts finitely often per instant); the guard turns a mistake into an error, not a hang.
+  uint64_t rounds = 0;
   auto start_all = [&] {
-    uint64_t rounds = 0;
-    for (bool progress = true; progress;) {
-      progress = false;
-      for (ActorId a = 0; a < n; ++a) {
-        uint64_t k = UINT64_MAX;
-        for (ChannelId c : adj_.inputs(a)) k = std::min(k, tokens[c] / g_.channel(c).cns);
-        for (ChannelId c : adj_.outputs(a)) k = std::min(k, space[c] / g_.channel(c).prd);
-        if (k == 0) continue;
-        if (k == UINT64_MAX) throw std::logic_error("bounded execution: an actor without channels");
-        if (track) {
-          // The batch waited for a channel when the tokens (places) there before this instant's
-          // arrivals would not have sufficed for all k firings.
-          for (ChannelId c : adj_.inputs(a)) {
-            const Channel& ch = g_.channel(c);
-            if (static_cast<u128>(tokens[c]) < static_cast<u128>(got_tokens[c]) + u128{k} * ch.cns)
-              waits.wait(a, ch.src);
-          }
-          for (ChannelId c : adj_.outputs(a)) {
-            const Channel& ch = g_.channel(c);
-            if (static_cast<u128>(space[c]) < static_cast<u128>(got_space[c]) + u128{k} * ch.prd) {
-              waits.wait(a, ch.dst);
-              waits.lack_places(c);
-            }
+    while (!todo.empty()) {
+      const ActorId a = todo.back();
+      todo.pop_back();
+      queued[a] = 0;
+      // Most looks find some channel short (no division needed for that).
+      bool blocked = false;
+      for (const Port& p : inputs(a)) blocked = blocked || tokens[p.channel] < p.rate;
+      for (const Port& p : outputs(a)) blocked = blocked || space[p.channel] < p.rate;
+      if (blocked) continue;
+      uint64_t k = UINT64_MAX;
+      for (const Port& p : inputs(a)) k = std::min(k, tokens[p.channel] / p.rate);
+      for (const Port& p : outputs(a)) k = std::min(k, space[p.channel] / p.rate);
+      if (k == UINT64_MAX) throw std::logic_error("bounded execution: an actor without channels");
+      if (track) {
+        // The batch waited for a channel when the tokens (places) there before this instant's
+        // arrivals would not have sufficed for all k firings.
+        for (const Port& p : inputs(a))
+          if (static_cast<u128>(tokens[p.channel]) <
+              static_cast<u128>(got_tokens[p.channel]) + u128{k} * p.rate)
+            waits.wait(a, p.other);
+        for (const Port& p : outputs(a)) {
+          if (static_cast<u128>(space[p.channel]) <
+              static_cast<u128>(got_space[p.channel]) + u128{k} * p.rate) {
+            waits.wait(a, p.other);
+            waits.lack_places(p.channel);
           }
         }
-        for (ChannelId c : adj_.inputs(a)) tokens[c] -= k * g_.channel(c).cns;
-        for (ChannelId c : adj_.outputs(a)) space[c] -= k * g_.channel(c).prd;
-        if (times_[a] == 0) {
-          complete(a, k);
-        } else {
-          const uint64_t end = add(now, times_[a], "the time of the bounded exploration");
-          auto& list = running[a];
-          auto it = std::lower_bound(list.begin(), list.end(), end,
-                                     [](const auto& e, uint64_t v) { return e.first < v; });
-          if (it != list.end() && it->first == end)
-            it->second += k;
-          else
-            list.insert(it, {end, k});
-          busy += k;
-        }
-        progress = true;
       }
-      if (++rounds > 100'000'000)
-        throw Error(Error::Kind::input, "buffers: firings without execution time do not end");
+      for (const Port& p : inputs(a)) tokens[p.channel] -= k * p.rate;
+      for (const Port& p : outputs(a)) space[p.channel] -= k * p.rate;
+      if (times_[a] == 0) {
+        complete(a, k);
+        if (++rounds > 1'000'000'000)
+          throw Error(Error::Kind::input, "buffers: firings without execution time do not end");
+      } else {
+        // An actor's firings all take the same time: later starts end later.
+        const uint64_t end = add(now, times_[a], "the time of the bounded exploration");
+        auto& list = running[a];
+        if (!list.empty() && list.back().first == end) {
+          list.back().second += k;
+        } else {
+          list.push_back({end, k});
+          ends.push({end, a});
+        }
+        busy += k;
+      }
     }
   };
 
@@ -243,6 +274,7 @@ BoundedRun BoundedModel::run(std::span<const uint64_t> cap, bool dependencies,
   std::unordered_map<std::string, std::pair<uint64_t, uint64_t>> seen;  // -> (time, done_ref)
   std::string period_key;
   uint64_t mark = q_[reference_];
+  for (ActorId a = 0; a < n; ++a) offer(a);
   start_all();
   for (;;) {
     if (busy == 0) {  // a standstill: nothing runs and nothing can start
@@ -282,17 +314,15 @@ BoundedRun BoundedModel::run(std::span<const uint64_t> cap, bool dependencies,
       }
     }
     // The next instant: the earliest end of a firing in progress.
-    uint64_t next = UINT64_MAX;
-    for (const auto& list : running)
-      if (!list.empty()) next = std::min(next, list.front().first);
-    now = next;
+    now = ends.top().first;
     if (track) {
       for (ChannelId c : touched) got_tokens[c] = got_space[c] = 0;
       touched.clear();
     }
-    for (ActorId a = 0; a < n; ++a) {
+    while (!ends.empty() && ends.top().first == now) {
+      const ActorId a = ends.top().second;
+      ends.pop();
       auto& list = running[a];
-      if (list.empty() || list.front().first != now) continue;
       const uint64_t k = list.front().second;
       list.erase(list.begin());
       busy -= k;

@@ -48,8 +48,23 @@ class BoundedModel {
   BoundedRun run(std::span<const uint64_t> cap, bool dependencies, uint64_t max_states) const;
 
  private:
+  // An actor's side of a channel, in compact arrays (a Channel is 128 bytes of mostly names):
+  // for an input the producer and cns, for an output the consumer and prd.
+  struct Port {
+    ChannelId channel;
+    ActorId other;
+    uint64_t rate;
+  };
+  std::span<const Port> inputs(ActorId a) const {
+    return {ports_.data() + in_off_[a], ports_.data() + in_off_[a + 1]};
+  }
+  std::span<const Port> outputs(ActorId a) const {
+    return {ports_.data() + out_off_[a], ports_.data() + out_off_[a + 1]};
+  }
+
   const Graph& g_;
-  Adjacency adj_;
+  std::vector<Port> ports_;  // inputs of every actor, then outputs of every actor
+  std::vector<uint32_t> in_off_, out_off_;
   std::vector<uint64_t> q_, times_;
   ActorId reference_ = 0;
   bool all_untimed_ = true;
