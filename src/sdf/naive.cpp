@@ -4,6 +4,8 @@
 #include <map>
 #include <numeric>
 
+#include "hsdf.hpp"
+#include "latency_detail.hpp"
 #include "sdf/checked.hpp"
 #include "sdf/throughput.hpp"
 
@@ -339,6 +341,150 @@ ParetoSearch pareto(const Graph& g, uint64_t max_size, std::span<const uint64_t>
     }
   }
   return r;
+}
+
+Latency latency(const Graph& g, const LatencyOptions& o, std::optional<uint64_t> default_time) {
+  const std::vector<uint64_t> q = detail::repetitions_or_throw(g, "latency");
+  detail::latency_caps(g, o, q);
+  const std::vector<uint64_t> times = execution_times(g, default_time);
+  const detail::Hsdf h = detail::expand(g, q, UINT32_MAX - 1);
+  const size_t f_count = h.actor.size(), k = o.iterations, n = g.actor_count();
+  Latency r;
+  // Deadlock: the token-free edges have a cycle.
+  std::vector<size_t> indegree(f_count, 0);
+  for (const detail::HsdfEdge& e : h.edges)
+    if (e.tokens == 0) ++indegree[e.dst];
+  std::vector<uint32_t> ready;
+  for (uint32_t f = 0; f < f_count; ++f)
+    if (indegree[f] == 0) ready.push_back(f);
+  size_t sorted = 0;
+  while (!ready.empty()) {
+    const uint32_t f = ready.back();
+    ready.pop_back();
+    ++sorted;
+    for (const detail::HsdfEdge& e : h.edges)
+      if (e.tokens == 0 && e.src == f && --indegree[e.dst] == 0) ready.push_back(e.dst);
+  }
+  if (sorted < f_count) {
+    r.deadlock = true;
+    return r;
+  }
+  // end[i][f]; relaxed iteration by iteration.
+  std::vector<std::vector<uint64_t>> end(k, std::vector<uint64_t>(f_count));
+  for (size_t i = 0; i < k; ++i) {
+    std::vector<uint64_t> start(f_count, 0);
+    for (size_t f = 0; f < f_count; ++f) end[i][f] = times[h.actor[f]];
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (const detail::HsdfEdge& e : h.edges) {
+        if (e.tokens > i) continue;
+        const uint64_t ready_at = end[i - e.tokens][e.src];
+        if (ready_at > start[e.dst]) start[e.dst] = ready_at, changed = true;
+      }
+      for (size_t f = 0; f < f_count; ++f)
+        end[i][f] = detail::add(start[f], times[h.actor[f]], "a time");
+    }
+  }
+  // First start and last end of each actor in each iteration.
+  std::vector<uint64_t> first_start(n * k, UINT64_MAX), last_end(n * k, 0);
+  for (size_t i = 0; i < k; ++i)
+    for (size_t f = 0; f < f_count; ++f) {
+      const ActorId a = h.actor[f];
+      const uint64_t s = end[i][f] - times[a];
+      first_start[a * k + i] = std::min(first_start[a * k + i], s);
+      last_end[a * k + i] = std::max(last_end[a * k + i], end[i][f]);
+    }
+  detail::latencies_from_times(o, n, first_start, last_end, r);
+  return r;
+}
+
+GraphStats stats(const Graph& g) {
+  GraphStats st;
+  const size_t n = g.actor_count();
+  st.actors = n;
+  st.channels = g.channel_count();
+  u128 tokens = 0;
+  for (const Channel& c : g.channels()) {
+    if (c.src == c.dst) ++st.self_loops;
+    tokens += c.delay;
+  }
+  if (tokens <= UINT64_MAX) st.initial_tokens = static_cast<uint64_t>(tokens);
+  try {
+    const Repetitions rep = repetitions(g);
+    st.consistent = rep.consistent;
+    if (rep.consistent) {
+      u128 sum = 0;
+      uint64_t max = 0;
+      for (uint64_t v : rep.q) sum += v, max = std::max(max, v);
+      if (sum <= UINT64_MAX) st.repetitions_sum = static_cast<uint64_t>(sum);
+      st.repetitions_max = max;
+    }
+  } catch (const Error& e) {
+    if (e.kind() != Error::Kind::overflow) throw;
+    st.repetitions_overflow = true;
+  }
+  // reach[u][v]: a path of channels from u to v (of length ≥ 0).
+  auto bfs = [&](ActorId from, bool undirected) {
+    std::vector<char> seen(n, 0);
+    std::vector<ActorId> work{from};
+    seen[from] = 1;
+    while (!work.empty()) {
+      const ActorId u = work.back();
+      work.pop_back();
+      for (const Channel& c : g.channels()) {
+        size_t next = n;
+        if (c.src == u) next = c.dst;
+        if (undirected && c.dst == u) next = c.src;
+        if (next < n && !seen[next]) seen[next] = 1, work.push_back(static_cast<ActorId>(next));
+      }
+    }
+    return seen;
+  };
+  std::vector<std::vector<char>> reach(n);
+  for (ActorId a = 0; a < n; ++a) reach[a] = bfs(a, false);
+  std::vector<char> done(n, 0);
+  for (ActorId a = 0; a < n; ++a) {
+    if (done[a]) continue;
+    ++st.sccs;
+    uint32_t size = 0;
+    bool cyclic = false;
+    for (ActorId b = 0; b < n; ++b) {
+      if (!(reach[a][b] && reach[b][a])) continue;
+      done[b] = 1;
+      ++size;
+    }
+    for (const Channel& c : g.channels())
+      cyclic = cyclic || (reach[a][c.src] && reach[c.src][a] && reach[a][c.dst] && reach[c.dst][a]);
+    st.largest_scc = std::max(st.largest_scc, size);
+    st.cyclic_sccs += cyclic;
+  }
+  std::vector<char> seen(n, 0);
+  for (ActorId a = 0; a < n; ++a) {
+    if (seen[a]) continue;
+    ++st.components;
+    const std::vector<char> part = bfs(a, true);
+    for (ActorId b = 0; b < n; ++b) seen[b] = seen[b] || part[b];
+  }
+  // Every simple cycle once, from its smallest actor.
+  std::vector<char> on_path(n, 0);
+  auto walk = [&](auto& self, ActorId s, ActorId v) -> void {
+    for (const Channel& c : g.channels()) {
+      if (c.src != v) continue;
+      if (c.dst == s) {
+        ++st.simple_cycles;
+      } else if (c.dst > s && !on_path[c.dst]) {
+        on_path[c.dst] = 1;
+        self(self, s, c.dst);
+        on_path[c.dst] = 0;
+      }
+    }
+  };
+  for (ActorId s = 0; s < n; ++s) {
+    on_path[s] = 1;
+    walk(walk, s, s);
+    on_path[s] = 0;
+  }
+  return st;
 }
 
 }  // namespace sdf::naive

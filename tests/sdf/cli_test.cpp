@@ -274,6 +274,34 @@ TEST(SdfschedCli, BuffersAndMinBufferSchedule) {
   EXPECT_NE(u.err.find("actor 'B' has no execution time"), std::string::npos) << u.err;
 }
 
+TEST(SdfschedCli, StatsAndLatency) {
+  const test::Cli s = test::sdfsched("stats " + graph("timed_modem.xml") + " --json");
+  ASSERT_EQ(s.status, 0) << s.err;
+  EXPECT_EQ(s.out,
+            R"({"actors":3,"channels":5,"self_loops":2,"initial_tokens":6,"consistent":true,)"
+            R"("repetitions_sum":4,"repetitions_max":2,"components":1,"sccs":1,"largest_scc":3,)"
+            R"("cyclic_sccs":1,"simple_cycles":3,"cycles_complete":true})"
+            "\n");
+  // An inconsistent graph is described, not refused.
+  const test::Cli i = test::sdfsched("stats " + graph("inconsistent.json") + " --json");
+  EXPECT_EQ(i.status, 0);
+  EXPECT_EQ(json::parse(i.out)["consistent"], false);
+  EXPECT_TRUE(json::parse(i.out)["repetitions_sum"].is_null());
+  // The timed modem: src (3), filt (2, twice in turn: a self-loop), sink (1); 8 from src's start to
+  // sink's end in the first iteration.
+  const test::Cli l = test::sdfsched("latency " + graph("timed_modem.xml") +
+                                     " --from src --to sink --iterations 4 --json");
+  ASSERT_EQ(l.status, 0) << l.err;
+  const json j = json::parse(l.out);
+  EXPECT_EQ(j["per_iteration"][0], 8);
+  EXPECT_EQ(j["per_iteration"].size(), 4u);
+  EXPECT_EQ(j["latency"], 9);
+  const test::Cli d = test::sdfsched("latency " + graph("deadlock.json") + " --default-time 1");
+  EXPECT_EQ(d.status, 1);
+  EXPECT_TRUE(one_line(d.err));
+  EXPECT_NE(d.err.find("stuck actors: P, Q, R"), std::string::npos) << d.err;
+}
+
 TEST(SdfschedCli, BadInputAndUsage) {
   struct Case {
     std::string args;
@@ -297,6 +325,12 @@ TEST(SdfschedCli, BadInputAndUsage) {
       {"buffers " + graph("cd2dat.json") + " --max-size -1", 2, "--max-size"},
       {"buffers " + graph("cd2dat.json") + " --max-distributions 0", 2, "--max-distributions"},
       {"buffers " + graph("inconsistent.json"), 1, "inconsistent graph"},
+      {"latency " + graph("timed_modem.xml") + " --from src", 2, "give both --from and --to"},
+      {"latency " + graph("timed_modem.xml") + " --from src --to nobody", 1,
+       "--to: unknown actor 'nobody'"},
+      {"latency " + graph("timed_modem.xml") + " --iterations 0", 2, "--iterations"},
+      {"latency " + graph("cd2dat.xml"), 1, "actor 'B' has no execution time"},
+      {"stats " + graph("cd2dat.json") + " --max-cycles 0", 2, "--max-cycles"},
   };
   for (const Case& c : cases) {
     const test::Cli r = test::sdfsched(c.args);

@@ -15,11 +15,13 @@
 #include "sdf/claims.hpp"
 #include "sdf/graph.hpp"
 #include "sdf/io.hpp"
+#include "sdf/latency.hpp"
 #include "sdf/metrics.hpp"
 #include "sdf/online.hpp"
 #include "sdf/rates.hpp"
 #include "sdf/repetitions.hpp"
 #include "sdf/schedule.hpp"
+#include "sdf/stats.hpp"
 #include "sdf/throughput.hpp"
 
 namespace {
@@ -583,6 +585,91 @@ int cmd_buffers(const std::string& path, bool pareto, std::optional<uint64_t> de
   return status;
 }
 
+int cmd_stats(const std::string& path, const sdf::StatsLimits& limits, bool json) {
+  const sdf::Graph g = read_graph(path);
+  const sdf::GraphStats s = sdf::graph_stats(g, limits);
+  auto opt = [](const std::optional<uint64_t>& v) { return v ? Json(*v) : Json(nullptr); };
+  if (json) {
+    print_json({{"actors", s.actors},
+                {"channels", s.channels},
+                {"self_loops", s.self_loops},
+                {"initial_tokens", opt(s.initial_tokens)},
+                {"consistent", s.repetitions_overflow ? Json(nullptr) : Json(s.consistent)},
+                {"repetitions_sum", opt(s.repetitions_sum)},
+                {"repetitions_max", opt(s.repetitions_max)},
+                {"components", s.components},
+                {"sccs", s.sccs},
+                {"largest_scc", s.largest_scc},
+                {"cyclic_sccs", s.cyclic_sccs},
+                {"simple_cycles", s.simple_cycles},
+                {"cycles_complete", s.cycles_complete}});
+    return 0;
+  }
+  auto text = [](const std::optional<uint64_t>& v) {
+    return v ? std::to_string(*v) : std::string("beyond 64 bits");
+  };
+  std::cout << "actors: " << s.actors << "\nchannels: " << s.channels << " (" << s.self_loops
+            << " self-loops)\ninitial tokens: " << text(s.initial_tokens) << "\nconsistent: "
+            << (s.repetitions_overflow ? "undecided (a repetition count beyond 64 bits)"
+                                       : (s.consistent ? "yes" : "no"))
+            << "\n";
+  if (s.consistent)
+    std::cout << "repetitions: sum " << text(s.repetitions_sum) << ", max "
+              << text(s.repetitions_max) << "\n";
+  std::cout << "connected components: " << s.components
+            << "\nstrongly connected components: " << s.sccs << " (largest " << s.largest_scc
+            << " actors; " << s.cyclic_sccs
+            << " with a cycle)\nsimple cycles: " << (s.cycles_complete ? "" : "at least ")
+            << s.simple_cycles << (s.cycles_complete ? "" : " (the count stopped at its limit)")
+            << "\n";
+  return 0;
+}
+
+int cmd_latency(const std::string& path, const std::string& from, const std::string& to,
+                uint64_t iterations, std::optional<uint64_t> default_time, bool json) {
+  const sdf::Graph g = read_graph(path);
+  const Consistency c = consistency(g, json);
+  if (c.status) return c.status;
+  sdf::LatencyOptions o;
+  o.iterations = iterations;
+  auto actor = [&](const std::string& name, const char* option) {
+    const auto a = g.find_actor(name);
+    if (!a) throw Error(Error::Kind::input, std::string(option) + ": unknown actor '" + name + "'");
+    return *a;
+  };
+  if (from.empty() != to.empty())
+    throw Error(Error::Kind::usage, "latency: give both --from and --to, or neither");
+  if (!from.empty()) o.from = actor(from, "--from"), o.to = actor(to, "--to");
+  const sdf::Latency l = sdf::latency(g, o, default_time);
+  if (l.deadlock) {
+    if (json) print_json({{"deadlock", true}, {"stuck", actor_list(g, l.stuck)}});
+    std::string stuck;
+    for (sdf::ActorId a : l.stuck) stuck += (stuck.empty() ? "" : ", ") + g.actor_name(a);
+    std::cerr << "sdfsched: deadlock: " << iterations
+              << " iteration(s) cannot complete; stuck actors: " << stuck << "\n";
+    return 1;
+  }
+  if (json) {
+    Json per = Json::array();
+    for (int64_t v : l.per_iteration) per.push_back(v);
+    print_json({{"from", from.empty() ? Json(nullptr) : Json(from)},
+                {"to", to.empty() ? Json(nullptr) : Json(to)},
+                {"iterations", iterations},
+                {"latency", l.max},
+                {"iteration", l.iteration},
+                {"per_iteration", per},
+                {"makespan", l.makespan}});
+    return 0;
+  }
+  std::cout << "latency: " << l.max << " (iteration " << l.iteration << ", "
+            << (from.empty() ? "span of all actors"
+                             : "from the start of " + from + " to the end of " + to)
+            << ")\nper iteration:";
+  for (int64_t v : l.per_iteration) std::cout << " " << v;
+  std::cout << "\nmakespan of " << iterations << " iteration(s): " << l.makespan << "\n";
+  return 0;
+}
+
 int cmd_convert(const std::string& path, const std::string& to, const std::string& out) {
   const sdf::Graph g = read_graph(path);
   auto by_output = [&](const sdf::Graph& h) {
@@ -761,6 +848,31 @@ int main(int argc, char** argv) {
   buf->add_flag("--json", json, "JSON output");
   buf->callback(
       [&] { action = [&] { return cmd_buffers(graph, pareto, default_time, limits, json); }; });
+
+  sdf::StatsLimits stats_limits;
+  auto* sta = app.add_subcommand(
+      "stats", "sizes, repetitions sum, components, strongly connected components, simple cycles");
+  sta->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
+  sta->add_option("--max-cycles", stats_limits.max_cycles, "stop counting cycles after this many")
+      ->check(crowddb::cli_checks::whole_at_least(1));
+  sta->add_flag("--json", json, "JSON output");
+  sta->callback([&] { action = [&] { return cmd_stats(graph, stats_limits, json); }; });
+
+  std::string from, to_actor;
+  uint64_t iterations = 1;
+  auto* lat = app.add_subcommand(
+      "latency", "latency of self-timed execution over the first iterations (docs/sdf.md)");
+  lat->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph with execution times")
+      ->required();
+  lat->add_option("--from", from, "source actor (with --to): from its first firing's start");
+  lat->add_option("--to", to_actor, "destination actor: to its iteration's last firing's end");
+  lat->add_option("--iterations", iterations, "iterations to simulate (the latency is the largest)")
+      ->check(crowddb::cli_checks::whole_at_least(1));
+  lat->add_option("--default-time", default_time, "execution time of actors that have none");
+  lat->add_flag("--json", json, "JSON output");
+  lat->callback([&] {
+    action = [&] { return cmd_latency(graph, from, to_actor, iterations, default_time, json); };
+  });
 
   uint64_t graphs = 100, seed = 1;
   std::string save;
