@@ -53,6 +53,12 @@ struct Channel {
   std::string dst_port;
 };
 
+// New rates for one channel (dynamic rate changes).
+struct ChannelRates {
+  ChannelId channel = 0;
+  uint64_t prd = 1, cns = 1;
+};
+
 class Graph {
  public:
   // Throws Error(input) on an empty or duplicate name.

@@ -149,6 +149,31 @@ TEST(SdfschedCli, SimulateRateChange) {
   EXPECT_EQ(json::parse(inc.out)["consistent_after"], false);
 }
 
+// The thesis's form (every rate of the actor scaled) and explicit per-channel rates.
+TEST(SdfschedCli, SimulateRateChangeForms) {
+  const test::Cli f =
+      test::sdfsched("simulate " + graph("cd2dat.json") + " --rate-change 'C*2@100' --json");
+  ASSERT_EQ(f.status, 0) << f.err;
+  const json j = json::parse(f.out);
+  EXPECT_EQ(j["change"]["form"], "factor");
+  EXPECT_EQ(j["change"]["factor"], "2/1");
+  EXPECT_EQ(j["change"]["rates"], json::parse(R"({"B->C#0":{"prd":2,"cns":6},
+                                                  "C->D#0":{"prd":4,"cns":7}})"));
+  // C's count halves relative to the others: q' = (294, 294, 98, 56, 64, 320) / 2.
+  EXPECT_EQ(j["repetitions_after"].dump(), R"({"A":147,"B":147,"C":49,"D":28,"E":32,"F":160})");
+  const test::Cli p = test::sdfsched("simulate " + graph("cd2dat.json") +
+                                     " --rate-change 'C:C->D#0=4,B->C#0=6@100' --json");
+  ASSERT_EQ(p.status, 0) << p.err;
+  const json k = json::parse(p.out);
+  EXPECT_EQ(k["change"]["form"], "ports");
+  EXPECT_EQ(k["repetitions_after"].dump(), j["repetitions_after"].dump());
+  const test::Cli half =
+      test::sdfsched("simulate " + graph("cd2dat.json") + " --rate-change 'C*1/2@1'");
+  EXPECT_EQ(half.status, 1);
+  EXPECT_NE(half.err.find("3·1/2 is not a whole number"), std::string::npos) << half.err;
+  EXPECT_TRUE(one_line(half.err));
+}
+
 // After a deadlock the text says there is no period, as the JSON form says null.
 TEST(SdfschedCli, SimulateTextAgreesWithJsonAfterADeadlock) {
   const std::string g = test::temp_path("cyc.json");
@@ -321,6 +346,13 @@ TEST(SdfschedCli, BadInputAndUsage) {
        "expected ACTOR:PRD/CNS@FIRING"},
       {"simulate " + graph("cd2dat.json") + " --rate-change C:0/3@1", 2, "not a positive integer"},
       {"simulate " + graph("cd2dat.json") + " --rate-change Z:1/3@1", 1, "unknown actor 'Z'"},
+      {"simulate " + graph("cd2dat.json") + " --rate-change 'Z*2@1'", 1, "unknown actor 'Z'"},
+      {"simulate " + graph("cd2dat.json") + " --rate-change 'C*0@1'", 2, "not a positive integer"},
+      {"simulate " + graph("cd2dat.json") + " --rate-change 'C:X=2@1'", 1, "unknown channel 'X'"},
+      {"simulate " + graph("cd2dat.json") + " --rate-change 'C:A->B#0=2@1'", 1,
+       "is not a channel of 'C'"},
+      {"simulate " + graph("cd2dat.json") + " --rate-change 'C:B->C#0=2,B->C#0=3@1'", 2,
+       "given twice"},
       {"convert " + graph("cd2dat.json") + " --to png", 2, "--to"},
       {"buffers " + graph("cd2dat.json") + " --max-size -1", 2, "--max-size"},
       {"buffers " + graph("cd2dat.json") + " --max-distributions 0", 2, "--max-distributions"},

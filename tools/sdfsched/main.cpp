@@ -341,32 +341,110 @@ int cmd_schedule(const std::string& path, const std::string& policy_text, bool j
   return status;
 }
 
-sdf::RateChange parse_rate_change(const sdf::Graph& g, const std::string& spec) {
-  // ACTOR:PRD/CNS@FIRING, parsed from the right so actor names may contain ':'.
+// --rate-change in its three forms (docs/sdf.md): ACTOR:PRD/CNS@FIRING, ACTOR*NUM[/DEN]@FIRING
+// and ACTOR:CHANNEL=RATE[,CHANNEL=RATE...]@FIRING. Actor and channel names may contain ':' and
+// '*': the actor is the longest prefix that names one and leaves a well-formed rest.
+struct ParsedChange {
+  sdf::RateChange change;
+  std::string form;           // uniform, factor, ports
+  uint64_t prd = 0, cns = 0;  // uniform
+  uint64_t num = 0, den = 0;  // factor
+};
+
+ParsedChange parse_rate_change(const sdf::Graph& g, const std::string& spec) {
+  const std::string expected =
+      "expected ACTOR:PRD/CNS@FIRING, ACTOR*FACTOR@FIRING or ACTOR:CHANNEL=RATE,...@FIRING";
   const auto at = spec.rfind('@');
-  const auto colon = spec.rfind(':', at);
-  const auto slash = spec.find('/', colon == std::string::npos ? 0 : colon);
-  if (at == std::string::npos || colon == std::string::npos || slash == std::string::npos ||
-      !(colon < slash && slash < at))
-    throw Error(Error::Kind::usage, "--rate-change '" + spec + "': expected ACTOR:PRD/CNS@FIRING");
-  auto number = [&](size_t from, size_t to, bool positive) {
-    const std::string s = spec.substr(from, to - from);
-    uint64_t v = 0;
+  if (at == std::string::npos)
+    throw Error(Error::Kind::usage, "--rate-change '" + spec + "': " + expected);
+  auto whole = [](std::string_view s, uint64_t& v) {
     const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc() || p != s.data() + s.size() || (positive && v == 0))
-      throw Error(Error::Kind::usage, "--rate-change '" + spec + "': '" + s + "' is not a " +
-                                          (positive ? "positive" : "non-negative") + " integer");
+    return !s.empty() && ec == std::errc() && p == s.data() + s.size();
+  };
+  auto number = [&](std::string_view s, bool positive) {
+    uint64_t v = 0;
+    if (!whole(s, v) || (positive && v == 0))
+      throw Error(Error::Kind::usage, "--rate-change '" + spec + "': '" + std::string(s) +
+                                          "' is not a " + (positive ? "positive" : "non-negative") +
+                                          " integer");
     return v;
   };
-  sdf::RateChange rc;
-  const std::string actor = spec.substr(0, colon);
-  const auto a = g.find_actor(actor);
-  if (!a) throw Error(Error::Kind::input, "--rate-change: unknown actor '" + actor + "'");
-  rc.actor = *a;
-  rc.prd = number(colon + 1, slash, true);
-  rc.cns = number(slash + 1, at, true);
-  rc.at_firing = number(at + 1, spec.size(), false);
-  return rc;
+  // N/D (or N when `slash_optional`), both whole numbers.
+  auto fraction = [&](std::string_view s, bool slash_optional) {
+    const auto slash = s.find('/');
+    uint64_t a = 0, b = 1;
+    if (slash == std::string_view::npos) return slash_optional && whole(s, a);
+    return whole(s.substr(0, slash), a) && whole(s.substr(slash + 1), b);
+  };
+  const std::string_view head(spec.data(), at);
+  const uint64_t firing = number(std::string_view(spec).substr(at + 1), false);
+  ParsedChange out;
+  bool unknown_actor = false;  // a well-formed change for an actor the graph does not have
+  for (size_t i = head.size(); i-- > 0;) {
+    if (head[i] != ':' && head[i] != '*') continue;
+    const auto a = g.find_actor(head.substr(0, i));
+    const std::string_view rest = head.substr(i + 1);
+    const bool well_formed =
+        head[i] == '*' ? fraction(rest, true)
+                       : fraction(rest, false) || rest.find('=') != std::string_view::npos;
+    if (!well_formed) continue;
+    if (!a) {
+      unknown_actor = true;
+      continue;
+    }
+    if (head[i] == '*') {
+      const auto slash = rest.find('/');
+      out.form = "factor";
+      out.num = number(rest.substr(0, slash), true);
+      out.den = slash == std::string_view::npos ? 1 : number(rest.substr(slash + 1), true);
+      out.change = sdf::RateChange::scaled(g, *a, out.num, out.den, firing);
+      return out;
+    }
+    if (fraction(rest, false)) {
+      const auto slash = rest.find('/');
+      out.form = "uniform";
+      out.prd = number(rest.substr(0, slash), true);
+      out.cns = number(rest.substr(slash + 1), true);
+      out.change = sdf::RateChange::uniform(g, *a, out.prd, out.cns, firing);
+      return out;
+    }
+    {
+      out.form = "ports";
+      out.change.actor = *a;
+      out.change.at_firing = firing;
+      size_t from = 0;
+      while (from <= rest.size()) {
+        const size_t comma = std::min(rest.find(',', from), rest.size());
+        const std::string_view item = rest.substr(from, comma - from);
+        const auto eq = item.rfind('=');
+        if (eq == std::string_view::npos)
+          throw Error(Error::Kind::usage, "--rate-change '" + spec + "': '" + std::string(item) +
+                                              "' is not CHANNEL=RATE");
+        const std::string name(item.substr(0, eq));
+        const auto c = g.find_channel(name);
+        if (!c) throw Error(Error::Kind::input, "--rate-change: unknown channel '" + name + "'");
+        const sdf::Channel& ch = g.channel(*c);
+        if (ch.src != *a && ch.dst != *a)
+          throw Error(Error::Kind::input, "--rate-change: channel '" + name +
+                                              "' is not a channel of '" + g.actor_name(*a) + "'");
+        const uint64_t rate = number(item.substr(eq + 1), true);
+        for (const sdf::ChannelRates& r : out.change.rates)
+          if (r.channel == *c)
+            throw Error(Error::Kind::usage, "--rate-change: channel '" + name + "' given twice");
+        // An output's prd, an input's cns; a self-loop (both) keeps prd = cns.
+        out.change.rates.push_back(
+            {*c, ch.src == *a ? rate : ch.prd, ch.dst == *a ? rate : ch.cns});
+        from = comma + 1;
+      }
+      return out;
+    }
+  }
+  // Name the actor for the most likely reading: everything before the last ':' or '*'.
+  const auto sep = head.find_last_of(":*");
+  if (sep != std::string_view::npos && unknown_actor)
+    throw Error(Error::Kind::input,
+                "--rate-change: unknown actor '" + std::string(head.substr(0, sep)) + "'");
+  throw Error(Error::Kind::usage, "--rate-change '" + spec + "': " + expected);
 }
 
 int cmd_simulate(const std::string& path, const std::string& policy_text,
@@ -376,7 +454,8 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
   if (c.status) return c.status;
   const sdf::StaticSchedule st = sdf::static_schedule(g, c.rep.q);
   if (!st.complete) return report_deadlock(g, st, json);
-  const sdf::RateChange rc = parse_rate_change(g, change_text);
+  const ParsedChange parsed = parse_rate_change(g, change_text);
+  const sdf::RateChange& rc = parsed.change;
   const sdf::Policy policy = parse_policy(policy_text);
   const sdf::RateChangeResult r = sdf::simulate_rate_change(
       g, policy, rc, flags.options(policy == sdf::Policy::online_bounded));
@@ -390,9 +469,16 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
     status = 3;
   }
   if (!json) {
-    std::cout << "policy: " << sdf::policy_name(policy) << "\nchange: " << g.actor_name(rc.actor)
-              << " to prd " << rc.prd << ", cns " << rc.cns << " after firing " << rc.at_firing
-              << "\n";
+    std::cout << "policy: " << sdf::policy_name(policy) << "\nchange: " << g.actor_name(rc.actor);
+    if (parsed.form == "uniform")
+      std::cout << " to prd " << parsed.prd << ", cns " << parsed.cns;
+    else if (parsed.form == "factor")
+      std::cout << " rates times " << parsed.num << "/" << parsed.den;
+    std::cout << " (";
+    for (size_t i = 0; i < rc.rates.size(); ++i)
+      std::cout << (i ? ", " : "") << g.channel(rc.rates[i].channel).name << " " << rc.rates[i].prd
+                << ":" << rc.rates[i].cns;
+    std::cout << ") after firing " << rc.at_firing << "\n";
     if (!r.after.consistent) {
       std::cerr << "sdfsched: the changed graph is inconsistent: channel "
                 << describe_channel(g2, r.after.channel) << "\n";
@@ -425,10 +511,16 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
   }
   Json j;
   j["policy"] = sdf::policy_name(policy);
-  j["change"] = {{"actor", g.actor_name(rc.actor)},
-                 {"prd", rc.prd},
-                 {"cns", rc.cns},
-                 {"at_firing", rc.at_firing}};
+  Json change = {{"actor", g.actor_name(rc.actor)}, {"form", parsed.form}};
+  if (parsed.form == "uniform") change["prd"] = parsed.prd, change["cns"] = parsed.cns;
+  if (parsed.form == "factor")
+    change["factor"] = std::to_string(parsed.num) + "/" + std::to_string(parsed.den);
+  Json rates = Json::object();
+  for (const sdf::ChannelRates& cr : rc.rates)
+    rates[g.channel(cr.channel).name] = {{"prd", cr.prd}, {"cns", cr.cns}};
+  change["rates"] = std::move(rates);
+  change["at_firing"] = rc.at_firing;
+  j["change"] = std::move(change);
   j["repetitions_before"] = per_actor(g, r.q_before);
   j["tokens_at_change"] = per_channel(g, r.tokens_at_change);
   j["buffers_before"] = per_channel(g, r.buffers_before);
@@ -796,7 +888,11 @@ int main(int argc, char** argv) {
 
   auto* sim = app.add_subcommand("simulate", "change an actor's rates mid-period and continue");
   sim->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
-  sim->add_option("--rate-change", change, "ACTOR:PRD/CNS@FIRING")->required();
+  sim->add_option(
+         "--rate-change", change,
+         "ACTOR:PRD/CNS@FIRING (every output PRD, every input CNS), ACTOR*NUM[/DEN]@FIRING "
+         "(every rate of ACTOR scaled) or ACTOR:CHANNEL=RATE,...@FIRING")
+      ->required();
   sim->add_option("--policy", policy, "static, online or online-bounded")
       ->check(CLI::IsMember({"static", "online", "online-bounded"}));
   sim->add_flag("--json", json, "JSON output");
