@@ -3,7 +3,9 @@
 // input channel consumes `cns` (`uniform`); every rate of the actor is scaled by a factor
 // num/den, the thesis's "scaling its w_i's by a factor new rate / old rate" (`scaled`; each rate
 // must stay a whole number; the graph stays consistent, the actor's count divided by the
-// factor); or explicit new rates per channel of the actor. The thesis notes the result is the
+// factor; self-loops keep their rates: they model the actor's state, as SDF3's one-token loops
+// that make it sequential, and scaled they would deadlock it); or explicit new rates per channel
+// of the actor. The thesis notes the result is the
 // new graph with different initial delays (the tokens at the change).
 //
 // The static path recomputes the repetitions vector and builds a new ready-queue schedule from

@@ -51,6 +51,7 @@ RateChange RateChange::scaled(const Graph& g, ActorId a, uint64_t num, uint64_t 
   };
   for (ChannelId c = 0; c < g.channel_count(); ++c) {
     const Channel& ch = g.channel(c);
+    if (ch.src == ch.dst) continue;  // a self-loop models the actor's state, not its data
     if (ch.src == a || ch.dst == a)
       rc.rates.push_back(
           {c, ch.src == a ? scale(ch, ch.prd) : ch.prd, ch.dst == a ? scale(ch, ch.cns) : ch.cns});

@@ -34,6 +34,12 @@ TEST(Claims, RandomSampleBoundedAlwaysValidAndEveryScheduleChecks) {
     returns += c.online.returns;
     periodic += c.online.periodic;
     unbounded += c.online.unbounded;
+    // After a rate change bounded completes a valid period unless the change deadlocks the
+    // graph; every period after a change passes the checker.
+    EXPECT_EQ(c.bounded_change.changes, c.graphs) << c.name;
+    EXPECT_EQ(c.bounded_change.periodic_again + c.bounded_change.deadlock, c.graphs) << c.name;
+    EXPECT_EQ(c.bounded_change.invalid + c.online_change.invalid, 0u) << c.name;
+    EXPECT_EQ(c.online_change.limit, 0u) << c.name;
   }
   EXPECT_EQ(graphs, 500u);
   EXPECT_EQ(r.counterexamples.count("generator-q"), 0u);
@@ -43,6 +49,20 @@ TEST(Claims, RandomSampleBoundedAlwaysValidAndEveryScheduleChecks) {
   EXPECT_GT(returns, 0u);
   EXPECT_GT(periodic, 0u);
   EXPECT_GT(unbounded, 0u);
+  // The verdicts add up the classes: `online` fails its claim on every graph it does not return
+  // on, and each failed claim names a counter-example that exists.
+  const std::vector<claims::Verdict> v = claims::verdicts(r);
+  ASSERT_EQ(v.size(), 9u);
+  EXPECT_EQ(v[0].graphs, graphs);
+  EXPECT_EQ(v[0].fails, graphs - returns);
+  EXPECT_EQ(v[5].fails, 0u);  // online-bounded
+  EXPECT_EQ(v[8].fails, 0u);  // online-bounded after a rate change
+  EXPECT_GT(v[6].fails, 0u);  // online is not periodic at once after every change
+  for (const claims::Verdict& x : v) {
+    EXPECT_LE(x.fails, x.graphs) << x.claim;
+    EXPECT_EQ(x.fails > 0, !x.counterexample.empty()) << x.claim;
+    EXPECT_TRUE(x.counterexample.empty() || r.counterexamples.count(x.counterexample) == 1);
+  }
 }
 
 // Each pinned counter-example still fails its claim. The file name says which:

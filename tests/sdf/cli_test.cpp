@@ -327,6 +327,19 @@ TEST(SdfschedCli, StatsAndLatency) {
   EXPECT_NE(d.err.find("stuck actors: P, Q, R"), std::string::npos) << d.err;
 }
 
+TEST(SdfschedCli, ClaimsPrintAVerdictPerClaim) {
+  const test::Cli r = test::sdfsched("claims --graphs 3 --seed 5");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("- `online-bounded` completes a valid period: holds on all 60\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("- `online` returns a valid period (thesis 5.3): fails on "),
+            std::string::npos);
+  const json j = json::parse(test::sdfsched("claims --graphs 3 --seed 5 --json").out);
+  EXPECT_EQ(j["verdicts"].size(), 9u);
+  EXPECT_EQ(j["classes"][0]["bounded_change"]["changes"], 3);
+}
+
 TEST(SdfschedCli, BadInputAndUsage) {
   struct Case {
     std::string args;

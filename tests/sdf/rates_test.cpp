@@ -105,8 +105,15 @@ TEST(RateChange, ScalingByAFactorKeepsTheGraphConsistent) {
     } catch (const Error&) {
       continue;  // a rate of a that is odd cannot be halved
     }
+    size_t listed = 0;
+    for (ChannelId c = 0; c < gg.graph.channel_count(); ++c) {
+      const Channel& ch = gg.graph.channel(c);
+      listed += (ch.src == a || ch.dst == a) && ch.src != ch.dst;  // self-loops keep their rates
+    }
+    EXPECT_EQ(rc.rates.size(), listed);
     for (const ChannelRates& r : rc.rates) {
       const Channel& ch = gg.graph.channel(r.channel);
+      EXPECT_NE(ch.src, ch.dst);
       EXPECT_EQ(r.prd * den, ch.src == a ? ch.prd * num : ch.prd * den);
       EXPECT_EQ(r.cns * den, ch.dst == a ? ch.cns * num : ch.cns * den);
     }

@@ -814,6 +814,22 @@ int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& sav
       f << sdf::write_json(g);
     }
   }
+  auto change_stats = [](const sdf::claims::RateChangeStats& s) {
+    return Json{
+        {"changes", s.changes},   {"periodic_again", s.periodic_again},
+        {"at_once", s.at_once},   {"unbounded", s.unbounded},
+        {"deadlock", s.deadlock}, {"limit", s.limit},
+        {"invalid", s.invalid},   {"max_firings_until_periodic", s.max_firings_until_periodic}};
+  };
+  const std::vector<sdf::claims::Verdict> verdicts = sdf::claims::verdicts(r);
+  auto example = [&](const sdf::claims::Verdict& v) -> std::string {
+    if (v.counterexample.empty()) return {};
+    const sdf::Graph& g = r.counterexamples.at(v.counterexample);
+    std::string s = v.counterexample + " (" + std::to_string(g.actor_count()) + " actors, " +
+                    std::to_string(g.channel_count()) + " channels";
+    if (v.counterexample.find("-change-") != std::string::npos) s += ", change " + g.name;
+    return s + ")";
+  };
   if (json) {
     Json j = Json::array();
     for (const auto& c : r.classes)
@@ -822,6 +838,8 @@ int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& sav
                    {"online", stats(c.online)},
                    {"online_one", stats(c.online_one)},
                    {"bounded", stats(c.bounded)},
+                   {"online_change", change_stats(c.online_change)},
+                   {"bounded_change", change_stats(c.bounded_change)},
                    {"buffers_on_common_graphs",
                     {{"graphs", c.common},
                      {"static", c.buffers_static},
@@ -829,7 +847,14 @@ int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& sav
                      {"bounded", c.buffers_bounded}}}});
     Json ce = Json::object();
     for (const auto& [claim, g] : r.counterexamples) ce[claim] = Json::parse(sdf::write_json(g));
-    print_json({{"classes", j}, {"counterexamples", ce}});
+    Json vs = Json::array();
+    for (const auto& v : verdicts)
+      vs.push_back(
+          {{"claim", v.claim},
+           {"fails", v.fails},
+           {"graphs", v.graphs},
+           {"counterexample", v.counterexample.empty() ? Json(nullptr) : Json(v.counterexample)}});
+    print_json({{"classes", j}, {"verdicts", vs}, {"counterexamples", ce}});
     return 0;
   }
   auto outcomes = [](const sdf::claims::PolicyStats& s) {
@@ -841,8 +866,10 @@ int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& sav
   };
   std::cout << "| class | graphs | online: returns / periodic / unbounded | max wait >= n-1 | "
                "max wait > n-1 | max wait | --firings one: returns / periodic / unbounded | "
-               "bounded valid | checker failures | buffers static : online : bounded (graphs) |\n"
-               "|---|---|---|---|---|---|---|---|---|---|\n";
+               "bounded valid | checker failures | buffers static : online : bounded (graphs) | "
+               "after a rate change, online: periodic (at once) / unbounded / deadlock | "
+               "after a rate change, bounded: valid / deadlock |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : r.classes) {
     const auto& o = c.online;
     std::cout << "| " << c.name << " | " << c.graphs << " | " << outcomes(o) << " | "
@@ -850,7 +877,20 @@ int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& sav
               << " | " << outcomes(c.online_one) << " | " << c.bounded.returns << " | "
               << o.checker_failures + c.online_one.checker_failures + c.bounded.checker_failures
               << " | " << c.buffers_static << " : " << c.buffers_online << " : "
-              << c.buffers_bounded << " (" << c.common << ") |\n";
+              << c.buffers_bounded << " (" << c.common << ") | " << c.online_change.periodic_again
+              << " (" << c.online_change.at_once << ") / "
+              << c.online_change.unbounded + c.online_change.limit << " / "
+              << c.online_change.deadlock << " | " << c.bounded_change.periodic_again << " / "
+              << c.bounded_change.deadlock << " |\n";
+  }
+  std::cout << "\n";
+  for (const auto& v : verdicts) {
+    std::cout << "- " << v.claim << ": ";
+    if (v.fails == 0)
+      std::cout << "holds on all " << v.graphs << "\n";
+    else
+      std::cout << "fails on " << v.fails << " of " << v.graphs << "; smallest counter-example "
+                << example(v) << "\n";
   }
   std::cout << "\nsmallest counter-examples:";
   for (const auto& [claim, g] : r.counterexamples)
