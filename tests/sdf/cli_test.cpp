@@ -340,6 +340,28 @@ TEST(SdfschedCli, ClaimsPrintAVerdictPerClaim) {
   EXPECT_EQ(j["classes"][0]["bounded_change"]["changes"], 3);
 }
 
+TEST(SdfschedCli, GenerateWritesConsistentLiveGraphs) {
+  const std::string out = test::temp_path("gen.xml");
+  const std::string args =
+      "generate --shape cyclic --actors 12 --self-loops --max-q 4 --times 1:9 --seed 11";
+  const test::Cli a = test::sdfsched(args);
+  ASSERT_EQ(a.status, 0) << a.err;
+  EXPECT_EQ(test::sdfsched(args).out, a.out);  // the seed decides
+  EXPECT_NE(test::sdfsched(args + " --seed 12").out, a.out);
+  const json g = json::parse(a.out);
+  EXPECT_EQ(g["actors"].size(), 12u);
+  for (const auto& actor : g["actors"]) {
+    EXPECT_GE(actor["time"].get<int>(), 1);
+    EXPECT_LE(actor["time"].get<int>(), 9);
+  }
+  ASSERT_EQ(test::sdfsched(args + " -o '" + out + "'").status, 0);
+  EXPECT_EQ(test::slurp(out).rfind("<?xml", 0), 0u);  // SDF3 by the extension
+  const test::Cli t = test::sdfsched("throughput '" + out + "' --json");
+  std::remove(out.c_str());
+  EXPECT_EQ(t.status, 0) << t.err;  // consistent, live, timed
+  EXPECT_NE(json::parse(t.out)["throughput"], "0");
+}
+
 TEST(SdfschedCli, BadInputAndUsage) {
   struct Case {
     std::string args;
@@ -376,6 +398,9 @@ TEST(SdfschedCli, BadInputAndUsage) {
       {"latency " + graph("timed_modem.xml") + " --iterations 0", 2, "--iterations"},
       {"latency " + graph("cd2dat.xml"), 1, "actor 'B' has no execution time"},
       {"stats " + graph("cd2dat.json") + " --max-cycles 0", 2, "--max-cycles"},
+      {"generate --times 5:1", 2, "expected LO:HI"},
+      {"generate --shape star", 2, "--shape"},
+      {"generate --actors 0", 2, "--actors"},
   };
   for (const Case& c : cases) {
     const test::Cli r = test::sdfsched(c.args);

@@ -13,6 +13,7 @@
 #include "sdf/buffers.hpp"
 #include "sdf/checker.hpp"
 #include "sdf/claims.hpp"
+#include "sdf/generate.hpp"
 #include "sdf/graph.hpp"
 #include "sdf/io.hpp"
 #include "sdf/latency.hpp"
@@ -762,21 +763,12 @@ int cmd_latency(const std::string& path, const std::string& from, const std::str
   return 0;
 }
 
-int cmd_convert(const std::string& path, const std::string& to, const std::string& out) {
-  const sdf::Graph g = read_graph(path);
-  auto by_output = [&](const sdf::Graph& h) {
-    const bool as_json = out.size() >= 5 && out.compare(out.size() - 5, 5, ".json") == 0;
-    return as_json ? sdf::write_json(h) : sdf::write_sdf3(h);
-  };
-  const std::string text = to == "json"   ? sdf::write_json(g)
-                           : to == "dot"  ? sdf::write_dot(g)
-                           : to == "hsdf" ? by_output(sdf::to_hsdf(g))
-                                          : sdf::write_sdf3(g);
+// To stdout, or written beside the target and renamed, so a failed run never leaves half a file.
+int write_output(const std::string& text, const std::string& out) {
   if (out.empty() || out == "-") {
     std::cout << text;
     return 0;
   }
-  // Written beside the target and renamed, so a failed run never leaves half a file.
   const std::string tmp = out + ".partial";
   {
     std::ofstream f(tmp, std::ios::binary);
@@ -788,6 +780,71 @@ int cmd_convert(const std::string& path, const std::string& to, const std::strin
   std::filesystem::rename(tmp, out, ec);
   if (ec) throw Error(Error::Kind::io, out + ": " + ec.message());
   return 0;
+}
+
+int cmd_convert(const std::string& path, const std::string& to, const std::string& out) {
+  const sdf::Graph g = read_graph(path);
+  auto by_output = [&](const sdf::Graph& h) {
+    const bool as_json = out.size() >= 5 && out.compare(out.size() - 5, 5, ".json") == 0;
+    return as_json ? sdf::write_json(h) : sdf::write_sdf3(h);
+  };
+  const std::string text = to == "json"   ? sdf::write_json(g)
+                           : to == "dot"  ? sdf::write_dot(g)
+                           : to == "hsdf" ? by_output(sdf::to_hsdf(g))
+                                          : sdf::write_sdf3(g);
+  return write_output(text, out);
+}
+
+struct GenerateFlags {
+  std::string shape = "dag";
+  uint32_t actors = 8;
+  bool homogeneous = false, self_loops = false;
+  uint32_t max_q = 12, max_multiplier = 3, extra_percent = 50, back_percent = 30;
+  std::string times;  // LO:HI
+  uint64_t seed = 1;
+  std::string format;  // json | sdf3; default by the output's extension, else json
+};
+
+int cmd_generate(const GenerateFlags& f, const std::string& out) {
+  sdf::gen::Spec spec;
+  const std::pair<const char*, sdf::gen::Shape> shapes[] = {
+      {"chain", sdf::gen::Shape::chain},   {"fan-out", sdf::gen::Shape::fan_out},
+      {"fan-in", sdf::gen::Shape::fan_in}, {"dag", sdf::gen::Shape::dag},
+      {"cyclic", sdf::gen::Shape::cyclic}, {"cyclic-random", sdf::gen::Shape::cyclic_random}};
+  for (const auto& [name, shape] : shapes)
+    if (f.shape == name) spec.shape = shape;
+  spec.actors = f.actors;
+  spec.multirate = !f.homogeneous;
+  spec.self_loops = f.self_loops;
+  spec.max_q = f.max_q;
+  spec.max_multiplier = f.max_multiplier;
+  spec.extra_percent = f.extra_percent;
+  spec.back_percent = f.back_percent;
+  uint64_t lo = 0, hi = 0;
+  if (!f.times.empty()) {
+    const auto colon = f.times.find(':');
+    auto whole = [&](std::string_view t, uint64_t& v) {
+      const auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+      return !t.empty() && ec == std::errc() && p == t.data() + t.size();
+    };
+    const std::string_view t(f.times);
+    if (colon == std::string::npos || !whole(t.substr(0, colon), lo) ||
+        !whole(t.substr(colon + 1), hi) || lo > hi || hi >= (uint64_t{1} << 63))
+      throw Error(Error::Kind::usage,
+                  "--times '" + f.times + "': expected LO:HI, whole numbers, LO <= HI < 2^63");
+  }
+  crowddb::Rng rng(f.seed);
+  sdf::gen::Generated gd = sdf::gen::generate(spec, rng);
+  sdf::Graph& g = gd.graph;
+  g.name = f.shape + "_" + std::to_string(f.actors) + "_seed" + std::to_string(f.seed);
+  if (!f.times.empty()) {
+    crowddb::Rng time_rng = crowddb::Rng::stream(f.seed, 1);  // times do not move the graph
+    for (sdf::ActorId a = 0; a < g.actor_count(); ++a)
+      g.set_actor_time(a, lo + (hi > lo ? time_rng.below(hi - lo + 1) : 0));
+  }
+  const bool xml = f.format == "sdf3" || (f.format.empty() && out.size() >= 4 &&
+                                          out.compare(out.size() - 4, 4, ".xml") == 0);
+  return write_output(xml ? sdf::write_sdf3(g) : sdf::write_json(g), out);
 }
 
 int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& save_dir) {
@@ -1009,6 +1066,32 @@ int main(int argc, char** argv) {
   lat->callback([&] {
     action = [&] { return cmd_latency(graph, from, to_actor, iterations, default_time, json); };
   });
+
+  GenerateFlags gf;
+  auto* gen = app.add_subcommand("generate", "write a random consistent graph (JSON or SDF3)");
+  gen->add_option("--shape", gf.shape, "chain, fan-out, fan-in, dag, cyclic or cyclic-random")
+      ->check(CLI::IsMember({"chain", "fan-out", "fan-in", "dag", "cyclic", "cyclic-random"}));
+  gen->add_option("--actors", gf.actors, "number of actors")
+      ->check(crowddb::cli_checks::whole(1, 50'000'000));
+  gen->add_flag("--homogeneous", gf.homogeneous, "every rate 1");
+  gen->add_flag("--self-loops", gf.self_loops, "SDF3's one-token self-loop on every actor");
+  gen->add_option("--max-q", gf.max_q,
+                  "repetition counts drawn from {1,2,3,4,5,6,8,9,10,12} up to this")
+      ->check(crowddb::cli_checks::whole(1, 12));
+  gen->add_option("--max-multiplier", gf.max_multiplier,
+                  "rates are (q_dst, q_src)/gcd times a multiplier from {1,2,3} up to this")
+      ->check(crowddb::cli_checks::whole(1, 3));
+  gen->add_option("--extra-percent", gf.extra_percent,
+                  "dag/cyclic: extra forward channels, % of the actors")
+      ->check(crowddb::cli_checks::whole(0, 1000));
+  gen->add_option("--back-percent", gf.back_percent, "cyclic: back channels, % of the actors")
+      ->check(crowddb::cli_checks::whole(0, 1000));
+  gen->add_option("--times", gf.times, "LO:HI: random execution times in [LO, HI]");
+  gen->add_option("--seed", gf.seed, "random seed");
+  gen->add_option("--format", gf.format, "json or sdf3 (default: sdf3 for -o *.xml, else json)")
+      ->check(CLI::IsMember({"json", "sdf3"}));
+  gen->add_option("-o,--output", out, "output file (default: standard output)");
+  gen->callback([&] { action = [&] { return cmd_generate(gf, out); }; });
 
   uint64_t graphs = 100, seed = 1;
   std::string save;
