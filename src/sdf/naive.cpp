@@ -1,12 +1,17 @@
 #include "sdf/naive.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <map>
 #include <numeric>
+#include <pugixml.hpp>
+#include <sstream>
 
 #include "hsdf.hpp"
+#include "json_detail.hpp"
 #include "latency_detail.hpp"
 #include "sdf/checked.hpp"
+#include "sdf/text.hpp"
 #include "sdf/throughput.hpp"
 
 namespace sdf::naive {
@@ -485,6 +490,190 @@ GraphStats stats(const Graph& g) {
     on_path[s] = 0;
   }
   return st;
+}
+
+namespace {
+
+// The SDF3 reader as it was before the streaming one (a pugixml document, two passes over
+// <sdf>), kept as its twin.
+struct DomPort {
+  ActorId actor;
+  std::string_view name;
+  bool out;
+  uint64_t rate;
+  size_t offset;  // of the <port> element; its line is computed only for an error message
+  int64_t channel = -1;
+};
+
+class DomReader {
+ public:
+  DomReader(std::string_view text, const std::string& source) : text_(text), source_(source) {}
+
+  Graph read(std::string_view text) {
+    const pugi::xml_parse_result res =
+        doc_.load_buffer(text.data(), text.size(), pugi::parse_default, pugi::encoding_utf8);
+    if (!res) fail(static_cast<size_t>(res.offset), std::string("XML: ") + res.description());
+    const pugi::xml_node root = doc_.child("sdf3");
+    if (!root) fail(0, "no <sdf3> root element");
+    const std::string_view type = root.attribute("type").value();
+    if (!type.empty() && type != "sdf")
+      fail(root, "graph type '" + std::string(type) + "' is not supported (only type=\"sdf\")");
+    const pugi::xml_node app = root.child("applicationGraph");
+    if (!app) fail(root, "<sdf3> has no <applicationGraph>");
+    const pugi::xml_node sdf = app.child("sdf");
+    if (!sdf) fail(app, "<applicationGraph> has no <sdf>");
+    Graph g;
+    g.name = sdf.attribute("name").value();
+    if (!valid_utf8(g.name)) fail(sdf, "attribute 'name' is not valid UTF-8");
+    g.type = sdf.attribute("type").value();
+    if (!valid_utf8(g.type)) fail(sdf, "attribute 'type' is not valid UTF-8");
+    for (pugi::xml_node actor : sdf.children("actor")) read_actor(g, actor);
+    std::sort(ports_.begin(), ports_.end(), [](const DomPort& a, const DomPort& b) {
+      return a.actor != b.actor ? a.actor < b.actor : a.name < b.name;
+    });
+    for (size_t i = 1; i < ports_.size(); ++i)
+      if (ports_[i].actor == ports_[i - 1].actor && ports_[i].name == ports_[i - 1].name)
+        fail(std::max(ports_[i].offset, ports_[i - 1].offset),
+             "duplicate port '" + std::string(ports_[i].name) + "' on actor '" +
+                 g.actor_name(ports_[i].actor) + "'");
+    port_begin_.assign(g.actor_count() + 1, 0);
+    for (const DomPort& p : ports_) ++port_begin_[p.actor + 1];
+    for (size_t a = 0; a < g.actor_count(); ++a) port_begin_[a + 1] += port_begin_[a];
+    for (pugi::xml_node ch : sdf.children("channel")) read_channel(g, ch);
+    for (const DomPort& p : ports_)
+      if (p.channel < 0)
+        fail(p.offset, "port '" + std::string(p.name) + "' of actor '" + g.actor_name(p.actor) +
+                           "' is not connected to a channel");
+    if (const pugi::xml_node props = app.child("sdfProperties")) read_properties(g, props);
+    return g;
+  }
+
+ private:
+  [[noreturn]] void fail_line(size_t line, const std::string& msg) const {
+    throw Error(Error::Kind::input, source_ + ":" + std::to_string(line) + ": " + msg);
+  }
+  [[noreturn]] void fail(size_t offset, const std::string& msg) const {
+    fail_line(LineIndex(text_).line_of(offset), msg);  // built only for the one error
+  }
+  [[noreturn]] void fail(pugi::xml_node node, const std::string& msg) const {
+    fail(static_cast<size_t>(std::max<ptrdiff_t>(0, node.offset_debug())), msg);
+  }
+
+  std::string_view required(pugi::xml_node node, const char* attr) const {
+    const pugi::xml_attribute a = node.attribute(attr);
+    if (!a) fail(node, "<" + std::string(node.name()) + "> lacks the attribute '" + attr + "'");
+    const std::string_view v = trim(a.value());
+    if (v.empty()) fail(node, "attribute '" + std::string(attr) + "' is empty");
+    if (!valid_utf8(v)) fail(node, "attribute '" + std::string(attr) + "' is not valid UTF-8");
+    return v;
+  }
+
+  uint64_t number(pugi::xml_node node, const char* attr, std::string_view text,
+                  bool positive) const {
+    uint64_t v = 0;
+    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec != std::errc() || ptr != text.data() + text.size() || (positive && v == 0)) {
+      std::string msg = "attribute " + std::string(attr) + "='" + std::string(text) +
+                        "' is not a " + (positive ? "positive" : "non-negative") +
+                        " 64-bit integer";
+      if (text.find(',') != std::string_view::npos) msg += " (CSDF rate lists are not supported)";
+      fail(node, msg);
+    }
+    return v;
+  }
+
+  void read_actor(Graph& g, pugi::xml_node actor) {
+    const std::string_view name = required(actor, "name");
+    ActorId id;
+    try {
+      id = g.add_actor(std::string(name));  // "duplicate actor name '...'"
+    } catch (const Error& e) {
+      fail(actor, e.what());
+    }
+    if (const pugi::xml_attribute type = actor.attribute("type")) {
+      if (!valid_utf8(type.value())) fail(actor, "attribute 'type' is not valid UTF-8");
+      g.set_actor_type(id, type.value());
+    }
+    for (pugi::xml_node port : actor.children("port")) {
+      DomPort p;
+      p.actor = id;
+      p.name = required(port, "name");
+      const std::string_view type = required(port, "type");
+      if (type != "in" && type != "out")
+        fail(port, "port type '" + std::string(type) + "' is neither 'in' nor 'out'");
+      p.out = type == "out";
+      p.rate = number(port, "rate", required(port, "rate"), true);
+      p.offset = static_cast<size_t>(std::max<ptrdiff_t>(0, port.offset_debug()));
+      ports_.push_back(p);
+    }
+  }
+
+  // Times and the kept text through the JSON form's path (its messages differ; the test
+  // compares graphs and whether reading fails).
+  void read_properties(Graph& g, pugi::xml_node props) {
+    std::ostringstream out;
+    props.print(out, "", pugi::format_raw, pugi::encoding_utf8);
+    detail::read_sdf3_properties(g, out.str(), source_);
+  }
+
+  DomPort& find_port(const Graph& g, pugi::xml_node ch, ActorId actor, std::string_view name) {
+    // The actor's ports are ports_[port_begin_[actor], port_begin_[actor + 1]), sorted by name.
+    const auto first = ports_.begin() + static_cast<ptrdiff_t>(port_begin_[actor]);
+    const auto last = ports_.begin() + static_cast<ptrdiff_t>(port_begin_[actor + 1]);
+    auto it = std::lower_bound(first, last, name,
+                               [](const DomPort& p, std::string_view k) { return p.name < k; });
+    if (it == last || it->name != name)
+      fail(ch, "actor '" + g.actor_name(actor) + "' has no port '" + std::string(name) + "'");
+    return *it;
+  }
+
+  void read_channel(Graph& g, pugi::xml_node ch) {
+    const pugi::xml_attribute name_attr = ch.attribute("name");
+    const std::string name(trim(name_attr.value()));
+    if (name_attr && name.empty()) fail(ch, "attribute 'name' is empty");
+    if (!valid_utf8(name)) fail(ch, "attribute 'name' is not valid UTF-8");
+    auto actor = [&](const char* attr) {
+      const std::string_view v = required(ch, attr);
+      const auto a = g.find_actor(v);
+      if (!a) fail(ch, "channel refers to an unknown actor '" + std::string(v) + "'");
+      return *a;
+    };
+    const ActorId src = actor("srcActor");
+    const ActorId dst = actor("dstActor");
+    DomPort& sp = find_port(g, ch, src, required(ch, "srcPort"));
+    DomPort& dp = find_port(g, ch, dst, required(ch, "dstPort"));
+    if (!sp.out) fail(ch, "srcPort '" + std::string(sp.name) + "' is an input port");
+    if (dp.out) fail(ch, "dstPort '" + std::string(dp.name) + "' is an output port");
+    for (DomPort* p : {&sp, &dp})
+      if (p->channel >= 0)
+        fail(ch, "port '" + std::string(p->name) + "' of actor '" + g.actor_name(p->actor) +
+                     "' is already connected to channel '" +
+                     g.channel(static_cast<ChannelId>(p->channel)).name + "'");
+    uint64_t delay = 0;
+    if (const pugi::xml_attribute t = ch.attribute("initialTokens"))
+      delay = number(ch, "initialTokens", trim(t.value()), false);
+    ChannelId c;
+    try {
+      c = g.add_channel(src, dst, sp.rate, dp.rate, delay, name);  // "duplicate channel name"
+    } catch (const Error& e) {
+      fail(ch, e.what());
+    }
+    g.set_port_names(c, std::string(sp.name), std::string(dp.name));
+    sp.channel = dp.channel = c;
+  }
+
+  std::string_view text_;
+  const std::string& source_;
+  pugi::xml_document doc_;
+  std::vector<DomPort> ports_;
+  std::vector<size_t> port_begin_;  // per actor, into ports_ (sorted by actor, then name)
+};
+
+}  // namespace
+
+Graph read_sdf3(std::string_view text, const std::string& source) {
+  DomReader reader(text, source);
+  return reader.read(text);
 }
 
 }  // namespace sdf::naive

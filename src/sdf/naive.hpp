@@ -65,6 +65,10 @@ Latency latency(const Graph& g, const LatencyOptions& options,
 // channels from each actor s through actors above s back to s (no blocking, no limit).
 GraphStats stats(const Graph& g);
 
+// The SDF3 reader before the streaming one: pugixml's document tree, actors then channels.
+// Same graphs; its error messages may differ (it reports in two passes, not in file order).
+Graph read_sdf3(std::string_view text, const std::string& source);
+
 // Points as storage_throughput_pareto's; `complete` when the graph's throughput (with unbounded
 // channels, by throughput_mcm) is reached at a size of at most max_size. Needs execution times.
 // Capacities start at `floor` (default: the delays). The tests pass the lower bounds, which
