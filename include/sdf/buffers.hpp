@@ -55,11 +55,12 @@ std::vector<uint64_t> buffer_lower_bounds(const Graph& g);
 // below the channel's delay or a name clashes.
 Graph bounded_graph(const Graph& g, std::span<const uint64_t> capacity);
 
+// minimal_storage's untimed runs store no states: the state limits bind the Pareto search only.
 struct BufferLimits {
   uint64_t max_distributions = 1'000'000;   // distributions explored, whole search
-  uint64_t max_states = 50'000'000;         // states stored, summed over the explorations
-  uint64_t max_states_per_run = 5'000'000;  // states stored by one exploration
-  uint64_t max_size = UINT64_MAX;           // Pareto: no distribution larger than this
+  uint64_t max_states = 50'000'000;         // Pareto: states stored, summed over the explorations
+  uint64_t max_states_per_run = 5'000'000;  // Pareto: states stored by one exploration
+  uint64_t max_size = UINT64_MAX;           // no distribution larger than this is explored
 };
 
 struct StorageSearch {
@@ -70,7 +71,8 @@ struct StorageSearch {
 };
 
 // Throws Error(input) when the graph is inconsistent, not connected, or deadlocks whatever the
-// capacities (then no distribution is deadlock-free), or when a limit is exceeded.
+// capacities (then no distribution is deadlock-free), or when a limit is exceeded (max_size:
+// when no deadlock-free distribution is that small).
 StorageSearch minimal_storage(const Graph& g, const BufferLimits& limits = {});
 
 struct ParetoPoint {
@@ -89,7 +91,8 @@ struct ParetoSearch {
 };
 
 // Execution times from execution_times(g, default_time). Throws Error(input) as
-// minimal_storage (a graph that always deadlocks has no point), or for a missing time.
+// minimal_storage (a graph that always deadlocks has no point), or for a missing time; a limit
+// reached ends the search with the points found so far (perhaps none).
 ParetoSearch storage_throughput_pareto(const Graph& g,
                                        std::optional<uint64_t> default_time = std::nullopt,
                                        const BufferLimits& limits = {});

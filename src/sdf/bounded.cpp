@@ -307,9 +307,9 @@ BoundedRun BoundedModel::run(std::span<const uint64_t> cap, bool dependencies,
           period_key = it->first;
           seen.clear();
         } else if (++r.states > max_states) {
-          throw Error(Error::Kind::input,
-                      "buffers: one exploration of a storage distribution stores more than " +
-                          std::to_string(max_states) + " states (the limit of this analysis)");
+          throw LimitExceeded(
+              "buffers: one exploration of a storage distribution stores more than " +
+              std::to_string(max_states) + " states (the limit of this analysis)");
         }
       }
     }

@@ -22,11 +22,19 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "sdf/graph.hpp"
 
 namespace sdf::detail {
+
+// A limit of BufferLimits exceeded: an Error(input) naming it, which the Pareto search turns into
+// an incomplete result (other errors it lets through).
+class LimitExceeded : public Error {
+ public:
+  explicit LimitExceeded(const std::string& message) : Error(Error::Kind::input, message) {}
+};
 
 struct BoundedRun {
   bool unbounded = false;        // every actor takes no time and the graph is live
@@ -44,7 +52,7 @@ class BoundedModel {
   // storage dependencies of the deadlock.
   bool live(std::span<const uint64_t> cap, std::vector<char>* dependency = nullptr) const;
 
-  // Throws Error(input) when more than max_states states would be stored.
+  // Throws LimitExceeded when more than max_states states would be stored.
   BoundedRun run(std::span<const uint64_t> cap, bool dependencies, uint64_t max_states) const;
 
  private:

@@ -122,12 +122,11 @@ void count_run(uint64_t& explored, uint64_t& states, uint64_t run_states,
   ++explored;
   states = detail::add_sat(states, run_states);
   if (explored > limits.max_distributions)
-    throw Error(Error::Kind::input, "buffers: more than " +
-                                        std::to_string(limits.max_distributions) +
-                                        " storage distributions explored (the limit)");
+    throw detail::LimitExceeded("buffers: more than " + std::to_string(limits.max_distributions) +
+                                " storage distributions explored (the limit)");
   if (states > limits.max_states)
-    throw Error(Error::Kind::input, "buffers: more than " + std::to_string(limits.max_states) +
-                                        " states stored over all explorations (the limit)");
+    throw detail::LimitExceeded("buffers: more than " + std::to_string(limits.max_states) +
+                                " states stored over all explorations (the limit)");
 }
 
 }  // namespace
@@ -200,8 +199,11 @@ StorageSearch minimal_storage(const Graph& g, const BufferLimits& limits) {
       return r;  // a std::set iterates in order: already sorted
     }
   }
-  // Unreachable when the search is complete (a live graph has a deadlock-free distribution);
-  // said plainly rather than answered wrongly.
+  // A live graph has a deadlock-free distribution, so only max_size can have hidden it; anything
+  // else is a mistake here, said plainly rather than answered wrongly.
+  if (queue.beyond_max_size())
+    throw detail::LimitExceeded("buffers: no deadlock-free distribution of size at most " +
+                                std::to_string(limits.max_size) + " (the size limit)");
   throw std::logic_error("buffers: no deadlock-free distribution found");
 }
 
@@ -244,9 +246,8 @@ ParetoSearch storage_throughput_pareto(const Graph& g, std::optional<uint64_t> d
                     ? "no distribution of size at most " + std::to_string(limits.max_size) +
                           " reaches the throughput with unbounded channels"
                     : "no channel left to enlarge (the dependency analysis found none)";
-  } catch (const Error& e) {
-    if (e.kind() != Error::Kind::input || r.points.empty()) throw;
-    r.stopped = e.what();
+  } catch (const detail::LimitExceeded& e) {
+    r.stopped = e.what();  // with the points so far, perhaps none
   }
   return r;
 }

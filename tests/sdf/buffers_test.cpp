@@ -70,6 +70,29 @@ TEST(Buffers, ParetoByHand) {
   EXPECT_EQ(s.points[1].distributions, (std::vector<std::vector<uint64_t>>{{2, 2, 2}}));
 }
 
+TEST(Buffers, LimitsBindBothSearches) {
+  // A → B and B → A, 1:1, with 1 and 2 tokens: at the lower bounds (the delays, 3) both
+  // channels are full and nothing fires; one more place on either channel is enough.
+  const Graph g = read_graph_file(test::data("full_ring.json"));
+  EXPECT_EQ(minimal_storage(g).size, 4u);
+  BufferLimits limits;
+  limits.max_size = 3;
+  try {
+    minimal_storage(g, limits);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "buffers: no deadlock-free distribution of size at most 3 (the size limit)");
+  }
+  // The Pareto search stops with what it has, here nothing: the first distribution deadlocks.
+  limits = {};
+  limits.max_distributions = 1;
+  const ParetoSearch p = storage_throughput_pareto(g, std::nullopt, limits);
+  EXPECT_FALSE(p.complete);
+  EXPECT_TRUE(p.points.empty());
+  EXPECT_EQ(p.stopped, "buffers: more than 1 storage distributions explored (the limit)");
+}
+
 TEST(Buffers, BoundedGraphAddsReverseChannels) {
   const Graph g = make({"A", "B"}, {{"A", "B", 2, 3, 1}});
   const Graph b = bounded_graph(g, std::vector<uint64_t>{5});

@@ -276,6 +276,24 @@ TEST(SdfschedCli, BuffersAndMinBufferSchedule) {
   EXPECT_NE(l["stopped"].get<std::string>().find("more than 2 storage distributions"),
             std::string::npos);
   EXPECT_EQ(l["points"].size(), 2u);
+  // Also when the limit comes before the first point: on a ring whose channels are full at
+  // the lower bounds, the first distribution deadlocks and gives no point.
+  const test::Cli none = test::sdfsched("buffers " + graph("full_ring.json") +
+                                        " --pareto --max-distributions 1 --json");
+  EXPECT_EQ(none.status, 3) << none.err;
+  const json n = json::parse(none.out);
+  EXPECT_EQ(n["complete"], false);
+  EXPECT_EQ(n["points"].size(), 0u);
+  EXPECT_NE(n["stopped"].get<std::string>().find("more than 1 storage distributions"),
+            std::string::npos);
+  // --max-size binds minimal storage too: nothing of CD-to-DAT's minimal 32 fits in 31.
+  const test::Cli small = test::sdfsched("buffers " + graph("cd2dat.json") + " --max-size 31");
+  EXPECT_EQ(small.status, 1);
+  EXPECT_TRUE(one_line(small.err));
+  EXPECT_NE(small.err.find("no deadlock-free distribution of size at most 31 (the size limit)"),
+            std::string::npos)
+      << small.err;
+  EXPECT_EQ(test::sdfsched("buffers " + graph("cd2dat.json") + " --max-size 32").status, 0);
   // The schedule within the minimal distribution: valid, buffers within it, 32 in all.
   const test::Cli s =
       test::sdfsched("schedule " + graph("cd2dat.json") + " --policy min-buffer --json");
@@ -391,6 +409,7 @@ TEST(SdfschedCli, BadInputAndUsage) {
       {"convert " + graph("cd2dat.json") + " --to png", 2, "--to"},
       {"buffers " + graph("cd2dat.json") + " --max-size -1", 2, "--max-size"},
       {"buffers " + graph("cd2dat.json") + " --max-distributions 0", 2, "--max-distributions"},
+      {"buffers " + graph("cd2dat.json") + " --max-states 9", 2, "applies to --pareto only"},
       {"buffers " + graph("inconsistent.json"), 1, "inconsistent graph"},
       {"latency " + graph("timed_modem.xml") + " --from src", 2, "give both --from and --to"},
       {"latency " + graph("timed_modem.xml") + " --from src --to nobody", 1,

@@ -1,6 +1,7 @@
 // sdfsched: SDF scheduling from the command line (DESIGN §9, docs/sdf.md).
 // Exit status: 0 ok; 1 inconsistent graph, deadlock or bad input; 2 usage; 3 an online outcome
-// other than `returns` (simulate: other than `returns` or `periodic`).
+// other than `returns` (simulate: other than `returns` or `periodic`; buffers --pareto: stopped
+// at a limit).
 #include <CLI/CLI.hpp>
 #include <charconv>
 #include <cstdio>
@@ -1033,14 +1034,20 @@ int main(int argc, char** argv) {
   buf->add_option("--max-distributions", limits.max_distributions,
                   "stop after exploring this many storage distributions")
       ->check(crowddb::cli_checks::whole_at_least(1));
-  buf->add_option("--max-states", limits.max_states,
-                  "stop after storing this many states over all explorations")
-      ->check(crowddb::cli_checks::whole_at_least(1));
-  buf->add_option("--max-size", limits.max_size, "--pareto: explore no distribution larger")
+  auto* max_states = buf->add_option("--max-states", limits.max_states,
+                                     "--pareto: stop after storing this many states over all "
+                                     "explorations (minimal storage stores none)")
+                         ->check(crowddb::cli_checks::whole_at_least(1));
+  buf->add_option("--max-size", limits.max_size, "explore no distribution larger")
       ->check(crowddb::cli_checks::whole_at_least(0));
   buf->add_flag("--json", json, "JSON output");
-  buf->callback(
-      [&] { action = [&] { return cmd_buffers(graph, pareto, default_time, limits, json); }; });
+  buf->callback([&] {
+    if (!pareto && max_states->count() > 0)
+      throw CLI::ValidationError("--max-states",
+                                 "applies to --pareto only (minimal storage runs "
+                                 "untimed and stores no states)");
+    action = [&] { return cmd_buffers(graph, pareto, default_time, limits, json); };
+  });
 
   sdf::StatsLimits stats_limits;
   auto* sta = app.add_subcommand(
