@@ -149,18 +149,17 @@ bool BoundedModel::live(std::span<const uint64_t> cap, std::vector<char>* depend
   return false;
 }
 
-BoundedRun BoundedModel::run(std::span<const uint64_t> cap, bool dependencies,
-                             uint64_t max_states) const {
+Throughput BoundedModel::run(std::span<const uint64_t> cap, uint64_t max_states,
+                             std::vector<char>* dependency) const {
   const size_t n = g_.actor_count(), m = g_.channel_count();
-  BoundedRun r;
+  Throughput r;
   if (all_untimed_ || m == 0) {
     // Without time a live graph fires without bound at one instant.
-    std::vector<char> dep;
-    const bool is_live = live(cap, dependencies ? &dep : nullptr);
-    r.unbounded = is_live;
-    r.num = 0;
-    r.den = 1;
-    if (dependencies) r.dependency = is_live ? std::vector<char>(m, 0) : std::move(dep);
+    r.unbounded = live(cap, dependency);
+    if (r.unbounded) {
+      r.num = r.den = 0;
+      if (dependency) dependency->assign(m, 0);
+    }
     return r;
   }
   std::vector<uint64_t> tokens(m), space(m);
@@ -280,7 +279,7 @@ BoundedRun BoundedModel::run(std::span<const uint64_t> cap, bool dependencies,
     if (busy == 0) {  // a standstill: nothing runs and nothing can start
       r.num = 0;
       r.den = 1;
-      if (dependencies) r.dependency = standstill_dependencies(g_, tokens, space);
+      if (dependency) *dependency = standstill_dependencies(g_, tokens, space);
       return r;
     }
     if (done_ref >= mark) {
@@ -289,7 +288,7 @@ BoundedRun BoundedModel::run(std::span<const uint64_t> cap, bool dependencies,
       std::string key = encode();
       if (track) {
         if (key == period_key) {
-          r.dependency = waits.storage_dependencies(g_);
+          *dependency = waits.storage_dependencies(g_);
           return r;
         }
       } else {
@@ -302,7 +301,7 @@ BoundedRun BoundedModel::run(std::span<const uint64_t> cap, bool dependencies,
           const uint64_t gcd = std::gcd(firings, den);
           r.num = firings / gcd;
           r.den = den / gcd;
-          if (!dependencies) return r;
+          if (!dependency) return r;
           track = true;
           period_key = it->first;
           seen.clear();

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "sdf/graph.hpp"
+#include "sdf/throughput.hpp"
 
 namespace sdf::detail {
 
@@ -34,13 +35,6 @@ namespace sdf::detail {
 class LimitExceeded : public Error {
  public:
   explicit LimitExceeded(const std::string& message) : Error(Error::Kind::input, message) {}
-};
-
-struct BoundedRun {
-  bool unbounded = false;        // every actor takes no time and the graph is live
-  uint64_t num = 0, den = 1;     // iterations per time unit (num = 0: deadlock)
-  std::vector<char> dependency;  // per channel, when asked for
-  uint64_t states = 0;
 };
 
 class BoundedModel {
@@ -52,8 +46,11 @@ class BoundedModel {
   // storage dependencies of the deadlock.
   bool live(std::span<const uint64_t> cap, std::vector<char>* dependency = nullptr) const;
 
-  // Throws LimitExceeded when more than max_states states would be stored.
-  BoundedRun run(std::span<const uint64_t> cap, bool dependencies, uint64_t max_states) const;
+  // The throughput (unbounded when every actor takes no time and the graph is live; `states`:
+  // those stored) and, when `dependency` is given, the storage dependencies per channel. Throws
+  // LimitExceeded when more than max_states states would be stored.
+  Throughput run(std::span<const uint64_t> cap, uint64_t max_states,
+                 std::vector<char>* dependency = nullptr) const;
 
  private:
   // An actor's side of a channel, in compact arrays (a Channel is 128 bytes of mostly names):

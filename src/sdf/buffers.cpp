@@ -70,15 +70,6 @@ int compare(const Throughput& a, const Throughput& b) {
   return detail::compare_fractions(a.num, a.den, b.num, b.den);
 }
 
-Throughput to_throughput(const detail::BoundedRun& r) {
-  Throughput t;
-  t.unbounded = r.unbounded;
-  t.num = r.unbounded ? 0 : r.num;
-  t.den = r.unbounded ? 0 : r.den;
-  t.states = r.states;
-  return t;
-}
-
 class Queue {
  public:
   Queue(const Graph& g, const BufferLimits& limits) : g_(g), limits_(limits) {}
@@ -216,17 +207,18 @@ ParetoSearch storage_throughput_pareto(const Graph& g, std::optional<uint64_t> d
   Queue queue(g, limits);
   queue.push(buffer_lower_bounds(g));
   Throughput best;  // 0
+  std::vector<char> dep;
   try {
     while (!queue.empty()) {
       auto [size, set] = queue.pop();
       std::vector<std::pair<const Distribution*, Throughput>> results;
       Throughput top;
       for (const Distribution& d : set) {
-        const detail::BoundedRun run = model.run(d, true, limits.max_states_per_run);
-        count_run(r.explored, r.states, run.states, limits);
-        results.push_back({&d, to_throughput(run)});
-        if (compare(results.back().second, top) > 0) top = results.back().second;
-        queue.enlarge(d, run.dependency);
+        const Throughput t = model.run(d, limits.max_states_per_run, &dep);
+        count_run(r.explored, r.states, t.states, limits);
+        results.push_back({&d, t});
+        if (compare(t, top) > 0) top = t;
+        queue.enlarge(d, dep);
       }
       if (compare(top, best) <= 0) continue;
       ParetoPoint p;
@@ -263,7 +255,7 @@ Throughput bounded_throughput(const Graph& g, std::span<const uint64_t> capacity
                                           std::to_string(capacity[c]) + " is below its " +
                                           std::to_string(g.channel(c).delay) + " initial tokens");
   const detail::BoundedModel model(g, q, execution_times(g, default_time));
-  return to_throughput(model.run(capacity, false, limits.max_states_per_run));
+  return model.run(capacity, limits.max_states_per_run);
 }
 
 std::vector<Run> min_buffer_schedule(const Graph& g, std::vector<uint64_t>* capacity,
