@@ -94,8 +94,10 @@ struct ChannelRecord {
 // they come; once a channel names an actor not seen yet (SDF3 does not fix the element order),
 // it and every later channel wait for the end of the document, so channels keep their file
 // order. <sdfProperties> is cut out of the text and parsed on its own (pugixml: it is small next
-// to the graph). Errors come in file order: a pending block is resolved before a later mistake
-// is reported.
+// to the graph). Errors come in file order as far as the text read tells them: a pending block,
+// and the waiting channels whose actors have been seen, are resolved before a later mistake is
+// reported; what only the end of the document decides (a port left unconnected, a channel
+// naming an actor that never comes, <sdfProperties>, parsed last) is reported there.
 class Sdf3Reader {
  public:
   Sdf3Reader(std::string_view text, const std::string& source,
@@ -103,19 +105,29 @@ class Sdf3Reader {
       : text_(text), source_(source), scan_(text), release_(release) {}
 
   Graph read() {
-    // Room for as many actors and channels as the text has tags that start like theirs (a
-    // quick count: the graph's arrays and tables then never grow).
+    // Room for as many actors and channels as the text has tags named like theirs (a quick
+    // count: the graph's arrays and tables then never grow). The count also finds such tags in
+    // comments or outside <sdf>, so it is capped at what a valid file of this size could hold:
+    // the shortest actor element, <actor name='A'/>, has 17 bytes, and a channel's four
+    // required attributes make it 60. A malformed file then costs no more before its first
+    // error than a valid one of its size.
     size_t actors = 0, channels = 0;
+    auto named = [&](size_t at, std::string_view name) {
+      if (text_.compare(at + 1, name.size(), name) != 0) return false;
+      const size_t after = at + 1 + name.size();
+      return after < text_.size() &&
+             (text_[after] == '/' || text_[after] == '>' || text_[after] == ' ' ||
+              text_[after] == '\t' || text_[after] == '\n' || text_[after] == '\r');
+    };
     for (size_t at = text_.find('<'); at != std::string_view::npos; at = text_.find('<', at + 1)) {
-      const std::string_view tag = text_.substr(at + 1, 8);
-      actors += tag.starts_with("actor");
-      channels += tag.starts_with("channel");
+      actors += named(at, "actor");
+      channels += named(at, "channel");
     }
-    g_.reserve(actors, channels);
+    g_.reserve(std::min(actors, text_.size() / 17), std::min(channels, text_.size() / 60));
     try {
       scan();
     } catch (const detail::XmlError& e) {
-      fail(e.offset, e.message);
+      fail_after_pending(e.offset, e.message);
     }
     flush_actors();
     flush_channels();
@@ -209,10 +221,15 @@ class Sdf3Reader {
     released_ = offset;
   }
 
-  // Reports a mistake at `offset` after the pending blocks, whose own mistakes come first.
+  // Reports a mistake at `offset` after the pending blocks, whose own mistakes come first, and
+  // after the waiting channels whose actors have been seen by now (a channel naming an actor
+  // not seen yet cannot be judged before the end of the document, which is not read).
   [[noreturn]] void fail_after_pending(size_t offset, const std::string& msg) {
     flush_actors();
     flush_channels();
+    std::vector<ChannelRecord> waiting;
+    waiting.swap(deferred_);
+    resolve(waiting, false);  // those from the first unknown actor on wait again
     fail(offset, msg);
   }
   [[noreturn]] void fail(size_t offset, const std::string& msg) const {
@@ -335,7 +352,7 @@ class Sdf3Reader {
     r.dst_port = required(t, "dstPort");
     if (const detail::XmlAttribute* a = scan_.attribute("initialTokens"))
       r.delay = number(t.offset, "initialTokens", trim(keep(a->raw)), false);
-    (deferring_ ? deferred_ : pending_).push_back(r);
+    (deferred_.empty() ? pending_ : deferred_).push_back(r);  // once one waits, all later do
     if (pending_.size() >= kBlock) flush_channels();
   }
 
@@ -370,7 +387,9 @@ class Sdf3Reader {
         if (stage == 0) {
           detail::prefetch(&port_begin_[static_cast<size_t>(a)]);
         } else {
-          const Port& p = ports_[port_begin_[static_cast<size_t>(a)]];
+          const auto first = port_begin_[static_cast<size_t>(a)];
+          if (first == port_begin_[static_cast<size_t>(a) + 1]) continue;  // an actor without ports
+          const Port& p = ports_[first];
           if (stage == 1)
             detail::prefetch(&p);
           else
@@ -414,10 +433,8 @@ class Sdf3Reader {
           {src, dst, sp.rate, dp.rate, r.delay, r.has_name ? r.name : std::string_view{}});
     }
     add_batch(records, batch);
-    if (i < records.size()) {  // not last_chance: records is pending_, and deferred_ is empty
-      deferring_ = true;
+    if (i < records.size())  // not last_chance; records is not deferred_, which is empty
       deferred_.assign(records.begin() + static_cast<ptrdiff_t>(i), records.end());
-    }
   }
 
   Port& find_port_or_flush(std::vector<ChannelRecord>& records,
@@ -507,7 +524,7 @@ class Sdf3Reader {
   // entry is where the next actor's begin.
   std::vector<uint32_t> port_begin_{0};
   std::vector<ChannelRecord> pending_, deferred_;
-  bool deferring_ = false, actor_open_ = false;
+  bool actor_open_ = false;
   std::vector<std::string_view> names_;
   std::vector<int64_t> ids_;
   std::string_view props_;

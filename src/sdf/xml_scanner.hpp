@@ -12,7 +12,6 @@
 #pragma once
 
 #include <cstddef>
-#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -44,8 +43,7 @@ class XmlScanner {
 
   // The next start or end tag, or eof (only once every element is closed). Throws XmlError.
   Token next();
-  // The attributes of the last start tag, in order (a repeated name: the first counts).
-  std::span<const XmlAttribute> attributes() const { return attributes_; }
+  // An attribute of the last start tag (a repeated name: the first counts), or null.
   const XmlAttribute* attribute(std::string_view name) const;
   size_t depth() const { return open_.size(); }
 

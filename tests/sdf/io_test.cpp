@@ -322,6 +322,39 @@ TEST(Sdf3Reader, AMistakeInsideAnActorWithAPendingChannelNamingIt) {
       std::string::npos);
 }
 
+// A channel naming a port of the last actor, which has none: the reader fetched that actor's
+// first port ahead (ports_[ports_.size()], out of bounds) before finding it missing.
+TEST(Sdf3Reader, AChannelToTheLastActorWithoutPorts) {
+  EXPECT_EQ(sdf3_error(sdf3("<actor name='A'><port name='o' type='out' rate='1'/></actor>\n"
+                            "<actor name='B'/>\n"
+                            "<channel name='c' srcActor='A' srcPort='o' dstActor='B' "
+                            "dstPort='i'/>\n")),
+            "f.xml:7: actor 'B' has no port 'i'");
+}
+
+// Errors come in file order as far as the text read tells them: a mistake in a channel that
+// waited for a later actor comes before a later mistake once that actor has been seen, and a
+// pending block's mistake before a later XML error.
+TEST(Sdf3Reader, EarlierMistakesComeFirst) {
+  const std::string waiting =
+      "<actor name='A'><port name='o' type='out' rate='1'/>"
+      "<port name='p' type='out' rate='1'/></actor>\n"
+      "<channel name='c' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n"
+      "<actor name='B'><port name='i' type='in' rate='1'/><port name='j' type='in' rate='1'/>"
+      "</actor>\n"
+      "<channel name='d' srcActor='A' srcPort='x' dstActor='B' dstPort='j'/>\n";
+  EXPECT_EQ(sdf3_error(sdf3(waiting + "<actor type='t'/>\n")),
+            "f.xml:8: actor 'A' has no port 'x'");
+  EXPECT_EQ(sdf3_error(sdf3(waiting + "<actor name='C' x='1\"/>\n")),
+            "f.xml:8: actor 'A' has no port 'x'");
+  // A channel still waiting for an actor the text has not reached cannot be judged yet.
+  EXPECT_EQ(sdf3_error(sdf3("<channel name='c' srcActor='A' srcPort='x' dstActor='B' "
+                            "dstPort='i'/>\n<actor type='t'/>\n")),
+            "f.xml:6: <actor> lacks the attribute 'name'");
+  EXPECT_EQ(sdf3_error(sdf3("<actor name='A'/>\n<actor name='A'/>\n<actor name='C' x='1\"/>\n")),
+            "f.xml:6: duplicate actor name 'A'");
+}
+
 TEST(Writers, RoundTripRandomGraphsThroughBothFormats) {
   crowddb::Rng rng(7);
   for (int i = 0; i < 60; ++i) {
