@@ -4,8 +4,9 @@
 //
 // Cycles are counted on the channels: a self-loop is a cycle, and parallel channels make
 // distinct cycles (A → B twice and B → A once: two cycles). Their number can grow exponentially
-// with the graph, so the count stops after `max_cycles` cycles or `max_steps` arcs followed
-// (then it is a lower bound and `cycles_complete` is false). Everything else is O(V + E).
+// with the graph, so the count stops at `max_cycles` cycles when there are more, or after
+// `max_steps` arcs followed (then it is a lower bound and `cycles_complete` is false; a graph
+// with exactly `max_cycles` cycles is counted completely). Everything else is O(V + E).
 //
 // Thread-safety: pure function.
 #pragma once

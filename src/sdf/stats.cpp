@@ -47,7 +47,8 @@ class Cycles {
         if (!in_scope(w)) continue;
         if (w == s) {
           f.found = true;
-          if (++count_ >= limits_.max_cycles) return false;
+          if (count_ == limits_.max_cycles) return false;  // one more than the limit allows
+          ++count_;
         } else if (!blocked_[w]) {
           push(w);
         }

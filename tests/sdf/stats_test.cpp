@@ -67,6 +67,13 @@ TEST(Stats, CycleCountStopsAtItsLimits) {
   const GraphStats s = graph_stats(g, few);
   EXPECT_FALSE(s.cycles_complete);
   EXPECT_EQ(s.simple_cycles, 1000u);
+  // A limit of exactly the count is enough: incomplete means a cycle beyond the limit exists.
+  few.max_cycles = 16064;
+  EXPECT_TRUE(graph_stats(g, few).cycles_complete);
+  EXPECT_EQ(graph_stats(g, few).simple_cycles, 16064u);
+  few.max_cycles = 16063;
+  EXPECT_FALSE(graph_stats(g, few).cycles_complete);
+  EXPECT_EQ(graph_stats(g, few).simple_cycles, 16063u);
   StatsLimits short_walk;
   short_walk.max_steps = 500;
   const GraphStats t = graph_stats(g, short_walk);
