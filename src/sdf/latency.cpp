@@ -12,12 +12,11 @@
 
 #include "checked.hpp"
 #include "hsdf.hpp"
-#include "latency_detail.hpp"
 #include "sdf/throughput.hpp"
 
 namespace sdf {
 
-namespace detail {
+namespace {
 
 // L_i from the first starts and last ends per actor and iteration (index a·K + i).
 void latencies_from_times(const LatencyOptions& o, size_t actors,
@@ -40,24 +39,26 @@ void latencies_from_times(const LatencyOptions& o, size_t actors,
       }
     }
     const i128 l = to - from;
-    if (l > INT64_MAX || l < INT64_MIN) overflow("a latency");
+    if (l > INT64_MAX || l < INT64_MIN) detail::overflow("a latency");
     r.per_iteration[i] = static_cast<int64_t>(l);
     if (i == 0 || r.per_iteration[i] > r.max) r.max = r.per_iteration[i], r.iteration = i;
   }
   for (size_t a = 0; a < actors; ++a) r.makespan = std::max(r.makespan, last_end[a * k + k - 1]);
 }
 
-// The checks and the firing caps shared with the naive twin.
+// The checks of the options, and K·q[a] per actor: the firings to simulate.
 std::vector<uint64_t> latency_caps(const Graph& g, const LatencyOptions& o,
                                    const std::vector<uint64_t>& q) {
   if (o.from.has_value() != o.to.has_value())
     throw Error(Error::Kind::input, "latency: give both the source and the destination actor");
   if (o.iterations == 0) throw Error(Error::Kind::input, "latency: at least one iteration");
+  if (g.actor_count() == 0)
+    throw Error(Error::Kind::input, "latency: the graph has no actors (no iteration to measure)");
   std::vector<uint64_t> cap(g.actor_count());
   uint64_t total = 0;
   for (ActorId a = 0; a < g.actor_count(); ++a) {
-    cap[a] = mul_sat(q[a], o.iterations);
-    total = add_sat(total, cap[a]);
+    cap[a] = detail::mul_sat(q[a], o.iterations);
+    total = detail::add_sat(total, cap[a]);
   }
   if (total > o.max_firings)
     throw Error(Error::Kind::input,
@@ -66,11 +67,11 @@ std::vector<uint64_t> latency_caps(const Graph& g, const LatencyOptions& o,
   return cap;
 }
 
-}  // namespace detail
+}  // namespace
 
 Latency latency(const Graph& g, const LatencyOptions& o, std::optional<uint64_t> default_time) {
   const std::vector<uint64_t> q = detail::repetitions_or_throw(g, "latency");
-  const std::vector<uint64_t> cap = detail::latency_caps(g, o, q);
+  const std::vector<uint64_t> cap = latency_caps(g, o, q);
   const std::vector<uint64_t> times = execution_times(g, default_time);
   const size_t n = g.actor_count(), k_iter = o.iterations;
   const Adjacency adj(g);
@@ -138,7 +139,7 @@ Latency latency(const Graph& g, const LatencyOptions& o, std::optional<uint64_t>
   for (ActorId a = 0; a < n; ++a)
     if (ended[a] < cap[a]) r.stuck.push_back(a);
   r.deadlock = !r.stuck.empty();
-  if (!r.deadlock) detail::latencies_from_times(o, n, first_start, last_end, r);
+  if (!r.deadlock) latencies_from_times(o, n, first_start, last_end, r);
   return r;
 }
 

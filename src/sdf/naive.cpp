@@ -9,7 +9,6 @@
 
 #include "hsdf.hpp"
 #include "json_detail.hpp"
-#include "latency_detail.hpp"
 #include "sdf/checked.hpp"
 #include "sdf/text.hpp"
 #include "sdf/throughput.hpp"
@@ -349,8 +348,9 @@ ParetoSearch pareto(const Graph& g, uint64_t max_size, std::span<const uint64_t>
 }
 
 Latency latency(const Graph& g, const LatencyOptions& o, std::optional<uint64_t> default_time) {
+  if (o.from.has_value() != o.to.has_value() || o.iterations == 0 || g.actor_count() == 0)
+    throw Error(Error::Kind::input, "naive latency: bad options or no actors");
   const std::vector<uint64_t> q = detail::repetitions_or_throw(g, "latency");
-  detail::latency_caps(g, o, q);
   const std::vector<uint64_t> times = execution_times(g, default_time);
   const detail::Hsdf h = detail::expand(g, q, UINT32_MAX - 1);
   const size_t f_count = h.actor.size(), k = o.iterations, n = g.actor_count();
@@ -374,32 +374,43 @@ Latency latency(const Graph& g, const LatencyOptions& o, std::optional<uint64_t>
     r.deadlock = true;
     return r;
   }
-  // end[i][f]; relaxed iteration by iteration.
-  std::vector<std::vector<uint64_t>> end(k, std::vector<uint64_t>(f_count));
+  // start[i][f], end[i][f]; relaxed iteration by iteration.
+  std::vector<std::vector<uint64_t>> start(k, std::vector<uint64_t>(f_count, 0)), end = start;
   for (size_t i = 0; i < k; ++i) {
-    std::vector<uint64_t> start(f_count, 0);
     for (size_t f = 0; f < f_count; ++f) end[i][f] = times[h.actor[f]];
     for (bool changed = true; changed;) {
       changed = false;
       for (const detail::HsdfEdge& e : h.edges) {
         if (e.tokens > i) continue;
         const uint64_t ready_at = end[i - e.tokens][e.src];
-        if (ready_at > start[e.dst]) start[e.dst] = ready_at, changed = true;
+        if (ready_at > start[i][e.dst]) start[i][e.dst] = ready_at, changed = true;
       }
       for (size_t f = 0; f < f_count; ++f)
-        end[i][f] = detail::add(start[f], times[h.actor[f]], "a time");
+        end[i][f] = detail::add(start[i][f], times[h.actor[f]], "a time");
     }
   }
-  // First start and last end of each actor in each iteration.
-  std::vector<uint64_t> first_start(n * k, UINT64_MAX), last_end(n * k, 0);
-  for (size_t i = 0; i < k; ++i)
-    for (size_t f = 0; f < f_count; ++f) {
-      const ActorId a = h.actor[f];
-      const uint64_t s = end[i][f] - times[a];
-      first_start[a * k + i] = std::min(first_start[a * k + i], s);
-      last_end[a * k + i] = std::max(last_end[a * k + i], end[i][f]);
+  // The definitions read off the expansion: firing i·q[a] + 1 of a is a_0 of iteration i,
+  // firing (i + 1)·q[a] is a_{q[a]−1}.
+  __extension__ using i128 = __int128;
+  auto first_start = [&](size_t i, ActorId a) -> i128 { return start[i][h.first[a]]; };
+  auto last_end = [&](size_t i, ActorId a) -> i128 { return end[i][h.first[a + 1] - 1]; };
+  for (size_t i = 0; i < k; ++i) {
+    i128 from = first_start(i, 0), to = last_end(i, 0);
+    if (o.from) {
+      from = first_start(i, *o.from);
+      to = last_end(i, *o.to);
+    } else {
+      for (ActorId a = 1; a < n; ++a)
+        from = std::min(from, first_start(i, a)), to = std::max(to, last_end(i, a));
     }
-  detail::latencies_from_times(o, n, first_start, last_end, r);
+    if (to - from > INT64_MAX || to - from < INT64_MIN) detail::overflow("a latency");
+    r.per_iteration.push_back(static_cast<int64_t>(to - from));
+  }
+  const auto top = std::max_element(r.per_iteration.begin(), r.per_iteration.end());
+  r.max = *top;
+  r.iteration = static_cast<uint64_t>(top - r.per_iteration.begin());  // the first largest
+  for (ActorId a = 0; a < n; ++a)
+    r.makespan = std::max(r.makespan, static_cast<uint64_t>(last_end(k - 1, a)));
   return r;
 }
 

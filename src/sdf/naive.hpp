@@ -55,8 +55,11 @@ StorageSearch minimal_storage(const Graph& g, uint64_t max_size);
 
 // Latency by longest paths in the HSDF expansion unfolded K times: firing f of iteration i
 // starts at the latest end of its predecessors (an edge with t tokens from firing u means u of
-// iteration i − t; none before iteration 0), relaxed until nothing changes. Deadlock when the
+// iteration i − t; none before iteration 0), relaxed until nothing changes; L_i then straight
+// from the definitions (S(a, i·q[a] + 1) is a_0's start in iteration i, E(a, (i + 1)·q[a])
+// a_{q[a]−1}'s end), sharing nothing with latency() but q and the times. Deadlock when the
 // expansion has a cycle without tokens (Kahn's topological sort fails); `stuck` is left empty.
+// No firing limit.
 Latency latency(const Graph& g, const LatencyOptions& options,
                 std::optional<uint64_t> default_time);
 

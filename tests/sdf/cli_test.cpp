@@ -416,6 +416,7 @@ TEST(SdfschedCli, BadInputAndUsage) {
        "--to: unknown actor 'nobody'"},
       {"latency " + graph("timed_modem.xml") + " --iterations 0", 2, "--iterations"},
       {"latency " + graph("cd2dat.xml"), 1, "actor 'B' has no execution time"},
+      {"latency " + graph("empty.xml"), 1, "latency: the graph has no actors"},
       {"stats " + graph("cd2dat.json") + " --max-cycles 0", 2, "--max-cycles"},
       {"generate --times 5:1", 2, "expected LO:HI"},
       {"generate --shape star", 2, "--shape"},

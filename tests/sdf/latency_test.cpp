@@ -57,6 +57,20 @@ TEST(Latency, DeadlockIsReported) {
   EXPECT_THROW(latency(g, bad), Error);
 }
 
+// An empty <sdf/> reads as a graph without actors, which has no iteration to measure: an error,
+// not a read past an empty vector.
+TEST(Latency, GraphWithoutActorsIsRefused) {
+  const Graph g = read_graph_file(test::data("empty.xml"));
+  ASSERT_EQ(g.actor_count(), 0u);
+  try {
+    latency(g);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::input);
+    EXPECT_EQ(std::string(e.what()), "latency: the graph has no actors (no iteration to measure)");
+  }
+}
+
 TEST(Latency, SimulationAgreesWithUnfoldedExpansion) {
   crowddb::Rng rng(9001);
   const gen::Shape shapes[] = {gen::Shape::chain, gen::Shape::fan_out, gen::Shape::fan_in,
