@@ -28,7 +28,7 @@
 // cure a deadlock. Every distribution explored costs one bounded state-space exploration.
 //
 // The graph must be consistent and connected (analyse the components of a disconnected graph
-// on their own). Work is bounded by BufferLimits; exceeding one is an Error(input) naming it for
+// on their own). Work is bounded by BufferLimits; exceeding one is an Error(limit) naming it for
 // minimal_storage and an incomplete result (`complete` false, `stopped` saying why) for the
 // Pareto search, which keeps the points found so far.
 //
@@ -56,23 +56,29 @@ std::vector<uint64_t> buffer_lower_bounds(const Graph& g);
 Graph bounded_graph(const Graph& g, std::span<const uint64_t> capacity);
 
 // minimal_storage's untimed runs store no states: the state limits bind the Pareto search only.
+// Firings count every firing simulated, of actors without execution time too; the run of a live
+// distribution simulates at least one iteration (Σq firings), so a graph whose iteration exceeds
+// max_firings_per_run is refused at once. A whole search is bounded by max_distributions runs of
+// at most max_firings_per_run firings (and, timed, max_states_per_run states) each.
 struct BufferLimits {
-  uint64_t max_distributions = 1'000'000;   // distributions explored, whole search
-  uint64_t max_states = 50'000'000;         // Pareto: states stored, summed over the explorations
-  uint64_t max_states_per_run = 5'000'000;  // Pareto: states stored by one exploration
-  uint64_t max_size = UINT64_MAX;           // no distribution larger than this is explored
+  uint64_t max_distributions = 1'000'000;      // distributions explored, whole search
+  uint64_t max_states = 50'000'000;            // Pareto: states stored, summed over the runs
+  uint64_t max_states_per_run = 5'000'000;     // Pareto: states stored by one exploration
+  uint64_t max_firings_per_run = 100'000'000;  // firings simulated by one exploration
+  uint64_t max_size = UINT64_MAX;              // no distribution larger than this is explored
 };
 
 struct StorageSearch {
   uint64_t size = 0;                                 // of each distribution below
   std::vector<std::vector<uint64_t>> distributions;  // capacity per channel, sorted
   uint64_t explored = 0;                             // distributions run
-  uint64_t states = 0;                               // states stored, summed
+  uint64_t states = 0;                               // states stored, summed (none: untimed)
+  uint64_t firings = 0;                              // firings simulated, summed
 };
 
 // Throws Error(input) when the graph is inconsistent, not connected, or deadlocks whatever the
-// capacities (then no distribution is deadlock-free), or when a limit is exceeded (max_size:
-// when no deadlock-free distribution is that small).
+// capacities (then no distribution is deadlock-free), and Error(limit) when a limit is exceeded
+// (max_size: when no deadlock-free distribution is that small).
 StorageSearch minimal_storage(const Graph& g, const BufferLimits& limits = {});
 
 struct ParetoPoint {
@@ -88,6 +94,7 @@ struct ParetoSearch {
   std::string stopped;              // when not complete: the limit that stopped the search
   uint64_t explored = 0;
   uint64_t states = 0;
+  uint64_t firings = 0;
 };
 
 // Execution times from execution_times(g, default_time). Throws Error(input) as

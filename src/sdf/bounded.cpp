@@ -81,10 +81,21 @@ BoundedModel::BoundedModel(const Graph& g, std::vector<uint64_t> q, std::vector<
   }
   for (ActorId a = 1; a < g.actor_count(); ++a)
     if (q_[a] < q_[reference_]) reference_ = a;
+  for (uint64_t v : q_) sum_q_ = add_sat(sum_q_, v);
   for (uint64_t t : times_) all_untimed_ = all_untimed_ && t == 0;
 }
 
-bool BoundedModel::live(std::span<const uint64_t> cap, std::vector<char>* dependency) const {
+void BoundedModel::spend(RunBudget& budget, uint64_t k) const {
+  budget.firings = add_sat(budget.firings, k);
+  if (budget.firings > budget.max_firings)
+    throw LimitExceeded("buffers: one exploration of a storage distribution simulates more than " +
+                        std::to_string(budget.max_firings) +
+                        " firings (the limit of this analysis; an iteration is " +
+                        std::to_string(sum_q_) + ")");
+}
+
+bool BoundedModel::live(std::span<const uint64_t> cap, RunBudget& budget,
+                        std::vector<char>* dependency) const {
   const size_t n = g_.actor_count(), m = g_.channel_count();
   std::vector<uint64_t> tokens(m), space(m), fired(n, 0);
   for (ChannelId c = 0; c < m; ++c) {
@@ -123,15 +134,14 @@ bool BoundedModel::live(std::span<const uint64_t> cap, std::vector<char>* depend
       }
     };
     for (ActorId a = 0; a < n; ++a) offer(a);
-    uint64_t steps = 0;
     while (!ready.empty()) {
       const ActorId a = ready.front();
       ready.pop_front();
       queued[a] = 0;
       const uint64_t k = can_fire(a, limit(a));
       if (k == 0) continue;
-      if (k == UINT64_MAX || ++steps > (uint64_t{1} << 40))
-        throw std::logic_error("bounded execution: a run without a standstill");
+      if (k == UINT64_MAX) throw std::logic_error("bounded execution: an actor without channels");
+      spend(budget, k);
       fire(a, k);
       for (const Port& p : outputs(a)) offer(p.other);
       for (const Port& p : inputs(a)) offer(p.other);  // places freed
@@ -149,13 +159,13 @@ bool BoundedModel::live(std::span<const uint64_t> cap, std::vector<char>* depend
   return false;
 }
 
-Throughput BoundedModel::run(std::span<const uint64_t> cap, uint64_t max_states,
+Throughput BoundedModel::run(std::span<const uint64_t> cap, RunBudget& budget,
                              std::vector<char>* dependency) const {
   const size_t n = g_.actor_count(), m = g_.channel_count();
   Throughput r;
   if (all_untimed_ || m == 0) {
     // Without time a live graph fires without bound at one instant.
-    r.unbounded = live(cap, dependency);
+    r.unbounded = live(cap, budget, dependency);
     if (r.unbounded) {
       r.num = r.den = 0;
       if (dependency) dependency->assign(m, 0);
@@ -206,8 +216,7 @@ Throughput BoundedModel::run(std::span<const uint64_t> cap, uint64_t max_states,
 
   // Starts every firing that can start now; firings without time end at once. In a connected
   // bounded graph with some timed actor this ends (every count is tied to that actor's, which
-  // starts finitely often per instant); the guard turns a mistake into an error, not a hang.
-  uint64_t rounds = 0;
+  // starts finitely often per instant); were that wrong, the firing budget would still end it.
   auto start_all = [&] {
     while (!todo.empty()) {
       const ActorId a = todo.back();
@@ -237,12 +246,11 @@ Throughput BoundedModel::run(std::span<const uint64_t> cap, uint64_t max_states,
           }
         }
       }
+      spend(budget, k);
       for (const Port& p : inputs(a)) tokens[p.channel] -= k * p.rate;
       for (const Port& p : outputs(a)) space[p.channel] -= k * p.rate;
       if (times_[a] == 0) {
         complete(a, k);
-        if (++rounds > 1'000'000'000)
-          throw Error(Error::Kind::input, "buffers: firings without execution time do not end");
       } else {
         // An actor's firings all take the same time: later starts end later.
         const uint64_t end = add(now, times_[a], "the time of the bounded exploration");
@@ -305,11 +313,12 @@ Throughput BoundedModel::run(std::span<const uint64_t> cap, uint64_t max_states,
           track = true;
           period_key = it->first;
           seen.clear();
-        } else if (++r.states > max_states) {
+        } else if (++budget.states > budget.max_states) {
           throw LimitExceeded(
               "buffers: one exploration of a storage distribution stores more than " +
-              std::to_string(max_states) + " states (the limit of this analysis)");
+              std::to_string(budget.max_states) + " states (the limit of this analysis)");
         }
+        r.states = budget.states;
       }
     }
     // The next instant: the earliest end of a firing in progress.

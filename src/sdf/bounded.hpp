@@ -30,11 +30,19 @@
 
 namespace sdf::detail {
 
-// A limit of BufferLimits exceeded: an Error(input) naming it, which the Pareto search turns into
+// A limit of BufferLimits exceeded: an Error(limit) naming it, which the Pareto search turns into
 // an incomplete result (other errors it lets through).
 class LimitExceeded : public Error {
  public:
-  explicit LimitExceeded(const std::string& message) : Error(Error::Kind::input, message) {}
+  explicit LimitExceeded(const std::string& message) : Error(Error::Kind::limit, message) {}
+};
+
+// What one run may do and what it did: the firings it simulates (of every actor, those without
+// execution time included) and the states it stores (run() only). Exceeding a maximum throws
+// LimitExceeded.
+struct RunBudget {
+  uint64_t max_firings = UINT64_MAX, max_states = UINT64_MAX;
+  uint64_t firings = 0, states = 0;
 };
 
 class BoundedModel {
@@ -43,14 +51,17 @@ class BoundedModel {
   BoundedModel(const Graph& g, std::vector<uint64_t> q, std::vector<uint64_t> times);
 
   // cap ≥ delay on every channel. When not live and `dependency` is given, it receives the
-  // storage dependencies of the deadlock.
-  bool live(std::span<const uint64_t> cap, std::vector<char>* dependency = nullptr) const;
+  // storage dependencies of the deadlock. A live distribution costs Σq firings, a deadlocked one
+  // at most Σq plus what the capacities let the run continue by.
+  bool live(std::span<const uint64_t> cap, RunBudget& budget,
+            std::vector<char>* dependency = nullptr) const;
 
   // The throughput (unbounded when every actor takes no time and the graph is live; `states`:
-  // those stored) and, when `dependency` is given, the storage dependencies per channel. Throws
-  // LimitExceeded when more than max_states states would be stored.
-  Throughput run(std::span<const uint64_t> cap, uint64_t max_states,
+  // those stored) and, when `dependency` is given, the storage dependencies per channel.
+  Throughput run(std::span<const uint64_t> cap, RunBudget& budget,
                  std::vector<char>* dependency = nullptr) const;
+
+  uint64_t iteration_firings() const { return sum_q_; }  // Σq, saturated at 2^64 − 1
 
  private:
   // An actor's side of a channel, in compact arrays (a Channel is 128 bytes of mostly names):
@@ -71,7 +82,11 @@ class BoundedModel {
   std::vector<Port> ports_;  // inputs of every actor, then outputs of every actor
   std::vector<uint32_t> in_off_, out_off_;
   std::vector<uint64_t> q_, times_;
+  // Counts k more firings against the budget.
+  void spend(RunBudget& budget, uint64_t k) const;
+
   ActorId reference_ = 0;
+  uint64_t sum_q_ = 0;
   bool all_untimed_ = true;
 };
 

@@ -108,14 +108,33 @@ class Queue {
   bool beyond_max_size_ = false;
 };
 
-void count_run(uint64_t& explored, uint64_t& states, uint64_t run_states,
-               const BufferLimits& limits) {
-  ++explored;
-  states = detail::add_sat(states, run_states);
-  if (explored > limits.max_distributions)
+detail::RunBudget run_budget(const BufferLimits& limits) {
+  detail::RunBudget b;
+  b.max_firings = limits.max_firings_per_run;
+  b.max_states = limits.max_states_per_run;
+  return b;
+}
+
+// The run of a live distribution simulates at least one iteration (live(): exactly one; run():
+// a period, which is whole iterations), so a larger iteration can only fail, after long work.
+void check_iteration(const detail::BoundedModel& model, const BufferLimits& limits) {
+  if (model.iteration_firings() > limits.max_firings_per_run)
+    throw detail::LimitExceeded(
+        "buffers: an iteration is " + std::to_string(model.iteration_firings()) +
+        " firings, more than the " + std::to_string(limits.max_firings_per_run) +
+        " one exploration may simulate (the limit of this analysis)");
+}
+
+// Counts one run against the limits of the whole search.
+template <class Search>
+void count_run(Search& r, const detail::RunBudget& used, const BufferLimits& limits) {
+  ++r.explored;
+  r.states = detail::add_sat(r.states, used.states);
+  r.firings = detail::add_sat(r.firings, used.firings);
+  if (r.explored > limits.max_distributions)
     throw detail::LimitExceeded("buffers: more than " + std::to_string(limits.max_distributions) +
                                 " storage distributions explored (the limit)");
-  if (states > limits.max_states)
+  if (r.states > limits.max_states)
     throw detail::LimitExceeded("buffers: more than " + std::to_string(limits.max_states) +
                                 " states stored over all explorations (the limit)");
 }
@@ -172,6 +191,7 @@ Graph bounded_graph(const Graph& g, std::span<const uint64_t> capacity) {
 StorageSearch minimal_storage(const Graph& g, const BufferLimits& limits) {
   const std::vector<uint64_t> q = checked_repetitions(g);
   const detail::BoundedModel model(g, q, {});
+  check_iteration(model, limits);
   Queue queue(g, limits);
   queue.push(buffer_lower_bounds(g));
   StorageSearch r;
@@ -179,8 +199,10 @@ StorageSearch minimal_storage(const Graph& g, const BufferLimits& limits) {
   while (!queue.empty()) {
     auto [size, set] = queue.pop();
     for (const Distribution& d : set) {
-      count_run(r.explored, r.states, 0, limits);
-      if (model.live(d, &dep))
+      detail::RunBudget budget = run_budget(limits);
+      const bool live = model.live(d, budget, &dep);
+      count_run(r, budget, limits);
+      if (live)
         r.distributions.push_back(d);
       else
         queue.enlarge(d, dep);
@@ -209,13 +231,15 @@ ParetoSearch storage_throughput_pareto(const Graph& g, std::optional<uint64_t> d
   Throughput best;  // 0
   std::vector<char> dep;
   try {
+    check_iteration(model, limits);
     while (!queue.empty()) {
       auto [size, set] = queue.pop();
       std::vector<std::pair<const Distribution*, Throughput>> results;
       Throughput top;
       for (const Distribution& d : set) {
-        const Throughput t = model.run(d, limits.max_states_per_run, &dep);
-        count_run(r.explored, r.states, t.states, limits);
+        detail::RunBudget budget = run_budget(limits);
+        const Throughput t = model.run(d, budget, &dep);
+        count_run(r, budget, limits);
         results.push_back({&d, t});
         if (compare(t, top) > 0) top = t;
         queue.enlarge(d, dep);
@@ -255,7 +279,9 @@ Throughput bounded_throughput(const Graph& g, std::span<const uint64_t> capacity
                                           std::to_string(capacity[c]) + " is below its " +
                                           std::to_string(g.channel(c).delay) + " initial tokens");
   const detail::BoundedModel model(g, q, execution_times(g, default_time));
-  return model.run(capacity, limits.max_states_per_run);
+  check_iteration(model, limits);
+  detail::RunBudget budget = run_budget(limits);
+  return model.run(capacity, budget);
 }
 
 std::vector<Run> min_buffer_schedule(const Graph& g, std::vector<uint64_t>* capacity,

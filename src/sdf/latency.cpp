@@ -61,7 +61,7 @@ std::vector<uint64_t> latency_caps(const Graph& g, const LatencyOptions& o,
     total = detail::add_sat(total, cap[a]);
   }
   if (total > o.max_firings)
-    throw Error(Error::Kind::input,
+    throw Error(Error::Kind::limit,
                 "latency: " + std::to_string(o.iterations) + " iterations take more than " +
                     std::to_string(o.max_firings) + " firings (the limit of this analysis)");
   return cap;

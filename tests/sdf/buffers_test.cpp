@@ -81,9 +81,28 @@ TEST(Buffers, LimitsBindBothSearches) {
     minimal_storage(g, limits);
     ADD_FAILURE() << "no error";
   } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::limit);
     EXPECT_EQ(std::string(e.what()),
               "buffers: no deadlock-free distribution of size at most 3 (the size limit)");
   }
+  // Firings: an iteration (A, B: 2) is the least a live run takes, so 1 is refused at once; with
+  // 2 the deadlocked first distribution's run to its standstill fires nothing and the second
+  // completes its iteration.
+  limits = {};
+  limits.max_firings_per_run = 1;
+  try {
+    minimal_storage(g, limits);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::limit);
+    EXPECT_EQ(std::string(e.what()),
+              "buffers: an iteration is 2 firings, more than the 1 one exploration may simulate "
+              "(the limit of this analysis)");
+  }
+  limits.max_firings_per_run = 2;
+  const StorageSearch two = minimal_storage(g, limits);
+  EXPECT_EQ(two.size, 4u);
+  EXPECT_EQ(two.firings, 2u * two.distributions.size());
   // The Pareto search stops with what it has, here nothing: the first distribution deadlocks.
   limits = {};
   limits.max_distributions = 1;

@@ -288,7 +288,7 @@ TEST(SdfschedCli, BuffersAndMinBufferSchedule) {
             std::string::npos);
   // --max-size binds minimal storage too: nothing of CD-to-DAT's minimal 32 fits in 31.
   const test::Cli small = test::sdfsched("buffers " + graph("cd2dat.json") + " --max-size 31");
-  EXPECT_EQ(small.status, 1);
+  EXPECT_EQ(small.status, 3);
   EXPECT_TRUE(one_line(small.err));
   EXPECT_NE(small.err.find("no deadlock-free distribution of size at most 31 (the size limit)"),
             std::string::npos)
@@ -343,6 +343,48 @@ TEST(SdfschedCli, StatsAndLatency) {
   EXPECT_EQ(d.status, 1);
   EXPECT_TRUE(one_line(d.err));
   EXPECT_NE(d.err.find("stuck actors: P, Q, R"), std::string::npos) << d.err;
+}
+
+// A work limit reached is exit 3 in every command (docs/sdf.md, "The CLI"), with one line on
+// stderr naming it, or the partial result on stdout where the command has one (stats, --pareto).
+TEST(SdfschedCli, LimitsExitWith3) {
+  // The timed modem: q = (1, 2, 1), 4 firings an iteration; CD-to-DAT 612.
+  const test::Cli l =
+      test::sdfsched("latency " + graph("timed_modem.xml") + " --iterations 4 --max-firings 15");
+  EXPECT_EQ(l.status, 3);
+  EXPECT_TRUE(one_line(l.err));
+  EXPECT_NE(l.err.find("take more than 15 firings"), std::string::npos) << l.err;
+  EXPECT_EQ(
+      test::sdfsched("latency " + graph("timed_modem.xml") + " --iterations 4 --max-firings 16")
+          .status,
+      0);
+  const test::Cli b = test::sdfsched("buffers " + graph("cd2dat.json") + " --max-firings 611");
+  EXPECT_EQ(b.status, 3);
+  EXPECT_TRUE(one_line(b.err));
+  EXPECT_NE(b.err.find("an iteration is 612 firings"), std::string::npos) << b.err;
+  EXPECT_EQ(test::sdfsched("buffers " + graph("cd2dat.json") + " --max-firings 612").status, 0);
+  const test::Cli p =
+      test::sdfsched("buffers " + graph("timed_modem.xml") + " --pareto --max-firings 5 --json");
+  EXPECT_EQ(p.status, 3) << p.err;
+  EXPECT_EQ(json::parse(p.out)["complete"], false);
+  EXPECT_NE(json::parse(p.out)["stopped"].get<std::string>().find("more than 5 firings"),
+            std::string::npos)
+      << p.out;
+  const test::Cli s =
+      test::sdfsched("stats " + graph("timed_modem.xml") + " --max-cycles 2 --json");
+  EXPECT_EQ(s.status, 3);
+  EXPECT_EQ(json::parse(s.out)["simple_cycles"], 2);
+  EXPECT_EQ(json::parse(s.out)["cycles_complete"], false);
+  EXPECT_EQ(test::sdfsched("stats " + graph("timed_modem.xml") + " --max-cycles 3").status, 0);
+  // An expansion beyond its limit (Σq = 4,295,163,907): --method mcm stops (3); auto notes it
+  // and answers from the state space (0).
+  const std::string chain = "throughput " + graph("chain65537.json") + " --default-time 1";
+  EXPECT_EQ(test::sdfsched(chain + " --method mcm").status, 3);
+  const test::Cli a = test::sdfsched(chain + " --json");
+  EXPECT_EQ(a.status, 0) << a.err;
+  EXPECT_NE(a.err.find("note: no critical cycle: the HSDF expansion has more than"),
+            std::string::npos)
+      << a.err;
 }
 
 TEST(SdfschedCli, ClaimsPrintAVerdictPerClaim) {
@@ -418,6 +460,8 @@ TEST(SdfschedCli, BadInputAndUsage) {
       {"latency " + graph("cd2dat.xml"), 1, "actor 'B' has no execution time"},
       {"latency " + graph("empty.xml"), 1, "latency: the graph has no actors"},
       {"stats " + graph("cd2dat.json") + " --max-cycles 0", 2, "--max-cycles"},
+      {"latency " + graph("timed_modem.xml") + " --max-firings 0", 2, "--max-firings"},
+      {"buffers " + graph("cd2dat.json") + " --max-firings 0", 2, "--max-firings"},
       {"generate --times 5:1", 2, "expected LO:HI"},
       {"generate --shape star", 2, "--shape"},
       {"generate --actors 0", 2, "--actors"},

@@ -1,7 +1,8 @@
 // sdfsched: SDF scheduling from the command line (DESIGN §9, docs/sdf.md).
-// Exit status: 0 ok; 1 inconsistent graph, deadlock or bad input; 2 usage; 3 an online outcome
-// other than `returns` (simulate: other than `returns` or `periodic`; buffers --pareto: stopped
-// at a limit).
+// Exit status: 0 ok; 1 inconsistent graph, deadlock or bad input; 2 usage; 3 no full answer: an
+// online outcome other than `returns` (simulate: other than `returns` or `periodic`), or a work
+// limit of an analysis reached (an Error(limit); buffers --pareto and stats print what they
+// found before it).
 #include <CLI/CLI.hpp>
 #include <charconv>
 #include <cstdio>
@@ -634,6 +635,7 @@ int cmd_buffers(const std::string& path, bool pareto, std::optional<uint64_t> de
       j["size"] = s.size;
       j["distributions"] = distribution_list(g, s.distributions);
       j["explored"] = s.explored;
+      j["firings"] = s.firings;
       print_json(j);
       return 0;
     }
@@ -641,7 +643,7 @@ int cmd_buffers(const std::string& path, bool pareto, std::optional<uint64_t> de
     print_distribution(g, lb);
     std::cout << "minimal deadlock-free storage: " << s.size << " (" << s.distributions.size()
               << (s.distributions.size() == 1 ? " distribution" : " distributions") << "; "
-              << s.explored << " explored)\n";
+              << s.explored << " explored, " << s.firings << " firings simulated)\n";
     for (const auto& d : s.distributions) print_distribution(g, d);
     return 0;
   }
@@ -659,6 +661,7 @@ int cmd_buffers(const std::string& path, bool pareto, std::optional<uint64_t> de
     if (!s.complete) j["stopped"] = s.stopped;
     j["explored"] = s.explored;
     j["states"] = s.states;
+    j["firings"] = s.firings;
     print_json(j);
     return status;
   }
@@ -672,10 +675,11 @@ int cmd_buffers(const std::string& path, bool pareto, std::optional<uint64_t> de
   }
   if (s.complete)
     std::cout << "complete: the last point reaches the throughput with unbounded channels ("
-              << s.explored << " distributions explored, " << s.states << " states)\n";
+              << s.explored << " distributions explored, " << s.states << " states, " << s.firings
+              << " firings)\n";
   else
     std::cout << "INCOMPLETE: " << s.stopped << " (" << s.explored << " distributions explored, "
-              << s.states << " states)\n";
+              << s.states << " states, " << s.firings << " firings)\n";
   return status;
 }
 
@@ -697,7 +701,7 @@ int cmd_stats(const std::string& path, const sdf::StatsLimits& limits, bool json
                 {"cyclic_sccs", s.cyclic_sccs},
                 {"simple_cycles", s.simple_cycles},
                 {"cycles_complete", s.cycles_complete}});
-    return 0;
+    return s.cycles_complete ? 0 : 3;
   }
   auto text = [](const std::optional<uint64_t>& v) {
     return v ? std::to_string(*v) : std::string("beyond 64 bits");
@@ -716,16 +720,18 @@ int cmd_stats(const std::string& path, const sdf::StatsLimits& limits, bool json
             << " with a cycle)\nsimple cycles: " << (s.cycles_complete ? "" : "at least ")
             << s.simple_cycles << (s.cycles_complete ? "" : " (the count stopped at its limit)")
             << "\n";
-  return 0;
+  return s.cycles_complete ? 0 : 3;  // a limit cut the count short
 }
 
 int cmd_latency(const std::string& path, const std::string& from, const std::string& to,
-                uint64_t iterations, std::optional<uint64_t> default_time, bool json) {
+                uint64_t iterations, uint64_t max_firings, std::optional<uint64_t> default_time,
+                bool json) {
   const sdf::Graph g = read_graph(path);
   const Consistency c = consistency(g, json);
   if (c.status) return c.status;
   sdf::LatencyOptions o;
   o.iterations = iterations;
+  o.max_firings = max_firings;
   auto actor = [&](const std::string& name, const char* option) {
     const auto a = g.find_actor(name);
     if (!a) throw Error(Error::Kind::input, std::string(option) + ": unknown actor '" + name + "'");
@@ -1040,6 +1046,9 @@ int main(int argc, char** argv) {
                          ->check(crowddb::cli_checks::whole_at_least(1));
   buf->add_option("--max-size", limits.max_size, "explore no distribution larger")
       ->check(crowddb::cli_checks::whole_at_least(0));
+  buf->add_option("--max-firings", limits.max_firings_per_run,
+                  "stop when the run of one distribution would simulate more firings")
+      ->check(crowddb::cli_checks::whole_at_least(1));
   buf->add_flag("--json", json, "JSON output");
   buf->callback([&] {
     if (!pareto && max_states->count() > 0)
@@ -1069,9 +1078,15 @@ int main(int argc, char** argv) {
   lat->add_option("--iterations", iterations, "iterations to simulate (the latency is the largest)")
       ->check(crowddb::cli_checks::whole_at_least(1));
   lat->add_option("--default-time", default_time, "execution time of actors that have none");
+  uint64_t max_firings = sdf::LatencyOptions{}.max_firings;
+  lat->add_option("--max-firings", max_firings,
+                  "refuse when the iterations take more firings (K times the repetitions sum)")
+      ->check(crowddb::cli_checks::whole_at_least(1));
   lat->add_flag("--json", json, "JSON output");
   lat->callback([&] {
-    action = [&] { return cmd_latency(graph, from, to_actor, iterations, default_time, json); };
+    action = [&] {
+      return cmd_latency(graph, from, to_actor, iterations, max_firings, default_time, json);
+    };
   });
 
   GenerateFlags gf;
