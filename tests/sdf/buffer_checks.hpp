@@ -106,22 +106,30 @@ inline void bounded_throughput_agrees(uint64_t seed, int count) {
 }
 
 // Minimal deadlock-free distributions: the search finds exactly the ones enumeration finds, and
-// none of them is below the lower bounds.
+// none of them is below the lower bounds. Every live graph is compared: enumeration (from the
+// delays, not the bounds) up to the bounds' size + 14, and where it finds nothing that small the
+// search, limited to that size, must find nothing either.
 inline void minimal_storage_matches(uint64_t seed, int count) {
   crowddb::Rng rng(seed);
   int graphs = 0;
-  int several = 0, above_bounds = 0;
+  int several = 0, above_bounds = 0, beyond = 0;
   for (int i = 0; graphs < count && i < 10 * count; ++i) {
     const gen::Generated gd = i % 2 ? ring_graph(rng) : small_graph(rng, i, 4);
     const Graph& g = gd.graph;
     if (!live(g, gd.q) || g.channel_count() > 7) continue;
+    ++graphs;
     const std::vector<uint64_t> lb = buffer_lower_bounds(g);
     uint64_t lb_size = 0;
     for (uint64_t v : lb) lb_size += v;
-    const StorageSearch s = minimal_storage(g);
-    if (s.size > lb_size + 14) continue;  // enumeration would take too long
-    ++graphs;
-    const StorageSearch n = naive::minimal_storage(g, s.size);
+    BufferLimits limits;
+    limits.max_size = lb_size + 14;
+    const StorageSearch n = naive::minimal_storage(g, limits.max_size);
+    if (n.distributions.empty()) {
+      ++beyond;
+      EXPECT_THROW(minimal_storage(g, limits), Error) << write_json(g);
+      continue;
+    }
+    const StorageSearch s = minimal_storage(g, limits);
     ASSERT_EQ(n.size, s.size) << write_json(g);
     ASSERT_EQ(n.distributions, s.distributions) << write_json(g);
     for (const auto& d : n.distributions)
@@ -130,28 +138,32 @@ inline void minimal_storage_matches(uint64_t seed, int count) {
     above_bounds += s.size > lb_size;
   }
   EXPECT_EQ(graphs, count);
+  EXPECT_LT(beyond, count / 20 + 1);  // nearly every graph compared distribution by distribution
   // Not only the trivial case (the bounds suffice, one distribution) was compared.
   EXPECT_GT(several, count / 20);
   EXPECT_GT(above_bounds, count / 7);
 }
 
 // The storage–throughput Pareto points: the search against enumeration of every distribution
-// with the throughput of each by both methods.
+// with the throughput of each by both methods, on every live graph, both up to the bounds' size
+// + 8: the same points, and complete (the throughput with unbounded channels reached) in both or
+// in neither.
 inline void pareto_matches(uint64_t seed, int count) {
   crowddb::Rng rng(seed);
-  int graphs = 0, points = 0;
+  int graphs = 0, points = 0, complete = 0;
   for (int i = 0; graphs < count && i < 40 * count; ++i) {
     gen::Generated gd = i % 2 ? ring_graph(rng) : small_graph(rng, i, 3);
     Graph& g = gd.graph;
     if (!live(g, gd.q) || g.channel_count() > 5) continue;
     for (ActorId a = 0; a < g.actor_count(); ++a) g.set_actor_time(a, 1 + rng.below(4));
-    BufferLimits limits;
-    limits.max_size = 40;
-    const ParetoSearch s = storage_throughput_pareto(g, std::nullopt, limits);
-    if (!s.complete || s.points.back().size > s.points.front().size + 8) continue;
     ++graphs;
-    const ParetoSearch n = naive::pareto(g, s.points.back().size, buffer_lower_bounds(g));
-    ASSERT_TRUE(n.complete) << write_json(g);
+    const std::vector<uint64_t> lb = buffer_lower_bounds(g);
+    BufferLimits limits;
+    limits.max_size = std::accumulate(lb.begin(), lb.end(), uint64_t{0}) + 8;
+    const ParetoSearch n = naive::pareto(g, limits.max_size, lb);
+    const ParetoSearch s = storage_throughput_pareto(g, std::nullopt, limits);
+    ASSERT_EQ(n.complete, s.complete) << s.stopped << "\n" << write_json(g);
+    complete += n.complete;
     ASSERT_EQ(n.points.size(), s.points.size()) << write_json(g);
     for (size_t k = 0; k < n.points.size(); ++k) {
       ASSERT_EQ(n.points[k].size, s.points[k].size) << write_json(g);
@@ -162,6 +174,7 @@ inline void pareto_matches(uint64_t seed, int count) {
   }
   EXPECT_EQ(graphs, count);
   EXPECT_GT(points, 2 * count);
+  EXPECT_GT(complete, count / 3);
 }
 
 // The schedule within a minimal distribution is a valid period whose buffers sum to the minimum

@@ -141,17 +141,29 @@ TEST(Buffers, MinBufferScheduleIsValidAndMinimal) {
 }
 
 TEST(Buffers, ParetoOfTimedModem) {
-  // The repository's small timed modem: the points rise to the unbounded graph's throughput.
+  // The repository's small timed modem (channels a, b, back, s_src, s_filt). Each point is
+  // checked by paths that share nothing with the search's bounded exploration: the throughput of
+  // the explicit bounded graph by the maximum cycle ratio of its expansion, the throughput with
+  // unbounded channels likewise, and the whole trade-off by enumeration of every distribution.
   const Graph g = read_graph_file(test::data("timed_modem.xml"));
   const ParetoSearch s = storage_throughput_pareto(g);
   ASSERT_TRUE(s.complete);
-  EXPECT_EQ(s.points.back().throughput.str(), throughput_state_space(g).str());
-  EXPECT_EQ(s.points.front().size, minimal_storage(g).size);
-  for (size_t k = 1; k < s.points.size(); ++k) {
-    EXPECT_LT(s.points[k - 1].size, s.points[k].size);
+  EXPECT_EQ(s.max_throughput.str(), throughput_mcm(g).str());
+  const std::vector<std::pair<uint64_t, std::string>> expected = {
+      {12, "1/7"}, {13, "1/5"}, {15, "1/4"}};
+  ASSERT_EQ(s.points.size(), expected.size());
+  for (size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(s.points[k].size, expected[k].first);
+    EXPECT_EQ(s.points[k].throughput.str(), expected[k].second);
     for (const auto& d : s.points[k].distributions)
-      EXPECT_EQ(bounded_throughput(g, d).str(), s.points[k].throughput.str());
+      EXPECT_EQ(throughput_mcm(bounded_graph(g, d)).str(), expected[k].second);
   }
+  EXPECT_EQ(s.points.back().throughput.str(), s.max_throughput.str());
+  const ParetoSearch n = naive::pareto(g, 15, buffer_lower_bounds(g));
+  ASSERT_TRUE(n.complete);
+  ASSERT_EQ(n.points.size(), s.points.size());
+  for (size_t k = 0; k < n.points.size(); ++k)
+    EXPECT_EQ(n.points[k].distributions, s.points[k].distributions);
 }
 
 }  // namespace

@@ -70,7 +70,8 @@ inline void streaming_reader_agrees(uint64_t seed, int count) {
       for (char c : text) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
       text = crlf;
     }
-    if (rng.below(4) == 0) text.insert(text.find("<sdf3"), "<!DOCTYPE sdf3 [ <!ENTITY x 'y'> ]>\n");
+    static const std::string kDoctype = "<!DOCTYPE sdf3 [ <!ENTITY x 'y'> ]>\n";
+    if (rng.below(4) == 0) text.insert(text.find("<sdf3"), kDoctype);
     const int mutations = i % 3 == 0 ? 0 : 1 + static_cast<int>(rng.below(3));
     for (int m = 0; m < mutations && !text.empty(); ++m) {
       const size_t at = rng.below(text.size());
@@ -98,8 +99,13 @@ inline void streaming_reader_agrees(uint64_t seed, int count) {
       EXPECT_NE(stream.find("f.xml:"), std::string::npos) << stream;  // a line, always
       continue;
     }
-    if (stream_failed != dom_failed && text.find("<!DOCTYPE") != std::string::npos) {
-      ++doctype;  // a mangled DOCTYPE: each reader skips its own way (the twin as pugixml does)
+    // A DOCTYPE that a mutation mangled: each reader skips it its own way (the twin as pugixml
+    // does), so only there may one read what the other refuses. An intact DOCTYPE, or none, is
+    // no excuse.
+    const size_t dt = text.find("<!DOCTYPE");
+    if (stream_failed != dom_failed && dt != std::string::npos &&
+        text.compare(dt, kDoctype.size(), kDoctype) != 0) {
+      ++doctype;
       continue;
     }
     EXPECT_EQ(stream, dom) << text;
