@@ -23,7 +23,7 @@ using ActorId = uint32_t;
 using ChannelId = uint32_t;
 
 // Every failure the library reports by exception. what() is one line naming the file, line,
-// element or field; the CLI prints it and exits with exit_code() (2 usage, 1 otherwise).
+// element or field; the CLI prints it and exits with exit_code() (2 usage, 3 limit, 1 otherwise).
 class Error : public std::runtime_error {
  public:
   enum class Kind {
@@ -31,10 +31,11 @@ class Error : public std::runtime_error {
     input,     // malformed or invalid graph file or parameter
     io,        // the operating system refused (missing file, unwritable path)
     overflow,  // a count does not fit in 64 bits; never reported as a wrong number instead
+    limit,     // an analysis reached one of its work limits (states, firings, distributions)
   };
   Error(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
   Kind kind() const { return kind_; }
-  int exit_code() const { return kind_ == Kind::usage ? 2 : 1; }
+  int exit_code() const { return kind_ == Kind::usage ? 2 : kind_ == Kind::limit ? 3 : 1; }
 
  private:
   Kind kind_;
@@ -51,6 +52,12 @@ struct Channel {
   // channel came from elsewhere (the writer then invents unique ones).
   std::string src_port;
   std::string dst_port;
+};
+
+// New rates for one channel (dynamic rate changes).
+struct ChannelRates {
+  ChannelId channel = 0;
+  uint64_t prd = 1, cns = 1;
 };
 
 class Graph {

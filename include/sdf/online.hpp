@@ -65,11 +65,12 @@ class OnlineScheduler {
   void set_caps(std::vector<uint64_t> caps);
   std::optional<ChannelId> exceeded_channel() const;
 
-  // Dynamic rates: every output channel of `a` now produces prd, every input consumes cns.
-  // Bounded mode: q_new is the repetitions vector of the changed graph and a new iteration
+  // Dynamic rates: the listed channels, each an input or output of `a`, get their new prd and
+  // cns. Bounded mode: q_new is the repetitions vector of the changed graph and a new iteration
   // starts from the current tokens (counts back to zero). Keys, eligibility and hashes are
-  // updated for the actors concerned.
-  void change_rates(ActorId a, uint64_t prd, uint64_t cns, std::span<const uint64_t> q_new = {});
+  // updated for the actors concerned (only a's key depends on the rates of its channels).
+  void change_rates(ActorId a, std::span<const ChannelRates> rates,
+                    std::span<const uint64_t> q_new = {});
 
   std::span<const uint64_t> tokens() const { return tokens_; }
   uint64_t decisions() const { return decisions_; }

@@ -1,7 +1,12 @@
 // Dynamic rate changes (thesis 5.4): an actor's rates change after a given number of firings,
-// mid-period. Every output channel of the actor then produces `prd` per firing and every input
-// channel consumes `cns`. The thesis notes the result is the new graph with different initial
-// delays (the tokens at the change).
+// mid-period. Three forms: every output channel of the actor produces `prd` per firing and every
+// input channel consumes `cns` (`uniform`); every rate of the actor is scaled by a factor
+// num/den, the thesis's "scaling its w_i's by a factor new rate / old rate" (`scaled`; each rate
+// must stay a whole number; the graph stays consistent, the actor's count divided by the
+// factor; self-loops keep their rates: they model the actor's state, as SDF3's one-token loops
+// that make it sequential, and scaled they would deadlock it); or explicit new rates per channel
+// of the actor. The thesis notes the result is the
+// new graph with different initial delays (the tokens at the change).
 //
 // The static path recomputes the repetitions vector and builds a new ready-queue schedule from
 // the tokens at the change: it is periodic at once (or deadlocks). The online path just
@@ -28,8 +33,17 @@ const char* policy_name(Policy p);
 
 struct RateChange {
   ActorId actor = 0;
-  uint64_t prd = 1, cns = 1;
+  // New rates of the actor's channels (each one an input or output of it; a self-loop is
+  // both): an output's prd, an input's cns. Channels not listed keep their rates.
+  std::vector<ChannelRates> rates;
   uint64_t at_firing = 0;  // the change happens after this many firings
+
+  // Throw Error(input) for a zero rate, or a scaled rate that is not a whole number or does not
+  // fit in 64 bits.
+  static RateChange uniform(const Graph& g, ActorId a, uint64_t prd, uint64_t cns,
+                            uint64_t at_firing);
+  static RateChange scaled(const Graph& g, ActorId a, uint64_t num, uint64_t den,
+                           uint64_t at_firing);
 };
 
 struct RateChangeResult {

@@ -38,7 +38,7 @@ std::vector<uint64_t> execution_times(const Graph& g,
 // clash), with a's execution time; for each channel and each token a firing consumes, an edge
 // from the firing that produced it, carrying as many tokens as iterations separate the two
 // (parallel edges merged, keeping the fewest tokens). Rates are 1. Throws Error(input) on an
-// inconsistent graph and Error(overflow) when Σq or an edge count exceeds `max_size` (edges +
+// inconsistent graph and Error(limit) when Σq or an edge count exceeds `max_size` (edges +
 // actors).
 Graph to_hsdf(const Graph& g, uint64_t max_size = 50'000'000);
 
@@ -67,7 +67,7 @@ struct ThroughputLimits {
 
 // Both throw Error(input) for an inconsistent graph or a missing execution time (times come
 // from execution_times(g, default_time)), Error(overflow) when a count or the time does not fit
-// in 64 bits, and Error(input) naming the limit when one is exceeded.
+// in 64 bits, and Error(limit) naming the limit when one is exceeded.
 Throughput throughput_state_space(const Graph& g, std::optional<uint64_t> default_time = {},
                                   const ThroughputLimits& limits = {});
 Throughput throughput_mcm(const Graph& g, std::optional<uint64_t> default_time = {},

@@ -1,8 +1,10 @@
 // The thesis's claims about `online`, tested on random consistent live graphs (DESIGN §8):
 // does it return to the initial state (a valid period), become periodic without returning, or
 // grow without bound; does its fairness stay below n - 1; does `online-bounded` always complete
-// a valid period. Every schedule produced is passed through the checker. Used by
-// `sdfsched claims`, the claims tests and docs/sdf.md.
+// a valid period; and after a mid-period rate change (thesis 5.4: one actor's rates scaled by a
+// factor, at a random firing), does each become periodic again, and `online` at once (the
+// thesis: "the convergence of the online algorithm being zero"). Every schedule produced is
+// passed through the checker. Used by `sdfsched claims`, the claims tests and docs/sdf.md.
 #pragma once
 
 #include <cstdint>
@@ -25,10 +27,20 @@ struct PolicyStats {
   uint64_t checker_failures = 0;  // a `returns` period or a periodic cycle the checker rejects
 };
 
+// After a rate change: `periodic_again` counts runs that returned or became periodic with a
+// period the checker accepts (from where it starts), `at_once` those among them with no firing
+// before the period; the rest grew without bound, deadlocked or hit the decision limit.
+struct RateChangeStats {
+  uint64_t changes = 0, periodic_again = 0, at_once = 0, unbounded = 0, deadlock = 0, limit = 0;
+  uint64_t invalid = 0;  // a period after the change that the checker rejects
+  uint64_t max_firings_until_periodic = 0;
+};
+
 struct ClassStats {
   std::string name;
   uint64_t graphs = 0;
   PolicyStats online, online_one, bounded;
+  RateChangeStats online_change, bounded_change;
   // Summed per-channel buffer sizes over one period, on the graphs where `online` returns (so
   // the three policies are compared on the same graphs).
   uint64_t common = 0;
@@ -38,9 +50,19 @@ struct ClassStats {
 struct Report {
   std::vector<ClassStats> classes;
   // Smallest failing graph per failed claim ("online-periodic", "online-unbounded",
-  // "online-fairness", "online-one-periodic", ... "bounded-invalid"), by actors, channels, size.
+  // "online-fairness", "online-one-periodic", ... "bounded-invalid", "online-change-not-at-once",
+  // "online-change-unbounded", ...), by actors, channels, size. A rate-change counter-example is
+  // named after its change, `ACTOR*NUM/DEN@FIRING` (the form of `simulate --rate-change`).
   std::map<std::string, Graph> counterexamples;
 };
+
+// One line per claim: how many graphs fail it out of how many, and the smallest counter-example.
+struct Verdict {
+  std::string claim;
+  uint64_t fails = 0, graphs = 0;
+  std::string counterexample;  // a key of Report::counterexamples, empty when none
+};
+std::vector<Verdict> verdicts(const Report& report);
 
 struct Options {
   uint64_t graphs_per_class = 100;

@@ -34,8 +34,15 @@ Generated generate(const Spec& spec, crowddb::Rng& rng) {
   std::iota(perm.begin(), perm.end(), 0);
   for (uint32_t i = n; i > 1; --i) std::swap(perm[i - 1], perm[rng.below(i)]);
   std::vector<uint64_t> q(n, 1);
+  // Tables cut at the spec's maxima (the defaults keep them whole, and the graphs as before).
+  size_t q_choices = 0, m_choices = 0;
+  while (q_choices < std::size(kQ) && kQ[q_choices] <= std::max<uint32_t>(spec.max_q, 1))
+    ++q_choices;
+  while (m_choices < std::size(kMult) &&
+         kMult[m_choices] <= std::max<uint32_t>(spec.max_multiplier, 1))
+    ++m_choices;
   if (spec.multirate)
-    for (auto& v : q) v = kQ[rng.below(std::size(kQ))];
+    for (auto& v : q) v = kQ[rng.below(q_choices)];
   for (uint32_t a = 0; a < n; ++a) {
     std::string name(1, 'a');
     name += std::to_string(a);
@@ -48,7 +55,7 @@ Generated generate(const Spec& spec, crowddb::Rng& rng) {
     uint64_t prd = 1, cns = 1;
     if (spec.multirate) {
       const uint64_t gcd = std::gcd(q[u], q[v]);
-      const uint64_t m = kMult[rng.below(std::size(kMult))];
+      const uint64_t m = kMult[rng.below(m_choices)];
       prd = q[v] / gcd * m;
       cns = q[u] / gcd * m;
     }

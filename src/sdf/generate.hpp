@@ -30,6 +30,8 @@ struct Spec {
   bool self_loops = false;
   uint32_t extra_percent = 50;  // dag/cyclic: extra forward channels, % of the actor count
   uint32_t back_percent = 30;   // cyclic: back channels, % of the actor count (at least one)
+  uint32_t max_q = 12;          // multi-rate: repetition counts drawn from those up to this
+  uint32_t max_multiplier = 3;  // multi-rate: rate multipliers m drawn from those up to this
 };
 
 struct Generated {

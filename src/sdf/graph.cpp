@@ -3,9 +3,13 @@
 #include <algorithm>
 #include <cstring>
 
+#include "prefetch.hpp"
+
 namespace sdf {
 
 namespace {
+
+using detail::prefetch;
 
 uint64_t mix64(uint64_t z) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -31,16 +35,6 @@ uint64_t hash_of(std::string_view s) {
 
 constexpr uint64_t tag_of(uint64_t hash) {
   return hash & 0xffffffff00000000ull;
-}
-
-// A prefetch hint. On x86-64 as inline assembly: GCC 12 silently dropped __builtin_prefetch
-// from some of the loops below (seen in the disassembly).
-inline void prefetch(const void* p) {
-#if defined(__x86_64__)
-  asm volatile("prefetcht0 (%0)" : : "r"(p));
-#else
-  __builtin_prefetch(p);  // NOLINT
-#endif
 }
 
 size_t table_size_for(size_t entries) {

@@ -45,9 +45,8 @@ std::vector<uint64_t> repetitions_or_throw(const Graph& g, const char* analysis)
 
 Hsdf expand(const Graph& g, const std::vector<uint64_t>& q, uint64_t max_size) {
   auto too_big = [&] {
-    throw Error(Error::Kind::overflow, "the HSDF expansion has more than " +
-                                           std::to_string(max_size) +
-                                           " firings and edges (the limit of this analysis)");
+    throw Error(Error::Kind::limit, "the HSDF expansion has more than " + std::to_string(max_size) +
+                                        " firings and edges (the limit of this analysis)");
   };
   Hsdf h;
   h.first.resize(g.actor_count() + 1);

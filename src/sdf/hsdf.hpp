@@ -21,7 +21,7 @@ struct Hsdf {
   std::vector<HsdfEdge> edges;  // sorted by (src, dst), one per pair
 };
 
-// q: the repetitions vector. Throws Error(overflow) when Σq + edges exceeds max_size.
+// q: the repetitions vector. Throws Error(limit) when Σq + edges exceeds max_size.
 Hsdf expand(const Graph& g, const std::vector<uint64_t>& q, uint64_t max_size);
 
 // q of a consistent graph; Error(input) naming the failing channel otherwise.

@@ -1,6 +1,8 @@
-// The two JSON readers behind sdf::read_json, exposed for the tests that compare them.
+// The two JSON readers behind sdf::read_json, exposed for the tests that compare them, and the
+// SDF3 reader's entry for mapped files.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -20,5 +22,11 @@ std::optional<Graph> read_json_plain(std::string_view text, const std::string& s
 // the SDF3 reader does (execution times for the actors that have no "time"; unknown actors are
 // errors); kept in g.sdf3_properties. Errors: Error(input) "SOURCE: sdf3_properties: ...".
 void read_sdf3_properties(Graph& g, std::string_view xml, const std::string& source);
+
+// read_sdf3 that calls release(offset) now and then with an offset before which it no longer
+// needs the text resident (it may still read it: a mapped file's dropped pages come back). The
+// file reader drops those pages, so a large file does not stay in memory beside its graph.
+Graph read_sdf3_released(std::string_view text, const std::string& source,
+                         const std::function<void(size_t)>& release);
 
 }  // namespace sdf::detail

@@ -378,12 +378,16 @@ std::optional<Run> OnlineScheduler::step(uint64_t max_firings) {
   return Run{a, k};
 }
 
-void OnlineScheduler::change_rates(ActorId a, uint64_t prd, uint64_t cns,
+void OnlineScheduler::change_rates(ActorId a, std::span<const ChannelRates> rates,
                                    std::span<const uint64_t> q_new) {
-  if (prd == 0 || cns == 0) throw Error(Error::Kind::input, "rates must be positive");
-  const Topology& t = *topo_;
-  for (uint32_t i = t.out_off[a]; i < t.out_off[a + 1]; ++i) prd_[t.out[i]] = prd;
-  for (uint32_t i = t.in_off[a]; i < t.in_off[a + 1]; ++i) cns_[t.in[i]] = cns;
+  for (const ChannelRates& r : rates) {
+    if (r.prd == 0 || r.cns == 0) throw Error(Error::Kind::input, "rates must be positive");
+    if (r.channel >= prd_.size()) throw Error(Error::Kind::input, "change_rates: unknown channel");
+  }
+  for (const ChannelRates& r : rates) {
+    prd_[r.channel] = r.prd;
+    cns_[r.channel] = r.cns;
+  }
   if (opt_.bounded) {
     if (q_new.size() != n_)
       throw Error(Error::Kind::input, "online-bounded needs the new repetitions vector");

@@ -19,6 +19,46 @@ const char* policy_name(Policy p) {
   return "?";
 }
 
+RateChange RateChange::uniform(const Graph& g, ActorId a, uint64_t prd, uint64_t cns,
+                               uint64_t at_firing) {
+  if (prd == 0 || cns == 0) throw Error(Error::Kind::input, "rate change: rates must be positive");
+  RateChange rc;
+  rc.actor = a;
+  rc.at_firing = at_firing;
+  for (ChannelId c = 0; c < g.channel_count(); ++c) {
+    const Channel& ch = g.channel(c);
+    if (ch.src == a || ch.dst == a)
+      rc.rates.push_back({c, ch.src == a ? prd : ch.prd, ch.dst == a ? cns : ch.cns});
+  }
+  return rc;
+}
+
+RateChange RateChange::scaled(const Graph& g, ActorId a, uint64_t num, uint64_t den,
+                              uint64_t at_firing) {
+  if (num == 0 || den == 0)
+    throw Error(Error::Kind::input, "rate change: the factor must be positive");
+  RateChange rc;
+  rc.actor = a;
+  rc.at_firing = at_firing;
+  auto scale = [&](const Channel& ch, uint64_t r) {
+    const detail::u128 v = static_cast<detail::u128>(r) * num;
+    if (v % den != 0 || v / den > UINT64_MAX)
+      throw Error(Error::Kind::input,
+                  "rate change: channel '" + ch.name + "': " + std::to_string(r) + "·" +
+                      std::to_string(num) + "/" + std::to_string(den) +
+                      (v % den != 0 ? " is not a whole number" : " does not fit in 64 bits"));
+    return static_cast<uint64_t>(v / den);
+  };
+  for (ChannelId c = 0; c < g.channel_count(); ++c) {
+    const Channel& ch = g.channel(c);
+    if (ch.src == ch.dst) continue;  // a self-loop models the actor's state, not its data
+    if (ch.src == a || ch.dst == a)
+      rc.rates.push_back(
+          {c, ch.src == a ? scale(ch, ch.prd) : ch.prd, ch.dst == a ? scale(ch, ch.cns) : ch.cns});
+  }
+  return rc;
+}
+
 namespace {
 
 // Buffers over the periodic part of an online run that starts at `start`.
@@ -42,8 +82,20 @@ std::vector<uint64_t> cycle_buffers(const Graph& g, std::span<const uint64_t> q,
 RateChangeResult simulate_rate_change(const Graph& g, Policy policy, const RateChange& change,
                                       const OnlineRunOptions& options) {
   if (change.actor >= g.actor_count()) throw Error(Error::Kind::input, "unknown actor");
-  if (change.prd == 0 || change.cns == 0)
-    throw Error(Error::Kind::input, "rate change: rates must be positive");
+  for (const ChannelRates& r : change.rates) {
+    if (r.channel >= g.channel_count())
+      throw Error(Error::Kind::input, "rate change: unknown channel");
+    const Channel& ch = g.channel(r.channel);
+    if (ch.src != change.actor && ch.dst != change.actor)
+      throw Error(Error::Kind::input, "rate change: channel '" + ch.name +
+                                          "' is not a channel of '" + g.actor_name(change.actor) +
+                                          "'");
+    if ((ch.src != change.actor && r.prd != ch.prd) || (ch.dst != change.actor && r.cns != ch.cns))
+      throw Error(Error::Kind::input,
+                  "rate change: channel '" + ch.name + "': only the actor's own ports change");
+    if (r.prd == 0 || r.cns == 0)
+      throw Error(Error::Kind::input, "rate change: rates must be positive");
+  }
   const Repetitions rep = compute_repetitions(g);
   if (!rep.consistent)
     throw Error(Error::Kind::input,
@@ -55,12 +107,7 @@ RateChangeResult simulate_rate_change(const Graph& g, Policy policy, const RateC
   RateChangeResult out;
   out.q_before = rep.q;
   out.changed = g;
-  for (ChannelId c = 0; c < g.channel_count(); ++c) {
-    const Channel& ch = g.channel(c);
-    if (ch.src == change.actor || ch.dst == change.actor)
-      out.changed.set_rates(c, ch.src == change.actor ? change.prd : ch.prd,
-                            ch.dst == change.actor ? change.cns : ch.cns);
-  }
+  for (const ChannelRates& r : change.rates) out.changed.set_rates(r.channel, r.prd, r.cns);
   out.after = compute_repetitions(out.changed);
   if (out.after.consistent) out.q_after = out.after.q;
   const Graph& g2 = out.changed;
@@ -113,7 +160,7 @@ RateChangeResult simulate_rate_change(const Graph& g, Policy policy, const RateC
   out.tokens_at_change.assign(s.tokens().begin(), s.tokens().end());
   if (!out.after.consistent) return out;
   // The scheduler copies the graph's rates; the changed graph is what the meter and caps see.
-  s.change_rates(change.actor, change.prd, change.cns, out.q_after);
+  s.change_rates(change.actor, change.rates, out.q_after);
   const OnlineRun after = run_online(g2, out.q_after, s, opts);
   out.outcome = after.outcome;
   out.channel = after.channel;

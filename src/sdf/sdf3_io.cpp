@@ -1,17 +1,20 @@
-// SDF3 XML reading and writing (pugixml). Two passes over <sdf>: actors and their ports first,
-// then channels, so element order does not matter. Ports are sorted by (actor, name) and found
-// by binary search among their actor's own: O(P log P) for P ports, never the quadratic scan
-// that makes SDF3's own loader take minutes on 10^5 actors. Line numbers are computed only for
-// an error message.
+// SDF3 XML reading (a streaming scan, xml_scanner.hpp; no document tree) and writing (pugixml).
+// Element order does not matter. Each actor's ports are sorted by name and found by binary
+// search: O(P log P) for P ports, never the quadratic scan that makes SDF3's own loader take
+// minutes on 10^5 actors. Line numbers are computed only for an error message.
 #include <algorithm>
 #include <charconv>
+#include <deque>
 #include <pugixml.hpp>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
 
+#include "json_detail.hpp"
+#include "prefetch.hpp"
 #include "sdf/io.hpp"
 #include "sdf/text.hpp"
+#include "xml_scanner.hpp"
 
 namespace sdf {
 
@@ -45,80 +48,219 @@ void apply_properties(Graph& g, pugi::xml_node props, Fail&& fail, Number&& numb
   if (!valid_utf8(g.sdf3_properties)) fail(props, "<sdfProperties> is not valid UTF-8");
 }
 
+// A port keeps a short name (all of SDF3's are) in itself, so that resolving channels does not
+// go back to the text (which the reader may release behind it); a longer one is a view.
 struct Port {
-  ActorId actor;
-  std::string_view name;
-  bool out;
   uint64_t rate;
   size_t offset;  // of the <port> element; its line is computed only for an error message
-  int64_t channel = -1;
+  uint32_t channel = UINT32_MAX;
+  bool out;
+  uint8_t length = 0;  // of a short name, kLong for a view
+  union {
+    char short_name[24];
+    struct {
+      const char* data;
+      size_t size;
+    } long_name;
+  };
+  static constexpr uint8_t kLong = 255;
+  Port() : short_name{} {}
+  std::string_view name() const {
+    return length == kLong ? std::string_view(long_name.data, long_name.size)
+                           : std::string_view(short_name, length);
+  }
+  void set_name(std::string_view n) {
+    if (n.size() <= sizeof short_name) {
+      std::copy(n.begin(), n.end(), short_name);
+      length = static_cast<uint8_t>(n.size());
+    } else {
+      long_name = {n.data(), n.size()};
+      length = kLong;
+    }
+  }
 };
 
+// A <channel> as read, resolved when its actors are known.
+struct ChannelRecord {
+  std::string_view name, src, src_port, dst, dst_port;
+  bool has_name = false;
+  uint64_t delay = 0;
+  size_t offset;
+};
+
+// One pass over the text with XmlScanner, no document tree. Actors are added in blocks (their
+// ids are their order in the file, so ports can refer to them before the block is added); each
+// actor's ports are sorted by name when its element closes. Channels are resolved in blocks as
+// they come; once a channel names an actor not seen yet (SDF3 does not fix the element order),
+// it and every later channel wait for the end of the document, so channels keep their file
+// order. <sdfProperties> is cut out of the text and parsed on its own (pugixml: it is small next
+// to the graph). Errors come in file order as far as the text read tells them: a pending block,
+// and the waiting channels whose actors have been seen, are resolved before a later mistake is
+// reported; what only the end of the document decides (a port left unconnected, a channel
+// naming an actor that never comes, <sdfProperties>, parsed last) is reported there.
 class Sdf3Reader {
  public:
-  Sdf3Reader(std::string_view text, const std::string& source) : text_(text), source_(source) {}
+  Sdf3Reader(std::string_view text, const std::string& source,
+             const std::function<void(size_t)>* release = nullptr)
+      : text_(text), source_(source), scan_(text), release_(release) {}
 
-  Graph read(std::string_view text) {
-    const pugi::xml_parse_result res =
-        doc_.load_buffer(text.data(), text.size(), pugi::parse_default, pugi::encoding_utf8);
-    if (!res) fail(static_cast<size_t>(res.offset), std::string("XML: ") + res.description());
-    const pugi::xml_node root = doc_.child("sdf3");
-    if (!root) fail(0, "no <sdf3> root element");
-    const std::string_view type = root.attribute("type").value();
-    if (!type.empty() && type != "sdf")
-      fail(root, "graph type '" + std::string(type) + "' is not supported (only type=\"sdf\")");
-    const pugi::xml_node app = root.child("applicationGraph");
-    if (!app) fail(root, "<sdf3> has no <applicationGraph>");
-    const pugi::xml_node sdf = app.child("sdf");
-    if (!sdf) fail(app, "<applicationGraph> has no <sdf>");
-    Graph g;
-    g.name = sdf.attribute("name").value();
-    if (!valid_utf8(g.name)) fail(sdf, "attribute 'name' is not valid UTF-8");
-    g.type = sdf.attribute("type").value();
-    if (!valid_utf8(g.type)) fail(sdf, "attribute 'type' is not valid UTF-8");
-    for (pugi::xml_node actor : sdf.children("actor")) read_actor(g, actor);
-    std::sort(ports_.begin(), ports_.end(), [](const Port& a, const Port& b) {
-      return a.actor != b.actor ? a.actor < b.actor : a.name < b.name;
-    });
-    for (size_t i = 1; i < ports_.size(); ++i)
-      if (ports_[i].actor == ports_[i - 1].actor && ports_[i].name == ports_[i - 1].name)
-        fail(std::max(ports_[i].offset, ports_[i - 1].offset),
-             "duplicate port '" + std::string(ports_[i].name) + "' on actor '" +
-                 g.actor_name(ports_[i].actor) + "'");
-    port_begin_.assign(g.actor_count() + 1, 0);
-    for (const Port& p : ports_) ++port_begin_[p.actor + 1];
-    for (size_t a = 0; a < g.actor_count(); ++a) port_begin_[a + 1] += port_begin_[a];
-    for (pugi::xml_node ch : sdf.children("channel")) read_channel(g, ch);
-    for (const Port& p : ports_)
-      if (p.channel < 0)
-        fail(p.offset, "port '" + std::string(p.name) + "' of actor '" + g.actor_name(p.actor) +
-                           "' is not connected to a channel");
-    if (const pugi::xml_node props = app.child("sdfProperties")) read_properties(g, props);
-    return g;
+  Graph read() {
+    // Room for as many actors and channels as the text has tags named like theirs (a quick
+    // count: the graph's arrays and tables then never grow). The count also finds such tags in
+    // comments or outside <sdf>, so it is capped at what a valid file of this size could hold:
+    // the shortest actor element, <actor name='A'/>, has 17 bytes, and a channel's four
+    // required attributes make it 60. A malformed file then costs no more before its first
+    // error than a valid one of its size.
+    size_t actors = 0, channels = 0;
+    auto named = [&](size_t at, std::string_view name) {
+      if (text_.compare(at + 1, name.size(), name) != 0) return false;
+      const size_t after = at + 1 + name.size();
+      return after < text_.size() &&
+             (text_[after] == '/' || text_[after] == '>' || text_[after] == ' ' ||
+              text_[after] == '\t' || text_[after] == '\n' || text_[after] == '\r');
+    };
+    for (size_t at = text_.find('<'); at != std::string_view::npos; at = text_.find('<', at + 1)) {
+      actors += named(at, "actor");
+      channels += named(at, "channel");
+    }
+    g_.reserve(std::min(actors, text_.size() / 17), std::min(channels, text_.size() / 60));
+    try {
+      scan();
+    } catch (const detail::XmlError& e) {
+      fail_after_pending(e.offset, e.message);
+    }
+    flush_actors();
+    flush_channels();
+    resolve(deferred_, true);
+    for (ActorId a = 0; a < g_.actor_count(); ++a)
+      for (uint32_t i = port_begin_[a]; i < port_begin_[a + 1]; ++i)
+        if (ports_[i].channel == UINT32_MAX)
+          fail(ports_[i].offset, "port '" + std::string(ports_[i].name()) + "' of actor '" +
+                                     g_.actor_name(a) + "' is not connected to a channel");
+    if (!props_.empty()) read_properties();
+    return std::move(g_);
   }
 
  private:
-  [[noreturn]] void fail_line(size_t line, const std::string& msg) const {
-    throw Error(Error::Kind::input, source_ + ":" + std::to_string(line) + ": " + msg);
+  enum class Where { outside, sdf3, app, sdf, actor, other };
+
+  void scan() {
+    std::vector<Where> stack;
+    bool seen_sdf3 = false, seen_app = false, seen_sdf = false;
+    for (;;) {
+      const detail::XmlScanner::Token t = scan_.next();
+      if (t.kind == detail::XmlScanner::Kind::eof) break;
+      if (release_ && t.offset >= released_ + kReleaseStep) release_behind(t.offset);
+      if (t.kind == detail::XmlScanner::Kind::end) {
+        if (stack.back() == Where::actor) close_actor();
+        stack.pop_back();
+        continue;
+      }
+      const Where parent = stack.empty() ? Where::outside : stack.back();
+      Where here = Where::other;
+      if (parent == Where::outside && t.name == "sdf3" && !seen_sdf3) {
+        seen_sdf3 = true;
+        here = Where::sdf3;
+        const std::string_view type = value("type");
+        if (!type.empty() && type != "sdf")
+          fail(t.offset,
+               "graph type '" + std::string(type) + "' is not supported (only type=\"sdf\")");
+        root_offset_ = t.offset;
+      } else if (parent == Where::sdf3 && t.name == "applicationGraph" && !seen_app) {
+        seen_app = true;
+        here = Where::app;
+        app_offset_ = t.offset;
+      } else if (parent == Where::app && t.name == "sdf" && !seen_sdf) {
+        seen_sdf = true;
+        here = Where::sdf;
+        g_.name = value("name");
+        if (!valid_utf8(g_.name)) fail(t.offset, "attribute 'name' is not valid UTF-8");
+        g_.type = value("type");
+        if (!valid_utf8(g_.type)) fail(t.offset, "attribute 'type' is not valid UTF-8");
+      } else if (parent == Where::app && t.name == "sdfProperties" && props_.empty()) {
+        props_offset_ = t.offset;
+        size_t end = t.end;
+        if (!t.self_closing) {
+          // Skip the element (still checking that it is well formed) and keep its text.
+          const size_t depth = scan_.depth();
+          for (;;) {
+            const detail::XmlScanner::Token u = scan_.next();
+            if (u.kind == detail::XmlScanner::Kind::end && scan_.depth() + 1 == depth) {
+              end = u.end;
+              break;
+            }
+          }
+        }
+        props_ = text_.substr(t.offset, end - t.offset);
+        continue;
+      } else if (parent == Where::sdf && t.name == "actor") {
+        here = Where::actor;
+        open_actor(t);
+      } else if (parent == Where::actor && t.name == "port") {
+        read_port(t);
+      } else if (parent == Where::sdf && t.name == "channel") {
+        read_channel(t);
+      }
+      if (!t.self_closing) {
+        stack.push_back(here);
+      } else if (here == Where::actor) {
+        close_actor();
+      }
+    }
+    if (!seen_sdf3) fail(0, "no <sdf3> root element");
+    if (!seen_app) fail(root_offset_, "<sdf3> has no <applicationGraph>");
+    if (!seen_sdf) fail(app_offset_, "<applicationGraph> has no <sdf>");
+  }
+
+  // Everything before `offset` that no pending actor or channel still points into.
+  void release_behind(size_t offset) {
+    if (!block_.empty()) offset = std::min(offset, block_.front().offset);
+    if (!pending_.empty()) offset = std::min(offset, pending_.front().offset);
+    if (offset < released_ + kReleaseStep) return;
+    (*release_)(offset);
+    released_ = offset;
+  }
+
+  // Reports a mistake at `offset` after the pending blocks, whose own mistakes come first, and
+  // after the waiting channels whose actors have been seen by now (a channel naming an actor
+  // not seen yet cannot be judged before the end of the document, which is not read).
+  [[noreturn]] void fail_after_pending(size_t offset, const std::string& msg) {
+    flush_actors();
+    flush_channels();
+    std::vector<ChannelRecord> waiting;
+    waiting.swap(deferred_);
+    resolve(waiting, false);  // those from the first unknown actor on wait again
+    fail(offset, msg);
   }
   [[noreturn]] void fail(size_t offset, const std::string& msg) const {
-    fail_line(LineIndex(text_).line_of(offset), msg);  // built only for the one error
-  }
-  [[noreturn]] void fail(pugi::xml_node node, const std::string& msg) const {
-    fail(static_cast<size_t>(std::max<ptrdiff_t>(0, node.offset_debug())), msg);
+    throw Error(Error::Kind::input, source_ + ":" +
+                                        std::to_string(LineIndex(text_).line_of(offset)) + ": " +
+                                        msg);  // the line index only for the one error
   }
 
-  std::string_view required(pugi::xml_node node, const char* attr) const {
-    const pugi::xml_attribute a = node.attribute(attr);
-    if (!a) fail(node, "<" + std::string(node.name()) + "> lacks the attribute '" + attr + "'");
-    const std::string_view v = trim(a.value());
-    if (v.empty()) fail(node, "attribute '" + std::string(attr) + "' is empty");
-    if (!valid_utf8(v)) fail(node, "attribute '" + std::string(attr) + "' is not valid UTF-8");
+  // The decoded value of an attribute of the current tag ("" when absent), kept alive as long
+  // as the reader.
+  std::string_view value(const char* attr) {
+    const detail::XmlAttribute* a = scan_.attribute(attr);
+    return a ? keep(a->raw) : std::string_view{};
+  }
+  std::string_view keep(std::string_view raw) {
+    const std::string_view v = detail::decode_attribute(raw, scratch_);
+    if (v.data() != scratch_.data()) return v;  // a view into the text
+    return decoded_.emplace_back(scratch_);     // a deque: earlier views stay valid
+  }
+  std::string_view required(const detail::XmlScanner::Token& t, const char* attr) {
+    const detail::XmlAttribute* a = scan_.attribute(attr);
+    if (!a)
+      fail_after_pending(t.offset,
+                         "<" + std::string(t.name) + "> lacks the attribute '" + attr + "'");
+    const std::string_view v = trim(keep(a->raw));
+    if (v.empty()) fail_after_pending(t.offset, "attribute '" + std::string(attr) + "' is empty");
+    if (!valid_utf8(v))
+      fail_after_pending(t.offset, "attribute '" + std::string(attr) + "' is not valid UTF-8");
     return v;
   }
-
-  uint64_t number(pugi::xml_node node, const char* attr, std::string_view text,
-                  bool positive) const {
+  uint64_t number(size_t offset, const char* attr, std::string_view text, bool positive) {
     uint64_t v = 0;
     const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
     if (ec != std::errc() || ptr != text.data() + text.size() || (positive && v == 0)) {
@@ -126,97 +268,267 @@ class Sdf3Reader {
                         "' is not a " + (positive ? "positive" : "non-negative") +
                         " 64-bit integer";
       if (text.find(',') != std::string_view::npos) msg += " (CSDF rate lists are not supported)";
-      fail(node, msg);
+      fail_after_pending(offset, msg);
     }
     return v;
   }
 
-  void read_actor(Graph& g, pugi::xml_node actor) {
-    const std::string_view name = required(actor, "name");
-    ActorId id;
-    try {
-      id = g.add_actor(std::string(name));  // "duplicate actor name '...'"
-    } catch (const Error& e) {
-      fail(actor, e.what());
+  void open_actor(const detail::XmlScanner::Token& t) {
+    const std::string_view name = required(t, "name");
+    std::string_view type;
+    const bool typed = scan_.attribute("type") != nullptr;
+    if (typed) {
+      type = value("type");
+      if (!valid_utf8(type)) fail_after_pending(t.offset, "attribute 'type' is not valid UTF-8");
     }
-    if (const pugi::xml_attribute type = actor.attribute("type")) {
-      if (!valid_utf8(type.value())) fail(actor, "attribute 'type' is not valid UTF-8");
-      g.set_actor_type(id, type.value());
-    }
-    for (pugi::xml_node port : actor.children("port")) {
-      Port p;
-      p.actor = id;
-      p.name = required(port, "name");
-      const std::string_view type = required(port, "type");
-      if (type != "in" && type != "out")
-        fail(port, "port type '" + std::string(type) + "' is neither 'in' nor 'out'");
-      p.out = type == "out";
-      p.rate = number(port, "rate", required(port, "rate"), true);
-      p.offset = static_cast<size_t>(std::max<ptrdiff_t>(0, port.offset_debug()));
-      ports_.push_back(p);
-    }
+    block_.push_back({name, t.offset, typed, type});
+    actor_open_ = true;
   }
 
-  void read_properties(Graph& g, pugi::xml_node props) {
+  void read_port(const detail::XmlScanner::Token& t) {
+    Port p;
+    p.set_name(required(t, "name"));
+    const std::string_view type = required(t, "type");
+    if (type != "in" && type != "out")
+      fail_after_pending(t.offset,
+                         "port type '" + std::string(type) + "' is neither 'in' nor 'out'");
+    p.out = type == "out";
+    p.rate = number(t.offset, "rate", required(t, "rate"), true);
+    p.offset = t.offset;
+    ports_.push_back(p);
+  }
+
+  // The actor's ports are ports_[port_begin_.back(), end): sorted by name, then closed off.
+  void close_actor() {
+    const auto first = ports_.begin() + port_begin_.back();
+    std::sort(first, ports_.end(),
+              [](const Port& a, const Port& b) { return a.name() < b.name(); });
+    // Indices, not iterators: `first + 1` on an empty vector's null data is undefined (UBSan).
+    for (size_t i = port_begin_.back(); i + 1 < ports_.size(); ++i)
+      if (ports_[i].name() == ports_[i + 1].name())
+        fail_after_pending(std::max(ports_[i].offset, ports_[i + 1].offset),
+                           "duplicate port '" + std::string(ports_[i].name()) + "' on actor '" +
+                               std::string(block_.back().name) + "'");
+    port_begin_.push_back(static_cast<uint32_t>(ports_.size()));
+    actor_open_ = false;
+    if (block_.size() >= kBlock) flush_actors();
+  }
+
+  // Adds the actors of the block (a duplicate name is the first mistake of the block), except
+  // one whose element is still open (its ports are not all read: a mistake inside it is being
+  // reported, and only earlier ones come first).
+  void flush_actors() {
+    const size_t count = block_.size() - (actor_open_ ? 1 : 0);
+    if (count == 0) return;
+    names_.clear();
+    for (size_t i = 0; i < count; ++i) names_.push_back(block_[i].name);
+    const auto base = static_cast<ActorId>(g_.actor_count());
+    const size_t ok = g_.add_actors(names_);
+    for (size_t i = 0; i < ok; ++i)
+      if (block_[i].typed)
+        g_.set_actor_type(base + static_cast<ActorId>(i), std::string(block_[i].type));
+    if (ok < count) {
+      try {
+        g_.add_actor(std::string(block_[ok].name));  // throws "duplicate actor name '...'"
+      } catch (const Error& e) {
+        fail(block_[ok].offset, e.what());
+      }
+    }
+    block_.erase(block_.begin(), block_.begin() + static_cast<ptrdiff_t>(count));
+  }
+
+  void read_channel(const detail::XmlScanner::Token& t) {
+    ChannelRecord r;
+    r.offset = t.offset;
+    if (const detail::XmlAttribute* a = scan_.attribute("name")) {
+      r.has_name = true;
+      r.name = trim(keep(a->raw));
+      if (r.name.empty()) fail_after_pending(t.offset, "attribute 'name' is empty");
+      if (!valid_utf8(r.name)) fail_after_pending(t.offset, "attribute 'name' is not valid UTF-8");
+    }
+    r.src = required(t, "srcActor");
+    r.dst = required(t, "dstActor");
+    r.src_port = required(t, "srcPort");
+    r.dst_port = required(t, "dstPort");
+    if (const detail::XmlAttribute* a = scan_.attribute("initialTokens"))
+      r.delay = number(t.offset, "initialTokens", trim(keep(a->raw)), false);
+    (deferred_.empty() ? pending_ : deferred_).push_back(r);  // once one waits, all later do
+    if (pending_.size() >= kBlock) flush_channels();
+  }
+
+  void flush_channels() {
+    if (pending_.empty()) return;
+    flush_actors();
+    std::vector<ChannelRecord> records;
+    records.swap(pending_);  // a mistake found while resolving must not resolve them again
+    resolve(records, false);
+    records.clear();
+    records.swap(pending_);  // keep the capacity
+  }
+
+  // Adds the channels of `records` in order. `last_chance`: an unknown actor is a mistake;
+  // otherwise the channels from the first one naming an unknown actor on are deferred.
+  void resolve(std::vector<ChannelRecord>& records, bool last_chance) {
+    if (records.empty()) return;
+    names_.resize(2 * records.size());
+    ids_.resize(2 * records.size());
+    for (size_t i = 0; i < records.size(); ++i)
+      names_[2 * i] = records[i].src, names_[2 * i + 1] = records[i].dst;
+    g_.find_actors(names_, ids_);
+    std::vector<Graph::NewChannel> batch;
+    batch.reserve(records.size());
+    // The ports of random actors are cache misses: the port ranges, then the first ports, then
+    // their names are fetched ahead, overlapping the misses of later channels.
+    auto ahead = [&](size_t k, int stage) {
+      if (k >= records.size()) return;
+      for (size_t side = 0; side < 2; ++side) {
+        const int64_t a = ids_[2 * k + side];
+        if (a < 0) continue;
+        if (stage == 0) {
+          detail::prefetch(&port_begin_[static_cast<size_t>(a)]);
+        } else {
+          const auto first = port_begin_[static_cast<size_t>(a)];
+          if (first == port_begin_[static_cast<size_t>(a) + 1]) continue;  // an actor without ports
+          const Port& p = ports_[first];
+          if (stage == 1)
+            detail::prefetch(&p);
+          else
+            detail::prefetch(p.name().data());
+        }
+      }
+    };
+    size_t i = 0;
+    for (; i < records.size(); ++i) {
+      ahead(i + 24, 0);
+      ahead(i + 16, 1);
+      ahead(i + 8, 2);
+      const ChannelRecord& r = records[i];
+      const int64_t s = ids_[2 * i], d = ids_[2 * i + 1];
+      if (s < 0 || d < 0) {
+        if (!last_chance) break;
+        add_batch(records, batch);
+        fail(r.offset,
+             "channel refers to an unknown actor '" + std::string(s < 0 ? r.src : r.dst) + "'");
+      }
+      const auto src = static_cast<ActorId>(s), dst = static_cast<ActorId>(d);
+      Port& sp = find_port_or_flush(records, batch, r, src, r.src_port);
+      Port& dp = find_port_or_flush(records, batch, r, dst, r.dst_port);
+      if (!sp.out)
+        fail_in_batch(records, batch, r,
+                      "srcPort '" + std::string(sp.name()) + "' is an input port");
+      if (dp.out)
+        fail_in_batch(records, batch, r,
+                      "dstPort '" + std::string(dp.name()) + "' is an output port");
+      for (Port* p : {&sp, &dp}) {
+        if (p->channel == UINT32_MAX) continue;
+        add_batch(records, batch);  // the other channel may be in the batch: named once added
+        fail(r.offset, "port '" + std::string(p->name()) + "' of actor '" +
+                           g_.actor_name(p == &sp ? src : dst) +
+                           "' is already connected to channel '" + g_.channel(p->channel).name +
+                           "'");
+      }
+      const auto c = static_cast<uint32_t>(g_.channel_count() + batch.size());
+      sp.channel = dp.channel = c;
+      batch.push_back(
+          {src, dst, sp.rate, dp.rate, r.delay, r.has_name ? r.name : std::string_view{}});
+    }
+    add_batch(records, batch);
+    if (i < records.size())  // not last_chance; records is not deferred_, which is empty
+      deferred_.assign(records.begin() + static_cast<ptrdiff_t>(i), records.end());
+  }
+
+  Port& find_port_or_flush(std::vector<ChannelRecord>& records,
+                           std::vector<Graph::NewChannel>& batch, const ChannelRecord& r,
+                           ActorId actor, std::string_view name) {
+    const auto first = ports_.begin() + port_begin_[actor];
+    const auto last = ports_.begin() + port_begin_[actor + 1];
+    auto it = std::lower_bound(first, last, name,
+                               [](const Port& p, std::string_view k) { return p.name() < k; });
+    if (it == last || it->name() != name)
+      fail_in_batch(records, batch, r,
+                    "actor '" + g_.actor_name(actor) + "' has no port '" + std::string(name) + "'");
+    return *it;
+  }
+
+  // A mistake in channel r: the channels before it in the batch are added first (one of them
+  // may be a duplicate name, an earlier mistake).
+  [[noreturn]] void fail_in_batch(std::vector<ChannelRecord>& records,
+                                  std::vector<Graph::NewChannel>& batch, const ChannelRecord& r,
+                                  const std::string& msg) {
+    add_batch(records, batch);
+    fail(r.offset, msg);
+  }
+
+  // Adds `batch` (the first batch.size() records); a duplicate name is reported at its channel.
+  void add_batch(const std::vector<ChannelRecord>& records, std::vector<Graph::NewChannel>& batch) {
+    if (batch.empty()) return;
+    const ChannelId base = static_cast<ChannelId>(g_.channel_count());
+    const size_t ok = g_.add_channels(batch);
+    for (size_t k = 0; k < ok; ++k) {
+      const ChannelRecord& r = records[k];
+      g_.set_port_names(base + static_cast<ChannelId>(k), std::string(r.src_port),
+                        std::string(r.dst_port));
+    }
+    if (ok < batch.size()) {
+      const Graph::NewChannel& c = batch[ok];
+      try {
+        g_.add_channel(c.src, c.dst, c.prd, c.cns, c.delay, std::string(c.name));
+      } catch (const Error& e) {
+        fail(records[ok].offset, e.what());
+      }
+    }
+    batch.clear();
+  }
+
+  void read_properties() {
+    pugi::xml_document doc;
+    const pugi::xml_parse_result res =
+        doc.load_buffer(props_.data(), props_.size(), pugi::parse_default, pugi::encoding_utf8);
+    if (!res)
+      fail(props_offset_ + static_cast<size_t>(res.offset),
+           std::string("XML: ") + res.description());
+    auto at = [&](pugi::xml_node n) {
+      return props_offset_ + static_cast<size_t>(std::max<ptrdiff_t>(0, n.offset_debug()));
+    };
     apply_properties(
-        g, props, [&](pugi::xml_node n, const std::string& m) { fail(n, m); },
+        g_, doc.first_child(), [&](pugi::xml_node n, const std::string& m) { fail(at(n), m); },
         [&](pugi::xml_node n, const char* attr) {
-          return number(n, attr, required(n, attr), false);
+          const pugi::xml_attribute a = n.attribute(attr);
+          if (!a) fail(at(n), "<" + std::string(n.name()) + "> lacks the attribute '" + attr + "'");
+          const std::string_view v = trim(a.value());
+          if (v.empty()) fail(at(n), "attribute '" + std::string(attr) + "' is empty");
+          return number(at(n), attr, v, false);
         },
         false);
   }
 
-  Port& find_port(const Graph& g, pugi::xml_node ch, ActorId actor, std::string_view name) {
-    // The actor's ports are ports_[port_begin_[actor], port_begin_[actor + 1]), sorted by name.
-    const auto first = ports_.begin() + static_cast<ptrdiff_t>(port_begin_[actor]);
-    const auto last = ports_.begin() + static_cast<ptrdiff_t>(port_begin_[actor + 1]);
-    auto it = std::lower_bound(first, last, name,
-                               [](const Port& p, std::string_view k) { return p.name < k; });
-    if (it == last || it->name != name)
-      fail(ch, "actor '" + g.actor_name(actor) + "' has no port '" + std::string(name) + "'");
-    return *it;
-  }
-
-  void read_channel(Graph& g, pugi::xml_node ch) {
-    const pugi::xml_attribute name_attr = ch.attribute("name");
-    const std::string name(trim(name_attr.value()));
-    if (name_attr && name.empty()) fail(ch, "attribute 'name' is empty");
-    if (!valid_utf8(name)) fail(ch, "attribute 'name' is not valid UTF-8");
-    auto actor = [&](const char* attr) {
-      const std::string_view v = required(ch, attr);
-      const auto a = g.find_actor(v);
-      if (!a) fail(ch, "channel refers to an unknown actor '" + std::string(v) + "'");
-      return *a;
-    };
-    const ActorId src = actor("srcActor");
-    const ActorId dst = actor("dstActor");
-    Port& sp = find_port(g, ch, src, required(ch, "srcPort"));
-    Port& dp = find_port(g, ch, dst, required(ch, "dstPort"));
-    if (!sp.out) fail(ch, "srcPort '" + std::string(sp.name) + "' is an input port");
-    if (dp.out) fail(ch, "dstPort '" + std::string(dp.name) + "' is an output port");
-    for (Port* p : {&sp, &dp})
-      if (p->channel >= 0)
-        fail(ch, "port '" + std::string(p->name) + "' of actor '" + g.actor_name(p->actor) +
-                     "' is already connected to channel '" +
-                     g.channel(static_cast<ChannelId>(p->channel)).name + "'");
-    uint64_t delay = 0;
-    if (const pugi::xml_attribute t = ch.attribute("initialTokens"))
-      delay = number(ch, "initialTokens", trim(t.value()), false);
-    ChannelId c;
-    try {
-      c = g.add_channel(src, dst, sp.rate, dp.rate, delay, name);  // "duplicate channel name"
-    } catch (const Error& e) {
-      fail(ch, e.what());
-    }
-    g.set_port_names(c, std::string(sp.name), std::string(dp.name));
-    sp.channel = dp.channel = c;
-  }
-
+  static constexpr size_t kBlock = 4096;
+  static constexpr size_t kReleaseStep = size_t{16} << 20;
   std::string_view text_;
   const std::string& source_;
-  pugi::xml_document doc_;
+  detail::XmlScanner scan_;
+  const std::function<void(size_t)>* release_;
+  size_t released_ = 0;
+  Graph g_;
+  std::string scratch_;
+  std::deque<std::string> decoded_;  // attribute values that entities or white space changed
+  struct ActorRecord {
+    std::string_view name;
+    size_t offset;
+    bool typed;
+    std::string_view type;
+  };
+  std::vector<ActorRecord> block_;  // actors read, not yet added to the graph
   std::vector<Port> ports_;
-  std::vector<size_t> port_begin_;  // per actor, into ports_ (sorted by actor, then name)
+  // Actor a's ports are ports_[port_begin_[a], port_begin_[a + 1]), sorted by name; the last
+  // entry is where the next actor's begin.
+  std::vector<uint32_t> port_begin_{0};
+  std::vector<ChannelRecord> pending_, deferred_;
+  bool actor_open_ = false;
+  std::vector<std::string_view> names_;
+  std::vector<int64_t> ids_;
+  std::string_view props_;
+  size_t props_offset_ = 0, root_offset_ = 0, app_offset_ = 0;
 };
 
 // Port names for writing: the ones read, else "in<k>"/"out<k>" avoiding names already taken.
@@ -316,8 +628,18 @@ void read_sdf3_properties(Graph& g, std::string_view xml, const std::string& sou
 
 Graph read_sdf3(std::string_view text, const std::string& source) {
   Sdf3Reader reader(text, source);
-  return reader.read(text);
+  return reader.read();
 }
+
+namespace detail {
+
+Graph read_sdf3_released(std::string_view text, const std::string& source,
+                         const std::function<void(size_t)>& release) {
+  Sdf3Reader reader(text, source, &release);
+  return reader.read();
+}
+
+}  // namespace detail
 
 std::string write_sdf3(const Graph& g) {
   const auto ports = port_names(g);

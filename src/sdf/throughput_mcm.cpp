@@ -198,7 +198,7 @@ class Mcm {
       if (tg_.tokens > UINT32_MAX - 1 ||
           static_cast<double>(tg_.tokens) * static_cast<double>(tg_.tokens + 1) >
               static_cast<double>(limits_.max_token_graph))
-        throw Error(Error::Kind::input,
+        throw Error(Error::Kind::limit,
                     "the HSDF expansion holds more initial tokens than the cycle-ratio analysis "
                     "takes (Karp's table would exceed " +
                         std::to_string(limits_.max_token_graph) + " entries)");

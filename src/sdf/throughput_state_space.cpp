@@ -69,7 +69,7 @@ class Component {
       const auto [it, fresh] = seen.try_emplace(std::move(key), now, fired);
       if (!fresh) return {fired - it->second.second, now - it->second.first};
       if (++states_ > max_states_)
-        throw Error(Error::Kind::input, "the state space of throughput has more than " +
+        throw Error(Error::Kind::limit, "the state space of throughput has more than " +
                                             std::to_string(max_states_) +
                                             " states (the limit of this analysis)");
       // Advance to the next completion.

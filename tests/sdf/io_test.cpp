@@ -10,6 +10,8 @@
 #include "helpers.hpp"
 #include "sdf/generate.hpp"
 #include "sdf/json_detail.hpp"
+#include "sdf/naive.hpp"
+#include "sdf3_reader_checks.hpp"
 
 namespace sdf {
 namespace {
@@ -227,27 +229,6 @@ TEST(JsonReader, NamesTheFieldOfEachMistake) {
   EXPECT_NE(json_error("").find("f.json: parse error"), std::string::npos);
 }
 
-// What a reader made of a text: the graph written out (names, rates, delays, channel names) or
-// the error message.
-std::string outcome(const std::function<Graph()>& read) {
-  try {
-    const Graph g = read();
-    std::string out = "graph '" + g.name + "':";
-    for (ActorId a = 0; a < g.actor_count(); ++a) out += " " + g.actor_name(a);
-    for (ActorId a = 0; a < g.actor_count(); ++a)
-      out += " " + g.actor_name(a) + ":" + g.actor_type(a) + ":" +
-             (g.actor_time(a) ? std::to_string(*g.actor_time(a)) : "-");
-    for (const Channel& c : g.channels())
-      out += " [" + std::to_string(c.src) + ">" + std::to_string(c.dst) + " " +
-             std::to_string(c.prd) + "/" + std::to_string(c.cns) + "+" + std::to_string(c.delay) +
-             " " + c.name + " " + c.src_port + " " + c.dst_port + "]";
-    out += " props " + g.sdf3_properties;
-    return out;
-  } catch (const Error& e) {
-    return std::string("error: ") + e.what();
-  }
-}
-
 // The direct scanner against nlohmann's SAX reader: on every text the scanner accepts, the same
 // graph or the same error (duplicate or unknown names are found after parsing); read_json, which
 // tries the scanner first, always agrees with the SAX reader. Texts: written random graphs in
@@ -288,10 +269,11 @@ TEST(JsonReader, DirectScannerAgreesWithTheSaxReader) {
           break;
       }
     }
-    const std::string sax = outcome([&] { return detail::read_json_sax(text, "f.json"); });
+    const std::string sax = test::outcome([&] { return detail::read_json_sax(text, "f.json"); });
     std::optional<std::string> plain;
     try {
-      if (auto pg = detail::read_json_plain(text, "f.json")) plain = outcome([&] { return *pg; });
+      if (auto pg = detail::read_json_plain(text, "f.json"))
+        plain = test::outcome([&] { return *pg; });
     } catch (const Error& e) {
       plain = std::string("error: ") + e.what();
     }
@@ -301,11 +283,76 @@ TEST(JsonReader, DirectScannerAgreesWithTheSaxReader) {
     } else {
       ++rejected;
     }
-    EXPECT_EQ(outcome([&] { return read_json(text, "f.json"); }), sax) << text;
+    EXPECT_EQ(test::outcome([&] { return read_json(text, "f.json"); }), sax) << text;
   }
   EXPECT_GT(accepted, 300);
   EXPECT_GT(scanned_errors, 20);
   EXPECT_GT(rejected, 300);
+}
+
+TEST(Sdf3Reader, StreamingReaderAgreesWithTheDocumentReader) {
+  test::streaming_reader_agrees(73, 1500);
+}
+
+// Found by fuzzing the streaming reader (inputs in fuzz/corpus/sdf3/): a NUL inside a name was
+// kept, and pugixml's writer cut the name there, so the graph changed in a round trip; an actor
+// without ports made the duplicate-port check step past an empty vector's null data (UBSan).
+TEST(Sdf3Reader, RejectsNulCharactersAndReadsActorsWithoutPorts) {
+  const std::string nul = std::string("<channel name='a") + '\0' +
+                          "b' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n";
+  EXPECT_NE(sdf3_error(sdf3(std::string(kTwo) + nul)).find("f.xml:7: XML: Error parsing attribute"),
+            std::string::npos);
+  const Graph g = read_sdf3(sdf3("<actor name='X'></actor>\n<actor name='Y'/>\n"));
+  EXPECT_EQ(g.actor_count(), 2u);
+  EXPECT_NE(sdf3_error(test::slurp(test::data(
+                           "../../../fuzz/corpus/sdf3/empty-actor-then-stray-end-tag.xml")))
+                .find("f.xml:7: <channel> lacks the attribute 'srcActor'"),
+            std::string::npos);
+}
+
+// Found by the test above: a mistake inside an actor whose element was still open, with a
+// channel naming that actor waiting in the pending block, made the reader resolve the channel
+// against the open actor's unfinished port list (out of bounds).
+TEST(Sdf3Reader, AMistakeInsideAnActorWithAPendingChannelNamingIt) {
+  EXPECT_NE(
+      sdf3_error(sdf3("<actor name='A' type='a'><port name='o' type='out' rate='1'/></actor>\n"
+                      "<channel name='c' srcActor='A' srcPort='o' dstActor='C' dstPort='i'/>\n"
+                      "<actor name='C'><port name='i' type='in'/></actor>\n"))
+          .find("f.xml:7: <port> lacks the attribute 'rate'"),
+      std::string::npos);
+}
+
+// A channel naming a port of the last actor, which has none: the reader fetched that actor's
+// first port ahead (ports_[ports_.size()], out of bounds) before finding it missing.
+TEST(Sdf3Reader, AChannelToTheLastActorWithoutPorts) {
+  EXPECT_EQ(sdf3_error(sdf3("<actor name='A'><port name='o' type='out' rate='1'/></actor>\n"
+                            "<actor name='B'/>\n"
+                            "<channel name='c' srcActor='A' srcPort='o' dstActor='B' "
+                            "dstPort='i'/>\n")),
+            "f.xml:7: actor 'B' has no port 'i'");
+}
+
+// Errors come in file order as far as the text read tells them: a mistake in a channel that
+// waited for a later actor comes before a later mistake once that actor has been seen, and a
+// pending block's mistake before a later XML error.
+TEST(Sdf3Reader, EarlierMistakesComeFirst) {
+  const std::string waiting =
+      "<actor name='A'><port name='o' type='out' rate='1'/>"
+      "<port name='p' type='out' rate='1'/></actor>\n"
+      "<channel name='c' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n"
+      "<actor name='B'><port name='i' type='in' rate='1'/><port name='j' type='in' rate='1'/>"
+      "</actor>\n"
+      "<channel name='d' srcActor='A' srcPort='x' dstActor='B' dstPort='j'/>\n";
+  EXPECT_EQ(sdf3_error(sdf3(waiting + "<actor type='t'/>\n")),
+            "f.xml:8: actor 'A' has no port 'x'");
+  EXPECT_EQ(sdf3_error(sdf3(waiting + "<actor name='C' x='1\"/>\n")),
+            "f.xml:8: actor 'A' has no port 'x'");
+  // A channel still waiting for an actor the text has not reached cannot be judged yet.
+  EXPECT_EQ(sdf3_error(sdf3("<channel name='c' srcActor='A' srcPort='x' dstActor='B' "
+                            "dstPort='i'/>\n<actor type='t'/>\n")),
+            "f.xml:6: <actor> lacks the attribute 'name'");
+  EXPECT_EQ(sdf3_error(sdf3("<actor name='A'/>\n<actor name='A'/>\n<actor name='C' x='1\"/>\n")),
+            "f.xml:6: duplicate actor name 'A'");
 }
 
 TEST(Writers, RoundTripRandomGraphsThroughBothFormats) {

@@ -1,6 +1,8 @@
 // sdfsched: SDF scheduling from the command line (DESIGN §9, docs/sdf.md).
-// Exit status: 0 ok; 1 inconsistent graph, deadlock or bad input; 2 usage; 3 an online outcome
-// other than `returns` (simulate: other than `returns` or `periodic`).
+// Exit status: 0 ok; 1 inconsistent graph, deadlock or bad input; 2 usage; 3 no full answer: an
+// online outcome other than `returns` (simulate: other than `returns` or `periodic`), or a work
+// limit of an analysis reached (an Error(limit); buffers --pareto and stats print what they
+// found before it).
 #include <CLI/CLI.hpp>
 #include <charconv>
 #include <cstdio>
@@ -10,15 +12,19 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_checks.hpp"
+#include "sdf/buffers.hpp"
 #include "sdf/checker.hpp"
 #include "sdf/claims.hpp"
+#include "sdf/generate.hpp"
 #include "sdf/graph.hpp"
 #include "sdf/io.hpp"
+#include "sdf/latency.hpp"
 #include "sdf/metrics.hpp"
 #include "sdf/online.hpp"
 #include "sdf/rates.hpp"
 #include "sdf/repetitions.hpp"
 #include "sdf/schedule.hpp"
+#include "sdf/stats.hpp"
 #include "sdf/throughput.hpp"
 
 namespace {
@@ -219,32 +225,46 @@ int cmd_schedule(const std::string& path, const std::string& policy_text, bool j
   const std::vector<uint64_t>& q = c.rep.q;
   const sdf::StaticSchedule st = sdf::static_schedule(g, q);
   if (!st.complete) return report_deadlock(g, st, json);
-  const sdf::Policy policy = parse_policy(policy_text);
-  Json j;
-  j["policy"] = sdf::policy_name(policy);
-  if (policy == sdf::Policy::static_order) {
-    const sdf::CheckResult check = sdf::check_period(g, q, st.runs);
-    const sdf::Metrics m = sdf::measure(g, q, sdf::Eligibility::owing, st.runs);
+  // The two single-period schedules: the ready queue, and the ready queue within a minimal
+  // deadlock-free storage distribution (min-buffer).
+  if (policy_text == "static" || policy_text == "min-buffer") {
+    std::vector<uint64_t> capacity;
+    const std::vector<sdf::Run> runs =
+        policy_text == "static" ? st.runs : sdf::min_buffer_schedule(g, &capacity);
+    const sdf::CheckResult check = sdf::check_period(g, q, runs);
+    const sdf::Metrics m = sdf::measure(g, q, sdf::Eligibility::owing, runs);
     if (!json) {
       std::cout << "outcome: returns ("
                 << (check.valid ? "valid period" : "INVALID: " + check.reason)
-                << ")\nperiod: " << sdf::total_firings(st.runs) << " firings in " << st.runs.size()
-                << " decisions\nschedule: " << sdf::run_length_form(g, st.runs) << "\n";
+                << ")\nperiod: " << sdf::total_firings(runs) << " firings in " << runs.size()
+                << " decisions\nschedule: " << sdf::run_length_form(g, runs) << "\n";
+      if (!capacity.empty()) {
+        std::cout << "within capacities:";
+        for (sdf::ChannelId ch = 0; ch < g.channel_count(); ++ch)
+          std::cout << " " << g.channel(ch).name << "=" << capacity[ch];
+        std::cout << "\n";
+      }
       print_text_metrics(g, m);
       return check.valid ? 0 : 1;
     }
+    Json j;
+    j["policy"] = policy_text;
     j["outcome"] = "returns";
     j["valid"] = check.valid;
     j["repetitions"] = per_actor(g, q);
-    j["decisions"] = st.runs.size();
-    j["period_firings"] = sdf::total_firings(st.runs);
-    j["firings"] = firings(g, st.runs, flags.max_list);
-    j["runs"] = st.runs.size() <= flags.max_list ? run_list(g, st.runs) : Json(nullptr);
+    j["decisions"] = runs.size();
+    j["period_firings"] = sdf::total_firings(runs);
+    j["firings"] = firings(g, runs, flags.max_list);
+    j["runs"] = runs.size() <= flags.max_list ? run_list(g, runs) : Json(nullptr);
+    if (!capacity.empty()) j["capacities"] = per_channel(g, capacity);
     j["buffers"] = per_channel(g, m.buffers);
     j["fairness"] = {{"max", m.fairness.max}, {"mean", m.fairness.mean}};
     print_json(j);
     return check.valid ? 0 : 1;
   }
+  const sdf::Policy policy = parse_policy(policy_text);
+  Json j;
+  j["policy"] = sdf::policy_name(policy);
   const sdf::OnlineRunOptions opt = flags.options(policy == sdf::Policy::online_bounded);
   const sdf::OnlineRun run = sdf::run_online(g, q, opt);
   const std::span<const sdf::Run> runs(run.runs);
@@ -324,32 +344,110 @@ int cmd_schedule(const std::string& path, const std::string& policy_text, bool j
   return status;
 }
 
-sdf::RateChange parse_rate_change(const sdf::Graph& g, const std::string& spec) {
-  // ACTOR:PRD/CNS@FIRING, parsed from the right so actor names may contain ':'.
+// --rate-change in its three forms (docs/sdf.md): ACTOR:PRD/CNS@FIRING, ACTOR*NUM[/DEN]@FIRING
+// and ACTOR:CHANNEL=RATE[,CHANNEL=RATE...]@FIRING. Actor and channel names may contain ':' and
+// '*': the actor is the longest prefix that names one and leaves a well-formed rest.
+struct ParsedChange {
+  sdf::RateChange change;
+  std::string form;           // uniform, factor, ports
+  uint64_t prd = 0, cns = 0;  // uniform
+  uint64_t num = 0, den = 0;  // factor
+};
+
+ParsedChange parse_rate_change(const sdf::Graph& g, const std::string& spec) {
+  const std::string expected =
+      "expected ACTOR:PRD/CNS@FIRING, ACTOR*FACTOR@FIRING or ACTOR:CHANNEL=RATE,...@FIRING";
   const auto at = spec.rfind('@');
-  const auto colon = spec.rfind(':', at);
-  const auto slash = spec.find('/', colon == std::string::npos ? 0 : colon);
-  if (at == std::string::npos || colon == std::string::npos || slash == std::string::npos ||
-      !(colon < slash && slash < at))
-    throw Error(Error::Kind::usage, "--rate-change '" + spec + "': expected ACTOR:PRD/CNS@FIRING");
-  auto number = [&](size_t from, size_t to, bool positive) {
-    const std::string s = spec.substr(from, to - from);
-    uint64_t v = 0;
+  if (at == std::string::npos)
+    throw Error(Error::Kind::usage, "--rate-change '" + spec + "': " + expected);
+  auto whole = [](std::string_view s, uint64_t& v) {
     const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc() || p != s.data() + s.size() || (positive && v == 0))
-      throw Error(Error::Kind::usage, "--rate-change '" + spec + "': '" + s + "' is not a " +
-                                          (positive ? "positive" : "non-negative") + " integer");
+    return !s.empty() && ec == std::errc() && p == s.data() + s.size();
+  };
+  auto number = [&](std::string_view s, bool positive) {
+    uint64_t v = 0;
+    if (!whole(s, v) || (positive && v == 0))
+      throw Error(Error::Kind::usage, "--rate-change '" + spec + "': '" + std::string(s) +
+                                          "' is not a " + (positive ? "positive" : "non-negative") +
+                                          " integer");
     return v;
   };
-  sdf::RateChange rc;
-  const std::string actor = spec.substr(0, colon);
-  const auto a = g.find_actor(actor);
-  if (!a) throw Error(Error::Kind::input, "--rate-change: unknown actor '" + actor + "'");
-  rc.actor = *a;
-  rc.prd = number(colon + 1, slash, true);
-  rc.cns = number(slash + 1, at, true);
-  rc.at_firing = number(at + 1, spec.size(), false);
-  return rc;
+  // N/D (or N when `slash_optional`), both whole numbers.
+  auto fraction = [&](std::string_view s, bool slash_optional) {
+    const auto slash = s.find('/');
+    uint64_t a = 0, b = 1;
+    if (slash == std::string_view::npos) return slash_optional && whole(s, a);
+    return whole(s.substr(0, slash), a) && whole(s.substr(slash + 1), b);
+  };
+  const std::string_view head(spec.data(), at);
+  const uint64_t firing = number(std::string_view(spec).substr(at + 1), false);
+  ParsedChange out;
+  bool unknown_actor = false;  // a well-formed change for an actor the graph does not have
+  for (size_t i = head.size(); i-- > 0;) {
+    if (head[i] != ':' && head[i] != '*') continue;
+    const auto a = g.find_actor(head.substr(0, i));
+    const std::string_view rest = head.substr(i + 1);
+    const bool well_formed =
+        head[i] == '*' ? fraction(rest, true)
+                       : fraction(rest, false) || rest.find('=') != std::string_view::npos;
+    if (!well_formed) continue;
+    if (!a) {
+      unknown_actor = true;
+      continue;
+    }
+    if (head[i] == '*') {
+      const auto slash = rest.find('/');
+      out.form = "factor";
+      out.num = number(rest.substr(0, slash), true);
+      out.den = slash == std::string_view::npos ? 1 : number(rest.substr(slash + 1), true);
+      out.change = sdf::RateChange::scaled(g, *a, out.num, out.den, firing);
+      return out;
+    }
+    if (fraction(rest, false)) {
+      const auto slash = rest.find('/');
+      out.form = "uniform";
+      out.prd = number(rest.substr(0, slash), true);
+      out.cns = number(rest.substr(slash + 1), true);
+      out.change = sdf::RateChange::uniform(g, *a, out.prd, out.cns, firing);
+      return out;
+    }
+    {
+      out.form = "ports";
+      out.change.actor = *a;
+      out.change.at_firing = firing;
+      size_t from = 0;
+      while (from <= rest.size()) {
+        const size_t comma = std::min(rest.find(',', from), rest.size());
+        const std::string_view item = rest.substr(from, comma - from);
+        const auto eq = item.rfind('=');
+        if (eq == std::string_view::npos)
+          throw Error(Error::Kind::usage, "--rate-change '" + spec + "': '" + std::string(item) +
+                                              "' is not CHANNEL=RATE");
+        const std::string name(item.substr(0, eq));
+        const auto c = g.find_channel(name);
+        if (!c) throw Error(Error::Kind::input, "--rate-change: unknown channel '" + name + "'");
+        const sdf::Channel& ch = g.channel(*c);
+        if (ch.src != *a && ch.dst != *a)
+          throw Error(Error::Kind::input, "--rate-change: channel '" + name +
+                                              "' is not a channel of '" + g.actor_name(*a) + "'");
+        const uint64_t rate = number(item.substr(eq + 1), true);
+        for (const sdf::ChannelRates& r : out.change.rates)
+          if (r.channel == *c)
+            throw Error(Error::Kind::usage, "--rate-change: channel '" + name + "' given twice");
+        // An output's prd, an input's cns; a self-loop (both) keeps prd = cns.
+        out.change.rates.push_back(
+            {*c, ch.src == *a ? rate : ch.prd, ch.dst == *a ? rate : ch.cns});
+        from = comma + 1;
+      }
+      return out;
+    }
+  }
+  // Name the actor for the most likely reading: everything before the last ':' or '*'.
+  const auto sep = head.find_last_of(":*");
+  if (sep != std::string_view::npos && unknown_actor)
+    throw Error(Error::Kind::input,
+                "--rate-change: unknown actor '" + std::string(head.substr(0, sep)) + "'");
+  throw Error(Error::Kind::usage, "--rate-change '" + spec + "': " + expected);
 }
 
 int cmd_simulate(const std::string& path, const std::string& policy_text,
@@ -359,7 +457,8 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
   if (c.status) return c.status;
   const sdf::StaticSchedule st = sdf::static_schedule(g, c.rep.q);
   if (!st.complete) return report_deadlock(g, st, json);
-  const sdf::RateChange rc = parse_rate_change(g, change_text);
+  const ParsedChange parsed = parse_rate_change(g, change_text);
+  const sdf::RateChange& rc = parsed.change;
   const sdf::Policy policy = parse_policy(policy_text);
   const sdf::RateChangeResult r = sdf::simulate_rate_change(
       g, policy, rc, flags.options(policy == sdf::Policy::online_bounded));
@@ -373,9 +472,16 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
     status = 3;
   }
   if (!json) {
-    std::cout << "policy: " << sdf::policy_name(policy) << "\nchange: " << g.actor_name(rc.actor)
-              << " to prd " << rc.prd << ", cns " << rc.cns << " after firing " << rc.at_firing
-              << "\n";
+    std::cout << "policy: " << sdf::policy_name(policy) << "\nchange: " << g.actor_name(rc.actor);
+    if (parsed.form == "uniform")
+      std::cout << " to prd " << parsed.prd << ", cns " << parsed.cns;
+    else if (parsed.form == "factor")
+      std::cout << " rates times " << parsed.num << "/" << parsed.den;
+    std::cout << " (";
+    for (size_t i = 0; i < rc.rates.size(); ++i)
+      std::cout << (i ? ", " : "") << g.channel(rc.rates[i].channel).name << " " << rc.rates[i].prd
+                << ":" << rc.rates[i].cns;
+    std::cout << ") after firing " << rc.at_firing << "\n";
     if (!r.after.consistent) {
       std::cerr << "sdfsched: the changed graph is inconsistent: channel "
                 << describe_channel(g2, r.after.channel) << "\n";
@@ -408,10 +514,16 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
   }
   Json j;
   j["policy"] = sdf::policy_name(policy);
-  j["change"] = {{"actor", g.actor_name(rc.actor)},
-                 {"prd", rc.prd},
-                 {"cns", rc.cns},
-                 {"at_firing", rc.at_firing}};
+  Json change = {{"actor", g.actor_name(rc.actor)}, {"form", parsed.form}};
+  if (parsed.form == "uniform") change["prd"] = parsed.prd, change["cns"] = parsed.cns;
+  if (parsed.form == "factor")
+    change["factor"] = std::to_string(parsed.num) + "/" + std::to_string(parsed.den);
+  Json rates = Json::object();
+  for (const sdf::ChannelRates& cr : rc.rates)
+    rates[g.channel(cr.channel).name] = {{"prd", cr.prd}, {"cns", cr.cns}};
+  change["rates"] = std::move(rates);
+  change["at_firing"] = rc.at_firing;
+  j["change"] = std::move(change);
   j["repetitions_before"] = per_actor(g, r.q_before);
   j["tokens_at_change"] = per_channel(g, r.tokens_at_change);
   j["buffers_before"] = per_channel(g, r.buffers_before);
@@ -493,21 +605,177 @@ int cmd_throughput(const std::string& path, const std::string& method,
   return 0;
 }
 
-int cmd_convert(const std::string& path, const std::string& to, const std::string& out) {
+Json distribution_list(const sdf::Graph& g, const std::vector<std::vector<uint64_t>>& ds) {
+  Json j = Json::array();
+  for (const auto& d : ds) j.push_back(per_channel(g, d));
+  return j;
+}
+
+void print_distribution(const sdf::Graph& g, const std::vector<uint64_t>& d) {
+  std::cout << " ";
+  for (sdf::ChannelId c = 0; c < g.channel_count(); ++c)
+    std::cout << " " << g.channel(c).name << "=" << d[c];
+  std::cout << "\n";
+}
+
+int cmd_buffers(const std::string& path, bool pareto, std::optional<uint64_t> default_time,
+                const sdf::BufferLimits& limits, bool json) {
   const sdf::Graph g = read_graph(path);
-  auto by_output = [&](const sdf::Graph& h) {
-    const bool as_json = out.size() >= 5 && out.compare(out.size() - 5, 5, ".json") == 0;
-    return as_json ? sdf::write_json(h) : sdf::write_sdf3(h);
+  const Consistency c = consistency(g, json);
+  if (c.status) return c.status;
+  const std::vector<uint64_t> lb = sdf::buffer_lower_bounds(g);
+  uint64_t lb_size = 0;
+  for (uint64_t v : lb) lb_size = lb_size + v < lb_size ? UINT64_MAX : lb_size + v;
+  Json j;
+  j["lower_bounds"] = per_channel(g, lb);
+  j["lower_bound_size"] = lb_size;
+  if (!pareto) {
+    const sdf::StorageSearch s = sdf::minimal_storage(g, limits);
+    if (json) {
+      j["size"] = s.size;
+      j["distributions"] = distribution_list(g, s.distributions);
+      j["explored"] = s.explored;
+      j["firings"] = s.firings;
+      print_json(j);
+      return 0;
+    }
+    std::cout << "lower bounds: " << lb_size << " in total\n";
+    print_distribution(g, lb);
+    std::cout << "minimal deadlock-free storage: " << s.size << " (" << s.distributions.size()
+              << (s.distributions.size() == 1 ? " distribution" : " distributions") << "; "
+              << s.explored << " explored, " << s.firings << " firings simulated)\n";
+    for (const auto& d : s.distributions) print_distribution(g, d);
+    return 0;
+  }
+  const sdf::ParetoSearch s = sdf::storage_throughput_pareto(g, default_time, limits);
+  const int status = s.complete ? 0 : 3;
+  if (json) {
+    j["max_throughput"] = s.max_throughput.str();
+    Json points = Json::array();
+    for (const sdf::ParetoPoint& p : s.points)
+      points.push_back({{"size", p.size},
+                        {"throughput", p.throughput.str()},
+                        {"distributions", distribution_list(g, p.distributions)}});
+    j["points"] = std::move(points);
+    j["complete"] = s.complete;
+    if (!s.complete) j["stopped"] = s.stopped;
+    j["explored"] = s.explored;
+    j["states"] = s.states;
+    j["firings"] = s.firings;
+    print_json(j);
+    return status;
+  }
+  std::cout << "lower bounds: " << lb_size
+            << " in total\nthroughput with unbounded channels: " << s.max_throughput.str() << "\n";
+  for (const sdf::ParetoPoint& p : s.points) {
+    std::cout << "size " << p.size << ": throughput " << p.throughput.str() << " ("
+              << p.distributions.size()
+              << (p.distributions.size() == 1 ? " distribution)" : " distributions)") << "\n";
+    for (const auto& d : p.distributions) print_distribution(g, d);
+  }
+  if (s.complete)
+    std::cout << "complete: the last point reaches the throughput with unbounded channels ("
+              << s.explored << " distributions explored, " << s.states << " states, " << s.firings
+              << " firings)\n";
+  else
+    std::cout << "INCOMPLETE: " << s.stopped << " (" << s.explored << " distributions explored, "
+              << s.states << " states, " << s.firings << " firings)\n";
+  return status;
+}
+
+int cmd_stats(const std::string& path, const sdf::StatsLimits& limits, bool json) {
+  const sdf::Graph g = read_graph(path);
+  const sdf::GraphStats s = sdf::graph_stats(g, limits);
+  auto opt = [](const std::optional<uint64_t>& v) { return v ? Json(*v) : Json(nullptr); };
+  if (json) {
+    print_json({{"actors", s.actors},
+                {"channels", s.channels},
+                {"self_loops", s.self_loops},
+                {"initial_tokens", opt(s.initial_tokens)},
+                {"consistent", s.repetitions_overflow ? Json(nullptr) : Json(s.consistent)},
+                {"repetitions_sum", opt(s.repetitions_sum)},
+                {"repetitions_max", opt(s.repetitions_max)},
+                {"components", s.components},
+                {"sccs", s.sccs},
+                {"largest_scc", s.largest_scc},
+                {"cyclic_sccs", s.cyclic_sccs},
+                {"simple_cycles", s.simple_cycles},
+                {"cycles_complete", s.cycles_complete}});
+    return s.cycles_complete ? 0 : 3;
+  }
+  auto text = [](const std::optional<uint64_t>& v) {
+    return v ? std::to_string(*v) : std::string("beyond 64 bits");
   };
-  const std::string text = to == "json"   ? sdf::write_json(g)
-                           : to == "dot"  ? sdf::write_dot(g)
-                           : to == "hsdf" ? by_output(sdf::to_hsdf(g))
-                                          : sdf::write_sdf3(g);
+  std::cout << "actors: " << s.actors << "\nchannels: " << s.channels << " (" << s.self_loops
+            << " self-loops)\ninitial tokens: " << text(s.initial_tokens) << "\nconsistent: "
+            << (s.repetitions_overflow ? "undecided (a repetition count beyond 64 bits)"
+                                       : (s.consistent ? "yes" : "no"))
+            << "\n";
+  if (s.consistent)
+    std::cout << "repetitions: sum " << text(s.repetitions_sum) << ", max "
+              << text(s.repetitions_max) << "\n";
+  std::cout << "connected components: " << s.components
+            << "\nstrongly connected components: " << s.sccs << " (largest " << s.largest_scc
+            << " actors; " << s.cyclic_sccs
+            << " with a cycle)\nsimple cycles: " << (s.cycles_complete ? "" : "at least ")
+            << s.simple_cycles << (s.cycles_complete ? "" : " (the count stopped at its limit)")
+            << "\n";
+  return s.cycles_complete ? 0 : 3;  // a limit cut the count short
+}
+
+int cmd_latency(const std::string& path, const std::string& from, const std::string& to,
+                uint64_t iterations, uint64_t max_firings, std::optional<uint64_t> default_time,
+                bool json) {
+  const sdf::Graph g = read_graph(path);
+  const Consistency c = consistency(g, json);
+  if (c.status) return c.status;
+  sdf::LatencyOptions o;
+  o.iterations = iterations;
+  o.max_firings = max_firings;
+  auto actor = [&](const std::string& name, const char* option) {
+    const auto a = g.find_actor(name);
+    if (!a) throw Error(Error::Kind::input, std::string(option) + ": unknown actor '" + name + "'");
+    return *a;
+  };
+  if (from.empty() != to.empty())
+    throw Error(Error::Kind::usage, "latency: give both --from and --to, or neither");
+  if (!from.empty()) o.from = actor(from, "--from"), o.to = actor(to, "--to");
+  const sdf::Latency l = sdf::latency(g, o, default_time);
+  if (l.deadlock) {
+    if (json) print_json({{"deadlock", true}, {"stuck", actor_list(g, l.stuck)}});
+    std::string stuck;
+    for (sdf::ActorId a : l.stuck) stuck += (stuck.empty() ? "" : ", ") + g.actor_name(a);
+    std::cerr << "sdfsched: deadlock: " << iterations
+              << " iteration(s) cannot complete; stuck actors: " << stuck << "\n";
+    return 1;
+  }
+  if (json) {
+    Json per = Json::array();
+    for (int64_t v : l.per_iteration) per.push_back(v);
+    print_json({{"from", from.empty() ? Json(nullptr) : Json(from)},
+                {"to", to.empty() ? Json(nullptr) : Json(to)},
+                {"iterations", iterations},
+                {"latency", l.max},
+                {"iteration", l.iteration},
+                {"per_iteration", per},
+                {"makespan", l.makespan}});
+    return 0;
+  }
+  std::cout << "latency: " << l.max << " (iteration " << l.iteration << ", "
+            << (from.empty() ? "span of all actors"
+                             : "from the start of " + from + " to the end of " + to)
+            << ")\nper iteration:";
+  for (int64_t v : l.per_iteration) std::cout << " " << v;
+  std::cout << "\nmakespan of " << iterations << " iteration(s): " << l.makespan << "\n";
+  return 0;
+}
+
+// To stdout, or written beside the target and renamed, so a failed run never leaves half a file.
+int write_output(const std::string& text, const std::string& out) {
   if (out.empty() || out == "-") {
     std::cout << text;
     return 0;
   }
-  // Written beside the target and renamed, so a failed run never leaves half a file.
   const std::string tmp = out + ".partial";
   {
     std::ofstream f(tmp, std::ios::binary);
@@ -519,6 +787,71 @@ int cmd_convert(const std::string& path, const std::string& to, const std::strin
   std::filesystem::rename(tmp, out, ec);
   if (ec) throw Error(Error::Kind::io, out + ": " + ec.message());
   return 0;
+}
+
+int cmd_convert(const std::string& path, const std::string& to, const std::string& out) {
+  const sdf::Graph g = read_graph(path);
+  auto by_output = [&](const sdf::Graph& h) {
+    const bool as_json = out.size() >= 5 && out.compare(out.size() - 5, 5, ".json") == 0;
+    return as_json ? sdf::write_json(h) : sdf::write_sdf3(h);
+  };
+  const std::string text = to == "json"   ? sdf::write_json(g)
+                           : to == "dot"  ? sdf::write_dot(g)
+                           : to == "hsdf" ? by_output(sdf::to_hsdf(g))
+                                          : sdf::write_sdf3(g);
+  return write_output(text, out);
+}
+
+struct GenerateFlags {
+  std::string shape = "dag";
+  uint32_t actors = 8;
+  bool homogeneous = false, self_loops = false;
+  uint32_t max_q = 12, max_multiplier = 3, extra_percent = 50, back_percent = 30;
+  std::string times;  // LO:HI
+  uint64_t seed = 1;
+  std::string format;  // json | sdf3; default by the output's extension, else json
+};
+
+int cmd_generate(const GenerateFlags& f, const std::string& out) {
+  sdf::gen::Spec spec;
+  const std::pair<const char*, sdf::gen::Shape> shapes[] = {
+      {"chain", sdf::gen::Shape::chain},   {"fan-out", sdf::gen::Shape::fan_out},
+      {"fan-in", sdf::gen::Shape::fan_in}, {"dag", sdf::gen::Shape::dag},
+      {"cyclic", sdf::gen::Shape::cyclic}, {"cyclic-random", sdf::gen::Shape::cyclic_random}};
+  for (const auto& [name, shape] : shapes)
+    if (f.shape == name) spec.shape = shape;
+  spec.actors = f.actors;
+  spec.multirate = !f.homogeneous;
+  spec.self_loops = f.self_loops;
+  spec.max_q = f.max_q;
+  spec.max_multiplier = f.max_multiplier;
+  spec.extra_percent = f.extra_percent;
+  spec.back_percent = f.back_percent;
+  uint64_t lo = 0, hi = 0;
+  if (!f.times.empty()) {
+    const auto colon = f.times.find(':');
+    auto whole = [&](std::string_view t, uint64_t& v) {
+      const auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+      return !t.empty() && ec == std::errc() && p == t.data() + t.size();
+    };
+    const std::string_view t(f.times);
+    if (colon == std::string::npos || !whole(t.substr(0, colon), lo) ||
+        !whole(t.substr(colon + 1), hi) || lo > hi || hi >= (uint64_t{1} << 63))
+      throw Error(Error::Kind::usage,
+                  "--times '" + f.times + "': expected LO:HI, whole numbers, LO <= HI < 2^63");
+  }
+  crowddb::Rng rng(f.seed);
+  sdf::gen::Generated gd = sdf::gen::generate(spec, rng);
+  sdf::Graph& g = gd.graph;
+  g.name = f.shape + "_" + std::to_string(f.actors) + "_seed" + std::to_string(f.seed);
+  if (!f.times.empty()) {
+    crowddb::Rng time_rng = crowddb::Rng::stream(f.seed, 1);  // times do not move the graph
+    for (sdf::ActorId a = 0; a < g.actor_count(); ++a)
+      g.set_actor_time(a, lo + (hi > lo ? time_rng.below(hi - lo + 1) : 0));
+  }
+  const bool xml = f.format == "sdf3" || (f.format.empty() && out.size() >= 4 &&
+                                          out.compare(out.size() - 4, 4, ".xml") == 0);
+  return write_output(xml ? sdf::write_sdf3(g) : sdf::write_json(g), out);
 }
 
 int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& save_dir) {
@@ -545,6 +878,22 @@ int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& sav
       f << sdf::write_json(g);
     }
   }
+  auto change_stats = [](const sdf::claims::RateChangeStats& s) {
+    return Json{
+        {"changes", s.changes},   {"periodic_again", s.periodic_again},
+        {"at_once", s.at_once},   {"unbounded", s.unbounded},
+        {"deadlock", s.deadlock}, {"limit", s.limit},
+        {"invalid", s.invalid},   {"max_firings_until_periodic", s.max_firings_until_periodic}};
+  };
+  const std::vector<sdf::claims::Verdict> verdicts = sdf::claims::verdicts(r);
+  auto example = [&](const sdf::claims::Verdict& v) -> std::string {
+    if (v.counterexample.empty()) return {};
+    const sdf::Graph& g = r.counterexamples.at(v.counterexample);
+    std::string s = v.counterexample + " (" + std::to_string(g.actor_count()) + " actors, " +
+                    std::to_string(g.channel_count()) + " channels";
+    if (v.counterexample.find("-change-") != std::string::npos) s += ", change " + g.name;
+    return s + ")";
+  };
   if (json) {
     Json j = Json::array();
     for (const auto& c : r.classes)
@@ -553,6 +902,8 @@ int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& sav
                    {"online", stats(c.online)},
                    {"online_one", stats(c.online_one)},
                    {"bounded", stats(c.bounded)},
+                   {"online_change", change_stats(c.online_change)},
+                   {"bounded_change", change_stats(c.bounded_change)},
                    {"buffers_on_common_graphs",
                     {{"graphs", c.common},
                      {"static", c.buffers_static},
@@ -560,7 +911,14 @@ int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& sav
                      {"bounded", c.buffers_bounded}}}});
     Json ce = Json::object();
     for (const auto& [claim, g] : r.counterexamples) ce[claim] = Json::parse(sdf::write_json(g));
-    print_json({{"classes", j}, {"counterexamples", ce}});
+    Json vs = Json::array();
+    for (const auto& v : verdicts)
+      vs.push_back(
+          {{"claim", v.claim},
+           {"fails", v.fails},
+           {"graphs", v.graphs},
+           {"counterexample", v.counterexample.empty() ? Json(nullptr) : Json(v.counterexample)}});
+    print_json({{"classes", j}, {"verdicts", vs}, {"counterexamples", ce}});
     return 0;
   }
   auto outcomes = [](const sdf::claims::PolicyStats& s) {
@@ -572,8 +930,10 @@ int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& sav
   };
   std::cout << "| class | graphs | online: returns / periodic / unbounded | max wait >= n-1 | "
                "max wait > n-1 | max wait | --firings one: returns / periodic / unbounded | "
-               "bounded valid | checker failures | buffers static : online : bounded (graphs) |\n"
-               "|---|---|---|---|---|---|---|---|---|---|\n";
+               "bounded valid | checker failures | buffers static : online : bounded (graphs) | "
+               "after a rate change, online: periodic (at once) / unbounded / deadlock | "
+               "after a rate change, bounded: valid / deadlock |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : r.classes) {
     const auto& o = c.online;
     std::cout << "| " << c.name << " | " << c.graphs << " | " << outcomes(o) << " | "
@@ -581,7 +941,20 @@ int cmd_claims(uint64_t graphs, uint64_t seed, bool json, const std::string& sav
               << " | " << outcomes(c.online_one) << " | " << c.bounded.returns << " | "
               << o.checker_failures + c.online_one.checker_failures + c.bounded.checker_failures
               << " | " << c.buffers_static << " : " << c.buffers_online << " : "
-              << c.buffers_bounded << " (" << c.common << ") |\n";
+              << c.buffers_bounded << " (" << c.common << ") | " << c.online_change.periodic_again
+              << " (" << c.online_change.at_once << ") / "
+              << c.online_change.unbounded + c.online_change.limit << " / "
+              << c.online_change.deadlock << " | " << c.bounded_change.periodic_again << " / "
+              << c.bounded_change.deadlock << " |\n";
+  }
+  std::cout << "\n";
+  for (const auto& v : verdicts) {
+    std::cout << "- " << v.claim << ": ";
+    if (v.fails == 0)
+      std::cout << "holds on all " << v.graphs << "\n";
+    else
+      std::cout << "fails on " << v.fails << " of " << v.graphs << "; smallest counter-example "
+                << example(v) << "\n";
   }
   std::cout << "\nsmallest counter-examples:";
   for (const auto& [claim, g] : r.counterexamples)
@@ -609,15 +982,21 @@ int main(int argc, char** argv) {
 
   auto* sch = app.add_subcommand("schedule", "one period by the static or an online scheduler");
   sch->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
-  sch->add_option("--policy", policy, "static, online or online-bounded")
-      ->check(CLI::IsMember({"static", "online", "online-bounded"}));
+  sch->add_option("--policy", policy,
+                  "static, min-buffer (the ready queue within a minimal deadlock-free storage "
+                  "distribution), online or online-bounded")
+      ->check(CLI::IsMember({"static", "min-buffer", "online", "online-bounded"}));
   sch->add_flag("--json", json, "JSON output");
   flags.add(sch);
   sch->callback([&] { action = [&] { return cmd_schedule(graph, policy, json, flags); }; });
 
   auto* sim = app.add_subcommand("simulate", "change an actor's rates mid-period and continue");
   sim->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
-  sim->add_option("--rate-change", change, "ACTOR:PRD/CNS@FIRING")->required();
+  sim->add_option(
+         "--rate-change", change,
+         "ACTOR:PRD/CNS@FIRING (every output PRD, every input CNS), ACTOR*NUM[/DEN]@FIRING "
+         "(every rate of ACTOR scaled) or ACTOR:CHANNEL=RATE,...@FIRING")
+      ->required();
   sim->add_option("--policy", policy, "static, online or online-bounded")
       ->check(CLI::IsMember({"static", "online", "online-bounded"}));
   sim->add_flag("--json", json, "JSON output");
@@ -648,6 +1027,93 @@ int main(int argc, char** argv) {
   thr->add_flag("--json", json, "JSON output");
   thr->callback(
       [&] { action = [&] { return cmd_throughput(graph, method, default_time, json); }; });
+
+  bool pareto = false;
+  sdf::BufferLimits limits;
+  auto* buf = app.add_subcommand(
+      "buffers", "minimal deadlock-free storage per channel, or the storage-throughput trade-off");
+  buf->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
+  buf->add_flag("--pareto", pareto,
+                "every size at which the best throughput grows, up to the throughput with "
+                "unbounded channels (needs execution times)");
+  buf->add_option("--default-time", default_time, "execution time of actors that have none");
+  buf->add_option("--max-distributions", limits.max_distributions,
+                  "stop after exploring this many storage distributions")
+      ->check(crowddb::cli_checks::whole_at_least(1));
+  auto* max_states = buf->add_option("--max-states", limits.max_states,
+                                     "--pareto: stop after storing this many states over all "
+                                     "explorations (minimal storage stores none)")
+                         ->check(crowddb::cli_checks::whole_at_least(1));
+  buf->add_option("--max-size", limits.max_size, "explore no distribution larger")
+      ->check(crowddb::cli_checks::whole_at_least(0));
+  buf->add_option("--max-firings", limits.max_firings_per_run,
+                  "stop when the run of one distribution would simulate more firings")
+      ->check(crowddb::cli_checks::whole_at_least(1));
+  buf->add_flag("--json", json, "JSON output");
+  buf->callback([&] {
+    if (!pareto && max_states->count() > 0)
+      throw CLI::ValidationError("--max-states",
+                                 "applies to --pareto only (minimal storage runs "
+                                 "untimed and stores no states)");
+    action = [&] { return cmd_buffers(graph, pareto, default_time, limits, json); };
+  });
+
+  sdf::StatsLimits stats_limits;
+  auto* sta = app.add_subcommand(
+      "stats", "sizes, repetitions sum, components, strongly connected components, simple cycles");
+  sta->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph")->required();
+  sta->add_option("--max-cycles", stats_limits.max_cycles, "stop counting cycles after this many")
+      ->check(crowddb::cli_checks::whole_at_least(1));
+  sta->add_flag("--json", json, "JSON output");
+  sta->callback([&] { action = [&] { return cmd_stats(graph, stats_limits, json); }; });
+
+  std::string from, to_actor;
+  uint64_t iterations = 1;
+  auto* lat = app.add_subcommand(
+      "latency", "latency of self-timed execution over the first iterations (docs/sdf.md)");
+  lat->add_option("graph", graph, "SDF3 XML (.xml) or JSON (.json) graph with execution times")
+      ->required();
+  lat->add_option("--from", from, "source actor (with --to): from its first firing's start");
+  lat->add_option("--to", to_actor, "destination actor: to its iteration's last firing's end");
+  lat->add_option("--iterations", iterations, "iterations to simulate (the latency is the largest)")
+      ->check(crowddb::cli_checks::whole_at_least(1));
+  lat->add_option("--default-time", default_time, "execution time of actors that have none");
+  uint64_t max_firings = sdf::LatencyOptions{}.max_firings;
+  lat->add_option("--max-firings", max_firings,
+                  "refuse when the iterations take more firings (K times the repetitions sum)")
+      ->check(crowddb::cli_checks::whole_at_least(1));
+  lat->add_flag("--json", json, "JSON output");
+  lat->callback([&] {
+    action = [&] {
+      return cmd_latency(graph, from, to_actor, iterations, max_firings, default_time, json);
+    };
+  });
+
+  GenerateFlags gf;
+  auto* gen = app.add_subcommand("generate", "write a random consistent graph (JSON or SDF3)");
+  gen->add_option("--shape", gf.shape, "chain, fan-out, fan-in, dag, cyclic or cyclic-random")
+      ->check(CLI::IsMember({"chain", "fan-out", "fan-in", "dag", "cyclic", "cyclic-random"}));
+  gen->add_option("--actors", gf.actors, "number of actors")
+      ->check(crowddb::cli_checks::whole(1, 50'000'000));
+  gen->add_flag("--homogeneous", gf.homogeneous, "every rate 1");
+  gen->add_flag("--self-loops", gf.self_loops, "SDF3's one-token self-loop on every actor");
+  gen->add_option("--max-q", gf.max_q,
+                  "repetition counts drawn from {1,2,3,4,5,6,8,9,10,12} up to this")
+      ->check(crowddb::cli_checks::whole(1, 12));
+  gen->add_option("--max-multiplier", gf.max_multiplier,
+                  "rates are (q_dst, q_src)/gcd times a multiplier from {1,2,3} up to this")
+      ->check(crowddb::cli_checks::whole(1, 3));
+  gen->add_option("--extra-percent", gf.extra_percent,
+                  "dag/cyclic: extra forward channels, % of the actors")
+      ->check(crowddb::cli_checks::whole(0, 1000));
+  gen->add_option("--back-percent", gf.back_percent, "cyclic: back channels, % of the actors")
+      ->check(crowddb::cli_checks::whole(0, 1000));
+  gen->add_option("--times", gf.times, "LO:HI: random execution times in [LO, HI]");
+  gen->add_option("--seed", gf.seed, "random seed");
+  gen->add_option("--format", gf.format, "json or sdf3 (default: sdf3 for -o *.xml, else json)")
+      ->check(CLI::IsMember({"json", "sdf3"}));
+  gen->add_option("-o,--output", out, "output file (default: standard output)");
+  gen->callback([&] { action = [&] { return cmd_generate(gf, out); }; });
 
   uint64_t graphs = 100, seed = 1;
   std::string save;
