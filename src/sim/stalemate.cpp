@@ -14,6 +14,7 @@ constexpr double kBlockGap = 0.6;  // [m] a blocker's disc is this close to the 
 constexpr double kSameWay = 0.5;   // cos 60 degrees: directions this close are the same way
 constexpr double kFreeWalk = 0.5;  // walking at half the preferred speed towards the target
 constexpr double kOpposed = -0.5;  // cos 120 degrees: directions further apart head at each other
+constexpr std::size_t kWatchGrain = 256;  // rows per chunk of the progress watch
 
 uint64_t priority(uint64_t seed, uint64_t id) {
   uint64_t s = seed ^ (id * 0x9e3779b97f4a7c15ull);
@@ -93,31 +94,38 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   const auto goals = world.goals();
   const uint64_t after = cfg.ticks_for(cfg.stall.after);
   StallCounts c;
-  // 1. progress watch
+  // 1. progress watch: each row on its own (in chunks, on every thread), then the stalled rows
+  // collected in row order, so the result does not depend on the thread count.
+  std::vector<uint8_t> look(t.size(), 0);
+  ex.for_each_chunk(t.size(), kWatchGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      if (t.state[i] == AgentState::arrived) {
+        t.stall_ticks[i] = 0;
+        t.stall_action[i] = StallAction::none;
+        continue;
+      }
+      const double d = path_left(t, goals, i);
+      if (!std::isfinite(t.progress_best[i])) {
+        t.progress_best[i] = d;  // a new goal: this tick is the reference
+      } else if (d < t.progress_best[i] - cfg.stall.progress) {
+        t.progress_best[i] = d;
+        t.stall_ticks[i] = 0;
+        t.replan_ticks[i] = 0;
+        t.stall_action[i] = StallAction::none;  // unstuck
+      } else {
+        ++t.stall_ticks[i];
+        ++t.replan_ticks[i];
+      }
+      if (t.stall_action[i] != StallAction::none && tick >= t.stall_until[i])
+        t.stall_action[i] = StallAction::none;
+      look[i] = t.stall_ticks[i] >= after;
+    }
+  });
   std::vector<uint32_t> looked_at;
   double rmax = 0;
   for (std::size_t i = 0; i < t.size(); ++i) {
     rmax = std::max(rmax, t.radius[i]);
-    if (t.state[i] == AgentState::arrived) {
-      t.stall_ticks[i] = 0;
-      t.stall_action[i] = StallAction::none;
-      continue;
-    }
-    const double d = path_left(t, goals, i);
-    if (!std::isfinite(t.progress_best[i])) {
-      t.progress_best[i] = d;  // a new goal: this tick is the reference
-    } else if (d < t.progress_best[i] - cfg.stall.progress) {
-      t.progress_best[i] = d;
-      t.stall_ticks[i] = 0;
-      t.replan_ticks[i] = 0;
-      t.stall_action[i] = StallAction::none;  // unstuck
-    } else {
-      ++t.stall_ticks[i];
-      ++t.replan_ticks[i];
-    }
-    if (t.stall_action[i] != StallAction::none && tick >= t.stall_until[i])
-      t.stall_action[i] = StallAction::none;
-    if (t.stall_ticks[i] >= after) looked_at.push_back(static_cast<uint32_t>(i));
+    if (look[i]) looked_at.push_back(static_cast<uint32_t>(i));
   }
   if (looked_at.empty()) return c;
   // 2. blockers, queueing
