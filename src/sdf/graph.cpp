@@ -1,6 +1,7 @@
 #include "sdf/graph.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cstring>
 
 #include "prefetch.hpp"
@@ -110,30 +111,36 @@ size_t Graph::pair_slot(uint64_t pair) {
   return i;
 }
 
-uint32_t Graph::next_parallel_index(uint64_t pair) {
-  return static_cast<uint32_t>(pairs_[pair_slot(pair)].count++);
+void Graph::default_name(ActorId src, ActorId dst, uint64_t k, std::string& out) const {
+  char digits[24];
+  const char* end = std::to_chars(digits, digits + sizeof digits, k).ptr;
+  out.clear();
+  out += actor_names_[src];
+  out += "->";
+  out += actor_names_[dst];
+  out += '#';
+  out.append(digits, static_cast<size_t>(end - digits));
 }
 
-std::string Graph::default_name(ActorId src, ActorId dst, uint64_t k) const {
-  std::string s;
-  s.reserve(actor_names_[src].size() + actor_names_[dst].size() + 8);
-  s += actor_names_[src];
-  s += "->";
-  s += actor_names_[dst];
-  s += '#';
-  s += std::to_string(k);
-  return s;
+namespace {
+
+void check_length(std::string_view s, const char* what) {
+  if (s.size() > detail::NameColumn::kMaxLength)
+    throw Error(Error::Kind::input, std::string(what) + " longer than 2^24 - 1 bytes");
 }
+
+}  // namespace
 
 void Graph::reserve(size_t actors, size_t channels) {
   actor_names_.reserve(actors);
   channels_.reserve(channels);
+  channel_names_.reserve(channels, 0);
   reserve_tables(actors, channels);
 }
 
 void Graph::reserve_tables(size_t actors, size_t channels) {
   auto actor_name = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
-  auto channel_name = [this](uint32_t c) -> std::string_view { return channels_[c].name; };
+  auto channel_name = [this](uint32_t c) -> std::string_view { return channel_names_[c]; };
   if (table_size_for(actors) > actor_index_.slots.size())
     flat_rehash(actor_index_, table_size_for(actors), actor_name);
   if (table_size_for(channels) > channel_index_.slots.size())
@@ -185,28 +192,24 @@ ChannelId Graph::add_channel(ActorId src, ActorId dst, uint64_t prd, uint64_t cn
   if (prd == 0 || cns == 0) throw Error(Error::Kind::input, "channel rates must be positive");
   if (channels_.size() >= UINT32_MAX) throw Error(Error::Kind::input, "too many channels");
   const uint64_t pair = (static_cast<uint64_t>(src) << 32) | dst;
-  const uint32_t k = next_parallel_index(pair);
-  if (channel_name.empty()) channel_name = default_name(src, dst, k);
+  check_length(channel_name, "channel name");
+  const size_t slot = pair_slot(pair);
+  if (channel_name.empty()) default_name(src, dst, pairs_[slot].count, channel_name);
   const auto id = static_cast<ChannelId>(channels_.size());
-  auto name_of = [this](uint32_t c) -> std::string_view { return channels_[c].name; };
+  auto name_of = [this](uint32_t c) -> std::string_view { return channel_names_[c]; };
   const uint64_t h = hash_of(channel_name);
   if (flat_find(channel_index_, channel_name, h, name_of) >= 0)
     throw Error(Error::Kind::input, "duplicate channel name '" + channel_name + "'");
-  Channel c;
-  c.src = src;
-  c.dst = dst;
-  c.prd = prd;
-  c.cns = cns;
-  c.delay = delay;
-  c.name = std::move(channel_name);
-  channels_.push_back(std::move(c));
+  ++pairs_[slot].count;
+  channels_.push_back({src, dst, prd, cns, delay});
+  channel_names_.push_back(channel_name);
   flat_insert(channel_index_, id, h, name_of);
   return id;
 }
 
 size_t Graph::add_channels(std::span<const NewChannel> cs) {
   reserve_tables(actor_names_.size(), channels_.size() + cs.size());  // no rehash below
-  auto name_of = [this](uint32_t c) -> std::string_view { return channels_[c].name; };
+  auto name_of = [this](uint32_t c) -> std::string_view { return channel_names_[c]; };
   // Three stages kAhead channels apart, each in channel order: prefetch the (src, dst) slot;
   // take the parallel index k from it (so the name is known), hash the name and prefetch its
   // slot; insert. A channel that fails is reached by the last stage after the middle stage has
@@ -220,7 +223,8 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
   Pending ring[kRing];
   const size_t n = cs.size();
   auto valid = [&](const NewChannel& c) {
-    return c.src < actor_count() && c.dst < actor_count() && c.prd != 0 && c.cns != 0;
+    return c.src < actor_count() && c.dst < actor_count() && c.prd != 0 && c.cns != 0 &&
+           c.name.size() <= detail::NameColumn::kMaxLength;
   };
   auto pair_of = [](const NewChannel& c) { return (static_cast<uint64_t>(c.src) << 32) | c.dst; };
   auto stage1 = [&](size_t i) {
@@ -240,7 +244,7 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
     const uint64_t k = pairs_[p.pair_slot].count++;
     counted = i + 1;
     if (cs[i].name.empty()) {
-      p.name = default_name(cs[i].src, cs[i].dst, k);
+      default_name(cs[i].src, cs[i].dst, k, p.name);
     } else {
       p.name.assign(cs[i].name);
     }
@@ -265,14 +269,8 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
       return i;
     }
     const auto id = static_cast<ChannelId>(channels_.size());
-    Channel c;
-    c.src = cs[i].src;
-    c.dst = cs[i].dst;
-    c.prd = cs[i].prd;
-    c.cns = cs[i].cns;
-    c.delay = cs[i].delay;
-    c.name = std::move(p.name);
-    channels_.push_back(std::move(c));
+    channels_.push_back({cs[i].src, cs[i].dst, cs[i].prd, cs[i].cns, cs[i].delay});
+    channel_names_.push_back(p.name);
     flat_insert(channel_index_, id, p.hash, name_of);
     if (i + 2 * kAhead < n) stage1(i + 2 * kAhead);
     if (stage2_open && i + kAhead < n) stage2_open = stage2(i + kAhead);
@@ -286,15 +284,15 @@ void Graph::set_rates(ChannelId c, uint64_t prd, uint64_t cns) {
   channels_[c].cns = cns;
 }
 
-const std::string& Graph::actor_type(ActorId a) const {
-  static const std::string kNone;
-  return a < actor_types_.size() ? actor_types_[a] : kNone;
+std::string_view Graph::actor_type(ActorId a) const {
+  return a < actor_types_.size() ? actor_types_[a] : std::string_view{};
 }
 
-void Graph::set_actor_type(ActorId a, std::string actor_type) {
+void Graph::set_actor_type(ActorId a, std::string_view actor_type) {
   if (a >= actor_count()) throw Error(Error::Kind::input, "set_actor_type: unknown actor");
+  check_length(actor_type, "actor type");
   if (actor_types_.size() < actor_count()) actor_types_.resize(actor_count());
-  actor_types_[a] = std::move(actor_type);
+  actor_types_.set(a, actor_type);
 }
 
 std::optional<uint64_t> Graph::actor_time(ActorId a) const {
@@ -311,9 +309,16 @@ void Graph::set_actor_time(ActorId a, std::optional<uint64_t> time) {
   actor_times_[a] = time ? *time : kNoTime;
 }
 
-void Graph::set_port_names(ChannelId c, std::string src_port, std::string dst_port) {
-  channels_[c].src_port = std::move(src_port);
-  channels_[c].dst_port = std::move(dst_port);
+void Graph::set_port_names(ChannelId c, std::string_view src_port, std::string_view dst_port) {
+  check_length(src_port, "port name");
+  check_length(dst_port, "port name");
+  if (src_port.empty() && dst_port.empty() && c >= src_ports_.size()) return;
+  if (src_ports_.size() < channels_.size()) {
+    src_ports_.resize(channels_.size());
+    dst_ports_.resize(channels_.size());
+  }
+  src_ports_.set(c, src_port);
+  dst_ports_.set(c, dst_port);
 }
 
 std::optional<ActorId> Graph::find_actor(std::string_view actor) const {
@@ -353,7 +358,7 @@ void Graph::find_actors(std::span<const std::string_view> names, std::span<int64
 
 std::optional<ChannelId> Graph::find_channel(std::string_view channel_name) const {
   const int64_t c = flat_find(channel_index_, channel_name,
-                              [this](uint32_t i) -> std::string_view { return channels_[i].name; });
+                              [this](uint32_t i) -> std::string_view { return channel_names_[i]; });
   if (c < 0) return std::nullopt;
   return static_cast<ChannelId>(c);
 }

@@ -113,11 +113,13 @@ Graph read_graph_file(const std::string& path) {
 std::string write_dot(const Graph& g) {
   std::string out = "digraph " + quoted(g.name.empty() ? "sdf" : g.name) + " {\n";
   for (ActorId a = 0; a < g.actor_count(); ++a) out += "  " + quoted(g.actor_name(a)) + ";\n";
-  for (const Channel& c : g.channels()) {
+  for (ChannelId id = 0; id < g.channel_count(); ++id) {
+    const Channel& c = g.channel(id);
     std::string label = std::to_string(c.prd) + ":" + std::to_string(c.cns);
     if (c.delay != 0) label += " (" + std::to_string(c.delay) + ")";
     out += "  " + quoted(g.actor_name(c.src)) + " -> " + quoted(g.actor_name(c.dst)) +
-           " [label=" + quoted(label) + ", tooltip=" + quoted(c.name) + "];\n";
+           " [label=" + quoted(label) + ", tooltip=" + quoted(std::string(g.channel_name(id))) +
+           "];\n";
   }
   return out + "}\n";
 }

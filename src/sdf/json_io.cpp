@@ -256,8 +256,7 @@ Graph build(Parsed& p, const std::string& source) {
     fail("actors[" + std::to_string(i) + "].name: duplicate actor name '" +
          std::string(p.actors[i]) + "'");
   for (size_t a = 0; a < p.actor_types.size(); ++a)
-    if (!p.actor_types[a].empty())
-      g.set_actor_type(static_cast<ActorId>(a), std::string(p.actor_types[a]));
+    if (!p.actor_types[a].empty()) g.set_actor_type(static_cast<ActorId>(a), p.actor_types[a]);
   for (size_t a = 0; a < p.actor_times.size(); ++a)
     if (p.actor_times[a] != kNoTime) g.set_actor_time(static_cast<ActorId>(a), p.actor_times[a]);
   // A block at a time: resolve the names (Graph::find_actors overlaps the probes), add the
@@ -286,8 +285,7 @@ Graph build(Parsed& p, const std::string& source) {
     for (size_t k = 0; k < added; ++k) {
       const ChannelView& c = p.channels[b + k];
       if (!c.src_port.empty() || !c.dst_port.empty())
-        g.set_port_names(static_cast<ChannelId>(b + k), std::string(c.src_port),
-                         std::string(c.dst_port));
+        g.set_port_names(static_cast<ChannelId>(b + k), c.src_port, c.dst_port);
     }
     const size_t i = b + added;
     if (i == end) continue;
@@ -530,17 +528,19 @@ std::string write_json(const Graph& g) {
   }
   auto& channels = j["channels"] = nlohmann::ordered_json::array();
   std::unordered_map<uint64_t, uint32_t> parallel;
-  for (const Channel& c : g.channels()) {
+  for (ChannelId id = 0; id < g.channel_count(); ++id) {
+    const Channel& c = g.channel(id);
+    const std::string_view name = g.channel_name(id);
     nlohmann::ordered_json e = {{"src", g.actor_name(c.src)},
                                 {"dst", g.actor_name(c.dst)},
                                 {"prd", c.prd},
                                 {"cns", c.cns},
                                 {"delay", c.delay}};
     const uint32_t k = parallel[(static_cast<uint64_t>(c.src) << 32) | c.dst]++;
-    if (c.name != g.actor_name(c.src) + "->" + g.actor_name(c.dst) + "#" + std::to_string(k))
-      e["name"] = c.name;
-    if (!c.src_port.empty()) e["src_port"] = c.src_port;
-    if (!c.dst_port.empty()) e["dst_port"] = c.dst_port;
+    if (name != g.actor_name(c.src) + "->" + g.actor_name(c.dst) + "#" + std::to_string(k))
+      e["name"] = name;
+    if (!g.src_port(id).empty()) e["src_port"] = g.src_port(id);
+    if (!g.dst_port(id).empty()) e["dst_port"] = g.dst_port(id);
     channels.push_back(std::move(e));
   }
   // Last: adding a key to an ordered_json moves its members (the references above).

@@ -90,7 +90,7 @@ Latency latency(const Graph& g, const LatencyOptions& o, std::optional<uint64_t>
   auto complete = [&](ActorId a, uint64_t k) {
     for (ChannelId c : adj.outputs(a)) {
       const Channel& ch = g.channel(c);
-      tokens[c] = detail::add_tokens(tokens[c], k, ch.prd, ch.name);
+      tokens[c] = detail::add_tokens(tokens[c], k, ch.prd, g, c);
       offer(ch.dst);
     }
     // Iterations whose last firing is among these k.

@@ -325,8 +325,7 @@ class Sdf3Reader {
     const auto base = static_cast<ActorId>(g_.actor_count());
     const size_t ok = g_.add_actors(names_);
     for (size_t i = 0; i < ok; ++i)
-      if (block_[i].typed)
-        g_.set_actor_type(base + static_cast<ActorId>(i), std::string(block_[i].type));
+      if (block_[i].typed) g_.set_actor_type(base + static_cast<ActorId>(i), block_[i].type);
     if (ok < count) {
       try {
         g_.add_actor(std::string(block_[ok].name));  // throws "duplicate actor name '...'"
@@ -424,8 +423,8 @@ class Sdf3Reader {
         add_batch(records, batch);  // the other channel may be in the batch: named once added
         fail(r.offset, "port '" + std::string(p->name()) + "' of actor '" +
                            g_.actor_name(p == &sp ? src : dst) +
-                           "' is already connected to channel '" + g_.channel(p->channel).name +
-                           "'");
+                           "' is already connected to channel '" +
+                           std::string(g_.channel_name(p->channel)) + "'");
       }
       const auto c = static_cast<uint32_t>(g_.channel_count() + batch.size());
       sp.channel = dp.channel = c;
@@ -466,8 +465,7 @@ class Sdf3Reader {
     const size_t ok = g_.add_channels(batch);
     for (size_t k = 0; k < ok; ++k) {
       const ChannelRecord& r = records[k];
-      g_.set_port_names(base + static_cast<ChannelId>(k), std::string(r.src_port),
-                        std::string(r.dst_port));
+      g_.set_port_names(base + static_cast<ChannelId>(k), r.src_port, r.dst_port);
     }
     if (ok < batch.size()) {
       const Graph::NewChannel& c = batch[ok];
@@ -535,9 +533,10 @@ class Sdf3Reader {
 std::vector<std::pair<std::string, std::string>> port_names(const Graph& g) {
   std::vector<std::unordered_set<std::string>> taken(g.actor_count());
   bool any_named = false;
-  for (const Channel& c : g.channels()) {
-    if (!c.src_port.empty()) taken[c.src].insert(c.src_port), any_named = true;
-    if (!c.dst_port.empty()) taken[c.dst].insert(c.dst_port), any_named = true;
+  for (ChannelId id = 0; id < g.channel_count(); ++id) {
+    const Channel& c = g.channel(id);
+    if (!g.src_port(id).empty()) taken[c.src].emplace(g.src_port(id)), any_named = true;
+    if (!g.dst_port(id).empty()) taken[c.dst].emplace(g.dst_port(id)), any_named = true;
   }
   std::vector<uint32_t> next(g.actor_count(), 0);
   auto invent = [&](ActorId a, const char* prefix) {
@@ -549,8 +548,8 @@ std::vector<std::pair<std::string, std::string>> port_names(const Graph& g) {
   std::vector<std::pair<std::string, std::string>> names(g.channel_count());
   for (ChannelId c = 0; c < g.channel_count(); ++c) {
     const Channel& ch = g.channel(c);
-    names[c].first = ch.src_port.empty() ? invent(ch.src, "out") : ch.src_port;
-    names[c].second = ch.dst_port.empty() ? invent(ch.dst, "in") : ch.dst_port;
+    names[c].first = g.src_port(c).empty() ? invent(ch.src, "out") : std::string(g.src_port(c));
+    names[c].second = g.dst_port(c).empty() ? invent(ch.dst, "in") : std::string(g.dst_port(c));
   }
   return names;
 }
@@ -660,7 +659,7 @@ std::string write_sdf3(const Graph& g) {
   for (ActorId a = 0; a < g.actor_count(); ++a) {
     pugi::xml_node actor = sdf.append_child("actor");
     actor.append_attribute("name") = g.actor_name(a).c_str();
-    const std::string& type = g.actor_type(a);
+    const std::string type(g.actor_type(a));
     actor.append_attribute("type") = (type.empty() ? g.actor_name(a) : type).c_str();
     for (ChannelId c : adj.inputs(a)) {
       pugi::xml_node p = actor.append_child("port");
@@ -678,7 +677,7 @@ std::string write_sdf3(const Graph& g) {
   for (ChannelId c = 0; c < g.channel_count(); ++c) {
     const Channel& ch = g.channel(c);
     pugi::xml_node e = sdf.append_child("channel");
-    e.append_attribute("name") = ch.name.c_str();
+    e.append_attribute("name") = std::string(g.channel_name(c)).c_str();
     e.append_attribute("srcActor") = g.actor_name(ch.src).c_str();
     e.append_attribute("srcPort") = ports[c].first.c_str();
     e.append_attribute("dstActor") = g.actor_name(ch.dst).c_str();

@@ -92,7 +92,7 @@ class Component {
   void produce(size_t a, uint64_t n) {
     for (uint32_t c : out_[a]) {
       const Channel& ch = g_.channel(channels_[c]);
-      tokens_[c] = detail::add_tokens(tokens_[c], n, ch.prd, ch.name);
+      tokens_[c] = detail::add_tokens(tokens_[c], n, ch.prd, g_, channels_[c]);
     }
   }
 

@@ -10,9 +10,9 @@ namespace {
 TEST(Graph, DefaultChannelNamesCountParallelChannels) {
   const Graph g =
       test::make({"A", "B"}, {{"A", "B", 1, 1, 0}, {"A", "B", 2, 2, 0}, {"B", "A", 1, 1, 1}});
-  EXPECT_EQ(g.channel(0).name, "A->B#0");
-  EXPECT_EQ(g.channel(1).name, "A->B#1");
-  EXPECT_EQ(g.channel(2).name, "B->A#0");
+  EXPECT_EQ(std::string(g.channel_name(0)), "A->B#0");
+  EXPECT_EQ(std::string(g.channel_name(1)), "A->B#1");
+  EXPECT_EQ(std::string(g.channel_name(2)), "B->A#0");
   EXPECT_EQ(g.find_channel("A->B#1"), 1u);
   EXPECT_FALSE(g.find_channel("A->B#2"));
 }
