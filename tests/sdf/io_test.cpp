@@ -231,7 +231,8 @@ TEST(JsonReader, NamesTheFieldOfEachMistake) {
 
 // The direct scanner against nlohmann's SAX reader: on every text the scanner accepts, the same
 // graph or the same error (duplicate or unknown names are found after parsing); read_json, which
-// tries the scanner first, always agrees with the SAX reader. Texts: written random graphs in
+// tries the scanner first, always agrees with the SAX reader, and the streaming form of the
+// scanner with the scanner. Texts: written random graphs in
 // three layouts, with channel names and a graph name, then random byte-level mutations.
 TEST(JsonReader, DirectScannerAgreesWithTheSaxReader) {
   crowddb::Rng rng(71);
@@ -244,9 +245,12 @@ TEST(JsonReader, DirectScannerAgreesWithTheSaxReader) {
     Graph g = gen::generate(spec, rng).graph;
     if (rng.below(3) == 0) g.name = "g" + std::to_string(i);
     std::string text = write_json(g);
-    if (rng.below(3) == 0) {  // explicit channel names, duplicates possible (an error later)
+    if (rng.below(3) == 0) {  // explicit channel and port names, duplicates possible (an error)
       nlohmann::ordered_json j = nlohmann::ordered_json::parse(text);
-      for (auto& c : j["channels"]) c["name"] = "c" + std::to_string(rng.below(5));
+      for (auto& c : j["channels"]) {
+        c["name"] = "c" + std::to_string(rng.below(5));
+        if (rng.below(4) == 0) c["src_port"] = "p" + std::to_string(rng.below(3));
+      }
       text = j.dump(1);
     }
     if (rng.below(2) == 0)
@@ -284,6 +288,15 @@ TEST(JsonReader, DirectScannerAgreesWithTheSaxReader) {
       ++rejected;
     }
     EXPECT_EQ(test::outcome([&] { return read_json(text, "f.json"); }), sax) << text;
+    // Blocks of two: the streaming reader adds and releases in many steps on these small graphs.
+    std::optional<std::string> streamed;
+    try {
+      if (auto sg = detail::read_json_streaming(text, "f.json", nullptr, 2))
+        streamed = test::outcome([&] { return *sg; });
+    } catch (const Error& e) {
+      streamed = std::string("error: ") + e.what();
+    }
+    EXPECT_EQ(streamed, plain) << text;
   }
   EXPECT_GT(accepted, 300);
   EXPECT_GT(scanned_errors, 20);
