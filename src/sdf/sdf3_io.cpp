@@ -113,7 +113,7 @@ class Sdf3Reader {
     // error than a valid one of its size.
     size_t actors = 0, channels = 0;
     auto named = [&](size_t at, std::string_view name) {
-      if (text_.compare(at + 1, name.size(), name) != 0) return false;
+      if (!same(text_.substr(at + 1, name.size()), name)) return false;
       const size_t after = at + 1 + name.size();
       return after < text_.size() &&
              (text_[after] == '/' || text_[after] == '>' || text_[after] == ' ' ||
@@ -122,7 +122,12 @@ class Sdf3Reader {
     for (size_t at = text_.find('<'); at != std::string_view::npos; at = text_.find('<', at + 1)) {
       actors += named(at, "actor");
       channels += named(at, "channel");
+      // The count reads the whole text: what it has passed is dropped as it goes (the scan
+      // faults it in again from the page cache), so the file is never resident at once.
+      if (release_ && at >= released_ + kReleaseStep) (*release_)(released_ = at);
     }
+    if (release_) (*release_)(text_.size());
+    released_ = 0;
     g_.reserve(std::min(actors, text_.size() / 17), std::min(channels, text_.size() / 60));
     try {
       scan();
@@ -158,7 +163,7 @@ class Sdf3Reader {
       }
       const Where parent = stack.empty() ? Where::outside : stack.back();
       Where here = Where::other;
-      if (parent == Where::outside && t.name == "sdf3" && !seen_sdf3) {
+      if (parent == Where::outside && same(t.name, "sdf3") && !seen_sdf3) {
         seen_sdf3 = true;
         here = Where::sdf3;
         const std::string_view type = value("type");
@@ -166,18 +171,18 @@ class Sdf3Reader {
           fail(t.offset,
                "graph type '" + std::string(type) + "' is not supported (only type=\"sdf\")");
         root_offset_ = t.offset;
-      } else if (parent == Where::sdf3 && t.name == "applicationGraph" && !seen_app) {
+      } else if (parent == Where::sdf3 && same(t.name, "applicationGraph") && !seen_app) {
         seen_app = true;
         here = Where::app;
         app_offset_ = t.offset;
-      } else if (parent == Where::app && t.name == "sdf" && !seen_sdf) {
+      } else if (parent == Where::app && same(t.name, "sdf") && !seen_sdf) {
         seen_sdf = true;
         here = Where::sdf;
         g_.name = value("name");
         if (!valid_utf8(g_.name)) fail(t.offset, "attribute 'name' is not valid UTF-8");
         g_.type = value("type");
         if (!valid_utf8(g_.type)) fail(t.offset, "attribute 'type' is not valid UTF-8");
-      } else if (parent == Where::app && t.name == "sdfProperties" && props_.empty()) {
+      } else if (parent == Where::app && same(t.name, "sdfProperties") && props_.empty()) {
         props_offset_ = t.offset;
         size_t end = t.end;
         if (!t.self_closing) {
@@ -193,12 +198,12 @@ class Sdf3Reader {
         }
         props_ = text_.substr(t.offset, end - t.offset);
         continue;
-      } else if (parent == Where::sdf && t.name == "actor") {
+      } else if (parent == Where::sdf && same(t.name, "actor")) {
         here = Where::actor;
         open_actor(t);
-      } else if (parent == Where::actor && t.name == "port") {
+      } else if (parent == Where::actor && same(t.name, "port")) {
         read_port(t);
-      } else if (parent == Where::sdf && t.name == "channel") {
+      } else if (parent == Where::sdf && same(t.name, "channel")) {
         read_channel(t);
       }
       if (!t.self_closing) {
@@ -240,21 +245,22 @@ class Sdf3Reader {
 
   // The decoded value of an attribute of the current tag ("" when absent), kept alive as long
   // as the reader.
-  std::string_view value(const char* attr) {
+  std::string_view value(std::string_view attr) {
     const detail::XmlAttribute* a = scan_.attribute(attr);
-    return a ? keep(a->raw) : std::string_view{};
+    return a ? keep(*a) : std::string_view{};
   }
-  std::string_view keep(std::string_view raw) {
-    const std::string_view v = detail::decode_attribute(raw, scratch_);
+  std::string_view keep(const detail::XmlAttribute& a) {
+    if (a.plain) return a.raw;
+    const std::string_view v = detail::decode_attribute(a.raw, scratch_);
     if (v.data() != scratch_.data()) return v;  // a view into the text
     return decoded_.emplace_back(scratch_);     // a deque: earlier views stay valid
   }
-  std::string_view required(const detail::XmlScanner::Token& t, const char* attr) {
+  std::string_view required(const detail::XmlScanner::Token& t, std::string_view attr) {
     const detail::XmlAttribute* a = scan_.attribute(attr);
     if (!a)
-      fail_after_pending(t.offset,
-                         "<" + std::string(t.name) + "> lacks the attribute '" + attr + "'");
-    const std::string_view v = trim(keep(a->raw));
+      fail_after_pending(t.offset, "<" + std::string(t.name) + "> lacks the attribute '" +
+                                       std::string(attr) + "'");
+    const std::string_view v = trim(keep(*a));
     if (v.empty()) fail_after_pending(t.offset, "attribute '" + std::string(attr) + "' is empty");
     if (!valid_utf8(v))
       fail_after_pending(t.offset, "attribute '" + std::string(attr) + "' is not valid UTF-8");
@@ -289,10 +295,10 @@ class Sdf3Reader {
     Port p;
     p.set_name(required(t, "name"));
     const std::string_view type = required(t, "type");
-    if (type != "in" && type != "out")
+    if (!same(type, "in") && !same(type, "out"))
       fail_after_pending(t.offset,
                          "port type '" + std::string(type) + "' is neither 'in' nor 'out'");
-    p.out = type == "out";
+    p.out = same(type, "out");
     p.rate = number(t.offset, "rate", required(t, "rate"), true);
     p.offset = t.offset;
     ports_.push_back(p);
@@ -341,7 +347,7 @@ class Sdf3Reader {
     r.offset = t.offset;
     if (const detail::XmlAttribute* a = scan_.attribute("name")) {
       r.has_name = true;
-      r.name = trim(keep(a->raw));
+      r.name = trim(keep(*a));
       if (r.name.empty()) fail_after_pending(t.offset, "attribute 'name' is empty");
       if (!valid_utf8(r.name)) fail_after_pending(t.offset, "attribute 'name' is not valid UTF-8");
     }
@@ -350,7 +356,7 @@ class Sdf3Reader {
     r.src_port = required(t, "srcPort");
     r.dst_port = required(t, "dstPort");
     if (const detail::XmlAttribute* a = scan_.attribute("initialTokens"))
-      r.delay = number(t.offset, "initialTokens", trim(keep(a->raw)), false);
+      r.delay = number(t.offset, "initialTokens", trim(keep(*a)), false);
     (deferred_.empty() ? pending_ : deferred_).push_back(r);  // once one waits, all later do
     if (pending_.size() >= kBlock) flush_channels();
   }
@@ -441,9 +447,14 @@ class Sdf3Reader {
                            ActorId actor, std::string_view name) {
     const auto first = ports_.begin() + port_begin_[actor];
     const auto last = ports_.begin() + port_begin_[actor + 1];
-    auto it = std::lower_bound(first, last, name,
-                               [](const Port& p, std::string_view k) { return p.name() < k; });
-    if (it == last || it->name() != name)
+    auto it = first;
+    if (last - first <= 8) {  // most actors have a few ports: a scan, no calls to memcmp
+      while (it != last && !same(it->name(), name)) ++it;
+    } else {
+      it = std::lower_bound(first, last, name,
+                            [](const Port& p, std::string_view k) { return p.name() < k; });
+    }
+    if (it == last || !same(it->name(), name))
       fail_in_batch(records, batch, r,
                     "actor '" + g_.actor_name(actor) + "' has no port '" + std::string(name) + "'");
     return *it;
