@@ -202,7 +202,11 @@ class Graph {
   template <class KeyOf>
   static void flat_rehash(FlatIndex& t, size_t capacity, KeyOf&& key_of);
   FlatIndex actor_index_, channel_index_;
-  // (src, dst) -> number of channels so far, for the default names `src->dst#k`.
+  // (src, dst) -> number of channels so far, for the default names `src->dst#k`. Built at the
+  // first channel that needs a default name (a graph whose channels are all named, as SDF3's
+  // are, never pays for it) and kept up to date from then on.
+  bool pairs_live_ = false;
+  void make_pairs_live();
   struct PairCount {
     uint64_t key;  // UINT64_MAX = free ((src, dst) are never both 2^32 - 1)
     uint64_t count;

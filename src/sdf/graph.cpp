@@ -99,6 +99,14 @@ void Graph::pair_rehash(size_t capacity) {
   }
 }
 
+void Graph::make_pairs_live() {
+  if (pairs_live_) return;
+  pairs_live_ = true;
+  pair_rehash(table_size_for(channels_.size()));
+  for (const Channel& c : channels_)
+    ++pairs_[pair_slot((static_cast<uint64_t>(c.src) << 32) | c.dst)].count;
+}
+
 size_t Graph::pair_slot(uint64_t pair) {
   if (2 * (pair_size_ + 1) > pairs_.size()) pair_rehash(std::max<size_t>(16, pairs_.size() * 2));
   const size_t mask = pairs_.size() - 1;
@@ -145,7 +153,8 @@ void Graph::reserve_tables(size_t actors, size_t channels) {
     flat_rehash(actor_index_, table_size_for(actors), actor_name);
   if (table_size_for(channels) > channel_index_.slots.size())
     flat_rehash(channel_index_, table_size_for(channels), channel_name);
-  if (table_size_for(channels) > pairs_.size()) pair_rehash(table_size_for(channels));
+  if (pairs_live_ && table_size_for(channels) > pairs_.size())
+    pair_rehash(table_size_for(channels));
 }
 
 ActorId Graph::add_actor(std::string actor_name) {
@@ -193,14 +202,15 @@ ChannelId Graph::add_channel(ActorId src, ActorId dst, uint64_t prd, uint64_t cn
   if (channels_.size() >= UINT32_MAX) throw Error(Error::Kind::input, "too many channels");
   const uint64_t pair = (static_cast<uint64_t>(src) << 32) | dst;
   check_length(channel_name, "channel name");
-  const size_t slot = pair_slot(pair);
+  if (channel_name.empty()) make_pairs_live();
+  const size_t slot = pairs_live_ ? pair_slot(pair) : 0;
   if (channel_name.empty()) default_name(src, dst, pairs_[slot].count, channel_name);
   const auto id = static_cast<ChannelId>(channels_.size());
   auto name_of = [this](uint32_t c) -> std::string_view { return channel_names_[c]; };
   const uint64_t h = hash_of(channel_name);
   if (flat_find(channel_index_, channel_name, h, name_of) >= 0)
     throw Error(Error::Kind::input, "duplicate channel name '" + channel_name + "'");
-  ++pairs_[slot].count;
+  if (pairs_live_) ++pairs_[slot].count;
   channels_.push_back({src, dst, prd, cns, delay});
   channel_names_.push_back(channel_name);
   flat_insert(channel_index_, id, h, name_of);
@@ -208,6 +218,9 @@ ChannelId Graph::add_channel(ActorId src, ActorId dst, uint64_t prd, uint64_t cn
 }
 
 size_t Graph::add_channels(std::span<const NewChannel> cs) {
+  if (!pairs_live_ &&
+      std::any_of(cs.begin(), cs.end(), [](const NewChannel& c) { return c.name.empty(); }))
+    make_pairs_live();
   reserve_tables(actor_names_.size(), channels_.size() + cs.size());  // no rehash below
   auto name_of = [this](uint32_t c) -> std::string_view { return channel_names_[c]; };
   // Three stages kAhead channels apart, each in channel order: prefetch the (src, dst) slot;
@@ -229,7 +242,7 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
   auto pair_of = [](const NewChannel& c) { return (static_cast<uint64_t>(c.src) << 32) | c.dst; };
   auto stage1 = [&](size_t i) {
     if (!valid(cs[i])) return;
-    prefetch(pairs_.data() + (mix64(pair_of(cs[i])) & (pairs_.size() - 1)));
+    if (pairs_live_) prefetch(pairs_.data() + (mix64(pair_of(cs[i])) & (pairs_.size() - 1)));
     if (cs[i].name.empty()) {  // the default name is made of the two actor names
       prefetch(&actor_names_[cs[i].src]);
       prefetch(&actor_names_[cs[i].dst]);
@@ -240,8 +253,11 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
     // Stops at an invalid channel: stage 3 returns there, and nothing after it is counted.
     if (!valid(cs[i])) return false;
     Pending& p = ring[i % kRing];
-    p.pair_slot = pair_slot(pair_of(cs[i]));
-    const uint64_t k = pairs_[p.pair_slot].count++;
+    uint64_t k = 0;
+    if (pairs_live_) {
+      p.pair_slot = pair_slot(pair_of(cs[i]));
+      k = pairs_[p.pair_slot].count++;
+    }
     counted = i + 1;
     if (cs[i].name.empty()) {
       default_name(cs[i].src, cs[i].dst, k, p.name);
@@ -253,7 +269,8 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
     return true;
   };
   auto undo = [&](size_t from) {
-    for (size_t j = from; j < counted; ++j) --pairs_[ring[j % kRing].pair_slot].count;
+    if (pairs_live_)
+      for (size_t j = from; j < counted; ++j) --pairs_[ring[j % kRing].pair_slot].count;
   };
   for (size_t i = 0; i < std::min(n, 2 * kAhead); ++i) stage1(i);
   bool stage2_open = true;

@@ -3,7 +3,9 @@
 // search: O(P log P) for P ports, never the quadratic scan that makes SDF3's own loader take
 // minutes on 10^5 actors. Line numbers are computed only for an error message.
 #include <algorithm>
+#include <bit>
 #include <charconv>
+#include <cstring>
 #include <deque>
 #include <pugixml.hpp>
 #include <sstream>
@@ -50,35 +52,46 @@ void apply_properties(Graph& g, pugi::xml_node props, Fail&& fail, Number&& numb
 
 // A port keeps a short name (all of SDF3's are) in itself, so that resolving channels does not
 // go back to the text (which the reader may release behind it); a longer one is a view.
+// 32 bytes (there are two per channel): the offset of the <port> element (its line is computed
+// only for an error message) and a long name's length take 40 bits, as texts stay far below
+// 2^40 bytes.
 struct Port {
   uint64_t rate;
-  size_t offset;  // of the <port> element; its line is computed only for an error message
+  uint32_t offset_low;
   uint32_t channel = UINT32_MAX;
+  uint8_t offset_high;
   bool out;
-  uint8_t length = 0;  // of a short name, kLong for a view
-  union {
-    char short_name[24];
-    struct {
-      const char* data;
-      size_t size;
-    } long_name;
-  };
+  uint8_t length = 0;   // of a short name, kLong for a view
+  char bytes[13] = {};  // a short name, or a long one's pointer and 40-bit length
   static constexpr uint8_t kLong = 255;
-  Port() : short_name{} {}
+  size_t offset() const { return static_cast<size_t>(offset_high) << 32 | offset_low; }
+  void set_offset(size_t at) {
+    offset_low = static_cast<uint32_t>(at);
+    offset_high = static_cast<uint8_t>(static_cast<uint64_t>(at) >> 32);
+  }
   std::string_view name() const {
-    return length == kLong ? std::string_view(long_name.data, long_name.size)
-                           : std::string_view(short_name, length);
+    if (length != kLong) return {bytes, length};
+    const char* data;
+    uint64_t size = 0;
+    std::memcpy(&data, bytes, sizeof data);
+    std::memcpy(&size, bytes + sizeof data, 5);  // little-endian
+    return {data, static_cast<size_t>(size)};
   }
   void set_name(std::string_view n) {
-    if (n.size() <= sizeof short_name) {
-      std::copy(n.begin(), n.end(), short_name);
+    if (n.size() <= sizeof bytes) {
+      std::copy(n.begin(), n.end(), bytes);
       length = static_cast<uint8_t>(n.size());
     } else {
-      long_name = {n.data(), n.size()};
+      const char* data = n.data();
+      const uint64_t size = n.size();
+      std::memcpy(bytes, &data, sizeof data);
+      std::memcpy(bytes + sizeof data, &size, 5);
       length = kLong;
     }
   }
 };
+static_assert(sizeof(Port) == 32);
+static_assert(std::endian::native == std::endian::little);
 
 // A <channel> as read, resolved when its actors are known.
 struct ChannelRecord {
@@ -140,8 +153,8 @@ class Sdf3Reader {
     for (ActorId a = 0; a < g_.actor_count(); ++a)
       for (uint32_t i = port_begin_[a]; i < port_begin_[a + 1]; ++i)
         if (ports_[i].channel == UINT32_MAX)
-          fail(ports_[i].offset, "port '" + std::string(ports_[i].name()) + "' of actor '" +
-                                     g_.actor_name(a) + "' is not connected to a channel");
+          fail(ports_[i].offset(), "port '" + std::string(ports_[i].name()) + "' of actor '" +
+                                       g_.actor_name(a) + "' is not connected to a channel");
     if (!props_.empty()) read_properties();
     return std::move(g_);
   }
@@ -300,7 +313,7 @@ class Sdf3Reader {
                          "port type '" + std::string(type) + "' is neither 'in' nor 'out'");
     p.out = same(type, "out");
     p.rate = number(t.offset, "rate", required(t, "rate"), true);
-    p.offset = t.offset;
+    p.set_offset(t.offset);
     ports_.push_back(p);
   }
 
@@ -312,7 +325,7 @@ class Sdf3Reader {
     // Indices, not iterators: `first + 1` on an empty vector's null data is undefined (UBSan).
     for (size_t i = port_begin_.back(); i + 1 < ports_.size(); ++i)
       if (ports_[i].name() == ports_[i + 1].name())
-        fail_after_pending(std::max(ports_[i].offset, ports_[i + 1].offset),
+        fail_after_pending(std::max(ports_[i].offset(), ports_[i + 1].offset()),
                            "duplicate port '" + std::string(ports_[i].name()) + "' on actor '" +
                                std::string(block_.back().name) + "'");
     port_begin_.push_back(static_cast<uint32_t>(ports_.size()));

@@ -17,6 +17,33 @@ TEST(Graph, DefaultChannelNamesCountParallelChannels) {
   EXPECT_FALSE(g.find_channel("A->B#2"));
 }
 
+// The count k of `src->dst#k` includes the named channels before it, also when every channel so
+// far was named (the counts are only kept from the first default name on) and in the bulk form.
+TEST(Graph, DefaultNamesCountNamedChannelsToo) {
+  for (bool bulk : {false, true}) {
+    Graph g;
+    g.add_actor("A");
+    g.add_actor("B");
+    g.add_channel(0, 1, 1, 1, 0, "x");
+    g.add_channel(1, 0, 1, 1, 0, "y");
+    if (bulk) {
+      const Graph::NewChannel cs[] = {
+          {0, 1, 1, 1, 0, ""}, {0, 1, 1, 1, 0, "z"}, {0, 1, 1, 1, 0, ""}};
+      EXPECT_EQ(g.add_channels(cs), 3u);
+    } else {
+      g.add_channel(0, 1, 1, 1, 0);
+      g.add_channel(0, 1, 1, 1, 0, "z");
+      g.add_channel(0, 1, 1, 1, 0);
+    }
+    EXPECT_EQ(g.channel_name(2), "A->B#1");
+    EXPECT_EQ(g.channel_name(4), "A->B#3");
+    EXPECT_THROW(g.add_channel(0, 1, 1, 1, 0, "A->B#3"), Error);
+    EXPECT_EQ(g.add_channel(0, 1, 1, 1, 0), 5u);  // a refused channel is not counted
+    EXPECT_EQ(g.channel_name(5), "A->B#4");
+    EXPECT_EQ(g.channel_name(1), "y");
+  }
+}
+
 TEST(Graph, RejectsDuplicatesAndZeroRates) {
   Graph g;
   g.add_actor("A");
