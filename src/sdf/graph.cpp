@@ -1,6 +1,7 @@
 #include "sdf/graph.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <charconv>
 #include <cstring>
 
@@ -38,6 +39,13 @@ constexpr uint64_t tag_of(uint64_t hash) {
   return hash & 0xffffffff00000000ull;
 }
 
+// A key's home slot in a table of `size` (a power of two) slots: the hash's top bits, which the
+// slot's tag keeps, so that a rehash moves the entries without hashing their names again (on a
+// large graph each name is a cache miss).
+size_t home(size_t size, uint64_t hash) {
+  return static_cast<size_t>(hash >> (64 - std::countr_zero(size)));
+}
+
 size_t table_size_for(size_t entries) {
   size_t cap = 16;
   while (cap < 2 * entries) cap *= 2;  // load factor at most 1/2
@@ -56,7 +64,7 @@ int64_t Graph::flat_find(const FlatIndex& t, std::string_view key, uint64_t h, K
   if (t.slots.empty()) return -1;
   const size_t mask = t.slots.size() - 1;
   const uint64_t tag = tag_of(h);
-  for (size_t i = h & mask;; i = (i + 1) & mask) {
+  for (size_t i = home(t.slots.size(), h);; i = (i + 1) & mask) {
     const uint64_t v = t.slots[i];
     if (v == 0) return -1;
     const auto id = static_cast<uint32_t>(v) - 1;
@@ -69,9 +77,10 @@ void Graph::flat_rehash(FlatIndex& t, size_t capacity, KeyOf&& key_of) {
   std::vector<uint64_t> old = std::move(t.slots);
   t.slots.assign(capacity, 0);
   const size_t mask = capacity - 1;
+  const bool tags_suffice = capacity <= (uint64_t{1} << 32);
   for (uint64_t v : old) {
     if (v == 0) continue;
-    size_t i = hash_of(key_of(static_cast<uint32_t>(v) - 1)) & mask;
+    size_t i = home(capacity, tags_suffice ? v : hash_of(key_of(static_cast<uint32_t>(v) - 1)));
     while (t.slots[i] != 0) i = (i + 1) & mask;
     t.slots[i] = v;
   }
@@ -82,7 +91,7 @@ void Graph::flat_insert(FlatIndex& t, uint32_t id, uint64_t hash, KeyOf&& key_of
   if (2 * (t.size + 1) > t.slots.size())
     flat_rehash(t, std::max<size_t>(16, t.slots.size() * 2), key_of);
   const size_t mask = t.slots.size() - 1;
-  size_t i = hash & mask;
+  size_t i = home(t.slots.size(), hash);
   while (t.slots[i] != 0) i = (i + 1) & mask;
   t.slots[i] = tag_of(hash) | (static_cast<uint64_t>(id) + 1);
   ++t.size;
@@ -175,10 +184,9 @@ size_t Graph::add_actors(std::span<const std::string_view> names) {
   auto name_of = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
   constexpr size_t kAhead = 8;
   uint64_t hashes[kAhead];
-  const size_t mask = actor_index_.slots.size() - 1;
   auto ahead = [&](size_t i) {
     hashes[i % kAhead] = hash_of(names[i]);
-    prefetch(&actor_index_.slots[hashes[i % kAhead] & mask]);
+    prefetch(&actor_index_.slots[home(actor_index_.slots.size(), hashes[i % kAhead])]);
   };
   for (size_t i = 0; i < std::min(names.size(), kAhead); ++i) ahead(i);
   for (size_t i = 0; i < names.size(); ++i) {
@@ -265,7 +273,7 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
       p.name.assign(cs[i].name);
     }
     p.hash = hash_of(p.name);
-    prefetch(&channel_index_.slots[p.hash & (channel_index_.slots.size() - 1)]);
+    prefetch(&channel_index_.slots[home(channel_index_.slots.size(), p.hash)]);
     return true;
   };
   auto undo = [&](size_t from) {
@@ -355,13 +363,13 @@ void Graph::find_actors(std::span<const std::string_view> names, std::span<int64
   // name it points to; probe (now mostly from cache).
   constexpr size_t kAhead = 8, kRing = 32;
   uint64_t hashes[kRing];
-  const size_t n = names.size(), mask = actor_index_.slots.size() - 1;
+  const size_t n = names.size(), size = actor_index_.slots.size();
   auto stage1 = [&](size_t i) {
     hashes[i % kRing] = hash_of(names[i]);
-    prefetch(&actor_index_.slots[hashes[i % kRing] & mask]);
+    prefetch(&actor_index_.slots[home(size, hashes[i % kRing])]);
   };
   auto stage2 = [&](size_t i) {
-    const uint64_t v = actor_index_.slots[hashes[i % kRing] & mask];
+    const uint64_t v = actor_index_.slots[home(size, hashes[i % kRing])];
     if (v != 0) prefetch(&actor_names_[static_cast<uint32_t>(v) - 1]);
   };
   for (size_t i = 0; i < std::min(n, 2 * kAhead); ++i) stage1(i);
