@@ -363,12 +363,13 @@ class Streamer {
     if (!reserved_) {
       // Room for as many channels as the rest of the text holds at the first block's density
       // (bounded by the shortest channel a valid text can have), so the tables do not regrow.
+      // No margin: the tables are zeroed, hence resident, and a margin that crosses a power of
+      // two doubles them; a longer tail costs one rehash.
       reserved_ = true;
       const auto done = static_cast<size_t>(at - first_channel_);
       const auto rest = static_cast<size_t>(text_.data() + text_.size() - at);
       const size_t per = std::max<size_t>(done / channels_.size(), 40);
-      g.reserve(g.actor_count(),
-                g.channel_count() + channels_.size() + rest / per + rest / per / 8);
+      g.reserve(g.actor_count(), g.channel_count() + channels_.size() + rest / per);
     }
     names_.clear();
     for (const ChannelView& c : channels_) {
