@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "prefetch.hpp"
+#include "text.hpp"
 
 namespace sdf {
 
@@ -68,7 +69,7 @@ int64_t Graph::flat_find(const FlatIndex& t, std::string_view key, uint64_t h, K
     const uint64_t v = t.slots[i];
     if (v == 0) return -1;
     const auto id = static_cast<uint32_t>(v) - 1;
-    if (tag_of(v) == tag && key_of(id) == key) return id;
+    if (tag_of(v) == tag && same(key_of(id), key)) return id;
   }
 }
 
