@@ -64,7 +64,7 @@ class BoundedModel {
   uint64_t iteration_firings() const { return sum_q_; }  // Σq, saturated at 2^64 − 1
 
  private:
-  // An actor's side of a channel, in compact arrays (a Channel is 128 bytes of mostly names):
+  // An actor's side of a channel, in compact arrays (one contiguous block per actor):
   // for an input the producer and cns, for an output the consumer and prd.
   struct Port {
     ChannelId channel;
