@@ -56,18 +56,20 @@ struct Channel {
 
 namespace detail {
 
-// Strings stored back to back in one buffer, each entry an offset and a length packed in 64 bits:
-// 8 bytes per entry plus the characters, no allocation per string (a std::string is 32 bytes, and
-// a name longer than 15 characters is another allocation). An entry changed later is appended
-// again (the old characters stay, unused). Views returned are valid until the next change.
+// Strings stored back to back in one buffer, each entry an offset (34 bits) and a length (30 bits)
+// packed in 64 bits: 8 bytes per entry plus the characters, no allocation per string (a
+// std::string is 32 bytes, and a name longer than 15 characters is another allocation). A name
+// may be up to 2^30 - 1 bytes (graph files are at most 1 GiB, so every name read fits), a column
+// up to 2^34 bytes (Error(input) beyond). An entry changed later is appended again (the old
+// characters stay, unused). Views returned are valid until the next change.
 class NameColumn {
  public:
-  static constexpr size_t kMaxLength = (size_t{1} << 24) - 1;  // Graph refuses longer names
+  static constexpr size_t kMaxLength = (size_t{1} << 30) - 1;  // Graph refuses longer names
   size_t size() const { return refs_.size(); }
   bool empty() const { return refs_.empty(); }
   std::string_view operator[](size_t i) const {
     const uint64_t r = refs_[i];
-    return {chars_.data() + (r >> 24), static_cast<size_t>(r & kMaxLength)};
+    return {chars_.data() + (r >> 30), static_cast<size_t>(r & kMaxLength)};
   }
   void push_back(std::string_view s) { refs_.push_back(append(s)); }
   void set(size_t i, std::string_view s) { refs_[i] = append(s); }
@@ -84,9 +86,11 @@ class NameColumn {
         before(s.data(), chars_.data() + chars_.size()))
       return append(std::string(s));  // a view into chars_, which the resize may move
     const size_t at = chars_.size();
+    if (at + s.size() > (size_t{1} << 34))
+      throw Error(Error::Kind::input, "the graph's names take more than 16 GiB");
     chars_.resize(at + s.size());
     std::copy(s.begin(), s.end(), chars_.begin() + static_cast<std::ptrdiff_t>(at));
-    return (static_cast<uint64_t>(at) << 24) | s.size();
+    return (static_cast<uint64_t>(at) << 30) | s.size();
   }
   std::vector<char> chars_;
   std::vector<uint64_t> refs_;
@@ -105,7 +109,7 @@ class Graph {
   // Throws Error(input) on an empty or duplicate name.
   ActorId add_actor(std::string name);
   // Throws Error(input) on an unknown actor id, a zero rate, a duplicate channel name or one
-  // longer than 2^24 - 1 bytes. An empty name becomes `src->dst#k`.
+  // longer than 2^30 - 1 bytes. An empty name becomes `src->dst#k`.
   ChannelId add_channel(ActorId src, ActorId dst, uint64_t prd, uint64_t cns, uint64_t delay,
                         std::string name = {});
 
@@ -139,7 +143,7 @@ class Graph {
   }
   // Changes the rates of an existing channel (dynamic rate changes). Rates must be positive.
   void set_rates(ChannelId c, uint64_t prd, uint64_t cns);
-  // Throws Error(input) for a name longer than 2^24 - 1 bytes.
+  // Throws Error(input) for a name longer than 2^30 - 1 bytes.
   void set_port_names(ChannelId c, std::string_view src_port, std::string_view dst_port);
 
   // Room for this many actors and channels in total, so a reader that knows the sizes builds

@@ -144,7 +144,7 @@ namespace {
 
 void check_length(std::string_view s, const char* what) {
   if (s.size() > detail::NameColumn::kMaxLength)
-    throw Error(Error::Kind::input, std::string(what) + " longer than 2^24 - 1 bytes");
+    throw Error(Error::Kind::input, std::string(what) + " longer than 2^30 - 1 bytes");
 }
 
 }  // namespace

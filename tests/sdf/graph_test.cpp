@@ -44,6 +44,27 @@ TEST(Graph, DefaultNamesCountNamedChannelsToo) {
   }
 }
 
+// Names live in columns: a value set again replaces the old one, a view of the graph's own
+// names may be passed back in, and copies keep their names.
+TEST(Graph, NameColumnsKeepEveryName) {
+  Graph g = test::make({"A", "B"}, {{"A", "B", 1, 1, 0}, {"B", "A", 1, 1, 1}});
+  EXPECT_EQ(g.actor_type(0), "");
+  g.set_actor_type(0, "a-long-type-name-beyond-any-small-buffer");
+  g.set_actor_type(1, g.actor_type(0));  // a view into the column being appended to
+  g.set_actor_type(0, "t");
+  EXPECT_EQ(g.actor_type(0), "t");
+  EXPECT_EQ(g.actor_type(1), "a-long-type-name-beyond-any-small-buffer");
+  EXPECT_EQ(g.src_port(1), "");
+  g.set_port_names(1, "o", "i");
+  g.set_port_names(0, "out", "in");
+  g.set_port_names(1, "o2", "i2");
+  const Graph copy = g;
+  EXPECT_EQ(copy.src_port(0), "out");
+  EXPECT_EQ(copy.dst_port(1), "i2");
+  EXPECT_EQ(copy.channel_name(1), "B->A#0");
+  EXPECT_EQ(copy.actor_type(1), "a-long-type-name-beyond-any-small-buffer");
+}
+
 TEST(Graph, RejectsDuplicatesAndZeroRates) {
   Graph g;
   g.add_actor("A");
