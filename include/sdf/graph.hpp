@@ -9,7 +9,10 @@
 // Thread-safety: a Graph is a plain value; concurrent const use is safe, mutation is not.
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -41,18 +44,59 @@ class Error : public std::runtime_error {
   Kind kind_;
 };
 
+// 32 bytes: the names (Graph::channel_name, src_port, dst_port) live in the graph's name columns,
+// so that the hot loops over channels read only the topology and rates.
 struct Channel {
   ActorId src = 0;
   ActorId dst = 0;
   uint64_t prd = 1;    // tokens produced per firing of src (> 0)
   uint64_t cns = 1;    // tokens consumed per firing of dst (> 0)
   uint64_t delay = 0;  // initial tokens
-  std::string name;
-  // SDF3 port names, kept so that a file read and written again keeps them; empty when the
-  // channel came from elsewhere (the writer then invents unique ones).
-  std::string src_port;
-  std::string dst_port;
 };
+
+namespace detail {
+
+// Strings stored back to back in one buffer, each entry an offset (34 bits) and a length (30 bits)
+// packed in 64 bits: 8 bytes per entry plus the characters, no allocation per string (a
+// std::string is 32 bytes, and a name longer than 15 characters is another allocation). A name
+// may be up to 2^30 - 1 bytes (graph files are at most 1 GiB, so every name read fits), a column
+// up to 2^34 bytes (Error(input) beyond). An entry changed later is appended again (the old
+// characters stay, unused). Views returned are valid until the next change.
+class NameColumn {
+ public:
+  static constexpr size_t kMaxLength = (size_t{1} << 30) - 1;  // Graph refuses longer names
+  size_t size() const { return refs_.size(); }
+  bool empty() const { return refs_.empty(); }
+  std::string_view operator[](size_t i) const {
+    const uint64_t r = refs_[i];
+    return {chars_.data() + (r >> 30), static_cast<size_t>(r & kMaxLength)};
+  }
+  void push_back(std::string_view s) { refs_.push_back(append(s)); }
+  void set(size_t i, std::string_view s) { refs_[i] = append(s); }
+  void resize(size_t n) { refs_.resize(n, 0); }  // new entries are empty
+  void reserve(size_t entries, size_t chars) {
+    refs_.reserve(entries);
+    chars_.reserve(chars);
+  }
+
+ private:
+  uint64_t append(std::string_view s) {
+    const std::less<const char*> before;
+    if (!s.empty() && !before(s.data(), chars_.data()) &&
+        before(s.data(), chars_.data() + chars_.size()))
+      return append(std::string(s));  // a view into chars_, which the resize may move
+    const size_t at = chars_.size();
+    if (at + s.size() > (size_t{1} << 34))
+      throw Error(Error::Kind::input, "the graph's names take more than 16 GiB");
+    chars_.resize(at + s.size());
+    std::copy(s.begin(), s.end(), chars_.begin() + static_cast<std::ptrdiff_t>(at));
+    return (static_cast<uint64_t>(at) << 30) | s.size();
+  }
+  std::vector<char> chars_;
+  std::vector<uint64_t> refs_;
+};
+
+}  // namespace detail
 
 // New rates for one channel (dynamic rate changes).
 struct ChannelRates {
@@ -64,8 +108,8 @@ class Graph {
  public:
   // Throws Error(input) on an empty or duplicate name.
   ActorId add_actor(std::string name);
-  // Throws Error(input) on an unknown actor id, a zero rate or a duplicate channel name. An empty
-  // name becomes `src->dst#k`.
+  // Throws Error(input) on an unknown actor id, a zero rate, a duplicate channel name or one
+  // longer than 2^30 - 1 bytes. An empty name becomes `src->dst#k`.
   ChannelId add_channel(ActorId src, ActorId dst, uint64_t prd, uint64_t cns, uint64_t delay,
                         std::string name = {});
 
@@ -87,9 +131,20 @@ class Graph {
   const std::string& actor_name(ActorId a) const { return actor_names_[a]; }
   const Channel& channel(ChannelId c) const { return channels_[c]; }
   std::span<const Channel> channels() const { return channels_; }
+  // A view into the graph, valid until the graph changes.
+  std::string_view channel_name(ChannelId c) const { return channel_names_[c]; }
+  // SDF3 port names, kept so that a file read and written again keeps them; empty when the
+  // channel came from elsewhere (the writer then invents unique ones). Views as channel_name.
+  std::string_view src_port(ChannelId c) const {
+    return c < src_ports_.size() ? src_ports_[c] : std::string_view{};
+  }
+  std::string_view dst_port(ChannelId c) const {
+    return c < dst_ports_.size() ? dst_ports_[c] : std::string_view{};
+  }
   // Changes the rates of an existing channel (dynamic rate changes). Rates must be positive.
   void set_rates(ChannelId c, uint64_t prd, uint64_t cns);
-  void set_port_names(ChannelId c, std::string src_port, std::string dst_port);
+  // Throws Error(input) for a name longer than 2^30 - 1 bytes.
+  void set_port_names(ChannelId c, std::string_view src_port, std::string_view dst_port);
 
   // Room for this many actors and channels in total, so a reader that knows the sizes builds
   // the graph without regrowing its arrays and hash tables. Changes nothing else.
@@ -99,8 +154,8 @@ class Graph {
   // SDF3's actor `type` (empty: unset; writers then use the name). The execution time is a
   // non-negative integer in the graph's time unit (SDF3 <executionTime time=...>, the JSON
   // form's "time"), needed by the timed analyses (throughput, latency); unset by default.
-  const std::string& actor_type(ActorId a) const;
-  void set_actor_type(ActorId a, std::string actor_type);
+  std::string_view actor_type(ActorId a) const;  // a view as channel_name
+  void set_actor_type(ActorId a, std::string_view actor_type);
   std::optional<uint64_t> actor_time(ActorId a) const;
   // Throws Error(input) for times of 2^63 or more (sums of times must stay exact).
   void set_actor_time(ActorId a, std::optional<uint64_t> time);
@@ -127,10 +182,13 @@ class Graph {
  private:
   std::vector<std::string> actor_names_;
   // Sized to the actors only once one is set, so graphs without annotations pay nothing.
-  std::vector<std::string> actor_types_;
+  detail::NameColumn actor_types_;
   std::vector<uint64_t> actor_times_;  // kNoTime = unset
   static constexpr uint64_t kNoTime = UINT64_MAX;
   std::vector<Channel> channels_;
+  detail::NameColumn channel_names_;
+  // Sized to the channels only once a port name is set.
+  detail::NameColumn src_ports_, dst_ports_;
   // Flat open-addressing tables of ids (the names live in actor_names_ / channels_): no node
   // per entry, so a 10^6-actor graph loads without millions of small allocations. A slot holds
   // the high 32 bits of the name's hash beside id + 1 (0 = empty), so a probe compares names
@@ -148,7 +206,11 @@ class Graph {
   template <class KeyOf>
   static void flat_rehash(FlatIndex& t, size_t capacity, KeyOf&& key_of);
   FlatIndex actor_index_, channel_index_;
-  // (src, dst) -> number of channels so far, for the default names `src->dst#k`.
+  // (src, dst) -> number of channels so far, for the default names `src->dst#k`. Built at the
+  // first channel that needs a default name (a graph whose channels are all named, as SDF3's
+  // are, never pays for it) and kept up to date from then on.
+  bool pairs_live_ = false;
+  void make_pairs_live();
   struct PairCount {
     uint64_t key;  // UINT64_MAX = free ((src, dst) are never both 2^32 - 1)
     uint64_t count;
@@ -158,8 +220,7 @@ class Graph {
   void pair_rehash(size_t capacity);
   void reserve_tables(size_t actors, size_t channels);
   size_t pair_slot(uint64_t pair);  // the pair's slot, created with count 0 if new
-  std::string default_name(ActorId src, ActorId dst, uint64_t k) const;
-  uint32_t next_parallel_index(uint64_t pair);
+  void default_name(ActorId src, ActorId dst, uint64_t k, std::string& out) const;
 };
 
 // Compressed incidence lists: for actor a, inputs(a) / outputs(a) are channel ids in channel

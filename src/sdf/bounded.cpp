@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <deque>
 #include <numeric>
-#include <queue>
 #include <string>
 #include <unordered_map>
 
@@ -65,20 +64,7 @@ std::vector<char> standstill_dependencies(const Graph& g, std::span<const uint64
 }  // namespace
 
 BoundedModel::BoundedModel(const Graph& g, std::vector<uint64_t> q, std::vector<uint64_t> times)
-    : g_(g), q_(std::move(q)), times_(std::move(times)) {
-  const Adjacency adj(g);
-  const auto n = static_cast<ActorId>(g.actor_count());
-  in_off_.assign(n + 1, 0);
-  out_off_.assign(n + 1, 0);
-  for (ActorId a = 0; a < n; ++a) {
-    for (ChannelId c : adj.inputs(a)) ports_.push_back({c, g.channel(c).src, g.channel(c).cns});
-    in_off_[a + 1] = static_cast<uint32_t>(ports_.size());
-  }
-  out_off_[0] = static_cast<uint32_t>(ports_.size());
-  for (ActorId a = 0; a < n; ++a) {
-    for (ChannelId c : adj.outputs(a)) ports_.push_back({c, g.channel(c).dst, g.channel(c).prd});
-    out_off_[a + 1] = static_cast<uint32_t>(ports_.size());
-  }
+    : g_(g), ports_(g), q_(std::move(q)), times_(std::move(times)) {
   for (ActorId a = 1; a < g.actor_count(); ++a)
     if (q_[a] < q_[reference_]) reference_ = a;
   for (uint64_t v : q_) sum_q_ = add_sat(sum_q_, v);
@@ -161,7 +147,7 @@ bool BoundedModel::live(std::span<const uint64_t> cap, RunBudget& budget,
 
 Throughput BoundedModel::run(std::span<const uint64_t> cap, RunBudget& budget,
                              std::vector<char>* dependency) const {
-  const size_t n = g_.actor_count(), m = g_.channel_count();
+  const size_t m = g_.channel_count();
   Throughput r;
   if (all_untimed_ || m == 0) {
     // Without time a live graph fires without bound at one instant.
@@ -172,145 +158,112 @@ Throughput BoundedModel::run(std::span<const uint64_t> cap, RunBudget& budget,
     }
     return r;
   }
-  std::vector<uint64_t> tokens(m), space(m);
-  for (ChannelId c = 0; c < m; ++c) {
-    tokens[c] = g_.channel(c).delay;
-    space[c] = cap[c] - tokens[c];
-  }
-  // Firings in progress per actor: (end time, count), sorted by end time; one entry of `ends`
-  // per (end time, actor), earliest first.
-  std::vector<std::vector<std::pair<uint64_t, uint64_t>>> running(n);
-  std::priority_queue<std::pair<uint64_t, ActorId>, std::vector<std::pair<uint64_t, ActorId>>,
-                      std::greater<>>
-      ends;
-  uint64_t now = 0, busy = 0, done_ref = 0;
-  bool track = false;
-  // What arrived at the current instant (while tracking): tokens and places per channel.
-  std::vector<uint64_t> got_tokens(m, 0), got_space(m, 0);
-  std::vector<ChannelId> touched;
-  Waits waits(m);
-
-  // Actors that may be able to start: only a firing's end can enable one (a start takes tokens
-  // and places that no other actor uses), so after the first instant only the neighbours of
-  // the actors whose firings ended are looked at.
-  std::vector<ActorId> todo;
-  std::vector<char> queued(n, 0);
-  auto offer = [&](ActorId a) {
-    if (!queued[a]) queued[a] = 1, todo.push_back(a);
-  };
-  auto complete = [&](ActorId a, uint64_t k) {
-    for (const Port& p : outputs(a)) {
-      const uint64_t more = k * p.rate;  // ≤ the places claimed ≤ capacity
-      tokens[p.channel] += more;
-      if (track) got_tokens[p.channel] += more, touched.push_back(p.channel);
-      offer(p.other);
+  // What arrived at the current instant (while tracking): tokens and places per channel; who
+  // waited for whom; the reference actor's completed firings.
+  struct Hooks {
+    const BoundedModel& model;
+    RunBudget& budget;
+    const std::vector<uint64_t>* tokens = nullptr;  // the engine's
+    const std::vector<uint64_t>* space = nullptr;
+    bool track = false;
+    uint64_t done_ref = 0;
+    std::vector<uint64_t> got_tokens, got_space;
+    std::vector<ChannelId> touched;
+    Waits waits;
+    void instant() {
+      if (!track) return;
+      for (ChannelId c : touched) got_tokens[c] = got_space[c] = 0;
+      touched.clear();
     }
-    for (const Port& p : inputs(a)) {
-      const uint64_t more = k * p.rate;
-      space[p.channel] += more;
-      if (track) got_space[p.channel] += more, touched.push_back(p.channel);
-      offer(p.other);
-    }
-    if (a == reference_) done_ref = add(done_ref, k, "the firings of the bounded exploration");
-  };
-
-  // Starts every firing that can start now; firings without time end at once. In a connected
-  // bounded graph with some timed actor this ends (every count is tied to that actor's, which
-  // starts finitely often per instant); were that wrong, the firing budget would still end it.
-  auto start_all = [&] {
-    while (!todo.empty()) {
-      const ActorId a = todo.back();
-      todo.pop_back();
-      queued[a] = 0;
-      // Most looks find some channel short (no division needed for that).
-      bool blocked = false;
-      for (const Port& p : inputs(a)) blocked = blocked || tokens[p.channel] < p.rate;
-      for (const Port& p : outputs(a)) blocked = blocked || space[p.channel] < p.rate;
-      if (blocked) continue;
-      uint64_t k = UINT64_MAX;
-      for (const Port& p : inputs(a)) k = std::min(k, tokens[p.channel] / p.rate);
-      for (const Port& p : outputs(a)) k = std::min(k, space[p.channel] / p.rate);
-      if (k == UINT64_MAX) throw std::logic_error("bounded execution: an actor without channels");
+    void started(ActorId a, uint64_t k) {
       if (track) {
         // The batch waited for a channel when the tokens (places) there before this instant's
         // arrivals would not have sufficed for all k firings.
-        for (const Port& p : inputs(a))
-          if (static_cast<u128>(tokens[p.channel]) <
+        for (const Port& p : model.inputs(a))
+          if (static_cast<u128>((*tokens)[p.channel]) <
               static_cast<u128>(got_tokens[p.channel]) + u128{k} * p.rate)
             waits.wait(a, p.other);
-        for (const Port& p : outputs(a)) {
-          if (static_cast<u128>(space[p.channel]) <
+        for (const Port& p : model.outputs(a)) {
+          if (static_cast<u128>((*space)[p.channel]) <
               static_cast<u128>(got_space[p.channel]) + u128{k} * p.rate) {
             waits.wait(a, p.other);
             waits.lack_places(p.channel);
           }
         }
       }
-      spend(budget, k);
-      for (const Port& p : inputs(a)) tokens[p.channel] -= k * p.rate;
-      for (const Port& p : outputs(a)) space[p.channel] -= k * p.rate;
-      if (times_[a] == 0) {
-        complete(a, k);
-      } else {
-        // An actor's firings all take the same time: later starts end later.
-        const uint64_t end = add(now, times_[a], "the time of the bounded exploration");
-        auto& list = running[a];
-        if (!list.empty() && list.back().first == end) {
-          list.back().second += k;
-        } else {
-          list.push_back({end, k});
-          ends.push({end, a});
+      model.spend(budget, k);
+    }
+    void completed(ActorId a, uint64_t k) {
+      if (track) {
+        for (const Port& p : model.outputs(a)) {
+          got_tokens[p.channel] += k * p.rate;
+          touched.push_back(p.channel);
         }
-        busy += k;
+        for (const Port& p : model.inputs(a)) {
+          got_space[p.channel] += k * p.rate;
+          touched.push_back(p.channel);
+        }
       }
+      if (a == model.reference_)
+        done_ref = add(done_ref, k, "the firings of the bounded exploration");
     }
   };
-
-  auto encode = [&] {
-    std::string key;
-    key.reserve((m + n + 4 * n) * 8);
-    auto put = [&](uint64_t v) { key.append(reinterpret_cast<const char*>(&v), sizeof v); };
-    for (uint64_t t : tokens) put(t);
-    for (const auto& list : running) {
-      put(list.size());
-      for (const auto& [end, k] : list) put(end - now), put(k);
-    }
-    return key;
-  };
+  Hooks hooks{*this,
+              budget,
+              nullptr,
+              nullptr,
+              false,
+              0,
+              std::vector<uint64_t>(m, 0),
+              std::vector<uint64_t>(m, 0),
+              {},
+              Waits(m)};
+  // In a connected bounded graph with some timed actor every instant ends (every count is tied
+  // to that actor's, which starts finitely often per instant); were that wrong, the firing
+  // budget would still end it.
+  SelfTimed<Hooks> run(ports_, g_, times_, hooks, "the time of the bounded exploration");
+  run.tokens.resize(m);
+  run.space.resize(m);
+  for (ChannelId c = 0; c < m; ++c) {
+    run.tokens[c] = g_.channel(c).delay;
+    run.space[c] = cap[c] - run.tokens[c];
+  }
+  hooks.tokens = &run.tokens;
+  hooks.space = &run.space;
 
   std::unordered_map<std::string, std::pair<uint64_t, uint64_t>> seen;  // -> (time, done_ref)
   std::string period_key;
   uint64_t mark = q_[reference_];
-  for (ActorId a = 0; a < n; ++a) offer(a);
-  start_all();
+  run.offer_all();
+  run.start_all();
   for (;;) {
-    if (busy == 0) {  // a standstill: nothing runs and nothing can start
+    if (run.busy == 0) {  // a standstill: nothing runs and nothing can start
       r.num = 0;
       r.den = 1;
-      if (dependency) *dependency = standstill_dependencies(g_, tokens, space);
+      if (dependency) *dependency = standstill_dependencies(g_, run.tokens, run.space);
       return r;
     }
-    if (done_ref >= mark) {
-      mark = add(done_ref / q_[reference_] * q_[reference_], q_[reference_],
+    if (hooks.done_ref >= mark) {
+      mark = add(hooks.done_ref / q_[reference_] * q_[reference_], q_[reference_],
                  "the firings of the bounded exploration");
-      std::string key = encode();
-      if (track) {
+      std::string key = run.encode();
+      if (hooks.track) {
         if (key == period_key) {
-          *dependency = waits.storage_dependencies(g_);
+          *dependency = hooks.waits.storage_dependencies(g_);
           return r;
         }
       } else {
-        const auto [it, fresh] = seen.try_emplace(std::move(key), now, done_ref);
+        const auto [it, fresh] = seen.try_emplace(std::move(key), run.now, hooks.done_ref);
         if (!fresh) {
-          const uint64_t firings = done_ref - it->second.second;
-          const uint64_t time = now - it->second.first;
+          const uint64_t firings = hooks.done_ref - it->second.second;
+          const uint64_t time = run.now - it->second.first;
           if (time == 0) throw std::logic_error("bounded execution: a period without time");
           const uint64_t den = mul(q_[reference_], time, "the throughput's denominator");
           const uint64_t gcd = std::gcd(firings, den);
           r.num = firings / gcd;
           r.den = den / gcd;
           if (!dependency) return r;
-          track = true;
+          hooks.track = true;
           period_key = it->first;
           seen.clear();
         } else if (++budget.states > budget.max_states) {
@@ -322,21 +275,8 @@ Throughput BoundedModel::run(std::span<const uint64_t> cap, RunBudget& budget,
       }
     }
     // The next instant: the earliest end of a firing in progress.
-    now = ends.top().first;
-    if (track) {
-      for (ChannelId c : touched) got_tokens[c] = got_space[c] = 0;
-      touched.clear();
-    }
-    while (!ends.empty() && ends.top().first == now) {
-      const ActorId a = ends.top().second;
-      ends.pop();
-      auto& list = running[a];
-      const uint64_t k = list.front().second;
-      list.erase(list.begin());
-      busy -= k;
-      complete(a, k);
-    }
-    start_all();
+    run.advance();
+    run.start_all();
   }
 }
 

@@ -7,7 +7,8 @@
 // not live comes to a complete standstill; every count stays within the capacities of its
 // channels from the stuck ones), and the waits of that state give the storage dependencies.
 //
-// run(): self-timed, as throughput_state_space but over the whole (connected) graph. The state
+// run(): self-timed (the engine of self_timed.hpp with capacities), as throughput_state_space
+// but over the whole (connected) graph. The state
 // (tokens and the remaining times of the firings in progress; free places follow from them) is
 // stored each time the reference actor (smallest q, lowest id) completes another multiple of
 // its count; the first repeat closes the period, F firings of it in T time units giving
@@ -27,6 +28,7 @@
 
 #include "sdf/graph.hpp"
 #include "sdf/throughput.hpp"
+#include "self_timed.hpp"
 
 namespace sdf::detail {
 
@@ -64,23 +66,14 @@ class BoundedModel {
   uint64_t iteration_firings() const { return sum_q_; }  // Σq, saturated at 2^64 − 1
 
  private:
-  // An actor's side of a channel, in compact arrays (a Channel is 128 bytes of mostly names):
-  // for an input the producer and cns, for an output the consumer and prd.
-  struct Port {
-    ChannelId channel;
-    ActorId other;
-    uint64_t rate;
-  };
-  std::span<const Port> inputs(ActorId a) const {
-    return {ports_.data() + in_off_[a], ports_.data() + in_off_[a + 1]};
-  }
-  std::span<const Port> outputs(ActorId a) const {
-    return {ports_.data() + out_off_[a], ports_.data() + out_off_[a + 1]};
-  }
+  // An actor's side of a channel (self_timed.hpp): for an input the producer and cns, for an
+  // output the consumer and prd, one contiguous block per actor.
+  using Port = TimedPorts::Port;
+  std::span<const Port> inputs(ActorId a) const { return ports_.inputs(a); }
+  std::span<const Port> outputs(ActorId a) const { return ports_.outputs(a); }
 
   const Graph& g_;
-  std::vector<Port> ports_;  // inputs of every actor, then outputs of every actor
-  std::vector<uint32_t> in_off_, out_off_;
+  TimedPorts ports_;  // the whole graph: local numbers are the graph's
   std::vector<uint64_t> q_, times_;
   // Counts k more firings against the budget.
   void spend(RunBudget& budget, uint64_t k) const;

@@ -173,17 +173,21 @@ Graph bounded_graph(const Graph& g, std::span<const uint64_t> capacity) {
     if (!g.actor_type(a).empty()) b.set_actor_type(a, g.actor_type(a));
     b.set_actor_time(a, g.actor_time(a));
   }
-  for (const Channel& ch : g.channels()) {
-    const ChannelId c = b.add_channel(ch.src, ch.dst, ch.prd, ch.cns, ch.delay, ch.name);
-    b.set_port_names(c, ch.src_port, ch.dst_port);
+  for (ChannelId id = 0; id < g.channel_count(); ++id) {
+    const Channel& ch = g.channel(id);
+    const ChannelId c =
+        b.add_channel(ch.src, ch.dst, ch.prd, ch.cns, ch.delay, std::string(g.channel_name(id)));
+    b.set_port_names(c, g.src_port(id), g.dst_port(id));
   }
   for (ChannelId c = 0; c < g.channel_count(); ++c) {
     const Channel& ch = g.channel(c);
     if (capacity[c] < ch.delay)
-      throw Error(Error::Kind::input, "channel '" + ch.name + "': capacity " +
-                                          std::to_string(capacity[c]) + " is below its " +
-                                          std::to_string(ch.delay) + " initial tokens");
-    b.add_channel(ch.dst, ch.src, ch.cns, ch.prd, capacity[c] - ch.delay, ch.name + "#space");
+      throw Error(Error::Kind::input, "channel '" + std::string(g.channel_name(c)) +
+                                          "': capacity " + std::to_string(capacity[c]) +
+                                          " is below its " + std::to_string(ch.delay) +
+                                          " initial tokens");
+    b.add_channel(ch.dst, ch.src, ch.cns, ch.prd, capacity[c] - ch.delay,
+                  std::string(g.channel_name(c)) + "#space");
   }
   return b;
 }
@@ -275,9 +279,10 @@ Throughput bounded_throughput(const Graph& g, std::span<const uint64_t> capacity
     throw Error(Error::Kind::input, "bounded_throughput: wrong number of capacities");
   for (ChannelId c = 0; c < g.channel_count(); ++c)
     if (capacity[c] < g.channel(c).delay)
-      throw Error(Error::Kind::input, "channel '" + g.channel(c).name + "': capacity " +
-                                          std::to_string(capacity[c]) + " is below its " +
-                                          std::to_string(g.channel(c).delay) + " initial tokens");
+      throw Error(Error::Kind::input, "channel '" + std::string(g.channel_name(c)) +
+                                          "': capacity " + std::to_string(capacity[c]) +
+                                          " is below its " + std::to_string(g.channel(c).delay) +
+                                          " initial tokens");
   const detail::BoundedModel model(g, q, execution_times(g, default_time));
   check_iteration(model, limits);
   detail::RunBudget budget = run_budget(limits);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <numeric>
 #include <string>
+#include <string_view>
 
 #include "sdf/graph.hpp"
 
@@ -29,13 +30,21 @@ inline uint64_t add(uint64_t a, uint64_t b, const char* what) {
 }
 
 // tokens + k·gain on channel `name`; an overflow names the channel.
-[[noreturn]] inline void token_overflow(const std::string& name) {
-  overflow("the token count on channel '" + name + "'");
+[[noreturn]] inline void token_overflow(std::string_view name) {
+  overflow("the token count on channel '" + std::string(name) + "'");
 }
-inline uint64_t add_tokens(uint64_t tokens, uint64_t k, uint64_t gain, const std::string& name) {
+inline uint64_t add_tokens(uint64_t tokens, uint64_t k, uint64_t gain, std::string_view name) {
   uint64_t r;
   if (__builtin_mul_overflow(k, gain, &r) || __builtin_add_overflow(tokens, r, &r))
     token_overflow(name);
+  return r;
+}
+// The same naming channel c of g, whose name is looked up only on overflow (hot loops).
+inline uint64_t add_tokens(uint64_t tokens, uint64_t k, uint64_t gain, const Graph& g,
+                           ChannelId c) {
+  uint64_t r;
+  if (__builtin_mul_overflow(k, gain, &r) || __builtin_add_overflow(tokens, r, &r))
+    token_overflow(g.channel_name(c));
   return r;
 }
 

@@ -60,7 +60,8 @@ CheckResult check_admissible(const Graph& g, std::span<const Run> runs,
       u128 t = r.tokens[c] + static_cast<u128>(run.count) * ch.prd;
       if (ch.src == ch.dst) t -= static_cast<u128>(run.count) * ch.cns;  // admissible: >= 0
       if (t > UINT64_MAX) {
-        r.reason = "the token count on channel '" + ch.name + "' exceeds 64 bits";
+        r.reason =
+            "the token count on channel '" + std::string(g.channel_name(c)) + "' exceeds 64 bits";
         r.failed_firing = done + 1;
         return r;
       }
@@ -89,8 +90,9 @@ CheckResult check_period(const Graph& g, std::span<const uint64_t> q, std::span<
       tokens0.empty() ? g.delays() : std::vector<uint64_t>(tokens0.begin(), tokens0.end());
   for (ChannelId c = 0; c < g.channel_count(); ++c) {
     if (r.tokens[c] != start[c]) {
-      r.reason = "channel '" + g.channel(c).name + "' ends with " + std::to_string(r.tokens[c]) +
-                 " tokens, not its initial " + std::to_string(start[c]);
+      r.reason = "channel '" + std::string(g.channel_name(c)) + "' ends with " +
+                 std::to_string(r.tokens[c]) + " tokens, not its initial " +
+                 std::to_string(start[c]);
       return r;
     }
   }

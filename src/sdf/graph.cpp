@@ -1,9 +1,12 @@
 #include "sdf/graph.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <charconv>
 #include <cstring>
 
 #include "prefetch.hpp"
+#include "text.hpp"
 
 namespace sdf {
 
@@ -37,6 +40,13 @@ constexpr uint64_t tag_of(uint64_t hash) {
   return hash & 0xffffffff00000000ull;
 }
 
+// A key's home slot in a table of `size` (a power of two) slots: the hash's top bits, which the
+// slot's tag keeps, so that a rehash moves the entries without hashing their names again (on a
+// large graph each name is a cache miss).
+size_t home(size_t size, uint64_t hash) {
+  return static_cast<size_t>(hash >> (64 - std::countr_zero(size)));
+}
+
 size_t table_size_for(size_t entries) {
   size_t cap = 16;
   while (cap < 2 * entries) cap *= 2;  // load factor at most 1/2
@@ -55,11 +65,11 @@ int64_t Graph::flat_find(const FlatIndex& t, std::string_view key, uint64_t h, K
   if (t.slots.empty()) return -1;
   const size_t mask = t.slots.size() - 1;
   const uint64_t tag = tag_of(h);
-  for (size_t i = h & mask;; i = (i + 1) & mask) {
+  for (size_t i = home(t.slots.size(), h);; i = (i + 1) & mask) {
     const uint64_t v = t.slots[i];
     if (v == 0) return -1;
     const auto id = static_cast<uint32_t>(v) - 1;
-    if (tag_of(v) == tag && key_of(id) == key) return id;
+    if (tag_of(v) == tag && same(key_of(id), key)) return id;
   }
 }
 
@@ -68,9 +78,10 @@ void Graph::flat_rehash(FlatIndex& t, size_t capacity, KeyOf&& key_of) {
   std::vector<uint64_t> old = std::move(t.slots);
   t.slots.assign(capacity, 0);
   const size_t mask = capacity - 1;
+  const bool tags_suffice = capacity <= (uint64_t{1} << 32);
   for (uint64_t v : old) {
     if (v == 0) continue;
-    size_t i = hash_of(key_of(static_cast<uint32_t>(v) - 1)) & mask;
+    size_t i = home(capacity, tags_suffice ? v : hash_of(key_of(static_cast<uint32_t>(v) - 1)));
     while (t.slots[i] != 0) i = (i + 1) & mask;
     t.slots[i] = v;
   }
@@ -81,7 +92,7 @@ void Graph::flat_insert(FlatIndex& t, uint32_t id, uint64_t hash, KeyOf&& key_of
   if (2 * (t.size + 1) > t.slots.size())
     flat_rehash(t, std::max<size_t>(16, t.slots.size() * 2), key_of);
   const size_t mask = t.slots.size() - 1;
-  size_t i = hash & mask;
+  size_t i = home(t.slots.size(), hash);
   while (t.slots[i] != 0) i = (i + 1) & mask;
   t.slots[i] = tag_of(hash) | (static_cast<uint64_t>(id) + 1);
   ++t.size;
@@ -98,6 +109,14 @@ void Graph::pair_rehash(size_t capacity) {
   }
 }
 
+void Graph::make_pairs_live() {
+  if (pairs_live_) return;
+  pairs_live_ = true;
+  pair_rehash(table_size_for(channels_.size()));
+  for (const Channel& c : channels_)
+    ++pairs_[pair_slot((static_cast<uint64_t>(c.src) << 32) | c.dst)].count;
+}
+
 size_t Graph::pair_slot(uint64_t pair) {
   if (2 * (pair_size_ + 1) > pairs_.size()) pair_rehash(std::max<size_t>(16, pairs_.size() * 2));
   const size_t mask = pairs_.size() - 1;
@@ -110,35 +129,42 @@ size_t Graph::pair_slot(uint64_t pair) {
   return i;
 }
 
-uint32_t Graph::next_parallel_index(uint64_t pair) {
-  return static_cast<uint32_t>(pairs_[pair_slot(pair)].count++);
+void Graph::default_name(ActorId src, ActorId dst, uint64_t k, std::string& out) const {
+  char digits[24];
+  const char* end = std::to_chars(digits, digits + sizeof digits, k).ptr;
+  out.clear();
+  out += actor_names_[src];
+  out += "->";
+  out += actor_names_[dst];
+  out += '#';
+  out.append(digits, static_cast<size_t>(end - digits));
 }
 
-std::string Graph::default_name(ActorId src, ActorId dst, uint64_t k) const {
-  std::string s;
-  s.reserve(actor_names_[src].size() + actor_names_[dst].size() + 8);
-  s += actor_names_[src];
-  s += "->";
-  s += actor_names_[dst];
-  s += '#';
-  s += std::to_string(k);
-  return s;
+namespace {
+
+void check_length(std::string_view s, const char* what) {
+  if (s.size() > detail::NameColumn::kMaxLength)
+    throw Error(Error::Kind::input, std::string(what) + " longer than 2^30 - 1 bytes");
 }
+
+}  // namespace
 
 void Graph::reserve(size_t actors, size_t channels) {
   actor_names_.reserve(actors);
   channels_.reserve(channels);
+  channel_names_.reserve(channels, 0);
   reserve_tables(actors, channels);
 }
 
 void Graph::reserve_tables(size_t actors, size_t channels) {
   auto actor_name = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
-  auto channel_name = [this](uint32_t c) -> std::string_view { return channels_[c].name; };
+  auto channel_name = [this](uint32_t c) -> std::string_view { return channel_names_[c]; };
   if (table_size_for(actors) > actor_index_.slots.size())
     flat_rehash(actor_index_, table_size_for(actors), actor_name);
   if (table_size_for(channels) > channel_index_.slots.size())
     flat_rehash(channel_index_, table_size_for(channels), channel_name);
-  if (table_size_for(channels) > pairs_.size()) pair_rehash(table_size_for(channels));
+  if (pairs_live_ && table_size_for(channels) > pairs_.size())
+    pair_rehash(table_size_for(channels));
 }
 
 ActorId Graph::add_actor(std::string actor_name) {
@@ -159,10 +185,9 @@ size_t Graph::add_actors(std::span<const std::string_view> names) {
   auto name_of = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
   constexpr size_t kAhead = 8;
   uint64_t hashes[kAhead];
-  const size_t mask = actor_index_.slots.size() - 1;
   auto ahead = [&](size_t i) {
     hashes[i % kAhead] = hash_of(names[i]);
-    prefetch(&actor_index_.slots[hashes[i % kAhead] & mask]);
+    prefetch(&actor_index_.slots[home(actor_index_.slots.size(), hashes[i % kAhead])]);
   };
   for (size_t i = 0; i < std::min(names.size(), kAhead); ++i) ahead(i);
   for (size_t i = 0; i < names.size(); ++i) {
@@ -185,28 +210,28 @@ ChannelId Graph::add_channel(ActorId src, ActorId dst, uint64_t prd, uint64_t cn
   if (prd == 0 || cns == 0) throw Error(Error::Kind::input, "channel rates must be positive");
   if (channels_.size() >= UINT32_MAX) throw Error(Error::Kind::input, "too many channels");
   const uint64_t pair = (static_cast<uint64_t>(src) << 32) | dst;
-  const uint32_t k = next_parallel_index(pair);
-  if (channel_name.empty()) channel_name = default_name(src, dst, k);
+  check_length(channel_name, "channel name");
+  if (channel_name.empty()) make_pairs_live();
+  const size_t slot = pairs_live_ ? pair_slot(pair) : 0;
+  if (channel_name.empty()) default_name(src, dst, pairs_[slot].count, channel_name);
   const auto id = static_cast<ChannelId>(channels_.size());
-  auto name_of = [this](uint32_t c) -> std::string_view { return channels_[c].name; };
+  auto name_of = [this](uint32_t c) -> std::string_view { return channel_names_[c]; };
   const uint64_t h = hash_of(channel_name);
   if (flat_find(channel_index_, channel_name, h, name_of) >= 0)
     throw Error(Error::Kind::input, "duplicate channel name '" + channel_name + "'");
-  Channel c;
-  c.src = src;
-  c.dst = dst;
-  c.prd = prd;
-  c.cns = cns;
-  c.delay = delay;
-  c.name = std::move(channel_name);
-  channels_.push_back(std::move(c));
+  if (pairs_live_) ++pairs_[slot].count;
+  channels_.push_back({src, dst, prd, cns, delay});
+  channel_names_.push_back(channel_name);
   flat_insert(channel_index_, id, h, name_of);
   return id;
 }
 
 size_t Graph::add_channels(std::span<const NewChannel> cs) {
+  if (!pairs_live_ &&
+      std::any_of(cs.begin(), cs.end(), [](const NewChannel& c) { return c.name.empty(); }))
+    make_pairs_live();
   reserve_tables(actor_names_.size(), channels_.size() + cs.size());  // no rehash below
-  auto name_of = [this](uint32_t c) -> std::string_view { return channels_[c].name; };
+  auto name_of = [this](uint32_t c) -> std::string_view { return channel_names_[c]; };
   // Three stages kAhead channels apart, each in channel order: prefetch the (src, dst) slot;
   // take the parallel index k from it (so the name is known), hash the name and prefetch its
   // slot; insert. A channel that fails is reached by the last stage after the middle stage has
@@ -220,12 +245,13 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
   Pending ring[kRing];
   const size_t n = cs.size();
   auto valid = [&](const NewChannel& c) {
-    return c.src < actor_count() && c.dst < actor_count() && c.prd != 0 && c.cns != 0;
+    return c.src < actor_count() && c.dst < actor_count() && c.prd != 0 && c.cns != 0 &&
+           c.name.size() <= detail::NameColumn::kMaxLength;
   };
   auto pair_of = [](const NewChannel& c) { return (static_cast<uint64_t>(c.src) << 32) | c.dst; };
   auto stage1 = [&](size_t i) {
     if (!valid(cs[i])) return;
-    prefetch(pairs_.data() + (mix64(pair_of(cs[i])) & (pairs_.size() - 1)));
+    if (pairs_live_) prefetch(pairs_.data() + (mix64(pair_of(cs[i])) & (pairs_.size() - 1)));
     if (cs[i].name.empty()) {  // the default name is made of the two actor names
       prefetch(&actor_names_[cs[i].src]);
       prefetch(&actor_names_[cs[i].dst]);
@@ -236,20 +262,24 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
     // Stops at an invalid channel: stage 3 returns there, and nothing after it is counted.
     if (!valid(cs[i])) return false;
     Pending& p = ring[i % kRing];
-    p.pair_slot = pair_slot(pair_of(cs[i]));
-    const uint64_t k = pairs_[p.pair_slot].count++;
+    uint64_t k = 0;
+    if (pairs_live_) {
+      p.pair_slot = pair_slot(pair_of(cs[i]));
+      k = pairs_[p.pair_slot].count++;
+    }
     counted = i + 1;
     if (cs[i].name.empty()) {
-      p.name = default_name(cs[i].src, cs[i].dst, k);
+      default_name(cs[i].src, cs[i].dst, k, p.name);
     } else {
       p.name.assign(cs[i].name);
     }
     p.hash = hash_of(p.name);
-    prefetch(&channel_index_.slots[p.hash & (channel_index_.slots.size() - 1)]);
+    prefetch(&channel_index_.slots[home(channel_index_.slots.size(), p.hash)]);
     return true;
   };
   auto undo = [&](size_t from) {
-    for (size_t j = from; j < counted; ++j) --pairs_[ring[j % kRing].pair_slot].count;
+    if (pairs_live_)
+      for (size_t j = from; j < counted; ++j) --pairs_[ring[j % kRing].pair_slot].count;
   };
   for (size_t i = 0; i < std::min(n, 2 * kAhead); ++i) stage1(i);
   bool stage2_open = true;
@@ -265,14 +295,8 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
       return i;
     }
     const auto id = static_cast<ChannelId>(channels_.size());
-    Channel c;
-    c.src = cs[i].src;
-    c.dst = cs[i].dst;
-    c.prd = cs[i].prd;
-    c.cns = cs[i].cns;
-    c.delay = cs[i].delay;
-    c.name = std::move(p.name);
-    channels_.push_back(std::move(c));
+    channels_.push_back({cs[i].src, cs[i].dst, cs[i].prd, cs[i].cns, cs[i].delay});
+    channel_names_.push_back(p.name);
     flat_insert(channel_index_, id, p.hash, name_of);
     if (i + 2 * kAhead < n) stage1(i + 2 * kAhead);
     if (stage2_open && i + kAhead < n) stage2_open = stage2(i + kAhead);
@@ -286,15 +310,15 @@ void Graph::set_rates(ChannelId c, uint64_t prd, uint64_t cns) {
   channels_[c].cns = cns;
 }
 
-const std::string& Graph::actor_type(ActorId a) const {
-  static const std::string kNone;
-  return a < actor_types_.size() ? actor_types_[a] : kNone;
+std::string_view Graph::actor_type(ActorId a) const {
+  return a < actor_types_.size() ? actor_types_[a] : std::string_view{};
 }
 
-void Graph::set_actor_type(ActorId a, std::string actor_type) {
+void Graph::set_actor_type(ActorId a, std::string_view actor_type) {
   if (a >= actor_count()) throw Error(Error::Kind::input, "set_actor_type: unknown actor");
+  check_length(actor_type, "actor type");
   if (actor_types_.size() < actor_count()) actor_types_.resize(actor_count());
-  actor_types_[a] = std::move(actor_type);
+  actor_types_.set(a, actor_type);
 }
 
 std::optional<uint64_t> Graph::actor_time(ActorId a) const {
@@ -311,9 +335,16 @@ void Graph::set_actor_time(ActorId a, std::optional<uint64_t> time) {
   actor_times_[a] = time ? *time : kNoTime;
 }
 
-void Graph::set_port_names(ChannelId c, std::string src_port, std::string dst_port) {
-  channels_[c].src_port = std::move(src_port);
-  channels_[c].dst_port = std::move(dst_port);
+void Graph::set_port_names(ChannelId c, std::string_view src_port, std::string_view dst_port) {
+  check_length(src_port, "port name");
+  check_length(dst_port, "port name");
+  if (src_port.empty() && dst_port.empty() && c >= src_ports_.size()) return;
+  if (src_ports_.size() < channels_.size()) {
+    src_ports_.resize(channels_.size());
+    dst_ports_.resize(channels_.size());
+  }
+  src_ports_.set(c, src_port);
+  dst_ports_.set(c, dst_port);
 }
 
 std::optional<ActorId> Graph::find_actor(std::string_view actor) const {
@@ -333,13 +364,13 @@ void Graph::find_actors(std::span<const std::string_view> names, std::span<int64
   // name it points to; probe (now mostly from cache).
   constexpr size_t kAhead = 8, kRing = 32;
   uint64_t hashes[kRing];
-  const size_t n = names.size(), mask = actor_index_.slots.size() - 1;
+  const size_t n = names.size(), size = actor_index_.slots.size();
   auto stage1 = [&](size_t i) {
     hashes[i % kRing] = hash_of(names[i]);
-    prefetch(&actor_index_.slots[hashes[i % kRing] & mask]);
+    prefetch(&actor_index_.slots[home(size, hashes[i % kRing])]);
   };
   auto stage2 = [&](size_t i) {
-    const uint64_t v = actor_index_.slots[hashes[i % kRing] & mask];
+    const uint64_t v = actor_index_.slots[home(size, hashes[i % kRing])];
     if (v != 0) prefetch(&actor_names_[static_cast<uint32_t>(v) - 1]);
   };
   for (size_t i = 0; i < std::min(n, 2 * kAhead); ++i) stage1(i);
@@ -353,7 +384,7 @@ void Graph::find_actors(std::span<const std::string_view> names, std::span<int64
 
 std::optional<ChannelId> Graph::find_channel(std::string_view channel_name) const {
   const int64_t c = flat_find(channel_index_, channel_name,
-                              [this](uint32_t i) -> std::string_view { return channels_[i].name; });
+                              [this](uint32_t i) -> std::string_view { return channel_names_[i]; });
   if (c < 0) return std::nullopt;
   return static_cast<ChannelId>(c);
 }

@@ -37,9 +37,9 @@ std::vector<uint64_t> repetitions_or_throw(const Graph& g, const char* analysis)
     throw Error(
         Error::Kind::input,
         std::string(analysis) + " needs a consistent graph: the balance equation of channel '" +
-            g.channel(rep.channel).name + "' fails (" + std::to_string(rep.q_src) + "*" +
-            std::to_string(g.channel(rep.channel).prd) + " != " + std::to_string(rep.q_dst) + "*" +
-            std::to_string(g.channel(rep.channel).cns) + ")");
+            std::string(g.channel_name(rep.channel)) + "' fails (" + std::to_string(rep.q_src) +
+            "*" + std::to_string(g.channel(rep.channel).prd) + " != " + std::to_string(rep.q_dst) +
+            "*" + std::to_string(g.channel(rep.channel).cns) + ")");
   return std::move(rep.q);
 }
 

@@ -40,11 +40,14 @@ Graph parse_graph_text(std::string_view text, const std::string& path,
                        const std::function<void(size_t)>* release = nullptr) {
   if (ends_with(path, ".xml"))
     return release ? detail::read_sdf3_released(text, path, *release) : read_sdf3(text, path);
-  if (ends_with(path, ".json")) return read_json(text, path);
+  auto json = [&] {
+    return release ? detail::read_json_released(text, path, *release) : read_json(text, path);
+  };
+  if (ends_with(path, ".json")) return json();
   for (char c : text) {
     if (c == '<')
       return release ? detail::read_sdf3_released(text, path, *release) : read_sdf3(text, path);
-    if (c == '{') return read_json(text, path);
+    if (c == '{') return json();
     if (c != ' ' && c != '\t' && c != '\r' && c != '\n') break;
   }
   throw Error(Error::Kind::input,
@@ -76,10 +79,8 @@ Graph read_graph_file(const std::string& path) {
   if (S_ISREG(st.st_mode) && static_cast<uint64_t>(st.st_size) > kMaxGraphBytes) throw too_long();
   if (S_ISREG(st.st_mode) && st.st_size > 0) {
     const auto size = static_cast<size_t>(st.st_size);
-    // Populated at once for the JSON readers (they keep views into the whole text); faulted in
-    // as the streaming SDF3 reader goes (an .xml file), which drops what it has passed.
-    const int populate = ends_with(path, ".xml") ? 0 : MAP_POPULATE;
-    void* p = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | populate, fd, 0);
+    // Faulted in as the streaming readers go; they drop what they have passed.
+    void* p = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0);
     if (p == MAP_FAILED)
       throw Error(Error::Kind::io, path + ": cannot map (" + std::strerror(errno) + ")");
     struct Unmap {
@@ -87,9 +88,9 @@ Graph read_graph_file(const std::string& path) {
       size_t size;
       ~Unmap() { ::munmap(p, size); }
     } unmap{p, size};
-    // The SDF3 reader streams: the pages it has passed are dropped (they are read back from the
-    // page cache if it looks again), so RSS holds the graph, not the file beside it.
-    if (!populate) ::madvise(p, size, MADV_SEQUENTIAL);
+    // The readers stream: the pages they have passed are dropped (they are read back from the
+    // page cache if one looks again), so RSS holds the graph, not the file beside it.
+    ::madvise(p, size, MADV_SEQUENTIAL);
     const std::function<void(size_t)> release = [&](size_t offset) {
       const auto page = static_cast<size_t>(::sysconf(_SC_PAGESIZE));
       const size_t end = offset / page * page;
@@ -113,11 +114,13 @@ Graph read_graph_file(const std::string& path) {
 std::string write_dot(const Graph& g) {
   std::string out = "digraph " + quoted(g.name.empty() ? "sdf" : g.name) + " {\n";
   for (ActorId a = 0; a < g.actor_count(); ++a) out += "  " + quoted(g.actor_name(a)) + ";\n";
-  for (const Channel& c : g.channels()) {
+  for (ChannelId id = 0; id < g.channel_count(); ++id) {
+    const Channel& c = g.channel(id);
     std::string label = std::to_string(c.prd) + ":" + std::to_string(c.cns);
     if (c.delay != 0) label += " (" + std::to_string(c.delay) + ")";
     out += "  " + quoted(g.actor_name(c.src)) + " -> " + quoted(g.actor_name(c.dst)) +
-           " [label=" + quoted(label) + ", tooltip=" + quoted(c.name) + "];\n";
+           " [label=" + quoted(label) + ", tooltip=" + quoted(std::string(g.channel_name(id))) +
+           "];\n";
   }
   return out + "}\n";
 }

@@ -2,6 +2,7 @@
 // SDF3 reader's entry for mapped files.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <optional>
 #include <string>
@@ -17,6 +18,16 @@ Graph read_json_sax(std::string_view text, const std::string& source);
 // decides). Errors found after parsing (duplicate or unknown names) are thrown as by the SAX
 // reader.
 std::optional<Graph> read_json_plain(std::string_view text, const std::string& source);
+// read_json_plain that builds the graph as it reads, in blocks of `block` actors or channels,
+// and calls release(offset) now and then (as read_sdf3_released) so that the text behind it
+// need not stay resident; where the graph refuses a block it reads the text again with
+// read_json_plain, which reports the error. Same result and errors as read_json_plain.
+std::optional<Graph> read_json_streaming(std::string_view text, const std::string& source,
+                                         const std::function<void(size_t)>* release = nullptr,
+                                         size_t block = 4096);
+// read_json over a mapped file, releasing as read_json_streaming does.
+Graph read_json_released(std::string_view text, const std::string& source,
+                         const std::function<void(size_t)>& release);
 
 // The JSON form's "sdf3_properties": an <sdfProperties> element as text, checked and read as
 // the SDF3 reader does (execution times for the actors that have no "time"; unknown actors are

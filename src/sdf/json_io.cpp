@@ -256,8 +256,7 @@ Graph build(Parsed& p, const std::string& source) {
     fail("actors[" + std::to_string(i) + "].name: duplicate actor name '" +
          std::string(p.actors[i]) + "'");
   for (size_t a = 0; a < p.actor_types.size(); ++a)
-    if (!p.actor_types[a].empty())
-      g.set_actor_type(static_cast<ActorId>(a), std::string(p.actor_types[a]));
+    if (!p.actor_types[a].empty()) g.set_actor_type(static_cast<ActorId>(a), p.actor_types[a]);
   for (size_t a = 0; a < p.actor_times.size(); ++a)
     if (p.actor_times[a] != kNoTime) g.set_actor_time(static_cast<ActorId>(a), p.actor_times[a]);
   // A block at a time: resolve the names (Graph::find_actors overlaps the probes), add the
@@ -286,8 +285,7 @@ Graph build(Parsed& p, const std::string& source) {
     for (size_t k = 0; k < added; ++k) {
       const ChannelView& c = p.channels[b + k];
       if (!c.src_port.empty() || !c.dst_port.empty())
-        g.set_port_names(static_cast<ChannelId>(b + k), std::string(c.src_port),
-                         std::string(c.dst_port));
+        g.set_port_names(static_cast<ChannelId>(b + k), c.src_port, c.dst_port);
     }
     const size_t i = b + added;
     if (i == end) continue;
@@ -319,10 +317,133 @@ Graph build(Parsed& p, const std::string& source) {
   return g;
 }
 
-// The direct scanner of the plain form; false as soon as the text leaves it.
+// Builds the graph while the scanner reads, so that neither the text nor views into it stay in
+// memory: actors, then channels, are added in blocks, and the text before a block is released
+// once the block is in the graph. It builds what build() would from the same text, but does not
+// report errors: at anything build() might refuse (a duplicate or unknown name, a port name used
+// twice) or cannot judge yet (channels before actors) it stops with `retry` set, and build()
+// then reads the text again for the error. Errors are rare; the common case reads the text once.
+class Streamer {
+ public:
+  Streamer(std::string_view text, const std::function<void(size_t)>* release, size_t block)
+      : text_(text), release_(release), block_(block) {
+    actors_.reserve(block);
+    channels_.reserve(block);
+  }
+  bool retry = false;
+  bool actors_done = false;  // every actor is in the graph; channels may come
+  Graph g;
+
+  bool actor(std::string_view name, std::string_view type, uint64_t time, const char* at) {
+    actors_.push_back({name, type, time});
+    return actors_.size() < block_ || flush_actors(at);
+  }
+  bool flush_actors(const char* at) {
+    names_.clear();
+    for (const ActorView& a : actors_) names_.push_back(a.name);
+    const auto base = static_cast<ActorId>(g.actor_count());
+    if (g.add_actors(names_) < names_.size()) return stop();
+    for (size_t i = 0; i < actors_.size(); ++i) {
+      if (!actors_[i].type.empty())
+        g.set_actor_type(base + static_cast<ActorId>(i), actors_[i].type);
+      if (actors_[i].time != kNoTime)
+        g.set_actor_time(base + static_cast<ActorId>(i), actors_[i].time);
+    }
+    actors_.clear();
+    release(at);
+    return true;
+  }
+  bool channel(const ChannelView& c, const char* at) {
+    if (!actors_done) return stop();
+    channels_.push_back(c);
+    return channels_.size() < block_ || flush_channels(at);
+  }
+  bool flush_channels(const char* at) {
+    if (channels_.empty()) return true;
+    if (!reserved_) {
+      // Room for as many channels as the rest of the text holds at the first block's density
+      // (bounded by the shortest channel a valid text can have), so the tables do not regrow.
+      // No margin: the tables are zeroed, hence resident, and a margin that crosses a power of
+      // two doubles them; a longer tail costs one rehash.
+      reserved_ = true;
+      const auto done = static_cast<size_t>(at - first_channel_);
+      const auto rest = static_cast<size_t>(text_.data() + text_.size() - at);
+      const size_t per = std::max<size_t>(done / channels_.size(), 40);
+      g.reserve(g.actor_count(), g.channel_count() + channels_.size() + rest / per);
+    }
+    names_.clear();
+    for (const ChannelView& c : channels_) {
+      names_.push_back(c.src);
+      names_.push_back(c.dst);
+    }
+    ids_.resize(names_.size());
+    g.find_actors(names_, ids_);
+    batch_.clear();
+    for (size_t i = 0; i < channels_.size(); ++i) {
+      const ChannelView& c = channels_[i];
+      if (ids_[2 * i] < 0 || ids_[2 * i + 1] < 0) return stop();
+      batch_.push_back({static_cast<ActorId>(ids_[2 * i]), static_cast<ActorId>(ids_[2 * i + 1]),
+                        c.prd, c.cns, c.delay, c.name});
+    }
+    const auto base = static_cast<ChannelId>(g.channel_count());
+    if (g.add_channels(batch_) < batch_.size()) return stop();
+    for (size_t i = 0; i < channels_.size(); ++i)
+      if (!channels_[i].src_port.empty() || !channels_[i].dst_port.empty()) {
+        g.set_port_names(base + static_cast<ChannelId>(i), channels_[i].src_port,
+                         channels_[i].dst_port);
+        ports_ = true;
+      }
+    channels_.clear();
+    release(at);
+    return true;
+  }
+  void channels_start(const char* at) { first_channel_ = at; }
+  // After the last block: the port names given must be unique per actor, as build() checks.
+  bool finish() {
+    if (!ports_) return true;
+    std::set<std::pair<ActorId, std::string_view>> seen;
+    for (ChannelId c = 0; c < g.channel_count(); ++c)
+      for (const auto& [actor, port] :
+           {std::pair{g.channel(c).src, g.src_port(c)}, std::pair{g.channel(c).dst, g.dst_port(c)}})
+        if (!port.empty() && !seen.insert({actor, port}).second) return stop();
+    return true;
+  }
+
+ private:
+  struct ActorView {
+    std::string_view name, type;
+    uint64_t time;
+  };
+  bool stop() {
+    retry = true;
+    return false;
+  }
+  void release(const char* at) {
+    const auto offset = static_cast<size_t>(at - text_.data());
+    if (release_ && offset >= released_ + kReleaseStep) {
+      (*release_)(offset);
+      released_ = offset;
+    }
+  }
+  static constexpr size_t kReleaseStep = size_t{16} << 20;
+  std::string_view text_;
+  const std::function<void(size_t)>* release_;
+  size_t block_, released_ = 0;
+  bool reserved_ = false, ports_ = false;
+  const char* first_channel_ = nullptr;
+  std::vector<ActorView> actors_;
+  std::vector<ChannelView> channels_;
+  std::vector<std::string_view> names_;
+  std::vector<int64_t> ids_;
+  std::vector<Graph::NewChannel> batch_;
+};
+
+// The direct scanner of the plain form; false as soon as the text leaves it. With a streamer,
+// the actors and channels go to it instead of `Parsed` (false also when it stops).
 class Scanner {
  public:
-  explicit Scanner(std::string_view text) : p_(text.data()), end_(text.data() + text.size()) {}
+  explicit Scanner(std::string_view text, Streamer* stream = nullptr)
+      : p_(text.data()), end_(text.data() + text.size()), stream_(stream) {}
 
   bool parse(Parsed& out) {
     bool seen_actors = false, seen_channels = false, seen_name = false;
@@ -440,6 +561,10 @@ class Scanner {
         return 0;
       };
       if (!object(field, seen) || !(seen & 1)) return false;
+      if (stream_) {
+        if (!stream_->actor(actor, type, time, p_)) return false;
+        continue;
+      }
       out.actors.push_back(actor);
       if (seen & 2) {
         out.actor_types.resize(out.actors.size());
@@ -450,10 +575,14 @@ class Scanner {
         out.actor_times.back() = time;
       }
     } while (peek_is(','));
-    return skip_to(']');
+    if (!skip_to(']')) return false;
+    if (stream_ && !stream_->flush_actors(p_)) return false;
+    if (stream_) stream_->actors_done = true;
+    return true;
   }
   bool channels(Parsed& out) {
     if (!skip_to('[')) return false;
+    if (stream_) stream_->channels_start(p_);
     if (peek_is(']')) return true;
     do {
       ChannelView c;
@@ -470,13 +599,19 @@ class Scanner {
         return 0;
       };
       if (!object(field, seen) || (seen & 15) != 15) return false;
+      if (stream_) {
+        if (!stream_->channel(c, p_)) return false;
+        continue;
+      }
       out.channels.push_back(c);
     } while (peek_is(','));
-    return skip_to(']');
+    if (!skip_to(']')) return false;
+    return !stream_ || stream_->flush_channels(p_);
   }
 
   const char* p_;
   const char* end_;
+  Streamer* stream_;
 };
 
 }  // namespace
@@ -500,6 +635,21 @@ Graph read_json_sax(std::string_view text, const std::string& source) {
   return build(p, source);
 }
 
+std::optional<Graph> read_json_streaming(std::string_view text, const std::string& source,
+                                         const std::function<void(size_t)>* release, size_t block) {
+  {
+    Streamer s(text, release, block);
+    Parsed p;
+    const bool ok = Scanner(text, &s).parse(p);
+    if (ok && s.finish()) {
+      s.g.name = std::move(p.graph_name);
+      return std::move(s.g);
+    }
+    if (!s.retry) return std::nullopt;  // not the plain form
+  }
+  return read_json_plain(text, source);  // an error to report, or channels before actors
+}
+
 std::optional<Graph> read_json_plain(std::string_view text, const std::string& source) {
   Parsed p;
   // Rough sizes from the file length, so the vectors do not grow in steps (a written actor
@@ -513,9 +663,19 @@ std::optional<Graph> read_json_plain(std::string_view text, const std::string& s
 }  // namespace detail
 
 Graph read_json(std::string_view text, const std::string& source) {
-  if (auto g = detail::read_json_plain(text, source)) return std::move(*g);
+  if (auto g = detail::read_json_streaming(text, source)) return std::move(*g);
   return detail::read_json_sax(text, source);
 }
+
+namespace detail {
+
+Graph read_json_released(std::string_view text, const std::string& source,
+                         const std::function<void(size_t)>& release) {
+  if (auto g = read_json_streaming(text, source, &release)) return std::move(*g);
+  return read_json_sax(text, source);
+}
+
+}  // namespace detail
 
 std::string write_json(const Graph& g) {
   nlohmann::ordered_json j;
@@ -530,17 +690,19 @@ std::string write_json(const Graph& g) {
   }
   auto& channels = j["channels"] = nlohmann::ordered_json::array();
   std::unordered_map<uint64_t, uint32_t> parallel;
-  for (const Channel& c : g.channels()) {
+  for (ChannelId id = 0; id < g.channel_count(); ++id) {
+    const Channel& c = g.channel(id);
+    const std::string_view name = g.channel_name(id);
     nlohmann::ordered_json e = {{"src", g.actor_name(c.src)},
                                 {"dst", g.actor_name(c.dst)},
                                 {"prd", c.prd},
                                 {"cns", c.cns},
                                 {"delay", c.delay}};
     const uint32_t k = parallel[(static_cast<uint64_t>(c.src) << 32) | c.dst]++;
-    if (c.name != g.actor_name(c.src) + "->" + g.actor_name(c.dst) + "#" + std::to_string(k))
-      e["name"] = c.name;
-    if (!c.src_port.empty()) e["src_port"] = c.src_port;
-    if (!c.dst_port.empty()) e["dst_port"] = c.dst_port;
+    if (name != g.actor_name(c.src) + "->" + g.actor_name(c.dst) + "#" + std::to_string(k))
+      e["name"] = name;
+    if (!g.src_port(id).empty()) e["src_port"] = g.src_port(id);
+    if (!g.dst_port(id).empty()) e["dst_port"] = g.dst_port(id);
     channels.push_back(std::move(e));
   }
   // Last: adding a key to an ordered_json moves its members (the references above).

@@ -1,18 +1,15 @@
 // Latency over the first K iterations by an event simulation of self-timed execution in which
-// each actor fires at most K·q[a] times (include/sdf/latency.hpp). Firings of one actor take the
-// same time and start in order, so they also end in order: per actor a list of (end, count)
-// batches, and a heap of (end, actor) with one entry per batch. Only a firing's end can enable
-// another firing, so after time 0 only the consumers of the actors whose firings ended are
-// looked at.
+// each actor fires at most K·q[a] times (include/sdf/latency.hpp): the shared engine
+// (self_timed.hpp) with a limit per actor, recording per actor and iteration the first start
+// and the last end.
 #include "sdf/latency.hpp"
 
 #include <algorithm>
-#include <deque>
-#include <queue>
 
 #include "checked.hpp"
 #include "hsdf.hpp"
 #include "sdf/throughput.hpp"
+#include "self_timed.hpp"
 
 namespace sdf {
 
@@ -74,72 +71,46 @@ Latency latency(const Graph& g, const LatencyOptions& o, std::optional<uint64_t>
   const std::vector<uint64_t> cap = latency_caps(g, o, q);
   const std::vector<uint64_t> times = execution_times(g, default_time);
   const size_t n = g.actor_count(), k_iter = o.iterations;
-  const Adjacency adj(g);
-  std::vector<uint64_t> tokens = g.delays(), started(n, 0), ended(n, 0);
-  std::vector<uint64_t> first_start(n * k_iter, 0), last_end(n * k_iter, 0);
-  std::vector<std::deque<std::pair<uint64_t, uint64_t>>> running(n);  // (end, count)
-  std::priority_queue<std::pair<uint64_t, ActorId>, std::vector<std::pair<uint64_t, ActorId>>,
-                      std::greater<>>
-      ends;
-  std::vector<ActorId> todo;
-  std::vector<char> queued(n, 0);
-  uint64_t now = 0;
-  auto offer = [&](ActorId a) {
-    if (!queued[a]) queued[a] = 1, todo.push_back(a);
-  };
-  auto complete = [&](ActorId a, uint64_t k) {
-    for (ChannelId c : adj.outputs(a)) {
-      const Channel& ch = g.channel(c);
-      tokens[c] = detail::add_tokens(tokens[c], k, ch.prd, ch.name);
-      offer(ch.dst);
-    }
-    // Iterations whose last firing is among these k.
-    for (uint64_t i = ended[a] / q[a]; (i + 1) * q[a] <= ended[a] + k; ++i)
-      last_end[a * k_iter + i] = now;
-    ended[a] += k;
-  };
-  for (ActorId a = 0; a < n; ++a) offer(a);
-  for (;;) {
-    while (!todo.empty()) {
-      const ActorId a = todo.back();
-      todo.pop_back();
-      queued[a] = 0;
-      uint64_t k = cap[a] - started[a];
-      for (ChannelId c : adj.inputs(a)) k = std::min(k, tokens[c] / g.channel(c).cns);
-      if (k == 0) continue;
-      for (ChannelId c : adj.inputs(a)) tokens[c] -= k * g.channel(c).cns;
+  const detail::TimedPorts ports(g);
+  // The first starts and last ends per actor and iteration (index a·K + i).
+  struct Hooks {
+    Hooks(const std::vector<uint64_t>& reps, size_t n, size_t iterations)
+        : q(reps),
+          k_iter(iterations),
+          begun(n, 0),
+          done(n, 0),
+          first_start(n * iterations, 0),
+          last_end(n * iterations, 0) {}
+    const std::vector<uint64_t>& q;
+    const size_t k_iter;
+    const uint64_t* now = nullptr;
+    std::vector<uint64_t> begun, done, first_start, last_end;  // firings started, ended per actor
+    void instant() {}
+    void started(uint32_t a, uint64_t k) {
       // Iterations whose first firing is among these k.
-      for (uint64_t i = (started[a] + q[a] - 1) / q[a]; i * q[a] < started[a] + k; ++i)
-        first_start[a * k_iter + i] = now;
-      started[a] += k;
-      if (times[a] == 0) {
-        complete(a, k);
-        continue;
-      }
-      const uint64_t end = detail::add(now, times[a], "the time of the latency simulation");
-      auto& list = running[a];
-      if (!list.empty() && list.back().first == end) {
-        list.back().second += k;
-      } else {
-        list.push_back({end, k});
-        ends.push({end, a});
-      }
+      for (uint64_t i = (begun[a] + q[a] - 1) / q[a]; i * q[a] < begun[a] + k; ++i)
+        first_start[a * k_iter + i] = *now;
+      begun[a] += k;
     }
-    if (ends.empty()) break;
-    now = ends.top().first;
-    while (!ends.empty() && ends.top().first == now) {
-      const ActorId a = ends.top().second;
-      ends.pop();
-      const uint64_t k = running[a].front().second;
-      running[a].pop_front();
-      complete(a, k);
+    void completed(uint32_t a, uint64_t k) {
+      // Iterations whose last firing is among these k.
+      for (uint64_t i = done[a] / q[a]; (i + 1) * q[a] <= done[a] + k; ++i)
+        last_end[a * k_iter + i] = *now;
+      done[a] += k;
     }
-  }
+  } hooks(q, n, k_iter);
+  detail::SelfTimed<Hooks> run(ports, g, times, hooks, "the time of the latency simulation");
+  hooks.now = &run.now;
+  run.tokens = g.delays();
+  run.left = cap;  // each actor fires at most K·q[a] times
+  run.offer_all();
+  do run.start_all();
+  while (run.advance());
   Latency r;
   for (ActorId a = 0; a < n; ++a)
-    if (ended[a] < cap[a]) r.stuck.push_back(a);
+    if (hooks.done[a] < cap[a]) r.stuck.push_back(a);
   r.deadlock = !r.stuck.empty();
-  if (!r.deadlock) latencies_from_times(o, n, first_start, last_end, r);
+  if (!r.deadlock) latencies_from_times(o, n, hooks.first_start, hooks.last_end, r);
   return r;
 }
 

@@ -70,7 +70,7 @@ void Meter::record(const Run& run) {
       tokens_[c] -= k * (ch.cns - ch.prd);
     } else {
       const uint64_t gain = ch.src == ch.dst ? ch.prd - ch.cns : ch.prd;
-      tokens_[c] = detail::add_tokens(tokens_[c], k, gain, ch.name);
+      tokens_[c] = detail::add_tokens(tokens_[c], k, gain, *g_, c);
     }
     m_.buffers[c] = std::max(m_.buffers[c], tokens_[c]);
   }

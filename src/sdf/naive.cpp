@@ -659,7 +659,7 @@ class DomReader {
       if (p->channel >= 0)
         fail(ch, "port '" + std::string(p->name) + "' of actor '" + g.actor_name(p->actor) +
                      "' is already connected to channel '" +
-                     g.channel(static_cast<ChannelId>(p->channel)).name + "'");
+                     std::string(g.channel_name(static_cast<ChannelId>(p->channel))) + "'");
     uint64_t delay = 0;
     if (const pugi::xml_attribute t = ch.attribute("initialTokens"))
       delay = number(ch, "initialTokens", trim(t.value()), false);

@@ -59,7 +59,7 @@ OnlineScheduler::OnlineScheduler(const Graph& g, std::span<const uint64_t> q, On
     topo->src[c] = ch.src;
     topo->dst[c] = ch.dst;
     topo->self[c] = ch.src == ch.dst;
-    topo->name.push_back(ch.name);
+    topo->name.emplace_back(g.channel_name(c));
     if (ch.src == ch.dst) topo->has_loop[ch.src] = 1;
     prd_[c] = ch.prd;
     cns_[c] = ch.cns;

@@ -40,12 +40,12 @@ RateChange RateChange::scaled(const Graph& g, ActorId a, uint64_t num, uint64_t 
   RateChange rc;
   rc.actor = a;
   rc.at_firing = at_firing;
-  auto scale = [&](const Channel& ch, uint64_t r) {
+  auto scale = [&](ChannelId c, uint64_t r) {
     const detail::u128 v = static_cast<detail::u128>(r) * num;
     if (v % den != 0 || v / den > UINT64_MAX)
       throw Error(Error::Kind::input,
-                  "rate change: channel '" + ch.name + "': " + std::to_string(r) + "·" +
-                      std::to_string(num) + "/" + std::to_string(den) +
+                  "rate change: channel '" + std::string(g.channel_name(c)) + "': " +
+                      std::to_string(r) + "·" + std::to_string(num) + "/" + std::to_string(den) +
                       (v % den != 0 ? " is not a whole number" : " does not fit in 64 bits"));
     return static_cast<uint64_t>(v / den);
   };
@@ -54,7 +54,7 @@ RateChange RateChange::scaled(const Graph& g, ActorId a, uint64_t num, uint64_t 
     if (ch.src == ch.dst) continue;  // a self-loop models the actor's state, not its data
     if (ch.src == a || ch.dst == a)
       rc.rates.push_back(
-          {c, ch.src == a ? scale(ch, ch.prd) : ch.prd, ch.dst == a ? scale(ch, ch.cns) : ch.cns});
+          {c, ch.src == a ? scale(c, ch.prd) : ch.prd, ch.dst == a ? scale(c, ch.cns) : ch.cns});
   }
   return rc;
 }
@@ -87,19 +87,20 @@ RateChangeResult simulate_rate_change(const Graph& g, Policy policy, const RateC
       throw Error(Error::Kind::input, "rate change: unknown channel");
     const Channel& ch = g.channel(r.channel);
     if (ch.src != change.actor && ch.dst != change.actor)
-      throw Error(Error::Kind::input, "rate change: channel '" + ch.name +
-                                          "' is not a channel of '" + g.actor_name(change.actor) +
-                                          "'");
-    if ((ch.src != change.actor && r.prd != ch.prd) || (ch.dst != change.actor && r.cns != ch.cns))
       throw Error(Error::Kind::input,
-                  "rate change: channel '" + ch.name + "': only the actor's own ports change");
+                  "rate change: channel '" + std::string(g.channel_name(r.channel)) +
+                      "' is not a channel of '" + g.actor_name(change.actor) + "'");
+    if ((ch.src != change.actor && r.prd != ch.prd) || (ch.dst != change.actor && r.cns != ch.cns))
+      throw Error(Error::Kind::input, "rate change: channel '" +
+                                          std::string(g.channel_name(r.channel)) +
+                                          "': only the actor's own ports change");
     if (r.prd == 0 || r.cns == 0)
       throw Error(Error::Kind::input, "rate change: rates must be positive");
   }
   const Repetitions rep = compute_repetitions(g);
   if (!rep.consistent)
-    throw Error(Error::Kind::input,
-                "the graph is inconsistent (channel '" + g.channel(rep.channel).name + "')");
+    throw Error(Error::Kind::input, "the graph is inconsistent (channel '" +
+                                        std::string(g.channel_name(rep.channel)) + "')");
   const StaticSchedule first = static_schedule(g, rep.q);
   if (!first.complete)
     throw Error(Error::Kind::input,

@@ -37,15 +37,31 @@ struct Visit {
   Fraction f;
 };
 
-// Non-throwing twin of scale(): false when a product does not fit.
+// Non-throwing twin of scale(): false when a product does not fit. The union-find calls it
+// several times per channel, mostly with a 1 somewhere (equal rates, 1/1 fractions): those skip
+// their gcds and divisions, which dominated.
 bool scale_to(Fraction f, uint64_t a, uint64_t b, Fraction& out) {
-  const uint64_t g = std::gcd(a, b);
-  a /= g;
-  b /= g;
-  const uint64_t g1 = std::gcd(f.num, b);
-  const uint64_t g2 = std::gcd(a, f.den);
-  return !__builtin_mul_overflow(f.num / g1, a / g2, &out.num) &&
-         !__builtin_mul_overflow(f.den / g2, b / g1, &out.den);
+  if (a == b) {
+    out = f;
+    return true;
+  }
+  if (a != 1 && b != 1) {
+    const uint64_t g = std::gcd(a, b);
+    a /= g;
+    b /= g;
+  }
+  uint64_t num = f.num, den = f.den;
+  if (b != 1 && num != 1) {
+    const uint64_t g1 = std::gcd(num, b);
+    num /= g1;
+    b /= g1;
+  }
+  if (a != 1 && den != 1) {
+    const uint64_t g2 = std::gcd(a, den);
+    a /= g2;
+    den /= g2;
+  }
+  return !__builtin_mul_overflow(num, a, &out.num) && !__builtin_mul_overflow(den, b, &out.den);
 }
 
 // Union-find over the channels in file order, each node holding q_node / q_parent as a reduced
@@ -144,9 +160,11 @@ std::optional<std::vector<uint64_t>> union_find_vector(const Graph& g) {
     const UnionFind::Node& node = uf.nodes[v];  // the root itself: parent v, rel 1/1
     if (__builtin_mul_overflow(node.rel.num, lcm[node.parent] / node.rel.den, &q[v]))
       return std::nullopt;
-    common[node.parent] = std::gcd(common[node.parent], q[v]);
+    uint64_t& c = common[node.parent];
+    if (c != 1) c = std::gcd(c, q[v]);  // once 1, always 1
   }
-  for (uint32_t v = 0; v < n; ++v) q[v] /= common[uf.nodes[v].parent];
+  for (uint32_t v = 0; v < n; ++v)
+    if (const uint64_t c = common[uf.nodes[v].parent]; c != 1) q[v] /= c;
   return q;
 }
 

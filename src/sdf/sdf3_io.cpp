@@ -3,7 +3,9 @@
 // search: O(P log P) for P ports, never the quadratic scan that makes SDF3's own loader take
 // minutes on 10^5 actors. Line numbers are computed only for an error message.
 #include <algorithm>
+#include <bit>
 #include <charconv>
+#include <cstring>
 #include <deque>
 #include <pugixml.hpp>
 #include <sstream>
@@ -50,35 +52,46 @@ void apply_properties(Graph& g, pugi::xml_node props, Fail&& fail, Number&& numb
 
 // A port keeps a short name (all of SDF3's are) in itself, so that resolving channels does not
 // go back to the text (which the reader may release behind it); a longer one is a view.
+// 32 bytes (there are two per channel): the offset of the <port> element (its line is computed
+// only for an error message) and a long name's length take 40 bits, as texts stay far below
+// 2^40 bytes.
 struct Port {
   uint64_t rate;
-  size_t offset;  // of the <port> element; its line is computed only for an error message
+  uint32_t offset_low;
   uint32_t channel = UINT32_MAX;
+  uint8_t offset_high;
   bool out;
-  uint8_t length = 0;  // of a short name, kLong for a view
-  union {
-    char short_name[24];
-    struct {
-      const char* data;
-      size_t size;
-    } long_name;
-  };
+  uint8_t length = 0;   // of a short name, kLong for a view
+  char bytes[13] = {};  // a short name, or a long one's pointer and 40-bit length
   static constexpr uint8_t kLong = 255;
-  Port() : short_name{} {}
+  size_t offset() const { return static_cast<size_t>(offset_high) << 32 | offset_low; }
+  void set_offset(size_t at) {
+    offset_low = static_cast<uint32_t>(at);
+    offset_high = static_cast<uint8_t>(static_cast<uint64_t>(at) >> 32);
+  }
   std::string_view name() const {
-    return length == kLong ? std::string_view(long_name.data, long_name.size)
-                           : std::string_view(short_name, length);
+    if (length != kLong) return {bytes, length};
+    const char* data;
+    uint64_t size = 0;
+    std::memcpy(&data, bytes, sizeof data);
+    std::memcpy(&size, bytes + sizeof data, 5);  // little-endian
+    return {data, static_cast<size_t>(size)};
   }
   void set_name(std::string_view n) {
-    if (n.size() <= sizeof short_name) {
-      std::copy(n.begin(), n.end(), short_name);
+    if (n.size() <= sizeof bytes) {
+      std::copy(n.begin(), n.end(), bytes);
       length = static_cast<uint8_t>(n.size());
     } else {
-      long_name = {n.data(), n.size()};
+      const char* data = n.data();
+      const uint64_t size = n.size();
+      std::memcpy(bytes, &data, sizeof data);
+      std::memcpy(bytes + sizeof data, &size, 5);
       length = kLong;
     }
   }
 };
+static_assert(sizeof(Port) == 32);
+static_assert(std::endian::native == std::endian::little);
 
 // A <channel> as read, resolved when its actors are known.
 struct ChannelRecord {
@@ -113,7 +126,7 @@ class Sdf3Reader {
     // error than a valid one of its size.
     size_t actors = 0, channels = 0;
     auto named = [&](size_t at, std::string_view name) {
-      if (text_.compare(at + 1, name.size(), name) != 0) return false;
+      if (!same(text_.substr(at + 1, name.size()), name)) return false;
       const size_t after = at + 1 + name.size();
       return after < text_.size() &&
              (text_[after] == '/' || text_[after] == '>' || text_[after] == ' ' ||
@@ -122,7 +135,12 @@ class Sdf3Reader {
     for (size_t at = text_.find('<'); at != std::string_view::npos; at = text_.find('<', at + 1)) {
       actors += named(at, "actor");
       channels += named(at, "channel");
+      // The count reads the whole text: what it has passed is dropped as it goes (the scan
+      // faults it in again from the page cache), so the file is never resident at once.
+      if (release_ && at >= released_ + kReleaseStep) (*release_)(released_ = at);
     }
+    if (release_) (*release_)(text_.size());
+    released_ = 0;
     g_.reserve(std::min(actors, text_.size() / 17), std::min(channels, text_.size() / 60));
     try {
       scan();
@@ -135,8 +153,8 @@ class Sdf3Reader {
     for (ActorId a = 0; a < g_.actor_count(); ++a)
       for (uint32_t i = port_begin_[a]; i < port_begin_[a + 1]; ++i)
         if (ports_[i].channel == UINT32_MAX)
-          fail(ports_[i].offset, "port '" + std::string(ports_[i].name()) + "' of actor '" +
-                                     g_.actor_name(a) + "' is not connected to a channel");
+          fail(ports_[i].offset(), "port '" + std::string(ports_[i].name()) + "' of actor '" +
+                                       g_.actor_name(a) + "' is not connected to a channel");
     if (!props_.empty()) read_properties();
     return std::move(g_);
   }
@@ -158,7 +176,7 @@ class Sdf3Reader {
       }
       const Where parent = stack.empty() ? Where::outside : stack.back();
       Where here = Where::other;
-      if (parent == Where::outside && t.name == "sdf3" && !seen_sdf3) {
+      if (parent == Where::outside && same(t.name, "sdf3") && !seen_sdf3) {
         seen_sdf3 = true;
         here = Where::sdf3;
         const std::string_view type = value("type");
@@ -166,18 +184,18 @@ class Sdf3Reader {
           fail(t.offset,
                "graph type '" + std::string(type) + "' is not supported (only type=\"sdf\")");
         root_offset_ = t.offset;
-      } else if (parent == Where::sdf3 && t.name == "applicationGraph" && !seen_app) {
+      } else if (parent == Where::sdf3 && same(t.name, "applicationGraph") && !seen_app) {
         seen_app = true;
         here = Where::app;
         app_offset_ = t.offset;
-      } else if (parent == Where::app && t.name == "sdf" && !seen_sdf) {
+      } else if (parent == Where::app && same(t.name, "sdf") && !seen_sdf) {
         seen_sdf = true;
         here = Where::sdf;
         g_.name = value("name");
         if (!valid_utf8(g_.name)) fail(t.offset, "attribute 'name' is not valid UTF-8");
         g_.type = value("type");
         if (!valid_utf8(g_.type)) fail(t.offset, "attribute 'type' is not valid UTF-8");
-      } else if (parent == Where::app && t.name == "sdfProperties" && props_.empty()) {
+      } else if (parent == Where::app && same(t.name, "sdfProperties") && props_.empty()) {
         props_offset_ = t.offset;
         size_t end = t.end;
         if (!t.self_closing) {
@@ -193,12 +211,12 @@ class Sdf3Reader {
         }
         props_ = text_.substr(t.offset, end - t.offset);
         continue;
-      } else if (parent == Where::sdf && t.name == "actor") {
+      } else if (parent == Where::sdf && same(t.name, "actor")) {
         here = Where::actor;
         open_actor(t);
-      } else if (parent == Where::actor && t.name == "port") {
+      } else if (parent == Where::actor && same(t.name, "port")) {
         read_port(t);
-      } else if (parent == Where::sdf && t.name == "channel") {
+      } else if (parent == Where::sdf && same(t.name, "channel")) {
         read_channel(t);
       }
       if (!t.self_closing) {
@@ -240,21 +258,22 @@ class Sdf3Reader {
 
   // The decoded value of an attribute of the current tag ("" when absent), kept alive as long
   // as the reader.
-  std::string_view value(const char* attr) {
+  std::string_view value(std::string_view attr) {
     const detail::XmlAttribute* a = scan_.attribute(attr);
-    return a ? keep(a->raw) : std::string_view{};
+    return a ? keep(*a) : std::string_view{};
   }
-  std::string_view keep(std::string_view raw) {
-    const std::string_view v = detail::decode_attribute(raw, scratch_);
+  std::string_view keep(const detail::XmlAttribute& a) {
+    if (a.plain) return a.raw;
+    const std::string_view v = detail::decode_attribute(a.raw, scratch_);
     if (v.data() != scratch_.data()) return v;  // a view into the text
     return decoded_.emplace_back(scratch_);     // a deque: earlier views stay valid
   }
-  std::string_view required(const detail::XmlScanner::Token& t, const char* attr) {
+  std::string_view required(const detail::XmlScanner::Token& t, std::string_view attr) {
     const detail::XmlAttribute* a = scan_.attribute(attr);
     if (!a)
-      fail_after_pending(t.offset,
-                         "<" + std::string(t.name) + "> lacks the attribute '" + attr + "'");
-    const std::string_view v = trim(keep(a->raw));
+      fail_after_pending(t.offset, "<" + std::string(t.name) + "> lacks the attribute '" +
+                                       std::string(attr) + "'");
+    const std::string_view v = trim(keep(*a));
     if (v.empty()) fail_after_pending(t.offset, "attribute '" + std::string(attr) + "' is empty");
     if (!valid_utf8(v))
       fail_after_pending(t.offset, "attribute '" + std::string(attr) + "' is not valid UTF-8");
@@ -289,12 +308,12 @@ class Sdf3Reader {
     Port p;
     p.set_name(required(t, "name"));
     const std::string_view type = required(t, "type");
-    if (type != "in" && type != "out")
+    if (!same(type, "in") && !same(type, "out"))
       fail_after_pending(t.offset,
                          "port type '" + std::string(type) + "' is neither 'in' nor 'out'");
-    p.out = type == "out";
+    p.out = same(type, "out");
     p.rate = number(t.offset, "rate", required(t, "rate"), true);
-    p.offset = t.offset;
+    p.set_offset(t.offset);
     ports_.push_back(p);
   }
 
@@ -306,7 +325,7 @@ class Sdf3Reader {
     // Indices, not iterators: `first + 1` on an empty vector's null data is undefined (UBSan).
     for (size_t i = port_begin_.back(); i + 1 < ports_.size(); ++i)
       if (ports_[i].name() == ports_[i + 1].name())
-        fail_after_pending(std::max(ports_[i].offset, ports_[i + 1].offset),
+        fail_after_pending(std::max(ports_[i].offset(), ports_[i + 1].offset()),
                            "duplicate port '" + std::string(ports_[i].name()) + "' on actor '" +
                                std::string(block_.back().name) + "'");
     port_begin_.push_back(static_cast<uint32_t>(ports_.size()));
@@ -325,8 +344,7 @@ class Sdf3Reader {
     const auto base = static_cast<ActorId>(g_.actor_count());
     const size_t ok = g_.add_actors(names_);
     for (size_t i = 0; i < ok; ++i)
-      if (block_[i].typed)
-        g_.set_actor_type(base + static_cast<ActorId>(i), std::string(block_[i].type));
+      if (block_[i].typed) g_.set_actor_type(base + static_cast<ActorId>(i), block_[i].type);
     if (ok < count) {
       try {
         g_.add_actor(std::string(block_[ok].name));  // throws "duplicate actor name '...'"
@@ -342,7 +360,7 @@ class Sdf3Reader {
     r.offset = t.offset;
     if (const detail::XmlAttribute* a = scan_.attribute("name")) {
       r.has_name = true;
-      r.name = trim(keep(a->raw));
+      r.name = trim(keep(*a));
       if (r.name.empty()) fail_after_pending(t.offset, "attribute 'name' is empty");
       if (!valid_utf8(r.name)) fail_after_pending(t.offset, "attribute 'name' is not valid UTF-8");
     }
@@ -351,7 +369,7 @@ class Sdf3Reader {
     r.src_port = required(t, "srcPort");
     r.dst_port = required(t, "dstPort");
     if (const detail::XmlAttribute* a = scan_.attribute("initialTokens"))
-      r.delay = number(t.offset, "initialTokens", trim(keep(a->raw)), false);
+      r.delay = number(t.offset, "initialTokens", trim(keep(*a)), false);
     (deferred_.empty() ? pending_ : deferred_).push_back(r);  // once one waits, all later do
     if (pending_.size() >= kBlock) flush_channels();
   }
@@ -424,8 +442,8 @@ class Sdf3Reader {
         add_batch(records, batch);  // the other channel may be in the batch: named once added
         fail(r.offset, "port '" + std::string(p->name()) + "' of actor '" +
                            g_.actor_name(p == &sp ? src : dst) +
-                           "' is already connected to channel '" + g_.channel(p->channel).name +
-                           "'");
+                           "' is already connected to channel '" +
+                           std::string(g_.channel_name(p->channel)) + "'");
       }
       const auto c = static_cast<uint32_t>(g_.channel_count() + batch.size());
       sp.channel = dp.channel = c;
@@ -442,9 +460,14 @@ class Sdf3Reader {
                            ActorId actor, std::string_view name) {
     const auto first = ports_.begin() + port_begin_[actor];
     const auto last = ports_.begin() + port_begin_[actor + 1];
-    auto it = std::lower_bound(first, last, name,
-                               [](const Port& p, std::string_view k) { return p.name() < k; });
-    if (it == last || it->name() != name)
+    auto it = first;
+    if (last - first <= 8) {  // most actors have a few ports: a scan, no calls to memcmp
+      while (it != last && !same(it->name(), name)) ++it;
+    } else {
+      it = std::lower_bound(first, last, name,
+                            [](const Port& p, std::string_view k) { return p.name() < k; });
+    }
+    if (it == last || !same(it->name(), name))
       fail_in_batch(records, batch, r,
                     "actor '" + g_.actor_name(actor) + "' has no port '" + std::string(name) + "'");
     return *it;
@@ -466,8 +489,7 @@ class Sdf3Reader {
     const size_t ok = g_.add_channels(batch);
     for (size_t k = 0; k < ok; ++k) {
       const ChannelRecord& r = records[k];
-      g_.set_port_names(base + static_cast<ChannelId>(k), std::string(r.src_port),
-                        std::string(r.dst_port));
+      g_.set_port_names(base + static_cast<ChannelId>(k), r.src_port, r.dst_port);
     }
     if (ok < batch.size()) {
       const Graph::NewChannel& c = batch[ok];
@@ -535,9 +557,10 @@ class Sdf3Reader {
 std::vector<std::pair<std::string, std::string>> port_names(const Graph& g) {
   std::vector<std::unordered_set<std::string>> taken(g.actor_count());
   bool any_named = false;
-  for (const Channel& c : g.channels()) {
-    if (!c.src_port.empty()) taken[c.src].insert(c.src_port), any_named = true;
-    if (!c.dst_port.empty()) taken[c.dst].insert(c.dst_port), any_named = true;
+  for (ChannelId id = 0; id < g.channel_count(); ++id) {
+    const Channel& c = g.channel(id);
+    if (!g.src_port(id).empty()) taken[c.src].emplace(g.src_port(id)), any_named = true;
+    if (!g.dst_port(id).empty()) taken[c.dst].emplace(g.dst_port(id)), any_named = true;
   }
   std::vector<uint32_t> next(g.actor_count(), 0);
   auto invent = [&](ActorId a, const char* prefix) {
@@ -549,8 +572,8 @@ std::vector<std::pair<std::string, std::string>> port_names(const Graph& g) {
   std::vector<std::pair<std::string, std::string>> names(g.channel_count());
   for (ChannelId c = 0; c < g.channel_count(); ++c) {
     const Channel& ch = g.channel(c);
-    names[c].first = ch.src_port.empty() ? invent(ch.src, "out") : ch.src_port;
-    names[c].second = ch.dst_port.empty() ? invent(ch.dst, "in") : ch.dst_port;
+    names[c].first = g.src_port(c).empty() ? invent(ch.src, "out") : std::string(g.src_port(c));
+    names[c].second = g.dst_port(c).empty() ? invent(ch.dst, "in") : std::string(g.dst_port(c));
   }
   return names;
 }
@@ -660,7 +683,7 @@ std::string write_sdf3(const Graph& g) {
   for (ActorId a = 0; a < g.actor_count(); ++a) {
     pugi::xml_node actor = sdf.append_child("actor");
     actor.append_attribute("name") = g.actor_name(a).c_str();
-    const std::string& type = g.actor_type(a);
+    const std::string type(g.actor_type(a));
     actor.append_attribute("type") = (type.empty() ? g.actor_name(a) : type).c_str();
     for (ChannelId c : adj.inputs(a)) {
       pugi::xml_node p = actor.append_child("port");
@@ -678,7 +701,7 @@ std::string write_sdf3(const Graph& g) {
   for (ChannelId c = 0; c < g.channel_count(); ++c) {
     const Channel& ch = g.channel(c);
     pugi::xml_node e = sdf.append_child("channel");
-    e.append_attribute("name") = ch.name.c_str();
+    e.append_attribute("name") = std::string(g.channel_name(c)).c_str();
     e.append_attribute("srcActor") = g.actor_name(ch.src).c_str();
     e.append_attribute("srcPort") = ports[c].first.c_str();
     e.append_attribute("dstActor") = g.actor_name(ch.dst).c_str();

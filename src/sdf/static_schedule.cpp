@@ -52,7 +52,7 @@ void fire(const Graph& g, const Adjacency& adj, std::vector<uint64_t>& tokens, A
       tokens[c] -= k * (ch.cns - ch.prd);
     } else {
       const uint64_t gain = ch.src == ch.dst ? ch.prd - ch.cns : ch.prd;
-      tokens[c] = detail::add_tokens(tokens[c], k, gain, ch.name);
+      tokens[c] = detail::add_tokens(tokens[c], k, gain, g, c);
     }
   }
 }

@@ -5,7 +5,8 @@
 //
 // A state, recorded at every instant once no more firings can start, is the tokens on the
 // component's channels and, per actor, the remaining times of its firings in progress (as
-// (remaining, count) pairs). Time advances to the next completion. Within a component tokens
+// (remaining, count) pairs). Time advances to the next completion (the self-timed engine of
+// self_timed.hpp, over the component). Within a component tokens
 // are bounded, so some state repeats; between its two visits lie F firings of a reference
 // actor r in T time units, and the throughput is F / (q[r]·T) iterations per time unit.
 // A state with nothing in progress and nothing enabled is a deadlock (throughput 0). A
@@ -20,6 +21,7 @@
 #include "hsdf.hpp"
 #include "scc.hpp"
 #include "sdf/throughput.hpp"
+#include "self_timed.hpp"
 
 namespace sdf {
 
@@ -34,121 +36,59 @@ class Component {
  public:
   Component(const Graph& g, const std::vector<ActorId>& actors, const std::vector<uint32_t>& local,
             const std::vector<uint64_t>& times, uint64_t& states, uint64_t max_states)
-      : g_(g), actors_(actors), times_(times), states_(states), max_states_(max_states) {
-    in_.resize(actors.size());
-    out_.resize(actors.size());
-    for (ChannelId c = 0; c < g.channel_count(); ++c) {
-      const Channel& ch = g.channel(c);
-      const uint32_t s = local[ch.src], d = local[ch.dst];
-      if (s == UINT32_MAX || d == UINT32_MAX) continue;
-      const auto id = static_cast<uint32_t>(channels_.size());
-      channels_.push_back(c);
-      out_[s].push_back(id);
-      in_[d].push_back(id);
-    }
+      : g_(g),
+        ports_(g, actors, local),
+        times_(actors.size()),
+        states_(states),
+        max_states_(max_states) {
+    for (size_t i = 0; i < actors.size(); ++i) times_[i] = times[actors[i]];
   }
 
-  bool has_channels() const { return !channels_.empty(); }
+  bool has_channels() const { return ports_.channels() != 0; }
 
   // Firings of actors_[0] and time between two visits of the first repeated state; time 0
   // never happens here (the caller handles all-zero-time components). firings == 0: deadlock.
   std::pair<uint64_t, uint64_t> explore() {
-    const size_t na = actors_.size();
-    tokens_.resize(channels_.size());
-    for (size_t i = 0; i < channels_.size(); ++i) tokens_[i] = g_.channel(channels_[i]).delay;
-    running_.assign(na, {});
+    struct Hooks {
+      uint64_t fired = 0;   // firings of the reference actor (local 0) started
+      uint64_t starts = 0;  // batches started at the current instant
+      void instant() { starts = 0; }
+      void started(uint32_t a, uint64_t k) {
+        // Unreachable in a consistent strongly connected component with a timed actor (its
+        // firings end later, and every other firing depends on them); kept as a guard.
+        if (++starts > 100'000'000)
+          throw Error(Error::Kind::input, "throughput: firings without execution time do not end");
+        if (a == 0) fired = detail::add(fired, k, "the firings of the state-space exploration");
+      }
+      void completed(uint32_t, uint64_t) {}
+    } hooks;
+    detail::SelfTimed<Hooks> run(ports_, g_, times_, hooks,
+                                 "the time of the state-space exploration");
+    run.tokens.resize(ports_.channels());
+    for (size_t i = 0; i < ports_.channels(); ++i)
+      run.tokens[i] = g_.channel(ports_.global[i]).delay;
     std::unordered_map<std::string, std::pair<uint64_t, uint64_t>>
         seen;  // state -> (time, firings)
-    uint64_t now = 0, fired = 0;
+    run.offer_all();
     for (;;) {
-      start_all(fired);
-      bool busy = false;
-      for (const auto& r : running_) busy = busy || !r.empty();
-      if (!busy) return {0, 1};  // deadlock
-      std::string key = encode();
-      const auto [it, fresh] = seen.try_emplace(std::move(key), now, fired);
-      if (!fresh) return {fired - it->second.second, now - it->second.first};
+      run.start_all();
+      if (run.busy == 0) return {0, 1};  // deadlock
+      const auto [it, fresh] = seen.try_emplace(run.encode(), run.now, hooks.fired);
+      if (!fresh) return {hooks.fired - it->second.second, run.now - it->second.first};
       if (++states_ > max_states_)
         throw Error(Error::Kind::limit, "the state space of throughput has more than " +
                                             std::to_string(max_states_) +
                                             " states (the limit of this analysis)");
-      // Advance to the next completion.
-      uint64_t dt = UINT64_MAX;
-      for (const auto& r : running_)
-        if (!r.empty()) dt = std::min(dt, r.front().first);
-      now = detail::add(now, dt, "the time of the state-space exploration");
-      for (size_t a = 0; a < na; ++a) {
-        auto& r = running_[a];
-        for (auto& [rem, n] : r) rem -= dt;
-        while (!r.empty() && r.front().first == 0) {
-          produce(a, r.front().second);
-          r.erase(r.begin());
-        }
-      }
+      run.advance();  // to the next completion
     }
   }
 
  private:
-  void produce(size_t a, uint64_t n) {
-    for (uint32_t c : out_[a]) {
-      const Channel& ch = g_.channel(channels_[c]);
-      tokens_[c] = detail::add_tokens(tokens_[c], n, ch.prd, ch.name);
-    }
-  }
-
-  // Starts every enabled firing; firings without execution time end at once and may enable
-  // more.
-  void start_all(uint64_t& fired) {
-    bool progress = true;
-    uint64_t rounds = 0;
-    while (progress) {
-      progress = false;
-      for (size_t a = 0; a < actors_.size(); ++a) {
-        uint64_t n = UINT64_MAX;
-        for (uint32_t c : in_[a]) n = std::min(n, tokens_[c] / g_.channel(channels_[c]).cns);
-        if (n == 0 || n == UINT64_MAX) continue;
-        for (uint32_t c : in_[a]) tokens_[c] -= n * g_.channel(channels_[c]).cns;
-        if (a == 0) fired = detail::add(fired, n, "the firings of the state-space exploration");
-        const uint64_t t = times_[actors_[a]];
-        if (t == 0) {
-          produce(a, n);
-        } else {
-          auto& r = running_[a];
-          // All started now end together: merge with an entry of the same remaining time.
-          auto it = std::lower_bound(r.begin(), r.end(), t,
-                                     [](const auto& e, uint64_t v) { return e.first < v; });
-          if (it != r.end() && it->first == t)
-            it->second += n;
-          else
-            r.insert(it, {t, n});
-        }
-        progress = true;
-      }
-      if (++rounds > 100'000'000)
-        throw Error(Error::Kind::input, "throughput: firings without execution time do not end");
-    }
-  }
-
-  std::string encode() const {
-    std::string k;
-    auto put = [&](uint64_t v) { k.append(reinterpret_cast<const char*>(&v), sizeof v); };
-    for (uint64_t t : tokens_) put(t);
-    for (const auto& r : running_) {
-      put(r.size());
-      for (const auto& [rem, n] : r) put(rem), put(n);
-    }
-    return k;
-  }
-
   const Graph& g_;
-  const std::vector<ActorId>& actors_;
-  const std::vector<uint64_t>& times_;
+  const detail::TimedPorts ports_;  // the component's actors and the channels between them
+  std::vector<uint64_t> times_;     // per local actor
   uint64_t& states_;
   uint64_t max_states_;
-  std::vector<ChannelId> channels_;
-  std::vector<std::vector<uint32_t>> in_, out_;
-  std::vector<uint64_t> tokens_;
-  std::vector<std::vector<std::pair<uint64_t, uint64_t>>> running_;  // sorted by remaining time
 };
 
 }  // namespace

@@ -1,25 +1,49 @@
 #include "xml_scanner.hpp"
 
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <cstdint>
 #include <cstring>
+
+#include "sdf/text.hpp"
 
 namespace sdf::detail {
 
 namespace {
 
+// Character classes by table (the tokenizer tests every byte of a tag).
+enum : uint8_t { kSpace = 1, kNameStart = 2, kNameChar = 4, kValueStop = 8 };
+constexpr auto kClass = [] {
+  std::array<uint8_t, 256> t{};
+  for (unsigned char c : {' ', '\t', '\n', '\r'}) t[c] = kSpace;
+  // Where a scan of an attribute value stops: a quote, NUL, or what decoding changes.
+  for (unsigned char c : {'"', '\'', '\0', '&', '\t', '\n', '\r'}) t[c] |= kValueStop;
+  // Name characters as pugixml accepts them: ASCII letters, digits (not first), '_', ':', '-',
+  // '.', and every byte of a multi-byte UTF-8 sequence.
+  for (unsigned c = 0; c < 256; ++c)
+    if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' || c == ':' || c >= 0x80)
+      t[c] = kNameStart | kNameChar;
+  for (unsigned char c : {'0', '1', '2', '3', '4', '5', '6', '7', '8', '9', '-', '.'})
+    t[c] |= kNameChar;
+  return t;
+}();
 bool space(char c) {
-  return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+  return kClass[static_cast<unsigned char>(c)] & kSpace;
 }
-// Name characters as pugixml accepts them: ASCII letters, digits (not first), '_', ':', '-',
-// '.', and every byte of a multi-byte UTF-8 sequence.
 bool name_start(char c) {
-  const auto u = static_cast<unsigned char>(c);
-  return (u >= 'a' && u <= 'z') || (u >= 'A' && u <= 'Z') || u == '_' || u == ':' || u >= 0x80;
+  return kClass[static_cast<unsigned char>(c)] & kNameStart;
 }
 bool name_char(char c) {
-  const auto u = static_cast<unsigned char>(c);
-  return name_start(c) || (u >= '0' && u <= '9') || u == '-' || u == '.';
+  return kClass[static_cast<unsigned char>(c)] & kNameChar;
+}
+// The first `c` at or after `from`, or npos. The gaps between tags and attribute values are
+// short: a plain loop first, memchr past that.
+size_t find_char(std::string_view text, char c, size_t from) {
+  const size_t near = std::min(text.size(), from + 32);
+  for (size_t i = from; i < near; ++i)
+    if (text[i] == c) return i;
+  return near == text.size() ? std::string_view::npos : text.find(c, near);
 }
 
 void append_utf8(std::string& out, uint32_t cp) {
@@ -54,13 +78,13 @@ void XmlScanner::skip_until(std::string_view close, size_t from, const char* wha
 
 const XmlAttribute* XmlScanner::attribute(std::string_view name) const {
   for (const XmlAttribute& a : attributes_)
-    if (a.name == name) return &a;
+    if (same(a.name, name)) return &a;
   return nullptr;
 }
 
 XmlScanner::Token XmlScanner::next() {
   for (;;) {
-    const size_t lt = text_.find('<', pos_);
+    const size_t lt = find_char(text_, '<', pos_);
     if (lt == std::string_view::npos) {
       if (!open_.empty()) fail(text_.size(), "Start-end tags mismatch (an element is not closed)");
       pos_ = text_.size();
@@ -148,13 +172,23 @@ XmlScanner::Token XmlScanner::start_tag(size_t lt) {
     if (i >= text_.size() || (text_[i] != '"' && text_[i] != '\''))
       fail(an, "Attribute value is not properly quoted");
     const char quote = text_[i++];
-    const size_t close = text_.find(quote, i);
-    if (close == std::string_view::npos) fail(an, "Error parsing attribute value");
+    // One pass to the closing quote, noting what decoding would change and any NUL.
+    bool plain = true, nul = false;
+    size_t close = i;
+    for (;; ++close) {
+      while (close < text_.size() &&
+             !(kClass[static_cast<unsigned char>(text_[close])] & kValueStop))
+        ++close;
+      if (close >= text_.size() || text_[close] == quote) break;
+      if (text_[close] == '\0') nul = true;
+      if (text_[close] != '"' && text_[close] != '\'') plain = false;
+    }
+    if (close >= text_.size()) fail(an, "Error parsing attribute value");
     const std::string_view raw = text_.substr(i, close - i);
     // XML has no NUL character; pugixml's tree cut values at one, which made names change
     // between a read and a write (found by fuzzing).
-    if (raw.find('\0') != std::string_view::npos) fail(an, "Error parsing attribute value (NUL)");
-    if (!attribute(name)) attributes_.push_back({name, raw});
+    if (nul) fail(an, "Error parsing attribute value (NUL)");
+    if (!attribute(name)) attributes_.push_back({name, raw, plain});
     i = close + 1;
   }
   pos_ = t.end;

@@ -21,6 +21,7 @@ namespace sdf::detail {
 struct XmlAttribute {
   std::string_view name;
   std::string_view raw;  // between the quotes, undecoded (see decode_attribute)
+  bool plain = false;    // no reference, tab or line end: decode_attribute would return raw
 };
 
 struct XmlError {

@@ -120,7 +120,7 @@ TEST(Buffers, BoundedGraphAddsReverseChannels) {
   EXPECT_EQ(b.channel(1).prd, 3u);
   EXPECT_EQ(b.channel(1).cns, 2u);
   EXPECT_EQ(b.channel(1).delay, 4u);
-  EXPECT_EQ(b.channel(1).name, "A->B#0#space");
+  EXPECT_EQ(std::string(b.channel_name(1)), "A->B#0#space");
   EXPECT_THROW(bounded_graph(g, std::vector<uint64_t>{0}), Error);  // below the delay
 }
 

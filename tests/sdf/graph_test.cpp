@@ -10,11 +10,59 @@ namespace {
 TEST(Graph, DefaultChannelNamesCountParallelChannels) {
   const Graph g =
       test::make({"A", "B"}, {{"A", "B", 1, 1, 0}, {"A", "B", 2, 2, 0}, {"B", "A", 1, 1, 1}});
-  EXPECT_EQ(g.channel(0).name, "A->B#0");
-  EXPECT_EQ(g.channel(1).name, "A->B#1");
-  EXPECT_EQ(g.channel(2).name, "B->A#0");
+  EXPECT_EQ(std::string(g.channel_name(0)), "A->B#0");
+  EXPECT_EQ(std::string(g.channel_name(1)), "A->B#1");
+  EXPECT_EQ(std::string(g.channel_name(2)), "B->A#0");
   EXPECT_EQ(g.find_channel("A->B#1"), 1u);
   EXPECT_FALSE(g.find_channel("A->B#2"));
+}
+
+// The count k of `src->dst#k` includes the named channels before it, also when every channel so
+// far was named (the counts are only kept from the first default name on) and in the bulk form.
+TEST(Graph, DefaultNamesCountNamedChannelsToo) {
+  for (bool bulk : {false, true}) {
+    Graph g;
+    g.add_actor("A");
+    g.add_actor("B");
+    g.add_channel(0, 1, 1, 1, 0, "x");
+    g.add_channel(1, 0, 1, 1, 0, "y");
+    if (bulk) {
+      const Graph::NewChannel cs[] = {
+          {0, 1, 1, 1, 0, ""}, {0, 1, 1, 1, 0, "z"}, {0, 1, 1, 1, 0, ""}};
+      EXPECT_EQ(g.add_channels(cs), 3u);
+    } else {
+      g.add_channel(0, 1, 1, 1, 0);
+      g.add_channel(0, 1, 1, 1, 0, "z");
+      g.add_channel(0, 1, 1, 1, 0);
+    }
+    EXPECT_EQ(g.channel_name(2), "A->B#1");
+    EXPECT_EQ(g.channel_name(4), "A->B#3");
+    EXPECT_THROW(g.add_channel(0, 1, 1, 1, 0, "A->B#3"), Error);
+    EXPECT_EQ(g.add_channel(0, 1, 1, 1, 0), 5u);  // a refused channel is not counted
+    EXPECT_EQ(g.channel_name(5), "A->B#4");
+    EXPECT_EQ(g.channel_name(1), "y");
+  }
+}
+
+// Names live in columns: a value set again replaces the old one, a view of the graph's own
+// names may be passed back in, and copies keep their names.
+TEST(Graph, NameColumnsKeepEveryName) {
+  Graph g = test::make({"A", "B"}, {{"A", "B", 1, 1, 0}, {"B", "A", 1, 1, 1}});
+  EXPECT_EQ(g.actor_type(0), "");
+  g.set_actor_type(0, "a-long-type-name-beyond-any-small-buffer");
+  g.set_actor_type(1, g.actor_type(0));  // a view into the column being appended to
+  g.set_actor_type(0, "t");
+  EXPECT_EQ(g.actor_type(0), "t");
+  EXPECT_EQ(g.actor_type(1), "a-long-type-name-beyond-any-small-buffer");
+  EXPECT_EQ(g.src_port(1), "");
+  g.set_port_names(1, "o", "i");
+  g.set_port_names(0, "out", "in");
+  g.set_port_names(1, "o2", "i2");
+  const Graph copy = g;
+  EXPECT_EQ(copy.src_port(0), "out");
+  EXPECT_EQ(copy.dst_port(1), "i2");
+  EXPECT_EQ(copy.channel_name(1), "B->A#0");
+  EXPECT_EQ(copy.actor_type(1), "a-long-type-name-beyond-any-small-buffer");
 }
 
 TEST(Graph, RejectsDuplicatesAndZeroRates) {

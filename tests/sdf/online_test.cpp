@@ -83,7 +83,7 @@ TEST(Online, ASourceFeedingAStarvedCycleGrowsWithoutBound) {
   const auto q = compute_repetitions(g).q;
   const OnlineRun r = run_online(g, q, options(FiringRule::floor_key, false));
   ASSERT_EQ(r.outcome, Outcome::unbounded);
-  EXPECT_EQ(g.channel(*r.channel).name, "S->X#0");
+  EXPECT_EQ(std::string(g.channel_name(*r.channel)), "S->X#0");
   expect_checked(g, q, r);
 }
 

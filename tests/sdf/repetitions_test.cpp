@@ -22,8 +22,10 @@ bool balanced(uint64_t q_src, uint64_t prd, uint64_t q_dst, uint64_t cns) {
 // one-dimensional lattice).
 void expect_primitive_solution(const Graph& g, const std::vector<uint64_t>& q) {
   ASSERT_EQ(q.size(), g.actor_count());
-  for (const Channel& c : g.channels())
-    EXPECT_TRUE(balanced(q[c.src], c.prd, q[c.dst], c.cns)) << c.name;
+  for (ChannelId id = 0; id < g.channel_count(); ++id) {
+    const Channel& c = g.channel(id);
+    EXPECT_TRUE(balanced(q[c.src], c.prd, q[c.dst], c.cns)) << g.channel_name(id);
+  }
   const Adjacency adj(g);
   const Components comp = connected_components(g, adj);
   std::vector<uint64_t> gcd(comp.count, 0);

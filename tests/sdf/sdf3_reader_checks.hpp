@@ -20,12 +20,15 @@ inline std::string outcome(const std::function<Graph()>& read) {
     std::string out = "graph '" + g.name + "':";
     for (ActorId a = 0; a < g.actor_count(); ++a) out += " " + g.actor_name(a);
     for (ActorId a = 0; a < g.actor_count(); ++a)
-      out += " " + g.actor_name(a) + ":" + g.actor_type(a) + ":" +
+      out += " " + g.actor_name(a) + ":" + std::string(g.actor_type(a)) + ":" +
              (g.actor_time(a) ? std::to_string(*g.actor_time(a)) : "-");
-    for (const Channel& c : g.channels())
+    for (ChannelId id = 0; id < g.channel_count(); ++id) {
+      const Channel& c = g.channel(id);
       out += " [" + std::to_string(c.src) + ">" + std::to_string(c.dst) + " " +
              std::to_string(c.prd) + "/" + std::to_string(c.cns) + "+" + std::to_string(c.delay) +
-             " " + c.name + " " + c.src_port + " " + c.dst_port + "]";
+             " " + std::string(g.channel_name(id)) + " " + std::string(g.src_port(id)) + " " +
+             std::string(g.dst_port(id)) + "]";
+    }
     out += " props " + g.sdf3_properties;
     return out;
   } catch (const Error& e) {

@@ -47,8 +47,8 @@ TEST(StaticSchedule, DeadlockNamesTheStuckActorsAndAStarvedCycle) {
   // downstream of them too.
   EXPECT_EQ(s.stuck, (std::vector<ActorId>{1, 2, 3}));
   ASSERT_EQ(s.starved_cycle.size(), 2u);
-  EXPECT_EQ(g.channel(s.starved_cycle[0]).name, "P->Q#0");
-  EXPECT_EQ(g.channel(s.starved_cycle[1]).name, "Q->P#0");
+  EXPECT_EQ(std::string(g.channel_name(s.starved_cycle[0])), "P->Q#0");
+  EXPECT_EQ(std::string(g.channel_name(s.starved_cycle[1])), "Q->P#0");
 }
 
 TEST(StaticSchedule, SelfLoopsThatGainOrLoseTokens) {

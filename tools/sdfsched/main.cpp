@@ -69,8 +69,8 @@ Json per_actor(const sdf::Graph& g, std::span<const uint64_t> v) {
 
 Json per_channel(const sdf::Graph& g, std::span<const uint64_t> v) {
   return keyed(
-      g.channel_count(), [&](size_t c) { return g.channel(static_cast<sdf::ChannelId>(c)).name; },
-      v);
+      g.channel_count(),
+      [&](size_t c) { return std::string(g.channel_name(static_cast<sdf::ChannelId>(c))); }, v);
 }
 
 Json actor_list(const sdf::Graph& g, std::span<const sdf::ActorId> actors) {
@@ -96,7 +96,7 @@ Json run_list(const sdf::Graph& g, std::span<const sdf::Run> runs) {
 
 std::string describe_channel(const sdf::Graph& g, sdf::ChannelId c) {
   const sdf::Channel& ch = g.channel(c);
-  std::string s = "'" + ch.name + "' (";
+  std::string s = "'" + std::string(g.channel_name(c)) + "' (";
   s += g.actor_name(ch.src);
   s += " -> ";
   s += g.actor_name(ch.dst);
@@ -116,7 +116,7 @@ Consistency consistency(const sdf::Graph& g, bool json) {
   const sdf::Channel& ch = g.channel(c.rep.channel);
   if (json) {
     print_json({{"consistent", false},
-                {"channel", ch.name},
+                {"channel", g.channel_name(c.rep.channel)},
                 {"src", g.actor_name(ch.src)},
                 {"dst", g.actor_name(ch.dst)},
                 {"prd", ch.prd},
@@ -134,7 +134,7 @@ Consistency consistency(const sdf::Graph& g, bool json) {
 int report_deadlock(const sdf::Graph& g, const sdf::StaticSchedule& s, bool json) {
   if (json) {
     Json cycle = Json::array();
-    for (sdf::ChannelId c : s.starved_cycle) cycle.push_back(g.channel(c).name);
+    for (sdf::ChannelId c : s.starved_cycle) cycle.push_back(std::string(g.channel_name(c)));
     print_json({{"deadlock", true},
                 {"stuck", actor_list(g, s.stuck)},
                 {"starved_cycle", cycle},
@@ -143,7 +143,8 @@ int report_deadlock(const sdf::Graph& g, const sdf::StaticSchedule& s, bool json
   std::string stuck;
   for (sdf::ActorId a : s.stuck) stuck += (stuck.empty() ? "" : ", ") + g.actor_name(a);
   std::string cycle;
-  for (sdf::ChannelId c : s.starved_cycle) cycle += (cycle.empty() ? "" : ", ") + g.channel(c).name;
+  for (sdf::ChannelId c : s.starved_cycle)
+    cycle += (cycle.empty() ? "" : ", ") + std::string(g.channel_name(c));
   std::cerr << "sdfsched: deadlock: stuck actors: " << stuck << "; cycle lacking tokens: " << cycle
             << "\n";
   return 1;
@@ -187,7 +188,7 @@ struct RunFlags {
 void print_text_metrics(const sdf::Graph& g, const sdf::Metrics& m) {
   std::cout << "buffers:";
   for (sdf::ChannelId c = 0; c < g.channel_count(); ++c)
-    std::cout << " " << g.channel(c).name << "=" << m.buffers[c];
+    std::cout << " " << std::string(g.channel_name(c)) << "=" << m.buffers[c];
   std::cout << "\nfairness: max " << m.fairness.max << ", mean " << m.fairness.mean << " over "
             << m.fairness.decisions << " decisions\n";
 }
@@ -241,7 +242,7 @@ int cmd_schedule(const std::string& path, const std::string& policy_text, bool j
       if (!capacity.empty()) {
         std::cout << "within capacities:";
         for (sdf::ChannelId ch = 0; ch < g.channel_count(); ++ch)
-          std::cout << " " << g.channel(ch).name << "=" << capacity[ch];
+          std::cout << " " << std::string(g.channel_name(ch)) << "=" << capacity[ch];
         std::cout << "\n";
       }
       print_text_metrics(g, m);
@@ -335,7 +336,7 @@ int cmd_schedule(const std::string& path, const std::string& policy_text, bool j
     j["cycle_repetitions"] = per_actor(g, run.cycle_fired);
     j["cycle_check"] = cycle_check;
   } else {
-    if (run.channel) j["channel"] = g.channel(*run.channel).name;
+    if (run.channel) j["channel"] = std::string(g.channel_name(*run.channel));
     j["decisions_explored"] = run.decisions_explored;
   }
   j["buffers"] = per_channel(g, run.metrics.buffers);
@@ -479,8 +480,8 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
       std::cout << " rates times " << parsed.num << "/" << parsed.den;
     std::cout << " (";
     for (size_t i = 0; i < rc.rates.size(); ++i)
-      std::cout << (i ? ", " : "") << g.channel(rc.rates[i].channel).name << " " << rc.rates[i].prd
-                << ":" << rc.rates[i].cns;
+      std::cout << (i ? ", " : "") << std::string(g.channel_name(rc.rates[i].channel)) << " "
+                << rc.rates[i].prd << ":" << rc.rates[i].cns;
     std::cout << ") after firing " << rc.at_firing << "\n";
     if (!r.after.consistent) {
       std::cerr << "sdfsched: the changed graph is inconsistent: channel "
@@ -505,7 +506,7 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
       std::cout << "firings until periodic again: none (not periodic)\nperiod after: none\n";
     std::cout << "buffers:";
     for (sdf::ChannelId ch = 0; ch < g.channel_count(); ++ch) {
-      std::cout << " " << g.channel(ch).name << "=" << r.buffers_before[ch] << "->";
+      std::cout << " " << std::string(g.channel_name(ch)) << "=" << r.buffers_before[ch] << "->";
       std::cout << (r.buffers_after.empty() ? std::string("?")
                                             : std::to_string(r.buffers_after[ch]));
     }
@@ -520,7 +521,7 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
     change["factor"] = std::to_string(parsed.num) + "/" + std::to_string(parsed.den);
   Json rates = Json::object();
   for (const sdf::ChannelRates& cr : rc.rates)
-    rates[g.channel(cr.channel).name] = {{"prd", cr.prd}, {"cns", cr.cns}};
+    rates[std::string(g.channel_name(cr.channel))] = {{"prd", cr.prd}, {"cns", cr.cns}};
   change["rates"] = std::move(rates);
   change["at_firing"] = rc.at_firing;
   j["change"] = std::move(change);
@@ -529,7 +530,7 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
   j["buffers_before"] = per_channel(g, r.buffers_before);
   j["consistent_after"] = r.after.consistent;
   if (!r.after.consistent) {
-    j["channel"] = g2.channel(r.after.channel).name;
+    j["channel"] = std::string(g2.channel_name(r.after.channel));
     print_json(j);
     std::cerr << "sdfsched: the changed graph is inconsistent: channel "
               << describe_channel(g2, r.after.channel) << "\n";
@@ -538,7 +539,7 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
   j["repetitions_after"] = per_actor(g2, r.q_after);
   j["outcome"] = sdf::outcome_name(r.outcome);
   if (r.outcome == sdf::Outcome::deadlock) j["stuck"] = actor_list(g2, r.stuck);
-  if (r.channel) j["channel"] = g2.channel(*r.channel).name;
+  if (r.channel) j["channel"] = std::string(g2.channel_name(*r.channel));
   const bool periodic = r.outcome == sdf::Outcome::returns || r.outcome == sdf::Outcome::periodic;
   j["firings_until_periodic"] = periodic ? Json(r.firings_until_periodic) : Json(nullptr);
   j["period_firings"] = periodic ? Json(r.period_firings) : Json(nullptr);
@@ -614,7 +615,7 @@ Json distribution_list(const sdf::Graph& g, const std::vector<std::vector<uint64
 void print_distribution(const sdf::Graph& g, const std::vector<uint64_t>& d) {
   std::cout << " ";
   for (sdf::ChannelId c = 0; c < g.channel_count(); ++c)
-    std::cout << " " << g.channel(c).name << "=" << d[c];
+    std::cout << " " << std::string(g.channel_name(c)) << "=" << d[c];
   std::cout << "\n";
 }
 

@@ -25,8 +25,9 @@ inline bool same(const Graph& a, const Graph& b) {
   for (ChannelId c = 0; c < a.channel_count(); ++c) {
     const Channel &p = a.channel(c), &q = b.channel(c);
     if (p.src != q.src || p.dst != q.dst || p.prd != q.prd || p.cns != q.cns ||
-        p.delay != q.delay || p.name != q.name ||
-        (!p.src_port.empty() && (p.src_port != q.src_port || p.dst_port != q.dst_port)))
+        p.delay != q.delay || a.channel_name(c) != b.channel_name(c) ||
+        (!a.src_port(c).empty() &&
+         (a.src_port(c) != b.src_port(c) || a.dst_port(c) != b.dst_port(c))))
       return false;
   }
   return true;
