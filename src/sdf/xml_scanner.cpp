@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "sdf/text.hpp"
+#include "util/utf8.hpp"
 
 namespace sdf::detail {
 
@@ -44,24 +45,6 @@ size_t find_char(std::string_view text, char c, size_t from) {
   for (size_t i = from; i < near; ++i)
     if (text[i] == c) return i;
   return near == text.size() ? std::string_view::npos : text.find(c, near);
-}
-
-void append_utf8(std::string& out, uint32_t cp) {
-  if (cp < 0x80) {
-    out += static_cast<char>(cp);
-  } else if (cp < 0x800) {
-    out += static_cast<char>(0xC0 | (cp >> 6));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  } else if (cp < 0x10000) {
-    out += static_cast<char>(0xE0 | (cp >> 12));
-    out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  } else {
-    out += static_cast<char>(0xF0 | (cp >> 18));
-    out += static_cast<char>(0x80 | ((cp >> 12) & 0x3F));
-    out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  }
 }
 
 }  // namespace
@@ -252,7 +235,7 @@ std::string_view decode_attribute(std::string_view raw, std::string& storage) {
           std::from_chars(digits.data(), digits.data() + digits.size(), cp, hex ? 16 : 10);
       if (!digits.empty() && ec == std::errc() && p == digits.data() + digits.size() && cp != 0 &&
           cp <= 0x10FFFF && !(cp >= 0xD800 && cp <= 0xDFFF)) {
-        append_utf8(storage, cp);
+        crowddb::append_utf8(storage, cp);
         done = true;
       }
     }

@@ -27,6 +27,7 @@
 
 #include "crowddb/error.hpp"
 #include "io/import/builder.hpp"
+#include "util/utf8.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb::io {
@@ -70,24 +71,6 @@ uint64_t child_hash(uint64_t h, std::string_view escaped_token) {
   h = (h ^ static_cast<unsigned char>('/')) * kFnvPrime;
   for (char c : escaped_token) h = (h ^ static_cast<unsigned char>(c)) * kFnvPrime;
   return h;
-}
-
-void append_utf8(std::string& out, uint32_t cp) {
-  if (cp < 0x80) {
-    out += static_cast<char>(cp);
-  } else if (cp < 0x800) {
-    out += static_cast<char>(0xC0 | (cp >> 6));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  } else if (cp < 0x10000) {
-    out += static_cast<char>(0xE0 | (cp >> 12));
-    out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  } else {
-    out += static_cast<char>(0xF0 | (cp >> 18));
-    out += static_cast<char>(0x80 | ((cp >> 12) & 0x3F));
-    out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  }
 }
 
 uint32_t hex4(std::string_view t, std::size_t i) {
