@@ -584,11 +584,7 @@ class DomReader {
     uint64_t v = 0;
     const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
     if (ec != std::errc() || ptr != text.data() + text.size() || (positive && v == 0)) {
-      std::string msg = "attribute " + std::string(attr) + "='" + std::string(text) +
-                        "' is not a " + (positive ? "positive" : "non-negative") +
-                        " 64-bit integer";
-      if (text.find(',') != std::string_view::npos) msg += " (CSDF rate lists are not supported)";
-      fail(node, msg);
+      fail(node, not_an_integer(attr, text, positive));
     }
     return v;
   }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -23,6 +24,15 @@ inline bool same(std::string_view a, std::string_view b) {
   for (size_t i = 0; i < a.size(); ++i)
     if (a[i] != b[i]) return false;
   return true;
+}
+
+// The readers' message for an attribute that is not a (positive) 64-bit integer; the DOM twin in
+// naive.cpp must word it the same way.
+inline std::string not_an_integer(std::string_view attr, std::string_view text, bool positive) {
+  std::string msg = "attribute " + std::string(attr) + "='" + std::string(text) + "' is not a " +
+                    (positive ? "positive" : "non-negative") + " 64-bit integer";
+  if (text.find(',') != std::string_view::npos) msg += " (CSDF rate lists are not supported)";
+  return msg;
 }
 
 // Names may not begin or end with white space: the SDF3 reader trims attribute values (XML
