@@ -20,11 +20,7 @@ namespace sdf {
 namespace {
 
 using test::make;
-
-Graph timed(Graph g, std::vector<uint64_t> times) {
-  for (ActorId a = 0; a < g.actor_count(); ++a) g.set_actor_time(a, times[a]);
-  return g;
-}
+using test::timed;
 
 TEST(Buffers, LowerBoundsByHand) {
   const Graph g = make({"A", "B"}, {{"A", "B", 2, 3, 0},

@@ -32,6 +32,12 @@ inline Graph make(std::vector<const char*> actors, std::vector<Edge> edges) {
   return g;
 }
 
+// `g` with execution times `times`, one per actor in actor order.
+inline Graph timed(Graph g, std::vector<uint64_t> times) {
+  for (ActorId a = 0; a < g.actor_count(); ++a) g.set_actor_time(a, times[a]);
+  return g;
+}
+
 inline std::string data(const std::string& name) {
   return std::string(SDF_DATA_DIR) + "/" + name;
 }

@@ -15,11 +15,7 @@ namespace sdf {
 namespace {
 
 using test::make;
-
-Graph timed(Graph g, std::vector<uint64_t> times) {
-  for (ActorId a = 0; a < g.actor_count(); ++a) g.set_actor_time(a, times[a]);
-  return g;
-}
+using test::timed;
 
 TEST(Latency, ChainByHand) {
   // A (2) → B (3) with 1:2, q = (2, 1): both A firings run at once (0–2), B runs 2–5.

@@ -18,11 +18,7 @@ namespace sdf {
 namespace {
 
 using test::make;
-
-Graph timed(Graph g, std::vector<uint64_t> times) {
-  for (ActorId a = 0; a < g.actor_count(); ++a) g.set_actor_time(a, times[a]);
-  return g;
-}
+using test::timed;
 
 // Both methods, which must agree; returns the value.
 std::string both(const Graph& g) {
