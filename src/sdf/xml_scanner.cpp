@@ -171,7 +171,9 @@ XmlScanner::Token XmlScanner::start_tag(size_t lt) {
     // XML has no NUL character; pugixml's tree cut values at one, which made names change
     // between a read and a write (found by fuzzing).
     if (nul) fail(an, "Error parsing attribute value (NUL)");
-    if (!attribute(name)) attributes_.push_back({name, raw, plain});
+    // A repeated name is kept too: attribute() returns the first, as pugixml does, and checking
+    // here would cost time quadratic in a tag's attributes.
+    attributes_.push_back({name, raw, plain});
     i = close + 1;
   }
   pos_ = t.end;

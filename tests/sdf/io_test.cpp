@@ -307,6 +307,23 @@ TEST(Sdf3Reader, StreamingReaderAgreesWithTheDocumentReader) {
   test::streaming_reader_agrees(73, 1500);
 }
 
+// A repeated attribute name: the first one counts, as in the document reader (pugixml), which
+// keeps every attribute. The scanner keeps them all too, without comparing each with the
+// earlier ones (that was quadratic in a tag's attributes).
+TEST(Sdf3Reader, ARepeatedAttributeTakesTheFirstValue) {
+  const std::string text = sdf3(
+      "<actor name='A' name='Z' type='a'><port name='o' type='out' rate='2' rate='5'/></actor>\n"
+      "<actor name='B' type='b' type='c'><port name='i' type='in' rate='3'/></actor>\n"
+      "<channel name='c' name='d' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n");
+  const Graph g = read_sdf3(text, "f.xml");
+  EXPECT_EQ(g.actor_name(0), "A");
+  EXPECT_EQ(g.actor_type(1), "b");
+  EXPECT_EQ(g.channel(0).prd, 2u);
+  EXPECT_EQ(g.channel_name(0), "c");
+  EXPECT_EQ(test::outcome([&] { return read_sdf3(text, "f.xml"); }),
+            test::outcome([&] { return naive::read_sdf3(text, "f.xml"); }));
+}
+
 // Found by fuzzing the streaming reader (inputs in fuzz/corpus/sdf3/): a NUL inside a name was
 // kept, and pugixml's writer cut the name there, so the graph changed in a round trip; an actor
 // without ports made the duplicate-port check step past an empty vector's null data (UBSan).
