@@ -131,14 +131,22 @@ class LineIndex {
   // `text` has been accepted by nlohmann (so it is valid JSON); the scan still never reads past
   // its end.
   LineIndex(std::string_view t, const std::string& file) {
+    // A frame keeps only its own pointer token, not its pointer: copies of the pointer in every
+    // frame took memory quadratic in the depth (a 2 MB file of nested arrays ran out of 24 GB).
     struct Frame {
       bool object;
       uint64_t h;
-      std::string pointer;  // for the duplicate-key message only
+      std::string token;  // how the parent reaches this container (for the message only)
       std::size_t index = 0;
       std::unordered_set<std::string> keys;
     };
     std::vector<Frame> stack;
+    // The pointer of the innermost container, built only for the duplicate-key message.
+    const auto pointer_of_stack = [&] {
+      std::string p;
+      for (std::size_t k = 1; k < stack.size(); ++k) p += "/" + stack[k].token;
+      return p.empty() ? std::string("/") : p;
+    };
     std::size_t i = 0;
     uint32_t ln = 1;
     if (t.substr(0, 3) == "\xEF\xBB\xBF") i = 3;
@@ -149,7 +157,7 @@ class LineIndex {
       }
     };
     uint64_t h = kFnvBasis;
-    std::string pointer;
+    std::string current;  // the pointer token of the value at i
     // Positions i at the next member's value (h, pointer set); false when the text ends.
     const auto next_member = [&](Frame& f) {
       std::string token;
@@ -159,8 +167,7 @@ class LineIndex {
         i = read_string(t, i, &key);
         if (!f.keys.insert(key).second)
           throw Error(Error::Kind::input, file + ":" + std::to_string(ln) + ": " +
-                                              (f.pointer.empty() ? "/" : f.pointer) +
-                                              ": duplicate key \"" + key +
+                                              pointer_of_stack() + ": duplicate key \"" + key +
                                               "\" (Vadere rejects repeated keys)");
         ws();
         if (i >= t.size() || t[i] != ':') return false;
@@ -171,7 +178,7 @@ class LineIndex {
         token = std::to_string(f.index);
       }
       h = child_hash(f.h, token);
-      pointer = f.pointer + "/" + token;
+      current = std::move(token);
       return true;
     };
     ws();
@@ -181,7 +188,7 @@ class LineIndex {
       const char c = t[i];
       bool descended = false;
       if (c == '{' || c == '[') {
-        stack.push_back(Frame{c == '{', h, pointer, 0, {}});
+        stack.push_back(Frame{c == '{', h, std::move(current), 0, {}});
         ++i;
         ws();
         if (i < t.size() && (t[i] == '}' || t[i] == ']')) {

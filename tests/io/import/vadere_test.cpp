@@ -712,6 +712,10 @@ TEST(VadereImport, BadInputNamesFileAndLine) {
        "string literal"},
       {"{\n  \"name\": \"x\",\n  \"scenario\": {\"topography\": {}},\n  \"name\": \"y\"\n}",
        "\"name\": \"y\"", "/: duplicate key \"name\" (Vadere rejects repeated keys)"},
+      {"{\n  \"name\": \"x\",\n  \"scenario\": {\"topography\": {\"obstacles\": [{\"id\": 1,\n"
+       "  \"i~d/\": {}, \"i~d/\": 2}]}}\n}",
+       "\"i~d/\": {}",
+       "/scenario/topography/obstacles/0: duplicate key \"i~d/\" (Vadere rejects repeated keys)"},
       {"{\n  \"description\": \"\",\n  \"scenario\": {\"topography\": {}}\n}", "{",
        "/: missing \"name\" (a string)"},
       {"{\n  \"name\": \"x\",\n  \"scenario\": {\n    \"attributesSimulation\": {}\n  }\n}",
@@ -769,6 +773,16 @@ TEST(VadereImport, BadInputNamesFileAndLine) {
             : "t.scenario:" + std::to_string(line_of(c.text, c.marker)) + ": " + c.message;
     EXPECT_EQ(error_of(c.text), expected);
   }
+}
+
+// Deep nesting costs memory in proportion to the text: the line index kept a copy of the JSON
+// pointer in every open container, which grew with the square of the depth (a 2 MB file of
+// nested arrays took 24 GB; this one, 100,000 deep, would take 20 GB).
+TEST(VadereImport, DeeplyNestedValuesCostLinearMemory) {
+  const std::size_t depth = 100000;
+  const std::string text = "{\"name\": \"x\", \"description\": " + std::string(depth, '[') +
+                           std::string(depth, ']') + "}";
+  EXPECT_EQ(error_of(text), "t.scenario:1: /description: expected a string, got array");
 }
 
 // Elements Vadere has and crowddb does not: one warning each, naming file, line and element.
