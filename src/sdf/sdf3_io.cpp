@@ -706,8 +706,21 @@ std::string write_sdf3(const Graph& g) {
       e.append_attribute("initialTokens") = static_cast<unsigned long long>(ch.delay);
   }
   write_properties(g, app);
+  // Indented, unless <sdfProperties> nests deeper than any real file: indentation grows with
+  // the depth on every line, so a 4 MB file of 300,000 nested elements would have been written
+  // as tens of gigabytes. Unindented, the output stays in proportion to the graph.
+  struct Depth : pugi::xml_tree_walker {
+    int deepest = 0;
+    bool for_each(pugi::xml_node&) override {
+      deepest = std::max(deepest, depth());
+      return true;
+    }
+  } depth;
+  app.child("sdfProperties").traverse(depth);  // iterative in pugixml: no recursion
+  constexpr int kIndentDepth = 32;
   std::ostringstream out;
-  doc.save(out, "  ", pugi::format_default, pugi::encoding_utf8);
+  doc.save(out, "  ", depth.deepest > kIndentDepth ? pugi::format_raw : pugi::format_default,
+           pugi::encoding_utf8);
   return out.str();
 }
 

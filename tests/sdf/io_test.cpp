@@ -307,6 +307,30 @@ TEST(Sdf3Reader, StreamingReaderAgreesWithTheDocumentReader) {
   test::streaming_reader_agrees(73, 1500);
 }
 
+// Deeply nested <sdfProperties> are written unindented: indentation grows with the depth on
+// every line, and 300,000 nested elements (4 MB) were written as tens of gigabytes. Shallow
+// ones stay indented.
+TEST(Writers, DeepPropertiesAreWrittenInProportion) {
+  const char* kChannel = "<channel name='c' srcActor='A' srcPort='o' dstActor='B' dstPort='i'/>\n";
+  const size_t depth = 100000;
+  std::string nested;
+  for (size_t i = 0; i < depth; ++i) nested += "<b>";
+  for (size_t i = 0; i < depth; ++i) nested += "</b>";
+  const std::string text =
+      "<?xml version='1.0'?>\n<sdf3 type='sdf' version='1.0'>\n<applicationGraph name='g'>\n"
+      "<sdf name='g' type='g'>\n" +
+      std::string(kTwo) + kChannel + "</sdf>\n<sdfProperties>" + nested +
+      "</sdfProperties>\n</applicationGraph>\n</sdf3>\n";
+  const Graph g = read_sdf3(text, "f.xml");
+  const std::string out = write_sdf3(g);
+  EXPECT_LT(out.size(), 2 * text.size());
+  EXPECT_EQ(write_sdf3(read_sdf3(out, "out.xml")), out);
+  EXPECT_EQ(read_sdf3(out, "out.xml").sdf3_properties, g.sdf3_properties);
+  // A real file's properties keep the indented form.
+  EXPECT_NE(write_sdf3(read_sdf3(sdf3(std::string(kTwo) + kChannel), "f.xml")).find("\n    <sdf "),
+            std::string::npos);
+}
+
 // A repeated attribute name: the first one counts, as in the document reader (pugixml), which
 // keeps every attribute. The scanner keeps them all too, without comparing each with the
 // earlier ones (that was quadratic in a tag's attributes).
