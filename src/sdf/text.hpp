@@ -26,8 +26,8 @@ inline bool same(std::string_view a, std::string_view b) {
   return true;
 }
 
-// The readers' message for an attribute that is not a (positive) 64-bit integer; the DOM twin in
-// naive.cpp must word it the same way.
+// The readers' message for an attribute that is not a (positive) 64-bit integer (the streaming
+// reader and its DOM twin in naive.cpp, whose messages the tests compare).
 inline std::string not_an_integer(std::string_view attr, std::string_view text, bool positive) {
   std::string msg = "attribute " + std::string(attr) + "='" + std::string(text) + "' is not a " +
                     (positive ? "positive" : "non-negative") + " 64-bit integer";
