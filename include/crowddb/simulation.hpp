@@ -120,15 +120,17 @@ struct NavigationParams {
 // Stalemates (issue "crowds that flow"): an agent that gets no closer to its current waypoint
 // for `after` seconds, frozen or not, and is not just queueing behind someone walking its way,
 // is stalled. With `resolve`, a stalled agent that has a stalled neighbour of higher seeded
-// priority in its way yields (steps aside for yield_time), otherwise it sidesteps at a seeded
-// angle (for sidestep_time); with navigation, one that stays stalled re-plans
-// (NavigationParams::replan_after). src/sim/stalemate.hpp has the detail.
+// priority in its way yields (steps aside for yield_time in a jam, head_on_yield_time where two
+// streams meet head-on), otherwise it sidesteps at a seeded angle (for sidestep_time); with
+// navigation, one that stays stalled re-plans (NavigationParams::replan_after).
+// src/sim/stalemate.hpp has the detail.
 struct StallParams {
   double after = 4;       // [s] (> 0)
   double progress = 0.1;  // [m] getting this much closer than ever counts as progress (> 0)
   bool resolve = true;
-  double yield_time = 1.5;     // [s] (> 0)
-  double sidestep_time = 1.5;  // [s] (> 0)
+  double yield_time = 1.5;          // [s] a yield in a jam (an arch at a door) (> 0)
+  double head_on_yield_time = 1.5;  // [s] a yield where two streams meet head-on (> 0)
+  double sidestep_time = 1.5;       // [s] (> 0)
 };
 
 struct SimConfig {

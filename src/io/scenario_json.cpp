@@ -989,6 +989,7 @@ Scenario parse_document(std::string_view text, const std::string& source, const 
     sp.progress = st.positive("progress", sp.progress);
     sp.resolve = st.boolean("resolve", sp.resolve);
     sp.yield_time = st.positive("yield_time", sp.yield_time);
+    sp.head_on_yield_time = st.positive("head_on_yield_time", sp.head_on_yield_time);
     sp.sidestep_time = st.positive("sidestep_time", sp.sidestep_time);
     st.finish();
   }

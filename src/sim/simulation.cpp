@@ -86,6 +86,8 @@ void SimConfig::validate() const {
   require(std::isfinite(stall.progress) && stall.progress > 0, "stall/progress", "must be > 0");
   require(std::isfinite(stall.yield_time) && stall.yield_time > 0, "stall/yield_time",
           "must be > 0");
+  require(std::isfinite(stall.head_on_yield_time) && stall.head_on_yield_time > 0,
+          "stall/head_on_yield_time", "must be > 0");
   require(std::isfinite(stall.sidestep_time) && stall.sidestep_time > 0, "stall/sidestep_time",
           "must be > 0");
   const NavigationParams& n = navigation;
@@ -101,8 +103,9 @@ void SimConfig::validate() const {
   require(std::isfinite(n.sight_interval) && n.sight_interval >= 0, "navigation/sight_interval",
           "must be >= 0");
   // Durations become tick counts: keep them representable.
-  for (double d : {gridlock_time, nudge_after, stall.after, stall.yield_time, stall.sidestep_time,
-                   n.latency, n.replan_after, n.sight_interval})
+  for (double d :
+       {gridlock_time, nudge_after, stall.after, stall.yield_time, stall.head_on_yield_time,
+        stall.sidestep_time, n.latency, n.replan_after, n.sight_interval})
     require(d / dt < 1e9, "dt", "is too small for the durations given (over 10^9 ticks)");
 }
 

@@ -223,7 +223,8 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
       t.stall_action[i] = jammed[q] ? StallAction::yield_ahead : StallAction::yield;
       t.stall_dir_x[i] = yx;
       t.stall_dir_y[i] = yy;
-      t.stall_until[i] = tick + cfg.ticks_for(cfg.stall.yield_time);
+      t.stall_until[i] =
+          tick + cfg.ticks_for(jammed[q] ? cfg.stall.yield_time : cfg.stall.head_on_yield_time);
       ++c.yielding;
     } else if (blocker_stalled) {
       continue;  // the blocker yields to this one

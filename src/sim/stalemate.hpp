@@ -19,9 +19,11 @@
 // nearest to getting through, as in orca's right of way); ties go by a seeded rank (a hash of
 // seed and id):
 //   - the blocker is stalled too and goes first: yield, i.e. step back from it and to the side
-//     away from it at half speed for yield_time; when the chain of stalled blockers in front
-//     ends in people going its way or across (an arch at a door, not two streams head-on), the
-//     yield goes first in orca, so that the people behind it make room (yield_ahead);
+//     away from it at half speed; when the chain of stalled blockers in front ends in people
+//     going its way or across (an arch at a door, not two streams head-on), the yield lasts
+//     yield_time and goes first in orca, so that the people behind it make room (yield_ahead);
+//     head-on it lasts head_on_yield_time (the same by default; shorter helps dense counter-flow
+//     and hurts doors with mixed destinations, measured in docs/verify.md);
 //   - the blocker is stalled too and goes second: keep going (the blocker yields);
 //   - no blocker and already walking towards the target at half its preferred speed or more:
 //     nothing (it is walking back to where a counter-stream carried it from; it stays counted as

@@ -170,6 +170,7 @@ TEST(ScenarioJson, InvalidFieldsNameTheirPointer) {
        "/bounds: coordinates must lie within +-1e9 m (got -1e+308)"},
       {head + R"("steering": {"cfsm": {"time_gap": -1}}})", "/steering/cfsm/time_gap"},
       {head + R"("stall": {"after": 0}})", "/stall/after"},
+      {head + R"("stall": {"head_on_yield_time": 0}})", "/stall/head_on_yield_time"},
       {R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "area": [[0,0],[4,4],[4,0],[0,3]]}]})",
        "/goals/0/area: polygon is not simple"},
       {R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "area": [[0,0],[2,0],[2,2]], "x": 5, "y": 5}]})",

@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <tuple>
+
+#include "sim/stages.hpp"
+
 namespace crowddb::sim {
 namespace {
 
@@ -73,6 +77,67 @@ TEST(Stalemates, AnAgentWalkingTowardsABlockerStillSidesteps) {
   EXPECT_EQ(c.stalled, 1u);
   EXPECT_EQ(c.sidestepping, 1u);
   EXPECT_EQ(s.action(), StallAction::sidestep);
+}
+
+// Two stalled agents touching (0.05 m apart): a at (ax, ay) heading for goal ga, b at (bx, by)
+// heading for goal gb; goals W (0, 5) and E (39, 5) far west and east, S (5, -20) far south. Both
+// have made no progress for 6 s.
+struct Pair {
+  World w{Bounds{-1, -25, 40, 30}};
+  SimConfig cfg;
+  Executor ex{1};
+  std::unique_ptr<NeighbourPath> path = neighbour_method("naive", 2).make();
+  QueryStats stats;
+
+  Pair(double ax, double ay, uint32_t ga, double bx, double by, uint32_t gb) {
+    w.add_goal({"W", 0, 5, 0.5, 1, {}});
+    w.add_goal({"E", 39, 5, 0.5, 1, {}});
+    w.add_goal({"S", 5, -20, 0.5, 1, {}});
+    for (auto [x, y, g] : {std::tuple{ax, ay, ga}, std::tuple{bx, by, gb}}) {
+      AgentSpec a;
+      a.x = x;
+      a.y = y;
+      a.pref_speed = 1.3;
+      a.max_speed = 1.3;
+      a.radius = 0.25;
+      a.goal = g;
+      w.insert(a);
+    }
+    w.apply_pending();
+    AgentTable& t = w.agents_for_tick();
+    for (std::size_t i = 0; i < 2; ++i) {
+      t.progress_best[i] = path_left(t, w.goals(), i);
+      t.stall_ticks[i] = static_cast<uint32_t>(cfg.ticks_for(6.0));
+    }
+  }
+
+  StallCounts run() { return stalemates(w, cfg, 100, *path, ex, stats); }
+};
+
+TEST(Stalemates, AHeadOnYieldLastsHeadOnYieldTime) {
+  // a (10 m from W) has less path left than b (29.5 m from E): b yields, briefly.
+  Pair s(10, 5, 0, 9.45, 5, 1);
+  s.cfg.stall.head_on_yield_time = 0.5;
+  s.cfg.stall.yield_time = 1.5;
+  EXPECT_EQ(s.run().yielding, 1u);
+  const AgentTable& t = s.w.agents();
+  EXPECT_EQ(t.stall_action[0], StallAction::none);
+  EXPECT_EQ(t.stall_action[1], StallAction::yield);
+  EXPECT_EQ(t.stall_until[1], 100 + s.cfg.ticks_for(0.5));
+}
+
+TEST(Stalemates, AYieldInAJamLastsYieldTime) {
+  // Side by side, both heading for S 30 m south: each is in the other's way and neither heads at
+  // the other, an arch: the one that yields goes first and yields for yield_time.
+  Pair s(4.7, 10, 2, 5.25, 10, 2);
+  s.cfg.stall.head_on_yield_time = 0.5;
+  s.cfg.stall.yield_time = 1.5;
+  EXPECT_EQ(s.run().yielding, 1u);
+  const AgentTable& t = s.w.agents();
+  const std::size_t y = t.stall_action[0] == StallAction::yield_ahead ? 0 : 1;
+  EXPECT_EQ(t.stall_action[y], StallAction::yield_ahead);
+  EXPECT_EQ(t.stall_action[1 - y], StallAction::none);
+  EXPECT_EQ(t.stall_until[y], 100 + s.cfg.ticks_for(1.5));
 }
 
 }  // namespace
