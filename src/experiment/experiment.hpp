@@ -20,12 +20,18 @@ struct Options {
   int threads = 1;
   uint64_t seed = 1;
   std::ostream* log = nullptr;  // progress lines; may be null
+  // Experiments that run scenario documents (fd, bottleneck): the steering models to run (empty:
+  // every model the experiment compares) and fields to set in each document before it is read
+  // ("KEY=VALUE" as crowddb run --set), to validate a parameter set against the data.
+  std::vector<std::string> models;
+  std::vector<std::string> overrides;
 };
 
 struct Experiment {
   std::string name;         // "e1"
   std::string description;  // one line for --help
   std::function<void(const Options&)> run;
+  bool runs_scenarios = false;  // takes Options::models and Options::overrides
 };
 
 // All registered experiments, in name order. Add new ones in registry.cpp.

@@ -27,6 +27,7 @@
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
 #include "experiment/experiment.hpp"
+#include "io/overrides.hpp"
 #include "steer/model.hpp"
 #include "util/rng.hpp"
 
@@ -40,11 +41,19 @@ double weidmann(double rho) {
   return rho <= 0 ? 1.34 : std::max(0.0, 1.34 * (1 - std::exp(-1.913 * (1 / rho - 1 / 5.4))));
 }
 
-std::vector<std::string> models() {
+// The models compared: those asked for, or every model but the thesis's rule (its own units).
+std::vector<std::string> models(const Options& opt) {
+  if (!opt.models.empty()) return opt.models;
   std::vector<std::string> m;
   for (const auto& info : steer::model_registry())
-    if (info.name != "thesis") m.push_back(info.name);  // the thesis's rule: its own units
+    if (info.name != "thesis") m.push_back(info.name);
   return m;
+}
+
+// A document of the experiment, with the fields the user set (Options::overrides).
+Scenario read(json& doc, const Options& opt, const std::string& source) {
+  io::apply_overrides(doc, opt.overrides);
+  return parse_scenario(doc.dump(), source);
 }
 
 }  // namespace
@@ -99,7 +108,7 @@ void run_fd(const Options& opt) {
                        {o0 * std::cos(a1), o0 * std::sin(a1)},
                        {i0 * std::cos(a1), i0 * std::sin(a1)}}}});
   }
-  for (const std::string& model : models())
+  for (const std::string& model : models(opt))
     for (double rho : densities) {
       // Lanes of agents at spacing s = 1 / sqrt(rho), across and along the ring.
       const double s = 1 / std::sqrt(rho);
@@ -135,7 +144,7 @@ void run_fd(const Options& opt) {
                 {"steering", {{"model", model}}},
                 {"goals", goals},
                 {"agents", agents}};
-      Scenario sc = parse_scenario(d.dump(), "fd");
+      Scenario sc = read(d, opt, "fd");
       const uint64_t ticks = sc.ticks, warm_ticks = sc.config.ticks_for(warm, 0);
       const std::size_t n = sc.world.agents().size();
       Simulation sim(std::move(sc.world), sc.config);
@@ -183,7 +192,7 @@ void run_fd(const Options& opt) {
       "weidmann(r) = r <= 0 ? 1.34 : 1.34 * (1 - exp(-1.913 * (1 / r - 1 / 5.4)))\n"
       "plot weidmann(x) with lines lw 2 dt 2 lc rgb 'black' title 'Weidmann 1993'";
   int pt = 5;
-  for (const std::string& m : models())
+  for (const std::string& m : models(opt))
     script += ", \\\n     'fd.csv' using ($1 eq '" + m + "' ? $3 : 1/0):4 skip 1 with points pt " +
               std::to_string(pt++) + " ps 1.5 title '" + m + "'";
   // gnuplot compares strings with eq only inside a ternary on a string column: use strcol.
@@ -206,7 +215,7 @@ void run_bottleneck(const Options& opt) {
         << std::setw(8) << "model" << std::setw(10) << "b [m]" << std::setw(12) << "J [1/s]"
         << std::setw(14) << "J/b [1/(m s)]"
         << "\n";
-  for (const std::string& model : models())
+  for (const std::string& model : models(opt))
     for (double b : widths) {
       const double y0 = 5 - b / 2, y1 = 5 + b / 2, x_exit = 14;
       json d = {
@@ -227,7 +236,7 @@ void run_bottleneck(const Options& opt) {
              {"pref_speed", {1.2, 1.5}},
              {"goal", "out"}}}},
           {"navigation", json::object()}};
-      Scenario sc = parse_scenario(d.dump(), "bottleneck");
+      Scenario sc = read(d, opt, "bottleneck");
       const uint64_t ticks = sc.ticks;
       Simulation sim(std::move(sc.world), sc.config);
       std::unordered_map<uint64_t, double> last_x;
@@ -276,7 +285,7 @@ void run_bottleneck(const Options& opt) {
       "plot 1.9 * x with lines lw 2 dt 2 lc rgb 'black' title 'J = 1.9 b (specific flow as usually "
       "quoted for the Juelich experiments)'";
   int pt = 5;
-  for (const std::string& m : models())
+  for (const std::string& m : models(opt))
     script += ", \\\n     'bottleneck.csv' using (strcol(1) eq '" + m +
               "' ? $2 : 1/0):3 skip 1 with linespoints pt " + std::to_string(pt++) +
               " ps 1.5 title '" + m + "'";

@@ -3,11 +3,11 @@
 
 namespace crowddb::experiment {
 
-void run_e1(const Options& opt);  // e1.cpp
-void run_e2(const Options& opt);  // e2.cpp
-void run_e3(const Options& opt);  // e3.cpp
-void run_e4(const Options& opt);  // e4.cpp
-void run_e5(const Options& opt);  // e5.cpp
+void run_e1(const Options& opt);          // e1.cpp
+void run_e2(const Options& opt);          // e2.cpp
+void run_e3(const Options& opt);          // e3.cpp
+void run_e4(const Options& opt);          // e4.cpp
+void run_e5(const Options& opt);          // e5.cpp
 void run_fd(const Options& opt);          // flows.cpp
 void run_bottleneck(const Options& opt);  // flows.cpp
 
@@ -16,7 +16,7 @@ const std::vector<Experiment>& registry() {
       {"bottleneck",
        "flow through a bottleneck of 0.8-2.5 m per steering model, beside the Juelich specific "
        "flow",
-       run_bottleneck},
+       run_bottleneck, true},
       {"e1",
        "first-to-collide scaling: index build/query vs naive, n = 1,000..15,000 (and 10^6 at E1 "
        "density)",
@@ -30,8 +30,10 @@ const std::vector<Experiment>& registry() {
        run_e4},
       {"e5", "potential-field speed: aggregate index vs naive, density x n = 1, n up to 10^6",
        run_e5},
-      {"fd", "speed against density in a 4 m wide ring corridor (RiMEA 4 with periodic ends) per steering model, beside Weidmann",
-       run_fd},
+      {"fd",
+       "speed against density in a 4 m wide ring corridor (RiMEA 4 with periodic ends) per "
+       "steering model, beside Weidmann",
+       run_fd, true},
   };
   return experiments;
 }

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <unordered_map>
 
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
+#include "io/overrides.hpp"
 #include "path/visibility_graph.hpp"
 #include "util/stopwatch.hpp"
 #include "world/geometry.hpp"
@@ -13,8 +15,12 @@
 namespace crowddb::verify {
 
 RunStats run_scenario(const std::string& json, const std::string& source, const std::string& model,
-                      int threads) {
-  Scenario sc = parse_scenario(json, source);
+                      int threads, const std::vector<std::string>& overrides) {
+  Scenario sc = overrides.empty() ? parse_scenario(json, source) : [&] {
+    nlohmann::json doc = nlohmann::json::parse(json);
+    io::apply_overrides(doc, overrides);
+    return parse_scenario(doc.dump(), source);
+  }();
   if (!model.empty()) sc.config.steering.model = model;
   sc.config.threads = threads;
   RunStats r;
@@ -102,9 +108,7 @@ std::vector<Check> standard_checks(const RunStats& r, const Limits& l) {
     }
     return std::pair{mean, worst};
   };
-  auto over = [](double a, double b) {
-    return std::isfinite(b) && b > 0 ? a / b : std::nan("");
-  };
+  auto over = [](double a, double b) { return std::isfinite(b) && b > 0 ? a / b : std::nan(""); };
   const auto time = ratios([&](std::size_t i) { return over(r.arrival[i], r.free_time[i]); });
   const auto path = ratios([&](std::size_t i) { return over(r.walked[i], r.shortest[i]); });
   if (l.time_mean > 0) c.push_back({"arrival / free-flow time (mean)", time.first, 0, l.time_mean});
@@ -114,12 +118,13 @@ std::vector<Check> standard_checks(const RunStats& r, const Limits& l) {
   return c;
 }
 
-CaseResult run_case(const Case& c, const std::string& model, int threads) {
+CaseResult run_case(const Case& c, const std::string& model, int threads,
+                    const std::vector<std::string>& overrides) {
   Stopwatch sw;
   std::vector<RunStats> runs;
   for (std::size_t k = 0; k < c.scenarios.size(); ++k)
-    runs.push_back(
-        run_scenario(c.scenarios[k], "verify/" + c.name + "#" + std::to_string(k), model, threads));
+    runs.push_back(run_scenario(c.scenarios[k], "verify/" + c.name + "#" + std::to_string(k), model,
+                                threads, overrides));
   CaseResult res{c.name, c.family, model, c.evaluate(runs), 0};
   res.wall_seconds = sw.seconds();
   return res;

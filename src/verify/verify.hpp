@@ -54,9 +54,10 @@ struct Case {
 
 const std::vector<Case>& cases();
 
-// Runs one scenario document under `model` ("" keeps the document's).
+// Runs one scenario document under `model` ("" keeps the document's), after setting the fields
+// `overrides` names ("KEY=VALUE", as crowddb run --set; io/overrides.hpp).
 RunStats run_scenario(const std::string& json, const std::string& source, const std::string& model,
-                      int threads);
+                      int threads, const std::vector<std::string>& overrides = {});
 
 struct CaseResult {
   std::string name, family, model;
@@ -68,7 +69,8 @@ struct CaseResult {
     return true;
   }
 };
-CaseResult run_case(const Case& c, const std::string& model, int threads);
+CaseResult run_case(const Case& c, const std::string& model, int threads,
+                    const std::vector<std::string>& overrides = {});
 
 // Limits of the checks every case shares. Time: each agent's arrival time over its free-flow
 // time (shortest path / pref_speed); path: its walked length over its shortest path. Encounters

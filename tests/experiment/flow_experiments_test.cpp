@@ -54,5 +54,28 @@ TEST(FlowExperiments, BottleneckQuick) {
   EXPECT_GT(std::filesystem::file_size(dir / "out" / "bottleneck.png"), 1000u);
 }
 
+// --model picks the models and --set reaches every run: a 2 s time gap keeps people about 2.6 m
+// apart at full speed, so the ring at 1 per m^2 walks far below its 1.07 m/s without it.
+TEST(FlowExperiments, ModelAndSetReachTheRuns) {
+  TempDir dir;
+  const CliResult r =
+      run_cli("experiment fd --quick --model orca --set steering.orca.time_gap=2 --out " +
+                  (dir / "out").string(),
+              dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = csv_rows(dir / "out" / "fd.csv");
+  ASSERT_EQ(rows.size(), 1u + 2);  // orca x densities (1, 3)
+  EXPECT_EQ(rows[1][0], "orca");
+  EXPECT_LT(std::stod(rows[1][3]), 0.8) << "the time gap was not applied";
+  const CliResult e1 =
+      run_cli("experiment e1 --quick --set seed=2 --out " + (dir / "e1").string(), dir);
+  EXPECT_EQ(e1.status, 2);
+  EXPECT_NE(e1.err.find("not to e1"), std::string::npos) << e1.err;
+  const CliResult model =
+      run_cli("experiment fd --quick --set steering.model=cfsm --out " + (dir / "m").string(), dir);
+  EXPECT_EQ(model.status, 2);
+  EXPECT_NE(model.err.find("pick models with --model"), std::string::npos) << model.err;
+}
+
 }  // namespace
 }  // namespace crowddb::test

@@ -71,5 +71,24 @@ TEST(VerifyCli, ListsRunsWritesCsvAndFailsWithStatus3) {
   EXPECT_EQ(test::run_cli("validate " + (dir / "cases" / "u-trap.json").string(), dir).status, 0);
 }
 
+// --set reaches every run of the cases (a pair cannot pass each other in one second), and a bad
+// field is the command's usage error before any case runs.
+TEST(VerifyCli, SetChangesTheRunsAndABadFieldStopsFirst) {
+  test::TempDir dir;
+  const test::CliResult short_run =
+      test::run_cli("verify --case oncoming-pair --set duration=1", dir);
+  EXPECT_EQ(short_run.status, 3) << short_run.out << short_run.err;
+  EXPECT_NE(short_run.out.find("FAIL arrived / agents"), std::string::npos) << short_run.out;
+  const test::CliResult typo =
+      test::run_cli("verify --case oncoming-pair --set steering.orca.time_gapp=1", dir);
+  EXPECT_EQ(typo.status, 1) << typo.out;
+  EXPECT_NE(typo.err.find("--set: /steering/orca/time_gapp: unknown key"), std::string::npos)
+      << typo.err;
+  EXPECT_EQ(typo.out.find("crowddb verify: model"), std::string::npos) << typo.out;
+  const test::CliResult malformed = test::run_cli("verify --set steering", dir);
+  EXPECT_EQ(malformed.status, 2);
+  EXPECT_NE(malformed.err.find("expected KEY=VALUE"), std::string::npos) << malformed.err;
+}
+
 }  // namespace
 }  // namespace crowddb::verify

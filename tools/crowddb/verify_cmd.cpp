@@ -4,13 +4,16 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
 #include "cli_checks.hpp"
 #include "commands.hpp"
 #include "crowddb/error.hpp"
+#include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
+#include "io/overrides.hpp"
 #include "steer/model.hpp"
 #include "verify/verify.hpp"
 
@@ -20,6 +23,7 @@ namespace {
 struct VerifyOptions {
   std::string model;
   std::vector<std::string> cases;
+  std::vector<std::string> overrides;
   std::string csv, write_dir;
   int threads = 1;
   bool list = false, quiet = false;
@@ -72,6 +76,12 @@ int verify_run(const VerifyOptions& o) {
     std::cout << "wrote the scenarios of " << chosen.size() << " cases to " << o.write_dir << "\n";
     return 0;
   }
+  if (!o.overrides.empty() && !chosen.empty()) {
+    // A malformed or invalid --set is the command's error, before any case runs.
+    nlohmann::json doc = nlohmann::json::parse(chosen.front()->scenarios.front());
+    io::apply_overrides(doc, o.overrides);
+    parse_scenario(doc.dump(), "--set");
+  }
   std::vector<std::string> models;
   if (o.model == "all") {
     for (const auto& m : steer::model_registry()) models.push_back(m.name);
@@ -88,7 +98,7 @@ int verify_run(const VerifyOptions& o) {
     std::size_t ok = 0;
     for (const verify::Case* c : chosen) {
       if (!o.quiet) std::cerr << "  running " << c->name << " ...\r" << std::flush;
-      const verify::CaseResult r = verify::run_case(*c, model, o.threads);
+      const verify::CaseResult r = verify::run_case(*c, model, o.threads, o.overrides);
       passed[mi].push_back(r.pass());
       ok += r.pass();
       char head[200];
@@ -137,6 +147,7 @@ void add_verify_command(CLI::App& app, Action& action) {
       "status 3 when a case fails");
   sub->add_option("--model", o.model,
                   "steering model to verify, or 'all' (default: the default model)");
+  add_set_option(sub, o.overrides);
   sub->add_option("--case", o.cases, "run only this case (repeatable; --list shows them)");
   sub->add_option("--csv", o.csv, "also write every check as CSV to this file");
   sub->add_option("--threads", o.threads, "threads (results do not depend on it)")
