@@ -131,6 +131,11 @@ struct StallParams {
   double yield_time = 1.5;          // [s] a yield in a jam (an arch at a door) (> 0)
   double head_on_yield_time = 1.5;  // [s] a yield where two streams meet head-on (> 0)
   double sidestep_time = 1.5;       // [s] (> 0)
+  // [s] Two stalled agents blocking each other who have both been stalled this long take turns:
+  // in every other period of reverse_period the one that would go on yields instead (an order
+  // that has not ended a stalemate in this long is tried the other way). 0 switches it off.
+  double reverse_after = 12;
+  double reverse_period = 3;  // [s] (> 0)
 };
 
 struct SimConfig {

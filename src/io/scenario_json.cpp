@@ -991,6 +991,8 @@ Scenario parse_document(std::string_view text, const std::string& source, const 
     sp.yield_time = st.positive("yield_time", sp.yield_time);
     sp.head_on_yield_time = st.positive("head_on_yield_time", sp.head_on_yield_time);
     sp.sidestep_time = st.positive("sidestep_time", sp.sidestep_time);
+    sp.reverse_after = st.non_negative("reverse_after", sp.reverse_after);
+    sp.reverse_period = st.positive("reverse_period", sp.reverse_period);
     st.finish();
   }
   if (root.has("navigation")) {

@@ -90,6 +90,10 @@ void SimConfig::validate() const {
           "stall/head_on_yield_time", "must be > 0");
   require(std::isfinite(stall.sidestep_time) && stall.sidestep_time > 0, "stall/sidestep_time",
           "must be > 0");
+  require(std::isfinite(stall.reverse_after) && stall.reverse_after >= 0, "stall/reverse_after",
+          "must be >= 0");
+  require(std::isfinite(stall.reverse_period) && stall.reverse_period > 0, "stall/reverse_period",
+          "must be > 0");
   const NavigationParams& n = navigation;
   require(std::isfinite(n.latency) && n.latency >= 0, "navigation/latency", "must be >= 0");
   require(n.budget >= 1, "navigation/budget", "must be >= 1");
@@ -103,9 +107,9 @@ void SimConfig::validate() const {
   require(std::isfinite(n.sight_interval) && n.sight_interval >= 0, "navigation/sight_interval",
           "must be >= 0");
   // Durations become tick counts: keep them representable.
-  for (double d :
-       {gridlock_time, nudge_after, stall.after, stall.yield_time, stall.head_on_yield_time,
-        stall.sidestep_time, n.latency, n.replan_after, n.sight_interval})
+  for (double d : {gridlock_time, nudge_after, stall.after, stall.yield_time,
+                   stall.head_on_yield_time, stall.sidestep_time, stall.reverse_after,
+                   stall.reverse_period, n.latency, n.replan_after, n.sight_interval})
     require(d / dt < 1e9, "dt", "is too small for the durations given (over 10^9 ticks)");
 }
 

@@ -93,6 +93,8 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   AgentTable& t = world.agents_for_tick();
   const auto goals = world.goals();
   const uint64_t after = cfg.ticks_for(cfg.stall.after);
+  const uint64_t reverse_after = cfg.ticks_for(cfg.stall.reverse_after, 0);
+  const uint64_t reverse_period = cfg.ticks_for(cfg.stall.reverse_period);
   StallCounts c;
   // 1. progress watch: each row on its own (in chunks, on every thread), then the stalled rows
   // collected in row order, so the result does not depend on the thread count.
@@ -203,8 +205,13 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     // The one with less of its path left goes first (at a clogged door: the one nearest to
     // getting through), as in orca's right of way; ties by the seeded rank.
     const double li = path_left(t, goals, i), lj = blocker_stalled ? path_left(t, goals, j) : 0;
-    const bool j_first =
+    bool j_first =
         lj < li || (lj == li && priority(cfg.seed, t.id[j]) > priority(cfg.seed, t.id[i]));
+    // Taking turns: a pair both stalled for reverse_after swaps the order in every other period
+    // (the same for both of them: it depends on the pair and the tick only).
+    if (blocker_stalled && reverse_after > 0 && t.stall_ticks[i] >= reverse_after &&
+        t.stall_ticks[j] >= reverse_after && (tick / reverse_period) % 2 == 1)
+      j_first = !j_first;
     if (blocker_stalled && j_first) {
       // Yield: back away from the blocker and to the side it is not on.
       const double rx = t.x[i] - t.x[j], ry = t.y[i] - t.y[j];

@@ -25,6 +25,11 @@
 //     head-on it lasts head_on_yield_time (the same by default; shorter helps dense counter-flow
 //     and hurts doors with mixed destinations, measured in docs/verify.md);
 //   - the blocker is stalled too and goes second: keep going (the blocker yields);
+//   - taking turns: when both have been stalled for reverse_after, the order is swapped in every
+//     other reverse_period. An order that has not ended a stalemate in that long will not: in
+//     dense counter-flow the block that went first pressed the other against the wall at its own
+//     goal, where the people pressed there cannot yield (the wall is behind them) and the ones
+//     with less path left cannot reach it; the other way round, those at the goal step aside;
 //   - no blocker and already walking towards the target at half its preferred speed or more:
 //     nothing (it is walking back to where a counter-stream carried it from; it stays counted as
 //     stalled until it gets there, but a sidestep would only slow it down);

@@ -171,6 +171,8 @@ TEST(ScenarioJson, InvalidFieldsNameTheirPointer) {
       {head + R"("steering": {"cfsm": {"time_gap": -1}}})", "/steering/cfsm/time_gap"},
       {head + R"("stall": {"after": 0}})", "/stall/after"},
       {head + R"("stall": {"head_on_yield_time": 0}})", "/stall/head_on_yield_time"},
+      {head + R"("stall": {"reverse_after": -1}})", "/stall/reverse_after"},
+      {head + R"("stall": {"reverse_period": 0}})", "/stall/reverse_period"},
       {R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "area": [[0,0],[4,4],[4,0],[0,3]]}]})",
        "/goals/0/area: polygon is not simple"},
       {R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "area": [[0,0],[2,0],[2,2]], "x": 5, "y": 5}]})",

@@ -111,7 +111,12 @@ struct Pair {
     }
   }
 
-  StallCounts run() { return stalemates(w, cfg, 100, *path, ex, stats); }
+  StallCounts run(uint64_t tick = 100) { return stalemates(w, cfg, tick, *path, ex, stats); }
+  void stalled_for(double a, double b) {
+    AgentTable& t = w.agents_for_tick();
+    t.stall_ticks[0] = static_cast<uint32_t>(cfg.ticks_for(a));
+    t.stall_ticks[1] = static_cast<uint32_t>(cfg.ticks_for(b));
+  }
 };
 
 TEST(Stalemates, AHeadOnYieldLastsHeadOnYieldTime) {
@@ -138,6 +143,39 @@ TEST(Stalemates, AYieldInAJamLastsYieldTime) {
   EXPECT_EQ(t.stall_action[y], StallAction::yield_ahead);
   EXPECT_EQ(t.stall_action[1 - y], StallAction::none);
   EXPECT_EQ(t.stall_until[y], 100 + s.cfg.ticks_for(1.5));
+}
+
+// Head-on, a (10 m from W) has less path left than b (29.5 m from E), so b yields. Once both
+// have been stalled for reverse_after (12 s), they take turns: in every other reverse_period (3 s,
+// 30 ticks: ticks 30-59, 90-119, ...) a yields instead.
+TEST(Stalemates, APairStalledLongTakesTurnsToYield) {
+  for (uint64_t tick : {0, 29, 60, 89, 120}) {  // even periods: the usual order
+    Pair s(10, 5, 0, 9.45, 5, 1);
+    s.stalled_for(13, 13);
+    EXPECT_EQ(s.run(tick).yielding, 1u);
+    EXPECT_EQ(s.w.agents().stall_action[1], StallAction::yield) << "tick " << tick;
+  }
+  for (uint64_t tick : {30, 59, 90, 119}) {  // odd periods: the other way round
+    Pair s(10, 5, 0, 9.45, 5, 1);
+    s.stalled_for(13, 13);
+    EXPECT_EQ(s.run(tick).yielding, 1u);
+    EXPECT_EQ(s.w.agents().stall_action[0], StallAction::yield) << "tick " << tick;
+    EXPECT_EQ(s.w.agents().stall_action[1], StallAction::none);
+  }
+}
+
+TEST(Stalemates, TurnsStartWhenBothHaveBeenStalledReverseAfter) {
+  for (auto [a, b] : {std::pair{13.0, 11.0}, std::pair{11.0, 13.0}, std::pair{6.0, 6.0}}) {
+    Pair s(10, 5, 0, 9.45, 5, 1);
+    s.stalled_for(a, b);
+    s.run(30);  // an odd period
+    EXPECT_EQ(s.w.agents().stall_action[1], StallAction::yield) << a << " s and " << b << " s";
+  }
+  Pair off(10, 5, 0, 9.45, 5, 1);
+  off.cfg.stall.reverse_after = 0;  // switched off
+  off.stalled_for(60, 60);
+  off.run(30);
+  EXPECT_EQ(off.w.agents().stall_action[1], StallAction::yield);
 }
 
 }  // namespace

@@ -209,6 +209,32 @@ TEST(Orca, AnArchOfMixedDestinationsInFrontOfADoorBreaks) {
   EXPECT_EQ(sim.arrived_total(), 80u);  // measured: the last at 259 s
 }
 
+// Two blocks of 50 meet head-on across a 4 m hallway (scripts/counterflow-scenario.py 50 16 1).
+// The westbound block went first and swept the eastbound one back against the west wall, onto
+// its own goal: the people pressed there cannot yield (the wall is behind them) and the
+// westbound ones cannot reach the wall, so 46 of 100 arrived in 120 s and nothing moved after
+// 60 s. When a pair has been stalled for 12 s the two take turns to yield, and all 100 arrive.
+TEST(Orca, ABlockSweptAgainstTheOthersGoalGetsOut) {
+  const std::string text = R"({"bounds": [0, 0, 16, 4], "duration": 120, "seed": 1,
+    "goals": [{"name": "E", "area": [[15, 0], [16, 0], [16, 4], [15, 4]]},
+              {"name": "W", "area": [[0, 0], [1, 0], [1, 4], [0, 4]]}],
+    "groups": [{"name": "eastbound", "count": 50, "goal": "E", "radius": [0.2, 0.25], "pref_speed": [1.2, 1.4],
+                "placement": {"type": "uniform", "region": [1, 0, 7.5, 4], "gap": 0.05}},
+               {"name": "westbound", "count": 50, "goal": "W", "radius": [0.2, 0.25], "pref_speed": [1.2, 1.4],
+                "placement": {"type": "uniform", "region": [8.5, 0, 15, 4], "gap": 0.05}}]})";
+  for (double reverse_after : {0.0, 12.0}) {
+    Scenario sc = parse_scenario(text, "t.json");
+    sc.config.stall.reverse_after = reverse_after;
+    Simulation sim(std::move(sc.world), sc.config);
+    for (uint64_t tick = 0; tick < sc.ticks && !sim.world().agents().empty(); ++tick)
+      EXPECT_EQ(sim.step().overlapping_pairs, 0u);
+    if (reverse_after == 0)
+      EXPECT_LT(sim.arrived_total(), 60u);  // measured: 46
+    else
+      EXPECT_EQ(sim.arrived_total(), 100u);
+  }
+}
+
 // ORCA's contact planes keep the crowd overlap-free by themselves: the backoff finds nothing.
 TEST(Orca, TheBackoffHasNothingToDoAndEveryoneArrives) {
   std::size_t frozen = 0, arrived = 0;
