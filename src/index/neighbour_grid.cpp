@@ -10,6 +10,7 @@ namespace crowddb::index {
 namespace {
 
 constexpr std::size_t kGrain = 64;
+constexpr std::size_t kCopyGrain = 4096;  // rows per chunk of the lists' compaction
 
 }  // namespace
 
@@ -205,12 +206,14 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
     for (std::size_t i = 0; i < d.n; ++i) out.offset[i + 1] = out.offset[i] + slot_count_[i];
     out.row.resize(out.offset[d.n]);
     out.dist2.resize(out.offset[d.n]);
-    for (std::size_t i = 0; i < d.n; ++i) {
-      std::copy_n(slot_row_.begin() + static_cast<std::ptrdiff_t>(i * k), slot_count_[i],
-                  out.row.begin() + out.offset[i]);
-      std::copy_n(slot_d2_.begin() + static_cast<std::ptrdiff_t>(i * k), slot_count_[i],
-                  out.dist2.begin() + out.offset[i]);
-    }
+    ex.for_each_chunk(d.n, kCopyGrain, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        std::copy_n(slot_row_.begin() + static_cast<std::ptrdiff_t>(i * k), slot_count_[i],
+                    out.row.begin() + out.offset[i]);
+        std::copy_n(slot_d2_.begin() + static_cast<std::ptrdiff_t>(i * k), slot_count_[i],
+                    out.dist2.begin() + out.offset[i]);
+      }
+    });
   } else {
     lists.gather(out, &NeighbourLists::row);
   }

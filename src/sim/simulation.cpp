@@ -22,6 +22,8 @@
 namespace crowddb {
 namespace {
 
+constexpr std::size_t kCommitGrain = 1024;  // rows per chunk of the commit stage
+
 void require(bool ok, const char* field, const std::string& what) {
   if (!ok) throw InvalidRow(field, std::string(field) + " " + what);
 }
@@ -490,55 +492,73 @@ const TickMetrics& Simulation::step() {
     t.vx.swap(e.next.vx);
     t.vy.swap(e.next.vy);
     e.join_idle_groups(world_, cfg, log.at("commit").query);
-    std::vector<std::size_t> leaving;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (t.state[i] == AgentState::arrived) continue;
-      if (e.next.frozen[i]) {
-        ++m.frozen;
-        t.state[i] = AgentState::frozen;
-        ++t.frozen_ticks[i];
-        if (t.frozen_ticks[i] == gridlock_ticks) ++m.gridlock_started;
-        m.longest_frozen = std::max<std::size_t>(m.longest_frozen, t.frozen_ticks[i]);
-      } else {
-        t.state[i] = AgentState::active;
-        t.frozen_ticks[i] = 0;
-      }
-      if (t.frozen_ticks[i] >= gridlock_ticks) ++m.gridlocked;
-      if (e.pref.skip[i] && !t.route[i].empty()) {  // the goal stage saw the waypoint after
-        t.route[i].erase(t.route[i].begin());
-        world_.refresh_target(i);
-      }
-      const double reach = cfg.waypoint_radius > 0 ? cfg.waypoint_radius : t.radius[i];
-      while (!t.route[i].empty() &&
-             std::hypot(t.route[i].front().x - t.x[i], t.route[i].front().y - t.y[i]) <= reach) {
-        t.route[i].erase(t.route[i].begin());
-        world_.refresh_target(i);
-      }
-      if (t.route[i].empty() && (world_.at_goal(i) || e.joined[i])) {
-        if (world_.advance_goal(i)) {
-          // an intermediate goal of its sequence: on to the next one
+    // Each row on its own (in chunks, on every thread: every write is to the row itself); the
+    // counts and the rows leaving are gathered in row order afterwards.
+    struct Part {
+      std::size_t frozen = 0, gridlock_started = 0, longest_frozen = 0, gridlocked = 0, arrived = 0;
+      std::vector<std::size_t> leaving;
+    };
+    std::vector<Part> parts((n + kCommitGrain - 1) / kCommitGrain);
+    e.ex.for_each_chunk(n, kCommitGrain, [&](std::size_t begin, std::size_t end) {
+      Part& c = parts[begin / kCommitGrain];
+      for (std::size_t i = begin; i < end; ++i) {
+        if (t.state[i] == AgentState::arrived) continue;
+        if (e.next.frozen[i]) {
+          ++c.frozen;
+          t.state[i] = AgentState::frozen;
+          ++t.frozen_ticks[i];
+          if (t.frozen_ticks[i] == gridlock_ticks) ++c.gridlock_started;
+          c.longest_frozen = std::max<std::size_t>(c.longest_frozen, t.frozen_ticks[i]);
         } else {
-          ++m.arrived;
-          if (cfg.arrival == ArrivalPolicy::remove) {
-            leaving.push_back(i);
-          } else if (cfg.arrival == ArrivalPolicy::retarget && world_.goals().size() > 1) {
-            // Another goal, from a stream keyed by seed, id and tick: thread- and
-            // order-independent.
-            Rng rng = Rng::stream(cfg.seed ^ (m.tick * 0x9e3779b97f4a7c15ull), t.id[i]);
-            const auto others = static_cast<uint32_t>(world_.goals().size() - 1);
-            const auto pick = static_cast<uint32_t>(rng.below(others));
-            t.goal[i] = pick >= t.goal[i] ? pick + 1 : pick;
-            t.route[i].clear();
-            t.path_goal[i] = AgentTable::kNoPath;  // a new goal: re-plan
-            t.progress_best[i] = INFINITY;
-            t.stall_ticks[i] = 0;
-            world_.refresh_target(i);
+          t.state[i] = AgentState::active;
+          t.frozen_ticks[i] = 0;
+        }
+        if (t.frozen_ticks[i] >= gridlock_ticks) ++c.gridlocked;
+        if (e.pref.skip[i] && !t.route[i].empty()) {  // the goal stage saw the waypoint after
+          t.route[i].erase(t.route[i].begin());
+          world_.refresh_target(i);
+        }
+        const double reach = cfg.waypoint_radius > 0 ? cfg.waypoint_radius : t.radius[i];
+        while (!t.route[i].empty() &&
+               std::hypot(t.route[i].front().x - t.x[i], t.route[i].front().y - t.y[i]) <= reach) {
+          t.route[i].erase(t.route[i].begin());
+          world_.refresh_target(i);
+        }
+        if (t.route[i].empty() && (world_.at_goal(i) || e.joined[i])) {
+          if (world_.advance_goal(i)) {
+            // an intermediate goal of its sequence: on to the next one
           } else {
-            t.state[i] = AgentState::arrived;
-            t.vx[i] = t.vy[i] = 0;
+            ++c.arrived;
+            if (cfg.arrival == ArrivalPolicy::remove) {
+              c.leaving.push_back(i);
+            } else if (cfg.arrival == ArrivalPolicy::retarget && world_.goals().size() > 1) {
+              // Another goal, from a stream keyed by seed, id and tick: thread- and
+              // order-independent.
+              Rng rng = Rng::stream(cfg.seed ^ (m.tick * 0x9e3779b97f4a7c15ull), t.id[i]);
+              const auto others = static_cast<uint32_t>(world_.goals().size() - 1);
+              const auto pick = static_cast<uint32_t>(rng.below(others));
+              t.goal[i] = pick >= t.goal[i] ? pick + 1 : pick;
+              t.route[i].clear();
+              t.path_goal[i] = AgentTable::kNoPath;  // a new goal: re-plan
+              t.progress_best[i] = INFINITY;
+              t.stall_ticks[i] = 0;
+              world_.refresh_target(i);
+            } else {
+              t.state[i] = AgentState::arrived;
+              t.vx[i] = t.vy[i] = 0;
+            }
           }
         }
       }
+    });
+    std::vector<std::size_t> leaving;
+    for (const Part& c : parts) {
+      m.frozen += c.frozen;
+      m.gridlock_started += c.gridlock_started;
+      m.longest_frozen = std::max(m.longest_frozen, c.longest_frozen);
+      m.gridlocked += c.gridlocked;
+      m.arrived += c.arrived;
+      leaving.insert(leaving.end(), c.leaving.begin(), c.leaving.end());
     }
     // Descending rows: each swap-remove moves in a row that is staying (or already handled).
     for (auto it = leaving.rbegin(); it != leaving.rend(); ++it) world_.remove_row(*it);

@@ -216,6 +216,8 @@ class OrcaModel final : public Model {
       arrive_.resize(n);
       yielding_.resize(n);
       rank_.resize(n);
+      avoid_x_.resize(n);
+      avoid_y_.resize(n);
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
           remaining_[i] =
@@ -223,6 +225,17 @@ class OrcaModel final : public Model {
           yielding_[i] =
               t.stall_action[i] == StallAction::yield_ahead && in.tick < t.stall_until[i];
           arrive_[i] = arrival_time(in, i);
+          // The velocity others avoid i at when i goes first: where it wants to go, as far as it
+          // is held up (1 - speed / preferred speed; see the top). Once per row, not per pair.
+          double ax = t.vx[i], ay = t.vy[i];
+          const double want =
+              std::sqrt(in.pref_vx[i] * in.pref_vx[i] + in.pref_vy[i] * in.pref_vy[i]);
+          const double held =
+              want > 0 ? std::clamp(1 - std::sqrt(ax * ax + ay * ay) / want, 0.0, 1.0) : 0.0;
+          ax += held * (in.pref_vx[i] - ax);
+          ay += held * (in.pref_vy[i] - ay);
+          avoid_x_[i] = ax;
+          avoid_y_[i] = ay;
           uint64_t h = in.cfg.seed ^ (t.id[i] * 0x9e3779b97f4a7c15ull);
           rank_[i] = splitmix64(h);
         }
@@ -253,16 +266,8 @@ class OrcaModel final : public Model {
             // Right of way: a neighbour that goes first is avoided where it wants to go, as far as
             // it is held up (walking as it wishes, its velocity says it already).
             const bool i_first = first(i, j);
-            double vjx = t.vx[j], vjy = t.vy[j];
-            if (!i_first) {
-              const double want =
-                  std::sqrt(in.pref_vx[j] * in.pref_vx[j] + in.pref_vy[j] * in.pref_vy[j]);
-              const double held =
-                  want > 0 ? std::clamp(1 - std::sqrt(vjx * vjx + vjy * vjy) / want, 0.0, 1.0)
-                           : 0.0;
-              vjx += held * (in.pref_vx[j] - vjx);
-              vjy += held * (in.pref_vy[j] - vjy);
-            }
+            const double vjx = i_first ? t.vx[j] : avoid_x_[j];
+            const double vjy = i_first ? t.vy[j] : avoid_y_[j];
             // The pair's horizon: no longer than until one of them arrives (see the top).
             const double tau =
                 std::clamp(std::min(arrive_[i], arrive_[j]), in.cfg.dt, p.time_horizon);
@@ -418,6 +423,7 @@ class OrcaModel final : public Model {
   std::vector<double> arrive_;
   std::vector<uint8_t> yielding_;
   std::vector<uint64_t> rank_;
+  std::vector<double> avoid_x_, avoid_y_;
   std::vector<uint64_t> infeasible_;
   std::map<std::string, std::unique_ptr<NeighbourPath>> neighbour_paths_;
   std::map<std::string, std::unique_ptr<FeaturePath>> feature_paths_;

@@ -95,7 +95,7 @@ double violation(const HalfPlane& h, double x, double y) {
 void lp3(std::span<const HalfPlane> planes, std::size_t hard, std::size_t from, double R,
          double& rx, double& ry) {
   double worst = 0;
-  std::vector<HalfPlane> sub;
+  thread_local std::vector<HalfPlane> sub;  // reused: the fallback runs for many rows a tick
   for (std::size_t i = from; i < planes.size(); ++i) {
     const HalfPlane& pi = planes[i];
     if (violation(pi, rx, ry) <= worst) continue;
