@@ -108,7 +108,7 @@ struct NavigationParams {
   double replan_after = 4;    // [s] re-plan after this long without progress; 0: never
   double radius_step = 0.25;  // [m] radius classes: an agent's radius rounded up to a multiple
   double cell_size = 0;       // [m] navmesh cell; 0: auto (a quarter of the class radius, at
-                              // most 4096 cells along the world's longer side)
+                              // most 4096 x 4096 cells over the world's area)
   double clearance = 0;       // [m] extra distance kept from obstacles beyond the class radius
   uint32_t tile_size = 256;   // navmesh tile side [cells] (16..4096)
   bool skip_visible = true;   // skip a waypoint when the one after it is in sight (Detour raycast)

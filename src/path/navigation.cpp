@@ -9,6 +9,11 @@
 #include "world/geometry.hpp"
 
 namespace crowddb::path {
+namespace {
+
+constexpr double kNarrowStep = 0.01;  // [m] narrow meshes are per radius to the centimetre
+
+}  // namespace
 
 Navigation::Navigation(const World& world, const SimConfig& cfg, Executor& ex)
     : params_(cfg.navigation),
@@ -44,21 +49,58 @@ const NavMesh& Navigation::mesh_for(double radius) {
 const NavMesh& Navigation::mesh_of_class(int k) {
   auto& slot = meshes_[k];
   if (!slot) {
+    const int c = std::abs(k);
+    // Cells: at most 4096 x 4096 over the world's area (a long, thin world, such as a queue of
+    // passengers 1 km long before a 30 m aircraft, keeps its fine cells).
+    const double side = std::sqrt(geometry_.bounds.width() * geometry_.bounds.height());
     NavMeshParams p;
-    p.radius = k * params_.radius_step + params_.clearance;
-    // Auto: a quarter of the class radius, but at most 4096 cells along the world's longer side
-    // (a 1 km world at 0.25: 16 M cells, seconds to build).
-    const double side = std::max(geometry_.bounds.width(), geometry_.bounds.height());
-    p.cell_size = params_.cell_size > 0 ? params_.cell_size
-                                        : std::max(k * params_.radius_step / 4, side / 4096);
     p.tile_size = static_cast<int>(params_.tile_size);
+    if (k > 0) {
+      p.radius = c * params_.radius_step + params_.clearance;
+      // Auto: a quarter of the class radius (a 1 km square world at 0.25: 16 M cells, seconds
+      // to build).
+      p.cell_size = params_.cell_size > 0 ? params_.cell_size
+                                          : std::max(c * params_.radius_step / 4, side / 4096);
+    } else {
+      // Narrow: for the agent's own radius r (to the centimetre, not its class), an eighth of it
+      // per cell, eroded by r less two cells, cells marked only when their centre is within half
+      // a cell of an obstacle. Its polygons then keep about r from the walls (the erosion's
+      // extra cell and the rounding give back what the two cells took), and a door is on it
+      // from 1.9-2.3 r wide, as the cells fall (tests/path/navmesh_test.cpp).
+      const double r = c * kNarrowStep;
+      p.cell_size = std::max(r / 8, side / 4096);
+      if (params_.cell_size > 0) p.cell_size = std::min(p.cell_size, params_.cell_size);
+      p.radius = std::max(r - 2 * p.cell_size, r / 2);
+      p.touch = 0.5;
+      // Its corners lie about r from the walls, the disc's edge on them: move them out by up to
+      // r more, into the middle of a door barely wider than the disc (aiming at a door's post, a
+      // crowd wedges at it: SteerSuite's bottleneck-evacuation-2, 100 -> 40-64 of 100).
+      p.corner_push = r;
+    }
     slot = NavMesh::build(geometry_, p, &ex_);
   }
   return *slot;
 }
 
-bool Navigation::visible(double radius, Vec2 from, Vec2 to) const {
-  auto it = meshes_.find(class_of(radius));
+bool Navigation::is_narrow(const NavMesh* m) const {
+  for (const auto& [k, mesh] : meshes_)
+    if (mesh.get() == m) return k < 0;
+  return false;
+}
+
+// The search did not find the goal from where the agent stands: no path, or the start or goal
+// moved onto the mesh by more than the clearance and two cells of rounding allow.
+bool Navigation::off_mesh(const PathResult& r, const NavMesh& m) const {
+  return r.status != PathStatus::ok || r.snap > m.clearance() + 2 * m.params().cell_size;
+}
+
+int Navigation::narrow_key(double radius) const {
+  const double k = std::ceil(radius / kNarrowStep - 1e-9);
+  return k >= 1e9 ? -1'000'000'000 : -std::max(1, static_cast<int>(k));
+}
+
+bool Navigation::visible(double radius, uint64_t agent, Vec2 from, Vec2 to) const {
+  auto it = meshes_.find(narrow_routes_.count(agent) ? narrow_key(radius) : class_of(radius));
   return it != meshes_.end() && it->second->visible(from, to);
 }
 
@@ -71,7 +113,7 @@ void Navigation::trim_passed(World& world, std::size_t row) {
   while (drop < route.size()) {
     const Vec2 next = drop + 1 < route.size() ? route[drop + 1] : goal;
     ++stats_.sight_checks;
-    if (!visible(t.radius[row], p, next)) break;
+    if (!visible(t.radius[row], t.id[row], p, next)) break;
     ++drop;
   }
   route.erase(route.begin(), route.begin() + static_cast<std::ptrdiff_t>(drop));
@@ -89,13 +131,29 @@ std::size_t Navigation::apply_results(World& world, uint64_t tick) {
     const std::size_t i = *row;
     t.path_ticket[i] = 0;
     ++stats_.applied;
-    if (r.result.status == PathStatus::no_start || r.result.status == PathStatus::no_goal) {
-      ++stats_.failed;
-      t.route[i].clear();  // no path: steer straight at the goal
-    } else {
-      stats_.partial += r.result.status == PathStatus::partial;
+    const bool narrow = is_narrow(r.mesh);
+    if (narrow) {
+      // Taken only when it reaches the goal; otherwise the class mesh's route stays.
+      if (off_mesh(r.result, *r.mesh)) continue;
+      ++stats_.narrow_routes;
+      narrow_routes_.insert(r.agent);
       t.route[i] = std::move(r.result.corners);
       if (params_.skip_visible) trim_passed(world, i);
+    } else {
+      narrow_routes_.erase(r.agent);
+      if (off_mesh(r.result, *r.mesh)) {
+        // Repeat the search on the narrow mesh (queued like any request, due latency later).
+        t.path_ticket[i] = ++next_ticket_;
+        queue_.push_back({t.path_ticket[i], r.agent, true});
+      }
+      if (r.result.status == PathStatus::no_start || r.result.status == PathStatus::no_goal) {
+        ++stats_.failed;
+        t.route[i].clear();  // no path: steer straight at the goal
+      } else {
+        stats_.partial += r.result.status == PathStatus::partial;
+        t.route[i] = std::move(r.result.corners);
+        if (params_.skip_visible) trim_passed(world, i);
+      }
     }
     world.refresh_target(i);
     // A new route changes the path-left measure of the progress watch (the first route of a
@@ -123,7 +181,9 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
     }
     t.path_goal[i] = t.goal[i];
     t.path_ticket[i] = ++next_ticket_;
-    queue_.push_back({t.path_ticket[i], t.id[i]});
+    // A re-plan for the same goal searches where the route came from: an agent on a narrow
+    // route keeps to the narrow mesh (the class mesh has no way there).
+    queue_.push_back({t.path_ticket[i], t.id[i], !new_goal && narrow_routes_.count(t.id[i]) > 0});
     ++stats_.requests;
     ++made;
   }
@@ -139,7 +199,9 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
     }
     const std::size_t i = *row;
     const Vec2 goal = goal_target(world.goals()[t.goal[i]], t.x[i], t.y[i], t.radius[i]);
-    jobs.push_back({q.ticket, q.agent, &mesh_for(t.radius[i]), {t.x[i], t.y[i]}, goal});
+    const int k = q.narrow ? narrow_key(t.radius[i]) : class_of(t.radius[i]);
+    stats_.narrow += q.narrow;
+    jobs.push_back({q.ticket, q.agent, &mesh_of_class(k), {t.x[i], t.y[i]}, goal});
   }
   if (!jobs.empty()) {
     stats_.dispatched += jobs.size();
@@ -150,14 +212,18 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
 
 void Navigation::save(ByteWriter& out) const {
   out.u64(next_ticket_);
-  for (uint64_t v : {stats_.requests, stats_.replans, stats_.dispatched, stats_.superseded,
-                     stats_.applied, stats_.failed, stats_.partial, stats_.sight_checks})
+  for (uint64_t v :
+       {stats_.requests, stats_.replans, stats_.dispatched, stats_.superseded, stats_.applied,
+        stats_.failed, stats_.partial, stats_.sight_checks, stats_.narrow, stats_.narrow_routes})
     out.u64(v);
   out.u64(queue_.size());
   for (const Queued& q : queue_) {
     out.u64(q.ticket);
     out.u64(q.agent);
+    out.u8(q.narrow ? 1 : 0);
   }
+  out.u64(narrow_routes_.size());
+  for (uint64_t a : narrow_routes_) out.u64(a);
   const auto batches = service_->pending_jobs();
   out.u64(batches.size());
   for (const auto& [due, jobs] : batches) {
@@ -169,7 +235,7 @@ void Navigation::save(ByteWriter& out) const {
         if (m.get() == j.mesh) k = c;
       out.u64(j.ticket);
       out.u64(j.agent);
-      out.u32(static_cast<uint32_t>(k));
+      out.u32(static_cast<uint32_t>(k));  // -class for a narrow mesh (two's complement)
       for (double v : {j.start.x, j.start.y, j.goal.x, j.goal.y}) out.f64(v);
     }
   }
@@ -178,13 +244,20 @@ void Navigation::save(ByteWriter& out) const {
 void Navigation::restore(ByteReader& in, uint64_t tick) {
   next_ticket_ = in.u64();
   for (uint64_t* v : {&stats_.requests, &stats_.replans, &stats_.dispatched, &stats_.superseded,
-                      &stats_.applied, &stats_.failed, &stats_.partial, &stats_.sight_checks})
+                      &stats_.applied, &stats_.failed, &stats_.partial, &stats_.sight_checks,
+                      &stats_.narrow, &stats_.narrow_routes})
     *v = in.u64();
-  queue_.resize(in.count(16));
+  queue_.resize(in.count(17));
   for (Queued& q : queue_) {
     q.ticket = in.u64();
     q.agent = in.u64();
+    const uint8_t narrow = in.u8();
+    if (narrow > 1) in.fail("a queued path request with a bad mesh flag");
+    q.narrow = narrow == 1;
   }
+  narrow_routes_.clear();
+  const uint64_t routes = in.count(8);
+  for (uint64_t k = 0; k < routes; ++k) narrow_routes_.insert(in.u64());
   // The searches the constructor dispatched are not this run's: start a fresh service.
   service_ = std::make_unique<PathService>();
   const uint64_t batches = in.count(16);
@@ -200,11 +273,14 @@ void Navigation::restore(ByteReader& in, uint64_t tick) {
     for (PathJob& j : jobs) {
       j.ticket = in.u64();
       j.agent = in.u64();
-      const uint32_t k = in.u32();
-      // A class is a multiple of radius_step no larger than the world is wide.
+      const auto k = static_cast<int32_t>(in.u32());
+      // A class is a multiple of radius_step no larger than the world is wide (negative: a
+      // narrow mesh, centimetres).
       const double side = std::max(geometry_.bounds.width(), geometry_.bounds.height());
-      if (k < 1 || k * params_.radius_step > side) in.fail("bad radius class " + std::to_string(k));
-      j.mesh = &mesh_of_class(static_cast<int>(k));
+      const int32_t c = k < 0 ? (k == INT32_MIN ? 0 : -k) : k;
+      if (c < 1 || c * (k < 0 ? kNarrowStep : params_.radius_step) > side)
+        in.fail("bad radius class " + std::to_string(k));
+      j.mesh = &mesh_of_class(k);
       j.start = {in.f64(), in.f64()};
       j.goal = {in.f64(), in.f64()};
       if (!std::isfinite(j.start.x) || !std::isfinite(j.start.y) || !std::isfinite(j.goal.x) ||
@@ -232,11 +308,13 @@ std::string Navigation::describe_meshes() const {
   for (const auto& [k, m] : meshes_) {
     const NavMeshStats& s = m->stats();
     char line[256];
-    std::snprintf(line, sizeof line,
-                  "       mesh r<=%g: cell %g, clearance %g, %d tile%s (%dx%d grid), %d polygons, "
-                  "built in %.1f ms\n",
-                  k * params_.radius_step, m->params().cell_size, m->clearance(), s.tiles,
-                  s.tiles == 1 ? "" : "s", s.tiles_x, s.tiles_y, s.polygons, s.seconds * 1e3);
+    std::snprintf(
+        line, sizeof line,
+        "       mesh r<=%g%s: cell %g, clearance %g, %d tile%s (%dx%d grid), %d polygons, "
+        "built in %.1f ms\n",
+        k < 0 ? -k * kNarrowStep : k * params_.radius_step, k < 0 ? " (narrow)" : "",
+        m->params().cell_size, m->clearance(), s.tiles, s.tiles == 1 ? "" : "s", s.tiles_x,
+        s.tiles_y, s.polygons, s.seconds * 1e3);
     os << line;
   }
   return os.str();

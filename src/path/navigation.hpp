@@ -14,6 +14,18 @@
 // supersedes an older one (tickets). Everything here is decided from simulation state only, so runs
 // are bit-identical whatever the worker's timing.
 //
+// Narrow passages: each class's mesh keeps the class radius plus a few cells of rounding from
+// every obstacle, so a passage less than about 3.25 class radii wide is not on it (an aircraft's
+// 0.46 m aisle for people of radius 0.21, a 0.9 m door for a radius of 0.3 rounded up to the 0.5
+// class). When the class mesh has no path to the goal, or had to move the start or the goal
+// farther than its own rounding to reach a polygon (the nearest one may lie across a wall), the
+// search is repeated on a narrow mesh for the agent's own radius to the centimetre, with cells
+// of an eighth of it (built when first needed): a door 1.9-2.3 radii wide is on it. Its route
+// is taken only when it reaches the goal; the agent's line-of-sight checks and re-plans then use
+// the narrow mesh too. The steering model keeps the agent's real disc off the walls either way; a
+// passage that is on the narrow mesh but too narrow for the disc stops it at the passage instead
+// of at the wall nearest the goal.
+//
 // Thread-safety: apply_results/request_paths on the tick's thread; visible() from any thread
 // during the steering queries (the meshes are read-only then).
 #pragma once
@@ -22,6 +34,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 
 #include "crowddb/simulation.hpp"
@@ -41,7 +54,9 @@ struct NavigationStats {
   uint64_t failed = 0;   // of which with no path (the agent keeps steering straight)
   uint64_t partial = 0;  // of which towards an unreachable goal
   uint64_t queued = 0;   // requests waiting for dispatch now
-  uint64_t sight_checks = 0;  // line-of-sight checks when applying results
+  uint64_t sight_checks = 0;   // line-of-sight checks when applying results
+  uint64_t narrow = 0;         // searches repeated on a narrow mesh
+  uint64_t narrow_routes = 0;  // of which gave the route (the goal reached)
 };
 
 class Navigation {
@@ -56,8 +71,9 @@ class Navigation {
   // After the commit of `tick`: progress watch, requests, dispatch. Returns requests made.
   std::size_t request_paths(World& world, uint64_t tick);
 
-  // Line of sight for a disc of `radius` (its class mesh). False when the class has no mesh yet.
-  bool visible(double radius, Vec2 from, Vec2 to) const;
+  // Line of sight for agent `agent` (AgentId value) of `radius`: on its class mesh, or on the
+  // narrow one when its route came from there. False when that mesh is not built yet.
+  bool visible(double radius, uint64_t agent, Vec2 from, Vec2 to) const;
 
   double class_radius(double radius) const;
   const NavigationParams& params() const { return params_; }
@@ -77,20 +93,27 @@ class Navigation {
  private:
   int class_of(double radius) const;
   const NavMesh& mesh_for(double radius);  // builds on first use
+  // Class k's mesh; k < 0: the narrow mesh for radius -k cm (narrow_key). Builds on first use.
   const NavMesh& mesh_of_class(int k);
+  int narrow_key(double radius) const;
+  bool is_narrow(const NavMesh* m) const;
+  bool off_mesh(const PathResult& r, const NavMesh& m) const;
   // Drops the leading waypoints the agent has already passed (the one after is in sight).
   void trim_passed(World& world, std::size_t row);
 
   struct Queued {
     uint64_t ticket;
     uint64_t agent;
+    bool narrow;  // search on the narrow mesh
   };
   NavigationParams params_;
   uint64_t latency_ticks_ = 1;  // params_.latency in ticks (>= 1)
   uint64_t replan_ticks_ = 0;   // params_.replan_after in ticks (0: never)
   NavGeometry geometry_;
   Executor& ex_;
-  std::map<int, std::unique_ptr<NavMesh>> meshes_;  // by class (radius = class * radius_step)
+  std::map<int, std::unique_ptr<NavMesh>> meshes_;  // by class (radius = class * radius_step);
+                                                    // negative: narrow meshes (narrow_key)
+  std::set<uint64_t> narrow_routes_;                // agents whose route came from a narrow mesh
   std::deque<Queued> queue_;
   uint64_t next_ticket_ = 0;
   NavigationStats stats_;

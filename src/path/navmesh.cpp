@@ -1,5 +1,6 @@
 #include "path/navmesh.hpp"
 
+#include <DetourCommon.h>
 #include <DetourNavMesh.h>
 #include <DetourNavMeshBuilder.h>
 #include <DetourNavMeshQuery.h>
@@ -97,19 +98,19 @@ LocalObstacles localise(const NavGeometry& g, Vec2 o) {
   return L;
 }
 
-// Marks every compact-heightfield cell whose square touches an obstacle as unwalkable: a cell
-// centre within half a cell diagonal of the obstacle. Exact geometry (no triangulation), so
-// non-convex polygons need no decomposition.
-void mark_obstacles(rcCompactHeightfield& chf, const LocalObstacles& L) {
-  const double cs = chf.cs, half_diag = cs * std::sqrt(0.5);
+// Marks every compact-heightfield cell whose centre lies within `touch` cells of an obstacle as
+// unwalkable (0.71, half a diagonal: every cell whose square touches it). Exact geometry (no
+// triangulation), so non-convex polygons need no decomposition.
+void mark_obstacles(rcCompactHeightfield& chf, const LocalObstacles& L, double touch_cells) {
+  const double cs = chf.cs, touch = touch_cells * cs, pad = std::max(touch, cs * std::sqrt(0.5));
   const double bx = chf.bmin[0], bz = chf.bmin[2];
   auto block = [&](const Box& box, auto&& touches) {
-    const int x0 = std::max(0, static_cast<int>(std::floor((box.xmin - half_diag - bx) / cs)));
+    const int x0 = std::max(0, static_cast<int>(std::floor((box.xmin - pad - bx) / cs)));
     const int x1 =
-        std::min(chf.width - 1, static_cast<int>(std::floor((box.xmax + half_diag - bx) / cs)));
-    const int z0 = std::max(0, static_cast<int>(std::floor((box.ymin - half_diag - bz) / cs)));
+        std::min(chf.width - 1, static_cast<int>(std::floor((box.xmax + pad - bx) / cs)));
+    const int z0 = std::max(0, static_cast<int>(std::floor((box.ymin - pad - bz) / cs)));
     const int z1 =
-        std::min(chf.height - 1, static_cast<int>(std::floor((box.ymax + half_diag - bz) / cs)));
+        std::min(chf.height - 1, static_cast<int>(std::floor((box.ymax + pad - bz) / cs)));
     for (int z = z0; z <= z1; ++z)
       for (int x = x0; x <= x1; ++x) {
         const rcCompactCell& c = chf.cells[x + z * chf.width];
@@ -120,21 +121,20 @@ void mark_obstacles(rcCompactHeightfield& chf, const LocalObstacles& L) {
   };
   const Box tile{bx, bz, bx + chf.width * cs, bz + chf.height * cs};
   for (std::size_t k = 0; k < L.circles.size(); ++k) {
-    if (!L.circle_boxes[k].overlaps({tile.xmin - half_diag, tile.ymin - half_diag,
-                                     tile.xmax + half_diag, tile.ymax + half_diag}))
+    if (!L.circle_boxes[k].overlaps(
+            {tile.xmin - pad, tile.ymin - pad, tile.xmax + pad, tile.ymax + pad}))
       continue;
     const CircleObstacle& c = L.circles[k];
-    block(L.circle_boxes[k], [&](double x, double y) {
-      return discs_overlap(x - c.x, y - c.y, c.radius + half_diag);
-    });
+    block(L.circle_boxes[k],
+          [&](double x, double y) { return discs_overlap(x - c.x, y - c.y, c.radius + touch); });
   }
   for (std::size_t k = 0; k < L.rings.size(); ++k) {
-    if (!L.ring_boxes[k].overlaps({tile.xmin - half_diag, tile.ymin - half_diag,
-                                   tile.xmax + half_diag, tile.ymax + half_diag}))
+    if (!L.ring_boxes[k].overlaps(
+            {tile.xmin - pad, tile.ymin - pad, tile.xmax + pad, tile.ymax + pad}))
       continue;
     const auto& ring = L.rings[k];
     block(L.ring_boxes[k],
-          [&](double x, double y) { return disc_overlaps_polygon(ring, x, y, half_diag); });
+          [&](double x, double y) { return disc_overlaps_polygon(ring, x, y, touch); });
   }
 }
 
@@ -151,6 +151,7 @@ struct TileJob {
   float cs;
   float world_w, world_h;  // local floor extent
   const LocalObstacles* obstacles;
+  double touch;  // [cells] see mark_obstacles
 };
 
 TileData build_tile(const TileJob& j) {
@@ -181,7 +182,7 @@ TileData build_tile(const TileJob& j) {
   CompactHeightfield chf(rcAllocCompactHeightfield());
   if (!chf.p || !rcBuildCompactHeightfield(&ctx, kWalkableHeight, kWalkableClimb, *hf, *chf))
     return fail("compact heightfield");
-  mark_obstacles(*chf, *j.obstacles);
+  mark_obstacles(*chf, *j.obstacles, j.touch);
   if (!rcErodeWalkableArea(&ctx, j.erode, *chf)) return fail("erode");
   // Watershed partitioning: the most regular polygons, hence the best A* corridors. Layer and
   // monotone partitioning built the 1 km benchmark world twice as fast but, in a single large
@@ -274,6 +275,7 @@ std::unique_ptr<NavMesh> NavMesh::build(const NavGeometry& g, const NavMeshParam
   if (!(std::isfinite(params.radius) && params.radius > 0)) bad("radius must be > 0");
   if (!(std::isfinite(cs) && cs > 0)) bad("cell_size must be > 0");
   if (params.tile_size < 16 || params.tile_size > 4096) bad("tile_size must be in 16..4096");
+  if (!(params.touch >= 0 && params.touch <= 1)) bad("touch must be in [0, 1] cells");
   const Bounds& b = g.bounds;
   if (!(b.width() > 0 && b.height() > 0)) bad("the bounds are empty");
   const double erode_cells = std::ceil(params.radius / cs) + kErodeMargin;  // may be huge
@@ -324,7 +326,8 @@ std::unique_ptr<NavMesh> NavMesh::build(const NavGeometry& g, const NavMeshParam
                 static_cast<float>(cs),
                 static_cast<float>(b.width()),
                 static_cast<float>(b.height()),
-                &local};
+                &local,
+                params.touch};
       tiles[k] = build_tile(j);
     }
   };
@@ -433,6 +436,9 @@ PathResult PathFinder::find(Vec2 start, Vec2 goal) {
     r.status = PathStatus::no_goal;
     return r;
   }
+  const Vec2 ws = mesh_.world(s), wg = mesh_.world(g);
+  r.snap = std::max(std::hypot(ws.x - start.x, ws.y - start.y),
+                    std::hypot(wg.x - goal.x, wg.y - goal.y));
   int npolys = 0;
   const dtStatus st =
       query_->findPath(sref, gref, s, g, filter, polys_.data(), &npolys, kMaxPathPolys);
@@ -460,14 +466,120 @@ PathResult PathFinder::find(Vec2 start, Vec2 goal) {
   if (!(flags[ns - 1] & DT_STRAIGHTPATH_END)) r.status = PathStatus::partial;  // truncated
   r.start = mesh_.world(&straight[0]);
   r.end = mesh_.world(&straight[(ns - 1) * 3]);
+  if (mesh_.params_.corner_push > 0)
+    funnel(r, s, end, npolys, mesh_.params_.corner_push);
+  else
+    for (int i = 1; i < ns - 1; ++i) r.corners.push_back(mesh_.world(&straight[i * 3]));
   Vec2 prev = r.start;
-  for (int i = 1; i < ns; ++i) {
-    const Vec2 p = mesh_.world(&straight[i * 3]);
-    r.length += std::hypot(p.x - prev.x, p.y - prev.y);
-    prev = p;
-    if (i < ns - 1) r.corners.push_back(p);
+  for (const Vec2& c : r.corners) {
+    r.length += std::hypot(c.x - prev.x, c.y - prev.y);
+    prev = c;
   }
+  r.length += std::hypot(r.end.x - prev.x, r.end.y - prev.y);
   return r;
+}
+
+// The edge shared by adjacent polygons `from` and `to` (a part of it at a tile border), as
+// Detour's private getPortalPoints finds it: left and right as seen walking from `from`.
+bool PathFinder::portal(unsigned int from, unsigned int to, float* left, float* right) const {
+  const dtMeshTile* tile = nullptr;
+  const dtPoly* poly = nullptr;
+  mesh_.mesh_->getTileAndPolyByRefUnsafe(from, &tile, &poly);
+  for (unsigned int k = poly->firstLink; k != DT_NULL_LINK; k = tile->links[k].next) {
+    const dtLink& link = tile->links[k];
+    if (link.ref != to) continue;
+    const float* v0 = &tile->verts[poly->verts[link.edge] * 3];
+    const float* v1 = &tile->verts[poly->verts[(link.edge + 1) % poly->vertCount] * 3];
+    dtVcopy(left, v0);
+    dtVcopy(right, v1);
+    if (link.side != 0xff && (link.bmin != 0 || link.bmax != 255)) {
+      dtVlerp(left, v0, v1, link.bmin / 255.0f);
+      dtVlerp(right, v0, v1, link.bmax / 255.0f);
+    }
+    return true;
+  }
+  return false;
+}
+
+// The funnel algorithm (Mononen's "simple stupid funnel", as Detour's findStraightPath runs it)
+// over the corridor's portals, each shrunk by `push` from both ends (to its midpoint when it is
+// narrower than twice that): the corners keep `push` from the corridor's edges where there is
+// room, and pass through the middle of a narrower gap.
+void PathFinder::funnel(PathResult& r, const float* start, const float* end, int npolys,
+                        double push) const {
+  struct Portal {
+    float l[3], rt[3];
+  };
+  std::vector<Portal> portals;
+  portals.reserve(static_cast<std::size_t>(npolys) + 1);
+  Portal first;
+  dtVcopy(first.l, start);
+  dtVcopy(first.rt, start);
+  portals.push_back(first);
+  for (int i = 0; i + 1 < npolys; ++i) {
+    Portal p;
+    if (!portal(polys_[static_cast<std::size_t>(i)], polys_[static_cast<std::size_t>(i + 1)], p.l,
+                p.rt))
+      break;
+    const float dx = p.rt[0] - p.l[0], dz = p.rt[2] - p.l[2];
+    const double len = std::sqrt(static_cast<double>(dx) * dx + static_cast<double>(dz) * dz);
+    const double t = len > 2 * push ? push / len : 0.5;
+    const float l0 = p.l[0], l2 = p.l[2];
+    p.l[0] = static_cast<float>(l0 + dx * t);
+    p.l[2] = static_cast<float>(l2 + dz * t);
+    p.rt[0] = static_cast<float>(l0 + dx * (1 - t));
+    p.rt[2] = static_cast<float>(l2 + dz * (1 - t));
+    portals.push_back(p);
+  }
+  Portal last;
+  dtVcopy(last.l, end);
+  dtVcopy(last.rt, end);
+  portals.push_back(last);
+
+  float apex[3], left[3], right[3];
+  dtVcopy(apex, start);
+  dtVcopy(left, start);
+  dtVcopy(right, start);
+  std::size_t apex_i = 0, left_i = 0, right_i = 0;
+  for (std::size_t i = 1; i < portals.size(); ++i) {
+    const float* pl = portals[i].l;
+    const float* pr = portals[i].rt;
+    if (dtTriArea2D(apex, right, pr) <= 0.0f) {  // the right side narrows the funnel
+      if (dtVequal(apex, right) || dtTriArea2D(apex, left, pr) > 0.0f) {
+        dtVcopy(right, pr);
+        right_i = i;
+      } else {  // crosses the left side: the left point is a corner
+        if (!dtVequal(left, end)) r.corners.push_back(mesh_.world(left));
+        dtVcopy(apex, left);
+        apex_i = left_i;
+        dtVcopy(left, apex);
+        dtVcopy(right, apex);
+        left_i = right_i = apex_i;
+        i = apex_i;
+        continue;
+      }
+    }
+    if (dtTriArea2D(apex, left, pl) >= 0.0f) {  // the left side narrows the funnel
+      if (dtVequal(apex, left) || dtTriArea2D(apex, right, pl) < 0.0f) {
+        dtVcopy(left, pl);
+        left_i = i;
+      } else {
+        if (!dtVequal(right, end)) r.corners.push_back(mesh_.world(right));
+        dtVcopy(apex, right);
+        apex_i = right_i;
+        dtVcopy(left, apex);
+        dtVcopy(right, apex);
+        left_i = right_i = apex_i;
+        i = apex_i;
+        continue;
+      }
+    }
+  }
+  // Consecutive corners at the same point (a portal shrunk to its midpoint twice) are one.
+  r.corners.erase(
+      std::unique(r.corners.begin(), r.corners.end(),
+                  [](const Vec2& a, const Vec2& b) { return a.x == b.x && a.y == b.y; }),
+      r.corners.end());
 }
 
 }  // namespace crowddb::path

@@ -2,11 +2,11 @@
 // with Detour.
 //
 // Build: the world's bounds are the floor; every cell whose square touches an obstacle (circle
-// or polygon, exact geometry) is marked unwalkable; Recast erodes the walkable cells by the
-// class radius plus a safety margin (its distance transform overestimates diagonal distances
-// by up to 12% and contour simplification moves edges by up to a cell), then partitions the
-// rest into regions, contours and convex polygons. Large worlds are split into square tiles
-// built independently (in parallel when an executor is given) and joined by Detour.
+// or polygon, exact geometry; `touch`) is marked unwalkable; Recast erodes the walkable cells by
+// the class radius plus a safety margin (its distance transform overestimates diagonal distances by
+// up to 12% and contour simplification moves edges by up to a cell), then partitions the rest into
+// regions, contours and convex polygons. Large worlds are split into square tiles built
+// independently (in parallel when an executor is given) and joined by Detour.
 //
 // Queries: PathFinder (A* over polygons, then the funnel algorithm for the corner points) and
 // NavMesh::visible (Detour raycast: is the straight segment inside the eroded walkable area,
@@ -51,6 +51,15 @@ struct NavMeshParams {
   double cell_size = 0.25;      // Recast cell side [length] (> 0)
   int tile_size = 256;          // cells per tile side (16..4096)
   double max_edge_error = 1.0;  // contour simplification tolerance [cells]
+  // [cells] a cell is unwalkable when its centre lies within this of an obstacle (0..1); half a
+  // diagonal marks every cell whose square touches one. 0.5 opens passages about half a cell
+  // narrower and still keeps `radius` from every obstacle (tests/path/navmesh_test.cpp).
+  double touch = 0.7071067811865476;  // sqrt(0.5)
+  // [length] PathFinder keeps a path's corners this far inside the mesh's edges where there is
+  // room (the funnel over portals shrunk by it; through the middle of a narrower gap); 0:
+  // corners on the mesh's edges (Detour's straight path). For a mesh eroded by less than the
+  // agent's radius.
+  double corner_push = 0;
 };
 
 struct NavMeshStats {
@@ -76,6 +85,10 @@ struct PathResult {
   std::vector<Vec2> corners;  // intermediate corners, start and end excluded
   Vec2 start{}, end{};        // the start and end points on the mesh
   double length = 0;          // start -> corners -> end
+  // How far the start or the goal (the larger) had to move onto the mesh: within the mesh's
+  // clearance for a point a disc of its radius can stand on; farther for one in a pocket or a
+  // passage too narrow for the mesh, whose nearest polygon may lie across a wall.
+  double snap = 0;
 };
 
 class NavMesh {
@@ -133,6 +146,8 @@ class PathFinder {
   PathResult find(Vec2 start, Vec2 goal);
 
  private:
+  bool portal(unsigned int from, unsigned int to, float* left, float* right) const;
+  void funnel(PathResult& r, const float* start, const float* end, int npolys, double push) const;
   const NavMesh& mesh_;
   dtNavMeshQuery* query_ = nullptr;
   std::vector<unsigned int> polys_;

@@ -35,6 +35,7 @@ struct PathReply {
   uint64_t ticket = 0;
   uint64_t agent = 0;
   PathResult result;
+  const NavMesh* mesh = nullptr;  // the job's
 };
 
 class PathService {

@@ -299,7 +299,7 @@ uint64_t Simulation::state_hash() const {
 namespace {
 
 constexpr std::string_view kCheckpointMagic = "crowddb-checkpoint";
-constexpr uint32_t kCheckpointVersion = 1;
+constexpr uint32_t kCheckpointVersion = 2;  // 2: narrow meshes in the path service's state
 
 // What a checkpoint must agree on with the simulation it is restored into: the static tables
 // and the settings that change what a tick computes (not the thread count).
@@ -676,7 +676,7 @@ std::string Simulation::explain() const {
 std::string Simulation::explain_analyze() const {
   const Engine& e = *engine_;
   std::ostringstream os;
-  char line[256];
+  char line[512];
   std::snprintf(line, sizeof line, "EXPLAIN ANALYZE  %llu ticks (%.2f s simulated), model %s\n",
                 static_cast<unsigned long long>(last_.tick), time(),
                 config_.steering.model.c_str());
@@ -724,12 +724,14 @@ std::string Simulation::explain_analyze() const {
         line, sizeof line,
         "  path service: %llu requests (%llu re-plans), %llu dispatched, %llu superseded, %llu "
         "queued; "
-        "%llu routes applied (%llu partial, %llu without a path)\n",
+        "%llu routes applied (%llu partial, %llu without a path); %llu searches on a narrow mesh, "
+        "%llu of them reaching the goal\n",
         static_cast<unsigned long long>(ns.requests), static_cast<unsigned long long>(ns.replans),
         static_cast<unsigned long long>(ns.dispatched),
         static_cast<unsigned long long>(ns.superseded), static_cast<unsigned long long>(ns.queued),
         static_cast<unsigned long long>(ns.applied), static_cast<unsigned long long>(ns.partial),
-        static_cast<unsigned long long>(ns.failed));
+        static_cast<unsigned long long>(ns.failed), static_cast<unsigned long long>(ns.narrow),
+        static_cast<unsigned long long>(ns.narrow_routes));
     os << line;
     std::snprintf(line, sizeof line,
                   "  worker: %llu searches in %.3f ms; the tick waited for it %llu times, %.3f ms; "

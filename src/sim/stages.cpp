@@ -106,7 +106,7 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
         const Vec2 next = route.size() > 1
                               ? route[1]
                               : goal_target(goals[t.goal[i]], t.x[i], t.y[i], t.radius[i]);
-        if (nav->visible(t.radius[i], {t.x[i], t.y[i]}, next)) {
+        if (nav->visible(t.radius[i], t.id[i], {t.x[i], t.y[i]}, next)) {
           pref.skip[i] = 1;
           target = next;
         }

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <regex>
 
 #include "crowddb/simulation.hpp"
 #include "support/configs.hpp"
@@ -173,6 +174,52 @@ TEST(Navigation, ExplainShowsThePathService) {
   Simulation off(std::move(plain), test::thesis_config());
   EXPECT_EQ(off.explain().find("path results"), std::string::npos);
   EXPECT_EQ(off.explain().find("path requests"), std::string::npos);
+}
+
+// End to end with the default model and navigation: a person of radius 0.3 m (the 0.5 class:
+// its mesh has no passage narrower than about 1.5 m) goes round a wall through its 0.9 m door,
+// found on the class's narrow mesh.
+TEST(Navigation, AWidePersonFindsANarrowDoorWithTheDefaults) {
+  World w(Bounds{0, 0, 20, 10});
+  w.add_goal({"behind", 16, 2, 1, 0.5, {}});
+  w.add_obstacle(PolygonObstacle{{{9.5, 0}, {10.5, 0}, {10.5, 8.1}, {9.5, 8.1}}, 0.1});
+  w.add_obstacle(PolygonObstacle{{{9.5, 9.0}, {10.5, 9.0}, {10.5, 10}, {9.5, 10}}, 0.1});
+  AgentSpec s;
+  s.x = 4;
+  s.y = 2;
+  s.radius = 0.3;
+  s.goal = 0;
+  w.insert(s);
+  SimConfig c;
+  c.navigation.enabled = true;
+  Simulation sim(std::move(w), c);
+  for (int k = 0; k < 400 && sim.arrived_total() == 0; ++k) sim.step();  // 40 s
+  EXPECT_EQ(sim.arrived_total(), 1u);
+  EXPECT_TRUE(std::regex_search(sim.explain_analyze(),
+                                std::regex("narrow mesh, [1-9][0-9]* of them reaching the goal")))
+      << sim.explain_analyze();
+}
+
+// An aircraft's aisle: a seat at the end of a 0.46 m corridor of thin walls, for a person of
+// radius 0.21 who starts beside it. The class mesh has no polygon in the aisle and moves the
+// goal onto the floor outside, across the wall; the narrow mesh has the aisle.
+TEST(Navigation, AGoalDownANarrowAisleIsReachedThroughItsEntrance) {
+  World w(Bounds{0, 0, 20, 6});
+  w.add_goal({"seat", 14.5, 3.1, 1, 0.1, {}});
+  w.add_obstacle(PolygonObstacle{{{5, 2.77}, {15.1, 2.77}, {15.1, 2.87}, {5, 2.87}}, 0.1});
+  w.add_obstacle(PolygonObstacle{{{5, 3.33}, {15.1, 3.33}, {15.1, 3.43}, {5, 3.43}}, 0.1});
+  w.add_obstacle(PolygonObstacle{{{15, 2.87}, {15.1, 2.87}, {15.1, 3.33}, {15, 3.33}}, 0.1});
+  AgentSpec s;
+  s.x = 10;
+  s.y = 1;
+  s.radius = 0.21;
+  s.goal = 0;
+  w.insert(s);
+  SimConfig c;
+  c.navigation.enabled = true;
+  Simulation sim(std::move(w), c);
+  for (int k = 0; k < 600 && sim.arrived_total() == 0; ++k) sim.step();  // 60 s
+  EXPECT_EQ(sim.arrived_total(), 1u);
 }
 
 TEST(Navigation, RadiusClassesRoundUp) {

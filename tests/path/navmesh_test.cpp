@@ -39,7 +39,7 @@ double min_clearance(const path::DiscWorld& w, const PathResult& r) {
     for (int k = 0; k <= n; ++k) {
       const double t = static_cast<double>(k) / n;
       worst = std::min(worst, path::clearance_at(w, {pts[i].x + t * (pts[i + 1].x - pts[i].x),
-                                                        pts[i].y + t * (pts[i + 1].y - pts[i].y)}));
+                                                     pts[i].y + t * (pts[i + 1].y - pts[i].y)}));
     }
   }
   return worst;
@@ -110,6 +110,61 @@ TEST(NavMesh, NarrowDoorPassesSmallDiscsOnly) {
   EXPECT_EQ(fl.find({5, 15}, {35, 15}).status, PathStatus::partial);
 }
 
+// Doors only a little wider than the disc: with the class mesh's cell (a quarter of the radius)
+// a door five cells wider than the disc is open, one narrower than the disc is closed. The
+// narrow meshes of src/path/navigation.cpp (cells of r / 8, eroded by r less two cells, cells
+// marked within half a cell of an obstacle) open a door 2.3 r wide (from 1.9-2.26 r, as the
+// cells fall), keep one of 1.8 r closed, and their paths keep three quarters of r from the
+// door's posts.
+TEST(NavMesh, DoorsALittleWiderThanTheDiscAreOpen) {
+  for (double R : {0.195, 0.2, 0.21, 0.25, 0.3, 0.4, 0.5}) {
+    auto door = [&](const NavMeshParams& p, double w) {
+      NavGeometry g{
+          {0, 0, 20, 10}, {}, {rect(9.5, 0, 10.5, 5 - w / 2), rect(9.5, 5 + w / 2, 10.5, 10)}};
+      auto mesh = NavMesh::build(g, p);
+      PathFinder f(*mesh);
+      PathResult r = f.find({3, 3}, {17, 7});
+      if (r.status == PathStatus::ok) EXPECT_GE(min_clearance(disc_world(g), r), 0.75 * R) << R;
+      return r.status;
+    };
+    const NavMeshParams cls{R, R / 4}, narrow{R - R / 4, R / 8, 256, 1.0, 0.5};
+    EXPECT_EQ(door(cls, 2 * R + 5 * R / 4), PathStatus::ok) << "radius " << R;
+    EXPECT_EQ(door(cls, 2 * R - 0.02), PathStatus::partial) << "radius " << R;
+    EXPECT_EQ(door(narrow, 2.3 * R), PathStatus::ok) << "radius " << R;
+    EXPECT_EQ(door(narrow, 1.8 * R), PathStatus::partial) << "radius " << R;
+  }
+}
+
+// Corner pushing: through a 1.4 m door for a disc of radius 0.5 on its narrow mesh, the path
+// from off the door's axis turns at the door's posts; with corners kept up to the radius inside
+// the mesh's edges it runs through the middle of the door instead of with the disc's edge on a
+// post.
+TEST(NavMesh, CornersArePushedIntoTheMiddleOfANarrowDoor) {
+  NavGeometry g{{0, 0, 30, 20}, {}, {rect(14.5, 0, 15.5, 9.3), rect(14.5, 10.7, 15.5, 20)}};
+  for (double push : {0.0, 0.5}) {
+    NavMeshParams p{0.375, 0.0625, 256, 1.0, 0.5};
+    p.corner_push = push;
+    auto mesh = NavMesh::build(g, p);
+    PathFinder f(*mesh);
+    const PathResult r = f.find({5, 3}, {25, 17});
+    ASSERT_EQ(r.status, PathStatus::ok);
+    double off_middle = 0;  // of the corners in the door
+    int in_door = 0;
+    for (const Vec2& c : r.corners)
+      if (c.x >= 14.4 && c.x <= 15.6) {
+        off_middle = std::max(off_middle, std::abs(c.y - 10));
+        ++in_door;
+      }
+    EXPECT_GE(in_door, 1) << "push " << push;
+    if (push == 0)
+      EXPECT_GT(off_middle, 0.2);  // on the mesh's edge, 0.45 from a post
+    else
+      EXPECT_LE(off_middle, 0.1);
+    EXPECT_NEAR(r.length, polyline_length(r), 1e-9);
+    EXPECT_GE(min_clearance(disc_world(g), r), 0.8 * p.radius);
+  }
+}
+
 TEST(NavMesh, NonConvexPolygonsAndCirclesAreRespected) {
   // A U opening west with the goal behind its closed side, and a pillar.
   PolygonObstacle u{
@@ -164,7 +219,9 @@ TEST(NavMesh, RandomWorldsAgreeWithTheVisibilityGraphOracle) {
       if (a < 0) std::reverse(p.vertices.begin(), p.vertices.end());
     }
     const double radius = world % 2 ? 0.5 : 1.0;
-    const NavMeshParams params{radius, radius / 4, 64};
+    // Every third world with the narrow meshes' marking (cells within half a cell).
+    const NavMeshParams params{radius, radius / 4, 64, 1.0,
+                               world % 3 == 2 ? 0.5 : 0.7071067811865476};
     auto mesh = NavMesh::build(g, params);
     PathFinder f(*mesh);
     const auto dw = disc_world(g);
