@@ -124,7 +124,9 @@ TEST(NavMesh, DoorsALittleWiderThanTheDiscAreOpen) {
       auto mesh = NavMesh::build(g, p);
       PathFinder f(*mesh);
       PathResult r = f.find({3, 3}, {17, 7});
-      if (r.status == PathStatus::ok) EXPECT_GE(min_clearance(disc_world(g), r), 0.75 * R) << R;
+      if (r.status == PathStatus::ok) {
+        EXPECT_GE(min_clearance(disc_world(g), r), 0.75 * R) << R;
+      }
       return r.status;
     };
     const NavMeshParams cls{R, R / 4}, narrow{R - R / 4, R / 8, 256, 1.0, 0.5};
@@ -156,10 +158,11 @@ TEST(NavMesh, CornersArePushedIntoTheMiddleOfANarrowDoor) {
         ++in_door;
       }
     EXPECT_GE(in_door, 1) << "push " << push;
-    if (push == 0)
+    if (push == 0) {
       EXPECT_GT(off_middle, 0.2);  // on the mesh's edge, 0.45 from a post
-    else
+    } else {
       EXPECT_LE(off_middle, 0.1);
+    }
     EXPECT_NEAR(r.length, polyline_length(r), 1e-9);
     EXPECT_GE(min_clearance(disc_world(g), r), 0.8 * p.radius);
   }
