@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <regex>
+#include <string>
 
 #include "crowddb/simulation.hpp"
 #include "support/configs.hpp"
@@ -195,9 +195,12 @@ TEST(Navigation, AWidePersonFindsANarrowDoorWithTheDefaults) {
   Simulation sim(std::move(w), c);
   for (int k = 0; k < 400 && sim.arrived_total() == 0; ++k) sim.step();  // 40 s
   EXPECT_EQ(sim.arrived_total(), 1u);
-  EXPECT_TRUE(std::regex_search(sim.explain_analyze(),
-                                std::regex("narrow mesh, [1-9][0-9]* of them reaching the goal")))
-      << sim.explain_analyze();
+  // "... N searches on a narrow mesh, M of them reaching the goal": M >= 1.
+  const std::string ea = sim.explain_analyze();
+  const std::string key = "on a narrow mesh, ";
+  const std::size_t at = ea.find(key);
+  ASSERT_NE(at, std::string::npos) << ea;
+  EXPECT_GE(std::stoul(ea.substr(at + key.size())), 1u) << ea;
 }
 
 // An aircraft's aisle: a seat at the end of a 0.46 m corridor of thin walls, for a person of
