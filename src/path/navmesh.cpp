@@ -541,7 +541,19 @@ void PathFinder::funnel(PathResult& r, const float* start, const float* end, int
   dtVcopy(left, start);
   dtVcopy(right, start);
   std::size_t apex_i = 0, left_i = 0, right_i = 0;
-  for (std::size_t i = 1; i < portals.size(); ++i) {
+  // The funnel's side `side` (index `side_i`) is crossed: its point is a corner (unless it is
+  // the end), the funnel restarts there and the scan resumes after its portal.
+  std::size_t i = 1;
+  const auto restart_at = [&](const float* side, std::size_t side_i) {
+    if (!dtVequal(side, end)) r.corners.push_back(mesh_.world(side));
+    dtVcopy(apex, side);
+    apex_i = side_i;
+    dtVcopy(left, apex);
+    dtVcopy(right, apex);
+    left_i = right_i = apex_i;
+    i = apex_i;
+  };
+  for (; i < portals.size(); ++i) {
     const float* pl = portals[i].l;
     const float* pr = portals[i].rt;
     if (dtTriArea2D(apex, right, pr) <= 0.0f) {  // the right side narrows the funnel
@@ -549,13 +561,7 @@ void PathFinder::funnel(PathResult& r, const float* start, const float* end, int
         dtVcopy(right, pr);
         right_i = i;
       } else {  // crosses the left side: the left point is a corner
-        if (!dtVequal(left, end)) r.corners.push_back(mesh_.world(left));
-        dtVcopy(apex, left);
-        apex_i = left_i;
-        dtVcopy(left, apex);
-        dtVcopy(right, apex);
-        left_i = right_i = apex_i;
-        i = apex_i;
+        restart_at(left, left_i);
         continue;
       }
     }
@@ -563,14 +569,8 @@ void PathFinder::funnel(PathResult& r, const float* start, const float* end, int
       if (dtVequal(apex, left) || dtTriArea2D(apex, right, pl) < 0.0f) {
         dtVcopy(left, pl);
         left_i = i;
-      } else {
-        if (!dtVequal(right, end)) r.corners.push_back(mesh_.world(right));
-        dtVcopy(apex, right);
-        apex_i = right_i;
-        dtVcopy(left, apex);
-        dtVcopy(right, apex);
-        left_i = right_i = apex_i;
-        i = apex_i;
+      } else {  // crosses the right side: the right point is a corner
+        restart_at(right, right_i);
         continue;
       }
     }

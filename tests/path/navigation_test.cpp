@@ -176,31 +176,40 @@ TEST(Navigation, ExplainShowsThePathService) {
   EXPECT_EQ(off.explain().find("path requests"), std::string::npos);
 }
 
-// End to end with the default model and navigation: a person of radius 0.3 m (the 0.5 class:
-// its mesh has no passage narrower than about 1.5 m) goes round a wall through its 0.9 m door,
-// found on the class's narrow mesh.
-TEST(Navigation, AWidePersonFindsANarrowDoorWithTheDefaults) {
-  World w(Bounds{0, 0, 20, 10});
-  w.add_goal({"behind", 16, 2, 1, 0.5, {}});
-  w.add_obstacle(PolygonObstacle{{{9.5, 0}, {10.5, 0}, {10.5, 8.1}, {9.5, 8.1}}, 0.1});
-  w.add_obstacle(PolygonObstacle{{{9.5, 9.0}, {10.5, 9.0}, {10.5, 10}, {9.5, 10}}, 0.1});
+// One person of radius `radius` from (x, y) to goal 0 of `w`, with the default model and
+// navigation on, for at most `ticks` ticks: the arrivals and EXPLAIN ANALYZE at the end.
+struct Walk {
+  std::size_t arrived;
+  std::string analyze;
+};
+Walk walk_alone(World w, double x, double y, double radius, int ticks) {
   AgentSpec s;
-  s.x = 4;
-  s.y = 2;
-  s.radius = 0.3;
+  s.x = x;
+  s.y = y;
+  s.radius = radius;
   s.goal = 0;
   w.insert(s);
   SimConfig c;
   c.navigation.enabled = true;
   Simulation sim(std::move(w), c);
-  for (int k = 0; k < 400 && sim.arrived_total() == 0; ++k) sim.step();  // 40 s
-  EXPECT_EQ(sim.arrived_total(), 1u);
+  for (int k = 0; k < ticks && sim.arrived_total() == 0; ++k) sim.step();
+  return {sim.arrived_total(), sim.explain_analyze()};
+}
+
+// A person of radius 0.3 m (the 0.5 class: its mesh has no passage narrower than about 1.5 m)
+// goes round a wall through its 0.9 m door, found on the agent's narrow mesh.
+TEST(Navigation, AWidePersonFindsANarrowDoorWithTheDefaults) {
+  World w(Bounds{0, 0, 20, 10});
+  w.add_goal({"behind", 16, 2, 1, 0.5, {}});
+  w.add_obstacle(PolygonObstacle{{{9.5, 0}, {10.5, 0}, {10.5, 8.1}, {9.5, 8.1}}, 0.1});
+  w.add_obstacle(PolygonObstacle{{{9.5, 9.0}, {10.5, 9.0}, {10.5, 10}, {9.5, 10}}, 0.1});
+  const Walk walk = walk_alone(std::move(w), 4, 2, 0.3, 400);  // 40 s
+  EXPECT_EQ(walk.arrived, 1u);
   // "... N searches on a narrow mesh, M of them reaching the goal": M >= 1.
-  const std::string ea = sim.explain_analyze();
   const std::string key = "on a narrow mesh, ";
-  const std::size_t at = ea.find(key);
-  ASSERT_NE(at, std::string::npos) << ea;
-  EXPECT_GE(std::stoul(ea.substr(at + key.size())), 1u) << ea;
+  const std::size_t at = walk.analyze.find(key);
+  ASSERT_NE(at, std::string::npos) << walk.analyze;
+  EXPECT_GE(std::stoul(walk.analyze.substr(at + key.size())), 1u) << walk.analyze;
 }
 
 // An aircraft's aisle: a seat at the end of a 0.46 m corridor of thin walls, for a person of
@@ -212,17 +221,7 @@ TEST(Navigation, AGoalDownANarrowAisleIsReachedThroughItsEntrance) {
   w.add_obstacle(PolygonObstacle{{{5, 2.77}, {15.1, 2.77}, {15.1, 2.87}, {5, 2.87}}, 0.1});
   w.add_obstacle(PolygonObstacle{{{5, 3.33}, {15.1, 3.33}, {15.1, 3.43}, {5, 3.43}}, 0.1});
   w.add_obstacle(PolygonObstacle{{{15, 2.87}, {15.1, 2.87}, {15.1, 3.33}, {15, 3.33}}, 0.1});
-  AgentSpec s;
-  s.x = 10;
-  s.y = 1;
-  s.radius = 0.21;
-  s.goal = 0;
-  w.insert(s);
-  SimConfig c;
-  c.navigation.enabled = true;
-  Simulation sim(std::move(w), c);
-  for (int k = 0; k < 600 && sim.arrived_total() == 0; ++k) sim.step();  // 60 s
-  EXPECT_EQ(sim.arrived_total(), 1u);
+  EXPECT_EQ(walk_alone(std::move(w), 10, 1, 0.21, 600).arrived, 1u);  // 60 s
 }
 
 TEST(Navigation, RadiusClassesRoundUp) {
