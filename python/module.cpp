@@ -441,7 +441,8 @@ PYBIND11_MODULE(_core, m) {
         const auto& s = a.table().state;
         return column(reinterpret_cast<const uint8_t*>(s.data()), s.size(), a.sim);
       },
-      "0 active, 1 frozen (put back by the backoff loop), 2 arrived (idling) (uint8)");
+      "0 active, 1 frozen (put back by the backoff loop), 2 arrived (idling), 3 waiting at a "
+      "goal (uint8)");
 
   bind_queries(m);
   bind_sdf(m);

@@ -46,7 +46,14 @@ enum class AgentState : uint8_t {
   active = 0,   // steering normally
   frozen = 1,   // put back by the backoff loop in the last tick
   arrived = 2,  // reached its last goal and idles there (only when arrivals idle)
+  waiting = 3,  // stands at a goal with a wait until AgentTable::wait_until, then goes on
 };
+
+// Arrived and waiting agents stand at their goal: they do not steer for it, go last when others
+// pass and make way for them.
+inline bool standing(AgentState s) {
+  return s == AgentState::arrived || s == AgentState::waiting;
+}
 
 // One agent row as the user supplies it. Units: metres and seconds (velocities in m/s).
 struct AgentSpec {
@@ -72,7 +79,13 @@ struct Goal {
   double charge = 1;          // attraction strength (c_goal) of the thesis model, finite
   double arrival_radius = 1;  // [m] > 0: the disc's radius (ignored for polygons)
   std::vector<Vec2> area;     // empty: a disc; else a simple polygon, stored counter-clockwise
+  // [s] An agent that reaches the goal stands there for a time drawn uniformly in [wait_min,
+  // wait_max] (per agent and visit, from the seeded generator) before it goes on to its next
+  // goal or its arrival policy applies. 0 <= wait_min <= wait_max <= kMaxWait; 0: no wait.
+  double wait_min = 0, wait_max = 0;
+  static constexpr double kMaxWait = 1e7;  // [s] about 116 days
   bool is_polygon() const { return !area.empty(); }
+  bool has_wait() const { return wait_max > 0; }
 };
 
 // Agents entering over time (the thesis's characters that join a crowd): from `start` on,
@@ -153,6 +166,8 @@ struct AgentTable {
   std::vector<uint32_t> path_goal;     // goal row the route is planned for; kNoPath: none
   std::vector<uint64_t> path_ticket;   // the path request in flight (0: none)
   std::vector<uint32_t> replan_ticks;  // ticks without progress since the last path request
+  // goal waits (Goal::wait_min/max); only read while the agent is waiting
+  std::vector<uint64_t> wait_until;  // tick at whose commit the wait ends
 
   std::size_t size() const { return x.size(); }
   bool empty() const { return x.empty(); }
@@ -194,6 +209,8 @@ class World {
   // ---- reads ----
   const AgentTable& agents() const { return agents_; }
   std::span<const Goal> goals() const { return goals_; }
+  // Does any goal make its visitors wait (Goal::has_wait)?
+  bool any_goal_wait() const { return any_goal_wait_; }
   std::span<const Source> sources() const { return sources_; }
   // Row of the goal with this name, or nothing.
   std::optional<uint32_t> goal_named(std::string_view name) const;
@@ -258,6 +275,7 @@ class World {
   std::vector<Bounds> polygon_boxes_;  // of polygons_, to skip most polygons in check_walkable
   AgentTable agents_;
   std::vector<Goal> goals_;
+  bool any_goal_wait_ = false;
   std::vector<Source> sources_;
   std::vector<CircleObstacle> circles_;
   std::vector<PolygonObstacle> polygons_;

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
 
 #include "crowddb/scenario.hpp"
@@ -373,6 +374,7 @@ struct Loader {
       Goal goal;
       goal.name = g.string("name");
       goal.charge = g.number("charge", 1.0);
+      std::tie(goal.wait_min, goal.wait_max) = g.range("wait", {0.0, 0.0});
       if (g.has("area")) {
         goal.area = g.points("area");
         if (g.has("arrival_radius"))

@@ -33,13 +33,16 @@ struct RunInfo {
   const std::vector<metrics::AgentScore>* scores = nullptr;  // SteerBench, per agent
 };
 
-// The state a frame records for agent row i: "arrived", "frozen" (put back by the backoff in the
+// The state a frame records for agent row i: "arrived", "waiting" (at a goal with a wait),
+// "frozen" (put back by the backoff in the
 // tick), "stalled" (active, but without progress for longer than the stall watch's `after`,
 // given in ticks; an agent waiting in a queue is not stalled), else "active".
 inline const char* agent_state_name(const AgentTable& t, std::size_t i, uint64_t stall_after) {
   switch (t.state[i]) {
     case AgentState::arrived:
       return "arrived";
+    case AgentState::waiting:
+      return "waiting";
     case AgentState::frozen:
       return "frozen";
     default:

@@ -194,6 +194,9 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
   s.agents_total = s.agents_at_start + s.entered;
   s.arrived = sim.arrived_total();
   s.still_walking = last.active;
+  const auto& states = sim.world().agents().state;
+  s.waiting_at_goals =
+      static_cast<std::size_t>(std::count(states.begin(), states.end(), AgentState::waiting));
   s.all_arrived = last.active == 0 && s.waiting_to_enter == 0;
   s.last_arrival_s = last_arrival ? static_cast<double>(last_arrival) * dt : -1;
   s.overlapping_pairs_at_end = last.overlapping_pairs;
@@ -230,6 +233,7 @@ std::string RunSummary::json() const {
   j["agents_total"] = agents_total;
   j["arrived"] = arrived;
   j["still_walking"] = still_walking;
+  j["waiting_at_goals"] = waiting_at_goals;
   j["all_arrived"] = all_arrived;
   if (last_arrival_s >= 0)
     j["last_arrival_s"] = ns(last_arrival_s);
@@ -290,6 +294,7 @@ std::string RunSummary::text(const SimConfig& cfg) const {
     os << ", " << static_cast<double>(arrived) * 60 / sim_seconds << " arrivals per minute";
   os << (all_arrived ? "; everyone arrived"
                      : "; " + std::to_string(still_walking) + " still walking");
+  if (waiting_at_goals > 0) os << " (" << waiting_at_goals << " of them waiting at a goal)";
   os << "\n  overlaps after a tick: at most " << max_overlapping_pairs << " agent pairs and "
      << max_obstacle_overlaps << " agent-obstacle; at the end " << overlapping_pairs_at_end
      << " pairs\n  backoff: " << (cfg.backoff ? "on" : "off") << ", " << frozen_agent_ticks

@@ -29,9 +29,10 @@ struct RunSummary {
   std::size_t agents_at_start = 0, entered = 0, waiting_to_enter = 0, agents_at_end = 0;
   std::size_t agents_total = 0;  // at start + entered
   std::size_t arrived = 0;
-  std::size_t still_walking = 0;  // not arrived at the end
-  bool all_arrived = false;       // nobody still walking and nobody waiting to enter
-  double last_arrival_s = -1;     // -1: nobody arrived
+  std::size_t still_walking = 0;     // not arrived at the end
+  std::size_t waiting_at_goals = 0;  // of those, waiting at a goal (Goal::wait_min/max)
+  bool all_arrived = false;          // nobody still walking and nobody waiting to enter
+  double last_arrival_s = -1;        // -1: nobody arrived
   std::size_t max_overlapping_pairs = 0, max_obstacle_overlaps = 0, overlapping_pairs_at_end = 0;
   std::size_t frozen_agent_ticks = 0, freeze_iterations_total = 0, freeze_iterations_max = 0;
   std::size_t gridlock_streaks = 0, gridlocked_max = 0, gridlocked_at_end = 0;

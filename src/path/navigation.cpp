@@ -169,7 +169,7 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
   AgentTable& t = world.agents_for_tick();
   std::size_t made = 0;
   for (std::size_t i = 0; i < t.size(); ++i) {
-    if (t.state[i] == AgentState::arrived) continue;  // idle at its goal
+    if (standing(t.state[i])) continue;  // idle or waiting at its goal
     // The progress watch (stalemate.cpp) counts the ticks without progress since the last request.
     const bool stalled = replan_ticks_ > 0 && t.replan_ticks[i] >= replan_ticks_;
     const bool new_goal = t.path_goal[i] != t.goal[i];

@@ -217,7 +217,8 @@ struct Simulation::Engine {
 
   // Arrivals that idle gather at their goal: an agent on its last goal also arrives when it
   // touches (a gap under kJoinGap) an agent already idle at that goal, so the group grows
-  // outwards instead of the later ones pushing through it for ever. joined[i] says who.
+  // outwards instead of the later ones pushing through it for ever. Likewise an agent reaches
+  // any goal when it touches one waiting at it (a crowd round a booth). joined[i] says who.
   static constexpr double kJoinGap = 0.1;  // [m]
   std::vector<uint8_t> joined;
   std::vector<uint32_t> join_queries;
@@ -226,24 +227,27 @@ struct Simulation::Engine {
   void join_idle_groups(const World& w, const SimConfig& cfg, QueryStats& stats) {
     const AgentTable& t = w.agents();
     joined.assign(t.size(), 0);
-    if (cfg.arrival != ArrivalPolicy::idle) return;
+    const bool idle = cfg.arrival == ArrivalPolicy::idle;
+    if (!idle && !w.any_goal_wait()) return;
     join_queries.clear();
     double rmax = 0;
-    bool any_idle = false;
+    bool any_standing = false;
     for (std::size_t i = 0; i < t.size(); ++i) {
       rmax = std::max(rmax, t.radius[i]);
-      any_idle = any_idle || t.state[i] == AgentState::arrived;
-      if (t.state[i] != AgentState::arrived && t.route[i].empty() && t.then[i].empty())
+      any_standing = any_standing || standing(t.state[i]);
+      if (!standing(t.state[i]) && t.route[i].empty() &&
+          ((idle && t.then[i].empty()) || w.goals()[t.goal[i]].has_wait()))
         join_queries.push_back(static_cast<uint32_t>(i));
     }
-    if (!any_idle || join_queries.empty()) return;
+    if (!any_standing || join_queries.empty()) return;
     if (!join_path) join_path = neighbour_method(cfg.access.neighbours, t.size()).make();
     join_path->run(DiscView::of(t), join_queries, 2 * rmax + kJoinGap, 8, join_lists, ex, stats);
     for (std::size_t q = 0; q < join_queries.size(); ++q) {
       const uint32_t i = join_queries[q];
       for (uint32_t a = join_lists.offset[q]; a < join_lists.offset[q + 1]; ++a) {
         const uint32_t j = join_lists.row[a];
-        if (t.state[j] != AgentState::arrived || t.goal[j] != t.goal[i]) continue;
+        if (!standing(t.state[j]) || t.goal[j] != t.goal[i]) continue;
+        if (t.state[j] == AgentState::arrived && !t.then[i].empty()) continue;
         if (std::sqrt(join_lists.dist2[a]) - t.radius[i] - t.radius[j] < kJoinGap) {
           joined[i] = 1;
           break;
@@ -299,7 +303,8 @@ uint64_t Simulation::state_hash() const {
 namespace {
 
 constexpr std::string_view kCheckpointMagic = "crowddb-checkpoint";
-constexpr uint32_t kCheckpointVersion = 2;  // 2: narrow meshes in the path service's state
+constexpr uint32_t kCheckpointVersion =
+    3;  // 2: narrow meshes in the path service's state; 3: goal waits
 
 // What a checkpoint must agree on with the simulation it is restored into: the static tables
 // and the settings that change what a tick computes (not the thread count).
@@ -440,17 +445,17 @@ const TickMetrics& Simulation::step() {
   e.next.resize(n);
 
   // 1. goal stage: preferred velocities
-  if (cfg.arrival == ArrivalPolicy::idle) {
+  if (cfg.arrival == ArrivalPolicy::idle || world_.any_goal_wait()) {
     e.demand.assign(world_.goals().size(), 0);
     for (std::size_t i = 0; i < n; ++i)
-      if (t.state[i] != AgentState::arrived) ++e.demand[t.goal[i]];
+      if (!standing(t.state[i])) ++e.demand[t.goal[i]];
   } else {
     e.demand.clear();
   }
   const uint64_t nudge_ticks = cfg.nudge_after > 0 ? cfg.ticks_for(cfg.nudge_after) : 0;
   if (nudge_ticks)
     for (std::size_t i = 0; i < n; ++i)
-      m.nudged += t.state[i] != AgentState::arrived && t.frozen_ticks[i] >= nudge_ticks;
+      m.nudged += !standing(t.state[i]) && t.frozen_ticks[i] >= nudge_ticks;
   log.timed("goal stage", n, [&] {
     sim::goal_stage(t, world_.goals(), cfg, m.tick, e.demand, e.pref, e.ex, e.nav.get());
   });
@@ -501,8 +506,40 @@ const TickMetrics& Simulation::step() {
     std::vector<Part> parts((n + kCommitGrain - 1) / kCommitGrain);
     e.ex.for_each_chunk(n, kCommitGrain, [&](std::size_t begin, std::size_t end) {
       Part& c = parts[begin / kCommitGrain];
+      // Done with goal t.goal[i] (reached, its wait over): on to the next goal of the sequence,
+      // or the arrival policy.
+      const auto done_with_goal = [&](std::size_t i) {
+        if (world_.advance_goal(i)) return;  // an intermediate goal: on to the next one
+        ++c.arrived;
+        if (cfg.arrival == ArrivalPolicy::remove) {
+          c.leaving.push_back(i);
+        } else if (cfg.arrival == ArrivalPolicy::retarget && world_.goals().size() > 1) {
+          // Another goal, from a stream keyed by seed, id and tick: thread- and
+          // order-independent.
+          Rng rng = Rng::stream(cfg.seed ^ (m.tick * 0x9e3779b97f4a7c15ull), t.id[i]);
+          const auto others = static_cast<uint32_t>(world_.goals().size() - 1);
+          const auto pick = static_cast<uint32_t>(rng.below(others));
+          t.goal[i] = pick >= t.goal[i] ? pick + 1 : pick;
+          t.route[i].clear();
+          t.path_goal[i] = AgentTable::kNoPath;  // a new goal: re-plan
+          t.progress_best[i] = INFINITY;
+          t.stall_ticks[i] = 0;
+          world_.refresh_target(i);
+        } else {
+          t.state[i] = AgentState::arrived;
+          t.vx[i] = t.vy[i] = 0;
+        }
+      };
       for (std::size_t i = begin; i < end; ++i) {
         if (t.state[i] == AgentState::arrived) continue;
+        if (t.state[i] == AgentState::waiting) {
+          if (m.tick < t.wait_until[i]) continue;
+          t.state[i] = AgentState::active;
+          t.progress_best[i] = INFINITY;
+          t.stall_ticks[i] = 0;
+          done_with_goal(i);
+          continue;
+        }
         if (e.next.frozen[i]) {
           ++c.frozen;
           t.state[i] = AgentState::frozen;
@@ -525,29 +562,21 @@ const TickMetrics& Simulation::step() {
           world_.refresh_target(i);
         }
         if (t.route[i].empty() && (world_.at_goal(i) || e.joined[i])) {
-          if (world_.advance_goal(i)) {
-            // an intermediate goal of its sequence: on to the next one
-          } else {
-            ++c.arrived;
-            if (cfg.arrival == ArrivalPolicy::remove) {
-              c.leaving.push_back(i);
-            } else if (cfg.arrival == ArrivalPolicy::retarget && world_.goals().size() > 1) {
-              // Another goal, from a stream keyed by seed, id and tick: thread- and
-              // order-independent.
-              Rng rng = Rng::stream(cfg.seed ^ (m.tick * 0x9e3779b97f4a7c15ull), t.id[i]);
-              const auto others = static_cast<uint32_t>(world_.goals().size() - 1);
-              const auto pick = static_cast<uint32_t>(rng.below(others));
-              t.goal[i] = pick >= t.goal[i] ? pick + 1 : pick;
-              t.route[i].clear();
-              t.path_goal[i] = AgentTable::kNoPath;  // a new goal: re-plan
-              t.progress_best[i] = INFINITY;
-              t.stall_ticks[i] = 0;
-              world_.refresh_target(i);
-            } else {
-              t.state[i] = AgentState::arrived;
+          const Goal& g = world_.goals()[t.goal[i]];
+          if (g.has_wait()) {
+            // Its wait, from a stream keyed by seed, id and tick (a visit of the agent).
+            Rng rng = Rng::stream(cfg.seed ^ (m.tick * 0xbf58476d1ce4e5b9ull), t.id[i] ^ 0x3a17);
+            const double wait = rng.uniform(g.wait_min, g.wait_max);
+            if (wait > 0) {  // whole ticks, at least one
+              t.state[i] = AgentState::waiting;
+              t.frozen_ticks[i] = 0;
+              t.stall_action[i] = StallAction::none;
               t.vx[i] = t.vy[i] = 0;
+              t.wait_until[i] = m.tick + cfg.ticks_for(wait);
+              continue;
             }
           }
+          done_with_goal(i);
         }
       }
     });

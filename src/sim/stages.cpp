@@ -14,8 +14,9 @@ namespace {
 
 constexpr std::size_t kGrain = 256;
 
+// Arrived or waiting at its goal: no steering for the goal, only making room at it.
 bool idle(const AgentTable& t, std::size_t i) {
-  return t.state[i] == AgentState::arrived;
+  return standing(t.state[i]);
 }
 
 }  // namespace

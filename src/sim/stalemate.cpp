@@ -101,7 +101,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   std::vector<uint8_t> look(t.size(), 0);
   ex.for_each_chunk(t.size(), kWatchGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
-      if (t.state[i] == AgentState::arrived) {
+      if (standing(t.state[i])) {
         t.stall_ticks[i] = 0;
         t.stall_action[i] = StallAction::none;
         continue;
@@ -152,7 +152,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     if (blocker[q] < 0) continue;
     const auto j = static_cast<std::size_t>(blocker[q]);
     const Vec2 dj = heading(t, goals, j);
-    same_way[q] = t.state[j] == AgentState::arrived || t.goal[j] == t.goal[i] ||
+    same_way[q] = standing(t.state[j]) || t.goal[j] == t.goal[i] ||
                   dj.x * dir[q].x + dj.y * dir[q].y >= kSameWay;
   }
   // A queue ends in someone who moves: an agent waits in one when its same-way blocker is
@@ -163,8 +163,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     for (std::size_t q = 0; q < looked_at.size(); ++q) {
       if (queueing[q] || !same_way[q]) continue;
       const auto j = static_cast<std::size_t>(blocker[q]);
-      if (t.state[j] == AgentState::arrived || pos[j] < 0 ||
-          queueing[static_cast<std::size_t>(pos[j])]) {
+      if (standing(t.state[j]) || pos[j] < 0 || queueing[static_cast<std::size_t>(pos[j])]) {
         queueing[q] = 1;
         changed = true;
       }

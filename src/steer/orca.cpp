@@ -220,8 +220,7 @@ class OrcaModel final : public Model {
       avoid_y_.resize(n);
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
-          remaining_[i] =
-              t.state[i] == AgentState::arrived ? INFINITY : sim::path_left(t, in.goals, i);
+          remaining_[i] = standing(t.state[i]) ? INFINITY : sim::path_left(t, in.goals, i);
           yielding_[i] =
               t.stall_action[i] == StallAction::yield_ahead && in.tick < t.stall_until[i];
           arrive_[i] = arrival_time(in, i);
@@ -397,8 +396,7 @@ class OrcaModel final : public Model {
   // idle).
   static double arrival_time(const TickInput& in, std::size_t i) {
     const AgentTable& t = in.agents;
-    if (t.state[i] == AgentState::arrived || !t.route[i].empty() || !t.then[i].empty() ||
-        t.pref_speed[i] <= 0)
+    if (standing(t.state[i]) || !t.route[i].empty() || !t.then[i].empty() || t.pref_speed[i] <= 0)
       return INFINITY;
     const Goal& g = in.goals[t.goal[i]];
     double d;

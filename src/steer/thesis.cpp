@@ -150,7 +150,7 @@ class ThesisModel final : public Model {
     const double tau = in.cfg.steering.thesis.tau;
     ex.for_each_chunk(t.size(), kGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
-        if (t.state[i] == AgentState::arrived) continue;
+        if (standing(t.state[i])) continue;
         const double c = in.goals[t.goal[i]].charge;
         ax_[i] = c * (in.pref_vx[i] - t.vx[i]) / tau;
         ay_[i] = c * (in.pref_vy[i] - t.vy[i]) / tau;
@@ -202,7 +202,7 @@ class ThesisModel final : public Model {
     ex.for_each_chunk(t.size(), kGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         const FtcHit& h = hits_[i];
-        if (h.with.kind == Collider::Kind::none || t.state[i] == AgentState::arrived) continue;
+        if (h.with.kind == Collider::Kind::none || standing(t.state[i])) continue;
         const double ts = h.time;
         const double ax = t.x[i] + t.vx[i] * ts, ay = t.y[i] + t.vy[i] * ts;  // a at t*
         double bx, by, bvx = 0, bvy = 0;                                      // b at t*
@@ -246,7 +246,7 @@ class ThesisModel final : public Model {
     const double dt = in.cfg.dt;
     ex.for_each_chunk(t.size(), kGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
-        if (t.state[i] == AgentState::arrived) {
+        if (standing(t.state[i])) {
           // Idle: still, unless the goal stage moves it off a goal area others need.
           vxo[i] = in.pref_vx[i];
           vyo[i] = in.pref_vy[i];

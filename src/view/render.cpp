@@ -43,6 +43,8 @@ uint32_t shade_colour(Shade s) {
       return colour::kArrived;
     case Shade::stalled:
       return colour::kStalled;
+    case Shade::waiting:
+      return colour::kWaiting;
     default:
       return colour::kActive;
   }
@@ -160,7 +162,7 @@ void render_png(const RunFile& run, int64_t frame, const RenderOptions& opt,
   if (!(top > 0))
     for (const FrameAgent& a : agents) top = std::max(top, std::hypot(a.vx, a.vy));
   top = std::max(top, 0.1);
-  std::size_t count[5] = {0, 0, 0, 0, 0};
+  std::size_t count[6] = {0, 0, 0, 0, 0, 0};
   cairo_set_line_width(cr, std::clamp(0.08 * v.scale, 0.3, 1.0));
   for (const FrameAgent& a : agents) {
     ++count[static_cast<int>(a.shade)];
@@ -208,6 +210,7 @@ void render_png(const RunFile& run, int64_t frame, const RenderOptions& opt,
     key(colour::kStalled, "stalled " + std::to_string(count[4]));
     key(colour::kFrozen, "frozen " + std::to_string(count[1]));
     key(colour::kArrived, "arrived " + std::to_string(count[2]));
+    if (count[5] > 0) key(colour::kWaiting, "waiting " + std::to_string(count[5]));
   } else {
     key(colour::kActive,
         "agents (radius " + fixed(RunFile::kDefaultRadius, 1) + " m: not in the file)");

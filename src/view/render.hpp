@@ -29,7 +29,8 @@ Viewport viewport_of(const RunFile& run, int width);
 // The colours things are drawn in (0xRRGGBB), for a legend and for tests that probe pixels.
 namespace colour {
 constexpr uint32_t kBackground = 0xffffff, kFloor = 0xf3efe6, kBlocked = 0x4d4d4d;
-constexpr uint32_t kActive = 0x1f77b4, kFrozen = 0xff7f0e, kArrived = 0x9e9e9e, kStalled = 0x9467bd;
+constexpr uint32_t kActive = 0x1f77b4, kFrozen = 0xff7f0e, kArrived = 0x9e9e9e, kStalled = 0x9467bd,
+                   kWaiting = 0x17becf;
 }  // namespace colour
 
 // Draws frame `frame` of the run: the walkable area (what is not walkable dark), the goal

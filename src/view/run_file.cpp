@@ -55,6 +55,7 @@ Shade shade_of(const std::string& s) {
   if (s == "frozen") return Shade::frozen;
   if (s == "arrived") return Shade::arrived;
   if (s == "stalled") return Shade::stalled;
+  if (s == "waiting") return Shade::waiting;
   return Shade::unknown;
 }
 

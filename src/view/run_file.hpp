@@ -17,7 +17,14 @@ struct sqlite3_stmt;
 namespace crowddb::view {
 
 // Codes fixed by the viewer's frame layout (src/view/server.hpp).
-enum class Shade : uint8_t { active = 0, frozen = 1, arrived = 2, unknown = 3, stalled = 4 };
+enum class Shade : uint8_t {
+  active = 0,
+  frozen = 1,
+  arrived = 2,
+  unknown = 3,
+  stalled = 4,
+  waiting = 5
+};
 
 struct FrameAgent {
   int64_t id = 0;

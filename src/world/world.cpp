@@ -99,6 +99,9 @@ uint32_t World::add_goal(Goal g) {
   require_finite("y", g.y);
   require_finite("charge", g.charge);
   require_positive("arrival_radius", g.arrival_radius);
+  if (!(g.wait_min >= 0 && g.wait_min <= g.wait_max && g.wait_max <= Goal::kMaxWait))
+    throw InvalidRow("wait", "the wait must be a range 0 <= low <= high <= " + fmt(Goal::kMaxWait) +
+                                 " s (got [" + fmt(g.wait_min) + ", " + fmt(g.wait_max) + "])");
   if (goal_named(g.name)) throw InvalidRow("name", "duplicate goal name '" + g.name + "'");
   if (g.is_polygon()) {
     normalize_ring(g.area, "area");
@@ -106,6 +109,7 @@ uint32_t World::add_goal(Goal g) {
       throw InvalidRow(
           "x", "the goal's point (" + fmt(g.x) + ", " + fmt(g.y) + ") lies outside its area");
   }
+  any_goal_wait_ = any_goal_wait_ || g.has_wait();
   goals_.push_back(std::move(g));
   return static_cast<uint32_t>(goals_.size() - 1);
 }
@@ -289,6 +293,7 @@ void World::push_row(AgentId id, const AgentSpec& s) {
   t.path_goal.push_back(AgentTable::kNoPath);
   t.path_ticket.push_back(0);
   t.replan_ticks.push_back(0);
+  t.wait_until.push_back(0);
   slots_[id.index].row = static_cast<uint32_t>(t.size() - 1);
   slots_[id.index].pending = false;
 }
@@ -327,6 +332,7 @@ void World::remove_row(std::size_t row) {
   move_last(t.path_goal);
   move_last(t.path_ticket);
   move_last(t.replan_ticks);
+  move_last(t.wait_until);
   if (row != last) slots_[AgentId::from_value(t.id[row]).index].row = static_cast<uint32_t>(row);
   Slot& s = slots_[dead.index];
   s.row = kNoRow;
@@ -396,7 +402,7 @@ std::size_t World::apply_pending() {
         agents_.path_goal[*row] = AgentTable::kNoPath;  // re-plan, even for the same goal
         agents_.progress_best[*row] = INFINITY;
         agents_.stall_ticks[*row] = 0;
-        if (agents_.state[*row] == AgentState::arrived) agents_.state[*row] = AgentState::active;
+        if (standing(agents_.state[*row])) agents_.state[*row] = AgentState::active;
         refresh_target(*row);
         break;
       }
@@ -437,6 +443,7 @@ void World::validate() const {
   same(t.path_goal.size(), "path_goal");
   same(t.path_ticket.size(), "path_ticket");
   same(t.replan_ticks.size(), "replan_ticks");
+  same(t.wait_until.size(), "wait_until");
   std::size_t live = 0;
   for (std::size_t r = 0; r < n; ++r) {
     const AgentId id = AgentId::from_value(t.id[r]);
@@ -513,6 +520,7 @@ void columns(Io& io, Table& t) {
   io.vec(t.path_goal);
   io.vec(t.path_ticket);
   io.vec(t.replan_ticks);
+  io.vec(t.wait_until);
 }
 
 }  // namespace
@@ -559,7 +567,8 @@ void World::restore_agents(ByteReader& in) {
   const AgentTable& a = trial.agents_;
   for (std::size_t r = 0; r < a.size(); ++r) {
     const std::string row = "row " + std::to_string(r);
-    if (static_cast<uint8_t>(a.state[r]) > 2) bad(row + ": bad state");
+    if (static_cast<uint8_t>(a.state[r]) > static_cast<uint8_t>(AgentState::waiting))
+      bad(row + ": bad state");
     if (static_cast<uint8_t>(a.stall_action[r]) > 3) bad(row + ": bad stall action");
     AgentSpec spec;  // the rules an inserted agent obeys
     spec.x = a.x[r];

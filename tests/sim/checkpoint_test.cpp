@@ -60,6 +60,7 @@ TEST(Checkpoint, ARestoredRunContinuesBitIdenticallyOnAnyThreadCount) {
       {"serpentine", 300, {0, 5, 150}, {}},
       {"bottleneck", 200, {3, 120}, {}},
       {"bottleneck", 200, {2, 3, 151}, {"groups.0.radius=0.3", "groups.0.count=60"}},
+      {"crossing", 260, {2, 200}, {"goals.0.wait=[1, 4]", "goals.1.wait=2"}},  // people waiting
   };
   for (const Case& c : cases) {
     const Reference ref = run_reference(c.name, c.ticks, c.at, c.overrides);

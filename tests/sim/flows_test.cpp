@@ -1,7 +1,10 @@
 // Goal areas, goal sequences, sources, idle arrivals and stalemates in the tick.
 #include <gtest/gtest.h>
 
+#include <climits>
 #include <cmath>
+#include <cstdint>
+#include <map>
 
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
@@ -79,6 +82,97 @@ TEST(Goals, IdleArrivalsWalkIntoAnAreaAndKeepItsEdgeFree) {
   // Nobody idles in the gap itself.
   const AgentTable& a = r.sim->world().agents();
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_FALSE(a.y[i] < 10 && a.y[i] > 8);
+}
+
+TEST(Goals, AWaitHoldsTheAgentAtTheGoalForItsTimeThenItGoesOn) {
+  // A counter with a 5 s wait on the way to an exit: 50 ticks standing there, then on.
+  Loaded r(R"({"bounds": [0, 0, 20, 10], "duration": 40,
+    "goals": [{"name": "counter", "x": 10, "y": 5, "arrival_radius": 0.5, "wait": 5},
+              {"name": "exit", "area": [[19, 0], [20, 0], [20, 10], [19, 10]]}],
+    "agents": [{"x": 2, "y": 5, "goal": ["counter", "exit"]}]})");
+  uint64_t waited = 0, first = 0, last = 0;
+  double wx = NAN, wy = NAN;
+  for (uint64_t t = 1; t <= r.sc.ticks && !r.sim->world().agents().empty(); ++t) {
+    r.sim->step();
+    const AgentTable& a = r.sim->world().agents();
+    if (a.empty() || a.state[0] != AgentState::waiting) continue;
+    if (waited++ == 0) {
+      first = t;
+      wx = a.x[0];
+      wy = a.y[0];
+    }
+    last = t;
+    EXPECT_EQ(a.goal[0], 0u);  // still at the counter
+    EXPECT_EQ(a.x[0], wx);     // standing: nobody else needs the spot
+    EXPECT_EQ(a.y[0], wy);
+    EXPECT_EQ(r.sim->arrived_total(), 0u);
+  }
+  EXPECT_EQ(waited, 50u);
+  EXPECT_EQ(last - first + 1, 50u);
+  EXPECT_LE(std::hypot(wx - 10, wy - 5), 0.5);
+  EXPECT_EQ(r.sim->arrived_total(), 1u);
+}
+
+TEST(Goals, WaitsAreDrawnPerAgentInTheirRangeAndAlikeOnAnyThreadCount) {
+  // 20 people through a booth with a 2-6 s wait to an exit; a wait at the last goal comes
+  // before the arrival policy (here: leaving the table).
+  const std::string text = R"({"bounds": [0, 0, 30, 20], "duration": 200, "threads": THREADS,
+    "goals": [{"name": "booth", "area": [[14, 8], [16, 8], [16, 12], [14, 12]], "wait": [2, 6]},
+              {"name": "exit", "x": 28, "y": 10, "arrival_radius": 0.5, "wait": 1}],
+    "groups": [{"count": 20, "placement": {"type": "uniform", "region": [1, 1, 8, 19], "gap": 0.1},
+                "goal": ["booth", "exit"]}]})";
+  std::map<uint64_t, uint64_t> wait_ticks[2];  // id -> ticks waiting at the booth
+  std::vector<uint64_t> hashes[2];
+  for (int k = 0; k < 2; ++k) {
+    std::string t = text;
+    t.replace(t.find("THREADS"), 7, k ? "2" : "1");
+    Loaded r(t);
+    for (uint64_t s = 0; s < r.sc.ticks; ++s) {
+      const TickMetrics& m = r.sim->step();
+      EXPECT_EQ(m.overlapping_pairs, 0u);
+      hashes[k].push_back(m.state_hash);
+      const AgentTable& a = r.sim->world().agents();
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        if (a.state[i] == AgentState::waiting && a.goal[i] == 0) ++wait_ticks[k][a.id[i]];
+        // Nobody leaves before the exit's 1 s: a row at the exit waits there first.
+        if (a.goal[i] == 1 && std::hypot(a.x[i] - 28, a.y[i] - 10) < 0.3) {
+          EXPECT_EQ(a.state[i], AgentState::waiting);
+        }
+      }
+    }
+    EXPECT_EQ(r.sim->arrived_total(), 20u);
+  }
+  EXPECT_EQ(hashes[0], hashes[1]);
+  EXPECT_EQ(wait_ticks[0], wait_ticks[1]);
+  ASSERT_EQ(wait_ticks[0].size(), 20u);
+  uint64_t lo = UINT64_MAX, hi = 0;
+  for (const auto& [id, n] : wait_ticks[0]) {
+    lo = std::min(lo, n);
+    hi = std::max(hi, n);
+  }
+  EXPECT_GE(lo, 20u);
+  EXPECT_LE(hi, 60u);
+  EXPECT_GE(hi - lo, 10u);  // drawn per agent, not one wait for all
+}
+
+TEST(Goals, BadWaitsAreRefusedNamingTheGoal) {
+  const auto error_of = [](const std::string& wait) {
+    try {
+      parse_scenario(R"({"bounds": [0, 0, 10, 10], "goals": [{"name": "g", "x": 5, "y": 5,
+        "wait": )" + wait +
+                         R"(}], "agents": [{"x": 1, "y": 1, "goal": "g"}]})",
+                     "t.json");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of("-1").find("/goals/0/wait"), std::string::npos) << error_of("-1");
+  EXPECT_NE(error_of("[5, 2]").find("/goals/0/wait"), std::string::npos) << error_of("[5, 2]");
+  EXPECT_NE(error_of("[1, 2, 3]").find("/goals/0/wait"), std::string::npos);
+  EXPECT_NE(error_of("\"long\"").find("/goals/0/wait"), std::string::npos);
+  EXPECT_NE(error_of("1e9").find("/goals/0/wait"), std::string::npos) << error_of("1e9");
+  EXPECT_EQ(error_of("[0, 2.5]"), "no error");
 }
 
 TEST(Sources, LetAgentsInAtTheirRateUntilCountOrEnd) {

@@ -6,8 +6,8 @@ import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
 import './style.css';
 
-const SHADES = ['active', 'frozen', 'arrived', 'unknown', 'stalled'];  // codes of the frame layout
-const COLOURS = { active: '#1f77b4', frozen: '#ff7f0e', arrived: '#9e9e9e', unknown: '#1f77b4', stalled: '#9467bd' };
+const SHADES = ['active', 'frozen', 'arrived', 'unknown', 'stalled', 'waiting'];  // codes of the frame layout
+const COLOURS = { active: '#1f77b4', frozen: '#ff7f0e', arrived: '#9e9e9e', unknown: '#1f77b4', stalled: '#9467bd', waiting: '#17becf' };
 const FLOOR = '#f3efe6', BLOCKED = '#4d4d4d';
 const VIRIDIS = [[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]];
 const MAX_WINDOWS = 6;
@@ -304,13 +304,14 @@ function legend() {
       html += `<span class="key" style="background:${speedColour(s / 4)}"></span>${(top * s / 4).toFixed(2)}`;
     html += ' m/s';
   } else {
-    const count = [0, 0, 0, 0, 0];
+    const count = [0, 0, 0, 0, 0, 0];
     for (let i = 0; i < d.n; ++i) ++count[d.shade[i]];
     if (st.run.crowddb)
       html += `<span class="key" style="background:${COLOURS.active}"></span>active ${count[0] + count[3]}` +
         `<span class="key" style="background:${COLOURS.stalled}"></span>stalled ${count[4]}` +
         `<span class="key" style="background:${COLOURS.frozen}"></span>frozen ${count[1]}` +
-        `<span class="key" style="background:${COLOURS.arrived}"></span>arrived ${count[2]}`;
+        `<span class="key" style="background:${COLOURS.arrived}"></span>arrived ${count[2]}` +
+        (count[5] > 0 ? `<span class="key" style="background:${COLOURS.waiting}"></span>waiting ${count[5]}` : '');
     else html += `<span class="key" style="background:${COLOURS.unknown}"></span>${d.n} agents (radius 0.2 m: not in the file)`;
   }
   if (st.density) html += '<span class="key" style="background:rgba(214,39,40,0.6)"></span>4+ people/m²';

@@ -21,10 +21,13 @@ DocBuilder::DocBuilder() {
   doc_["agents"] = nlohmann::json::array();
 }
 
-std::string DocBuilder::disc_goal(Vec2 c, double arrival_radius, const std::string& origin) {
+std::string DocBuilder::disc_goal(Vec2 c, double arrival_radius, const std::string& origin,
+                                  double wait) {
   extent_.add(c.x - arrival_radius, c.y - arrival_radius);
   extent_.add(c.x + arrival_radius, c.y + arrival_radius);
-  return named_goal({{"x", c.x}, {"y", c.y}, {"arrival_radius", arrival_radius}}, origin);
+  nlohmann::json g = {{"x", c.x}, {"y", c.y}, {"arrival_radius", arrival_radius}};
+  if (wait > 0) g["wait"] = wait;
+  return named_goal(std::move(g), origin);
 }
 
 std::string DocBuilder::named_goal(nlohmann::json g, const std::string& origin) {
@@ -38,13 +41,16 @@ std::string DocBuilder::named_goal(nlohmann::json g, const std::string& origin) 
   return name;
 }
 
-std::string DocBuilder::area_goal(const std::vector<Vec2>& polygon, const std::string& origin) {
+std::string DocBuilder::area_goal(const std::vector<Vec2>& polygon, const std::string& origin,
+                                  double wait) {
   nlohmann::json area = nlohmann::json::array();
   for (const Vec2& v : polygon) {
     area.push_back({v.x, v.y});
     extent_.add(v.x, v.y);
   }
-  return named_goal({{"area", area}}, origin);
+  nlohmann::json g = {{"area", area}};
+  if (wait > 0) g["wait"] = wait;
+  return named_goal(std::move(g), origin);
 }
 
 void DocBuilder::polygon(const std::vector<Vec2>& vertices, const std::string& origin) {

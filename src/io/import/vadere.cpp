@@ -425,6 +425,7 @@ struct Target {
   Shape shape;
   bool absorbing = true;
   double deletion = kDeletionDistance;
+  double wait = 0;   // [s] a fixed wait of each agent at the target (the goal's "wait")
   std::string goal;  // the crowddb goal, made when an agent first heads for it
 };
 
@@ -949,10 +950,12 @@ class Reader {
         tg.deletion = num(*dd);
         if (tg.deletion < 0) fail(*dd, "must be >= 0");
       }
-      const std::string wait = waiting(t);
-      if (!wait.empty())
+      const Waiting wait = waiting(t);
+      if (!wait.unsupported.empty())
         warn("waiting", t,
-             "waiting at targets is not supported (" + wait + "): agents pass without waiting");
+             "this kind of waiting at targets is not supported (" + wait.unsupported +
+                 "): agents pass without waiting");
+      tg.wait = wait.seconds;
       std::optional<Val> lv = get(t, "leavingSpeed");
       if (!lv) lv = get(t, "nextSpeed");
       if (lv && num(*lv) >= 0 && !tg.absorbing)
@@ -970,28 +973,41 @@ class Reader {
     }
   }
 
-  // How a target makes agents wait ("" when it does not).
-  std::string waiting(const Val& t) {
+  // How a target makes agents wait: a fixed time per agent (the goal's "wait"), or a kind
+  // crowddb does not model (a description for the warning), or neither.
+  struct Waiting {
+    double seconds = 0;
+    std::string unsupported;
+  };
+  Waiting waiting(const Val& t) {
     if (const auto w = object(t, "waiter")) {  // 2.4
       known(*w, "enabled distribution");
-      if (!boolean(*w, "enabled", false)) return "";
+      if (!boolean(*w, "enabled", false)) return {};
       const auto d = object(*w, "distribution");
       std::string type = d ? string(*d, "type", std::string("?")) : std::string("none");
       const auto dot = type.rfind('.');
       if (dot != std::string::npos) type = type.substr(dot + 1);
-      return "waiter " + type;
+      // A constant distribution's one parameter is its value, whatever it is used for.
+      if (type == "AttributesConstantDistribution")
+        if (const auto v = get(*d, "updateFrequency")) return fixed_wait(*v);
+      return {0, "waiter " + type};
     }
     if (t.j->contains("waitingTimeDistribution")) {  // 2.3
       const std::string behaviour = string(t, "waitingBehaviour", std::string("INDIVIDUAL"));
-      if (behaviour == "NO_WAITING" || !get(t, "waitingTimeDistribution")) return "";
-      return "waitingTimeDistribution " + string(t, "waitingTimeDistribution", std::string()) +
-             (behaviour == "TRAFFIC_LIGHT" ? " as a traffic light" : "");
+      if (behaviour == "NO_WAITING" || !get(t, "waitingTimeDistribution")) return {};
+      return {0, "waitingTimeDistribution " + string(t, "waitingTimeDistribution", std::string()) +
+                     (behaviour == "TRAFFIC_LIGHT" ? " as a traffic light" : "")};
     }
-    const double wt = number(t, "waitingTime", 0);  // <= 2.2
-    if (!(wt > 0)) return "";
-    return boolean(t, "individualWaiting", true)
-               ? "waitingTime " + fmt(wt) + " s"
-               : "a traffic light, green and red " + fmt(wt) + " s each";
+    const auto wv = get(t, "waitingTime");  // <= 2.2
+    if (!wv || !(num(*wv) > 0)) return {};
+    if (boolean(t, "individualWaiting", true)) return fixed_wait(*wv);
+    return {0, "a traffic light, green and red " + fmt(num(*wv)) + " s each"};
+  }
+  Waiting fixed_wait(const Val& v) {
+    const double s = num(v);
+    if (!(s >= 0 && s <= Goal::kMaxWait))
+      fail(v, "a waiting time must be in [0, " + fmt(Goal::kMaxWait) + "] s");
+    return {s, ""};
   }
 
   // The crowddb goal of a target, made on first use. Vadere reaches a target when the agent's
@@ -999,6 +1015,10 @@ class Reader {
   // polygon's area is used as it is (docs/importers/vadere.md says why).
   const std::string& goal_of(Target& t) {
     if (!t.goal.empty()) return t.goal;
+    make_goal(t);
+    return t.goal;
+  }
+  void make_goal(Target& t) {
     const Shape& s = t.shape;
     const std::string origin = where(t.where);
     const std::string world = "[" + fmt(world_.x0) + ", " + fmt(world_.y0) + ", " + fmt(world_.x1) +
@@ -1010,8 +1030,8 @@ class Reader {
       if (!world_.contains(s.centre))
         fail(t.where, "a target outside the world: the centre of target " + std::to_string(t.id) +
                           " lies outside the bounds " + world);
-      t.goal = b_.disc_goal(s.centre, s.radius + t.deletion, origin);
-      return t.goal;
+      t.goal = b_.disc_goal(s.centre, s.radius + t.deletion, origin, t.wait);
+      return;
     }
     std::vector<Vec2> area = s.points;
     if (!world_.contains(s.box)) {
@@ -1023,7 +1043,7 @@ class Reader {
            "target " + std::to_string(t.id) + " reaches beyond the bounds " + world +
                ": the part outside is dropped");
     }
-    t.goal = b_.area_goal(area, origin);
+    t.goal = b_.area_goal(area, origin, t.wait);
     if (pointed_.insert(t.goal).second)
       if (const auto p = area_point(area))
         for (json& g : b_.doc()["goals"])
@@ -1031,7 +1051,6 @@ class Reader {
             g["x"] = p->x;
             g["y"] = p->y;
           }
-    return t.goal;
   }
 
   // The point of a goal area that navigation aims at (the reader's "x", "y"): its centroid when

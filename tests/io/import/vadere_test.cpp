@@ -417,6 +417,29 @@ TEST(VadereImport, TargetSequencesAndAbsorption) {
   EXPECT_FALSE(has_warning(idle.warnings, "arrival policy")) << all(idle.warnings);
 }
 
+// A target whose waiter has a constant distribution makes each agent wait that long: the goal's
+// "wait". The same area without a waiter is another goal.
+TEST(VadereImport, ConstantWaitsAtTargetsBecomeGoalWaits) {
+  const std::string counter =
+      R"({"id": 2, "shape": )" + rect(20, 1, 1, 1) +
+      R"(, "absorber": {"enabled": false, "deletionDistance": 0.1}, "waiter": {"enabled": true, "distribution": {"type": "org.vadere.state.attributes.distributions.AttributesConstantDistribution", "updateFrequency": 4.5}}, "leavingSpeed": -1.0, "parallelEvents": 0})";
+  Spec s;
+  s.topography =
+      join({list("targets",
+                 {counter, target(3, rect(20, 1, 1, 1), false), target(1, rect(40, 1, 1, 1))}),
+            list("dynamicElements", {pedestrian(5, 1.5, "[2, 1]"), pedestrian(5, 2.5, "[3, 1]")})});
+  const io::Imported im = import(v24(s));
+  const json& goals = im.doc["goals"];
+  ASSERT_EQ(goals.size(), 3u) << goals.dump();
+  EXPECT_EQ(goals[0]["wait"], 4.5);  // made in the order of first use: counter, exit, plain
+  EXPECT_FALSE(goals[1].contains("wait"));
+  EXPECT_FALSE(goals[2].contains("wait"));
+  EXPECT_EQ(goals[0]["area"], goals[2]["area"]);
+  EXPECT_FALSE(has_warning(im.warnings, "waiting")) << all(im.warnings);
+  EXPECT_EQ(im.doc["agents"][0]["goal"], json({"g0", "g1"}));
+  EXPECT_EQ(im.doc["agents"][1]["goal"], json({"g2", "g1"}));
+}
+
 // Ids may repeat (rimea_08 has two exits with id 1): each agent takes the nearest.
 TEST(VadereImport, SharedTargetIdsTakeTheNearest) {
   Spec s;
@@ -808,7 +831,7 @@ TEST(VadereImport, DeeplyNestedValuesCostLinearMemory) {
 TEST(VadereImport, WarningsForUnsupportedElements) {
   const std::string waiting =
       R"({"id": 2, "shape": )" + rect(20, 1, 1, 1) +
-      R"(, "absorber": {"enabled": false, "deletionDistance": 0.1}, "waiter": {"enabled": true, "distribution": {"type": "org.vadere.state.attributes.distributions.AttributesConstantDistribution", "updateFrequency": 5.0}}, "leavingSpeed": 0.5, "parallelEvents": 2})";
+      R"(, "absorber": {"enabled": false, "deletionDistance": 0.1}, "waiter": {"enabled": true, "distribution": {"type": "org.vadere.state.attributes.distributions.AttributesNegativeExponentialDistribution", "mean": 5.0}}, "leavingSpeed": 0.5, "parallelEvents": 2})";
   const std::string groups =
       R"({"id": 1, "shape": )" + rect(1, 1, 1, 1) +
       R"(, "targetIds": [2, 1], "spawner": {"constraintsTimeStart": 0.0, "constraintsTimeEnd": 0.0, "eventPositionRandom": true, "eventElementCount": 4}, "groupSizeDistribution": [0.5, 0.5]})";
@@ -852,7 +875,8 @@ TEST(VadereImport, WarningsForUnsupportedElements) {
           "1 absorbing areas are not supported",
       at("\"teleporter\"", "/scenario/topography/teleporter") + "the teleporter",
       at("\"id\": 2, \"shape\"", "/scenario/topography/targets/1") +
-          "waiting at targets is not supported (waiter AttributesConstantDistribution)",
+          "this kind of waiting at targets is not supported (waiter "
+          "AttributesNegativeExponentialDistribution)",
       at("\"id\": 2, \"shape\"", "/scenario/topography/targets/1/leavingSpeed") +
           "leavingSpeed 0.5 m/s",
       at("\"id\": 2, \"shape\"", "/scenario/topography/targets/1/parallelEvents") +
