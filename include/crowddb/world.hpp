@@ -79,13 +79,15 @@ struct Goal {
   double charge = 1;          // attraction strength (c_goal) of the thesis model, finite
   double arrival_radius = 1;  // [m] > 0: the disc's radius (ignored for polygons)
   std::vector<Vec2> area;     // empty: a disc; else a simple polygon, stored counter-clockwise
-  // [s] An agent that reaches the goal stands there for a time drawn uniformly in [wait_min,
-  // wait_max] (per agent and visit, from the seeded generator) before it goes on to its next
-  // goal or its arrival policy applies. 0 <= wait_min <= wait_max <= kMaxWait; 0: no wait.
-  double wait_min = 0, wait_max = 0;
+  // [s] An agent that reaches the goal stands there for a time drawn (per agent and visit, from
+  // the seeded generator) before it goes on to its next goal or its arrival policy applies:
+  // uniformly in [wait_min, wait_max] (0 <= wait_min <= wait_max <= kMaxWait; 0: no wait), or,
+  // when wait_mean > 0 (then wait_min = wait_max = 0), from an exponential distribution with
+  // that mean, cut at kMaxWait (a queue's service time).
+  double wait_min = 0, wait_max = 0, wait_mean = 0;
   static constexpr double kMaxWait = 1e7;  // [s] about 116 days
   bool is_polygon() const { return !area.empty(); }
-  bool has_wait() const { return wait_max > 0; }
+  bool has_wait() const { return wait_max > 0 || wait_mean > 0; }
 };
 
 // Agents entering over time (the thesis's characters that join a crowd): from `start` on,

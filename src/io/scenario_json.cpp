@@ -374,7 +374,13 @@ struct Loader {
       Goal goal;
       goal.name = g.string("name");
       goal.charge = g.number("charge", 1.0);
-      std::tie(goal.wait_min, goal.wait_max) = g.range("wait", {0.0, 0.0});
+      if (g.has("wait") && g.raw("wait").is_object()) {
+        Node w = g.child("wait");
+        goal.wait_mean = w.positive("exponential");
+        w.finish();
+      } else {
+        std::tie(goal.wait_min, goal.wait_max) = g.range("wait", {0.0, 0.0});
+      }
       if (g.has("area")) {
         goal.area = g.points("area");
         if (g.has("arrival_radius"))

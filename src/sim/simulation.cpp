@@ -566,7 +566,10 @@ const TickMetrics& Simulation::step() {
           if (g.has_wait()) {
             // Its wait, from a stream keyed by seed, id and tick (a visit of the agent).
             Rng rng = Rng::stream(cfg.seed ^ (m.tick * 0xbf58476d1ce4e5b9ull), t.id[i] ^ 0x3a17);
-            const double wait = rng.uniform(g.wait_min, g.wait_max);
+            const double wait =
+                g.wait_mean > 0
+                    ? std::min(-g.wait_mean * std::log1p(-rng.uniform()), Goal::kMaxWait)
+                    : rng.uniform(g.wait_min, g.wait_max);
             if (wait > 0) {  // whole ticks, at least one
               t.state[i] = AgentState::waiting;
               t.frozen_ticks[i] = 0;

@@ -99,6 +99,11 @@ uint32_t World::add_goal(Goal g) {
   require_finite("y", g.y);
   require_finite("charge", g.charge);
   require_positive("arrival_radius", g.arrival_radius);
+  if (!(g.wait_mean >= 0 && g.wait_mean <= Goal::kMaxWait))
+    throw InvalidRow("wait", "the exponential wait's mean must be in [0, " + fmt(Goal::kMaxWait) +
+                                 "] s (got " + fmt(g.wait_mean) + ")");
+  if (g.wait_mean > 0 && g.wait_max > 0)
+    throw InvalidRow("wait", "give a uniform range or an exponential mean, not both");
   if (!(g.wait_min >= 0 && g.wait_min <= g.wait_max && g.wait_max <= Goal::kMaxWait))
     throw InvalidRow("wait", "the wait must be a range 0 <= low <= high <= " + fmt(Goal::kMaxWait) +
                                  " s (got [" + fmt(g.wait_min) + ", " + fmt(g.wait_max) + "])");

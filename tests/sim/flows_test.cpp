@@ -172,7 +172,40 @@ TEST(Goals, BadWaitsAreRefusedNamingTheGoal) {
   EXPECT_NE(error_of("[1, 2, 3]").find("/goals/0/wait"), std::string::npos);
   EXPECT_NE(error_of("\"long\"").find("/goals/0/wait"), std::string::npos);
   EXPECT_NE(error_of("1e9").find("/goals/0/wait"), std::string::npos) << error_of("1e9");
+  EXPECT_NE(error_of(R"({"exponential": -1})").find("/goals/0/wait/exponential"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"exponential": 5, "mean": 5})").find("/goals/0/wait"), std::string::npos);
+  EXPECT_NE(error_of(R"({"exponential": 2e7})").find("/goals/0/wait"), std::string::npos);
   EXPECT_EQ(error_of("[0, 2.5]"), "no error");
+  EXPECT_EQ(error_of(R"({"exponential": 5})"), "no error");
+}
+
+TEST(Goals, ExponentialWaitsHaveTheirMean) {
+  // 100 people through a counter with exponential waits of mean 3 s (a queue's service time).
+  Loaded r(R"({"bounds": [0, 0, 60, 40], "duration": 300, "seed": 11,
+    "goals": [{"name": "counter", "area": [[30, 0], [32, 0], [32, 40], [30, 40]],
+               "wait": {"exponential": 3}},
+              {"name": "exit", "area": [[59, 0], [60, 0], [60, 40], [59, 40]]}],
+    "groups": [{"count": 100, "placement": {"type": "uniform", "region": [1, 1, 20, 39], "gap": 0.1},
+                "goal": ["counter", "exit"]}]})");
+  std::map<uint64_t, uint64_t> ticks;
+  for (uint64_t s = 0; s < r.sc.ticks && !r.sim->world().agents().empty(); ++s) {
+    r.sim->step();
+    const AgentTable& a = r.sim->world().agents();
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (a.state[i] == AgentState::waiting) ++ticks[a.id[i]];
+  }
+  EXPECT_EQ(r.sim->arrived_total(), 100u);
+  double sum = 0, longest = 0;
+  for (const auto& [id, n] : ticks) {
+    sum += static_cast<double>(n) * 0.1;
+    longest = std::max(longest, static_cast<double>(n) * 0.1);
+  }
+  // Whole ticks round each draw up by < 0.1 s. The mean of 100 draws lies within 3 +- 0.9 s
+  // with probability > 0.997, and the longest of 100 is above 6 s with probability > 0.999.
+  EXPECT_EQ(ticks.size(), 100u);
+  EXPECT_NEAR(sum / 100, 3.0, 0.9);
+  EXPECT_GT(longest, 6.0);
 }
 
 TEST(Sources, LetAgentsInAtTheirRateUntilCountOrEnd) {

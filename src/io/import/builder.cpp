@@ -22,11 +22,11 @@ DocBuilder::DocBuilder() {
 }
 
 std::string DocBuilder::disc_goal(Vec2 c, double arrival_radius, const std::string& origin,
-                                  double wait) {
+                                  const nlohmann::json& wait) {
   extent_.add(c.x - arrival_radius, c.y - arrival_radius);
   extent_.add(c.x + arrival_radius, c.y + arrival_radius);
   nlohmann::json g = {{"x", c.x}, {"y", c.y}, {"arrival_radius", arrival_radius}};
-  if (wait > 0) g["wait"] = wait;
+  if (!wait.is_null()) g["wait"] = wait;
   return named_goal(std::move(g), origin);
 }
 
@@ -42,14 +42,14 @@ std::string DocBuilder::named_goal(nlohmann::json g, const std::string& origin) 
 }
 
 std::string DocBuilder::area_goal(const std::vector<Vec2>& polygon, const std::string& origin,
-                                  double wait) {
+                                  const nlohmann::json& wait) {
   nlohmann::json area = nlohmann::json::array();
   for (const Vec2& v : polygon) {
     area.push_back({v.x, v.y});
     extent_.add(v.x, v.y);
   }
   nlohmann::json g = {{"area", area}};
-  if (wait > 0) g["wait"] = wait;
+  if (!wait.is_null()) g["wait"] = wait;
   return named_goal(std::move(g), origin);
 }
 

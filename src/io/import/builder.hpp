@@ -39,10 +39,12 @@ class DocBuilder {
   nlohmann::json& doc() { return doc_; }
 
   // Goals. Identical goals share one entry (and name); `origin` is "file:LINE: <element>".
-  // `wait` > 0: the goal's "wait" [s] (goals that differ in it are different goals).
-  std::string disc_goal(Vec2 c, double arrival_radius, const std::string& origin, double wait = 0);
+  // `wait` not null: the goal's "wait" (scenario-format.md; goals that differ in it are
+  // different goals).
+  std::string disc_goal(Vec2 c, double arrival_radius, const std::string& origin,
+                        const nlohmann::json& wait = nullptr);
   std::string area_goal(const std::vector<Vec2>& polygon, const std::string& origin,
-                        double wait = 0);
+                        const nlohmann::json& wait = nullptr);
 
   // Obstacles (polygons in either orientation; the reader checks them).
   void polygon(const std::vector<Vec2>& vertices, const std::string& origin);

@@ -425,7 +425,7 @@ struct Target {
   Shape shape;
   bool absorbing = true;
   double deletion = kDeletionDistance;
-  double wait = 0;   // [s] a fixed wait of each agent at the target (the goal's "wait")
+  json wait;         // the goal's "wait" (null: none)
   std::string goal;  // the crowddb goal, made when an agent first heads for it
 };
 
@@ -955,7 +955,7 @@ class Reader {
         warn("waiting", t,
              "this kind of waiting at targets is not supported (" + wait.unsupported +
                  "): agents pass without waiting");
-      tg.wait = wait.seconds;
+      tg.wait = wait.wait;
       std::optional<Val> lv = get(t, "leavingSpeed");
       if (!lv) lv = get(t, "nextSpeed");
       if (lv && num(*lv) >= 0 && !tg.absorbing)
@@ -973,10 +973,11 @@ class Reader {
     }
   }
 
-  // How a target makes agents wait: a fixed time per agent (the goal's "wait"), or a kind
-  // crowddb does not model (a description for the warning), or neither.
+  // How a target makes agents wait: a goal's "wait" (a fixed time, or an exponential
+  // distribution's mean), or a kind crowddb does not model (a description for the warning), or
+  // neither.
   struct Waiting {
-    double seconds = 0;
+    json wait;
     std::string unsupported;
   };
   Waiting waiting(const Val& t) {
@@ -990,23 +991,32 @@ class Reader {
       // A constant distribution's one parameter is its value, whatever it is used for.
       if (type == "AttributesConstantDistribution")
         if (const auto v = get(*d, "updateFrequency")) return fixed_wait(*v);
-      return {0, "waiter " + type};
+      if (type == "AttributesNegativeExponentialDistribution")
+        if (const auto v = get(*d, "mean")) {
+          const double mean = num(*v);
+          if (!(mean > 0 && mean <= Goal::kMaxWait))
+            fail(*v, "a mean waiting time must be in (0, " + fmt(Goal::kMaxWait) + "] s");
+          return {json{{"exponential", mean}}, ""};
+        }
+      return {nullptr, "waiter " + type};
     }
     if (t.j->contains("waitingTimeDistribution")) {  // 2.3
       const std::string behaviour = string(t, "waitingBehaviour", std::string("INDIVIDUAL"));
       if (behaviour == "NO_WAITING" || !get(t, "waitingTimeDistribution")) return {};
-      return {0, "waitingTimeDistribution " + string(t, "waitingTimeDistribution", std::string()) +
-                     (behaviour == "TRAFFIC_LIGHT" ? " as a traffic light" : "")};
+      return {nullptr, "waitingTimeDistribution " +
+                           string(t, "waitingTimeDistribution", std::string()) +
+                           (behaviour == "TRAFFIC_LIGHT" ? " as a traffic light" : "")};
     }
     const auto wv = get(t, "waitingTime");  // <= 2.2
     if (!wv || !(num(*wv) > 0)) return {};
     if (boolean(t, "individualWaiting", true)) return fixed_wait(*wv);
-    return {0, "a traffic light, green and red " + fmt(num(*wv)) + " s each"};
+    return {nullptr, "a traffic light, green and red " + fmt(num(*wv)) + " s each"};
   }
   Waiting fixed_wait(const Val& v) {
     const double s = num(v);
     if (!(s >= 0 && s <= Goal::kMaxWait))
       fail(v, "a waiting time must be in [0, " + fmt(Goal::kMaxWait) + "] s");
+    if (s == 0) return {};
     return {s, ""};
   }
 

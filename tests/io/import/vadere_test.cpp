@@ -417,20 +417,26 @@ TEST(VadereImport, TargetSequencesAndAbsorption) {
   EXPECT_FALSE(has_warning(idle.warnings, "arrival policy")) << all(idle.warnings);
 }
 
-// A target whose waiter has a constant distribution makes each agent wait that long: the goal's
-// "wait". The same area without a waiter is another goal.
-TEST(VadereImport, ConstantWaitsAtTargetsBecomeGoalWaits) {
+// A target whose waiter has a constant distribution makes each agent wait that long, one with a
+// negative exponential distribution a time drawn from it: the goal's "wait". The same area
+// without a waiter is another goal.
+TEST(VadereImport, ConstantAndExponentialWaitsAtTargetsBecomeGoalWaits) {
   const std::string counter =
       R"({"id": 2, "shape": )" + rect(20, 1, 1, 1) +
       R"(, "absorber": {"enabled": false, "deletionDistance": 0.1}, "waiter": {"enabled": true, "distribution": {"type": "org.vadere.state.attributes.distributions.AttributesConstantDistribution", "updateFrequency": 4.5}}, "leavingSpeed": -1.0, "parallelEvents": 0})";
+  const std::string queue =
+      R"({"id": 4, "shape": )" + rect(30, 1, 1, 1) +
+      R"(, "absorber": {"enabled": true, "deletionDistance": 0.1}, "waiter": {"enabled": true, "distribution": {"type": "org.vadere.state.attributes.distributions.AttributesNegativeExponentialDistribution", "mean": 5.0}}, "leavingSpeed": -1.0, "parallelEvents": 0})";
   Spec s;
   s.topography =
-      join({list("targets",
-                 {counter, target(3, rect(20, 1, 1, 1), false), target(1, rect(40, 1, 1, 1))}),
-            list("dynamicElements", {pedestrian(5, 1.5, "[2, 1]"), pedestrian(5, 2.5, "[3, 1]")})});
+      join({list("targets", {counter, target(3, rect(20, 1, 1, 1), false),
+                             target(1, rect(40, 1, 1, 1)), queue}),
+            list("dynamicElements", {pedestrian(5, 1.5, "[2, 1]"), pedestrian(6, 1.5, "[3, 1]"),
+                                     pedestrian(7, 1.5, "[4]")})});
   const io::Imported im = import(v24(s));
   const json& goals = im.doc["goals"];
-  ASSERT_EQ(goals.size(), 3u) << goals.dump();
+  ASSERT_EQ(goals.size(), 4u) << goals.dump();
+  EXPECT_EQ(goals[3]["wait"], json({{"exponential", 5.0}}));
   EXPECT_EQ(goals[0]["wait"], 4.5);  // made in the order of first use: counter, exit, plain
   EXPECT_FALSE(goals[1].contains("wait"));
   EXPECT_FALSE(goals[2].contains("wait"));
@@ -438,6 +444,10 @@ TEST(VadereImport, ConstantWaitsAtTargetsBecomeGoalWaits) {
   EXPECT_FALSE(has_warning(im.warnings, "waiting")) << all(im.warnings);
   EXPECT_EQ(im.doc["agents"][0]["goal"], json({"g0", "g1"}));
   EXPECT_EQ(im.doc["agents"][1]["goal"], json({"g2", "g1"}));
+  EXPECT_EQ(im.doc["agents"][2]["goal"], "g3");
+  // And it loads.
+  TempDir dir;
+  EXPECT_NO_THROW(load_scenario(dir.write("t.scenario", v24(s))));
 }
 
 // Ids may repeat (rimea_08 has two exits with id 1): each agent takes the nearest.
@@ -831,7 +841,7 @@ TEST(VadereImport, DeeplyNestedValuesCostLinearMemory) {
 TEST(VadereImport, WarningsForUnsupportedElements) {
   const std::string waiting =
       R"({"id": 2, "shape": )" + rect(20, 1, 1, 1) +
-      R"(, "absorber": {"enabled": false, "deletionDistance": 0.1}, "waiter": {"enabled": true, "distribution": {"type": "org.vadere.state.attributes.distributions.AttributesNegativeExponentialDistribution", "mean": 5.0}}, "leavingSpeed": 0.5, "parallelEvents": 2})";
+      R"(, "absorber": {"enabled": false, "deletionDistance": 0.1}, "waiter": {"enabled": true, "distribution": {"type": "org.vadere.state.attributes.distributions.AttributesNormalDistribution", "mean": 5.0, "sd": 1.0}}, "leavingSpeed": 0.5, "parallelEvents": 2})";
   const std::string groups =
       R"({"id": 1, "shape": )" + rect(1, 1, 1, 1) +
       R"(, "targetIds": [2, 1], "spawner": {"constraintsTimeStart": 0.0, "constraintsTimeEnd": 0.0, "eventPositionRandom": true, "eventElementCount": 4}, "groupSizeDistribution": [0.5, 0.5]})";
@@ -876,7 +886,7 @@ TEST(VadereImport, WarningsForUnsupportedElements) {
       at("\"teleporter\"", "/scenario/topography/teleporter") + "the teleporter",
       at("\"id\": 2, \"shape\"", "/scenario/topography/targets/1") +
           "this kind of waiting at targets is not supported (waiter "
-          "AttributesNegativeExponentialDistribution)",
+          "AttributesNormalDistribution)",
       at("\"id\": 2, \"shape\"", "/scenario/topography/targets/1/leavingSpeed") +
           "leavingSpeed 0.5 m/s",
       at("\"id\": 2, \"shape\"", "/scenario/topography/targets/1/parallelEvents") +
