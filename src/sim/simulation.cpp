@@ -303,8 +303,8 @@ uint64_t Simulation::state_hash() const {
 namespace {
 
 constexpr std::string_view kCheckpointMagic = "crowddb-checkpoint";
-constexpr uint32_t kCheckpointVersion =
-    3;  // 2: narrow meshes in the path service's state; 3: goal waits
+// 2: narrow meshes in the path service's state; 3: goal waits (the wait_until column).
+constexpr uint32_t kCheckpointVersion = 3;
 
 // What a checkpoint must agree on with the simulation it is restored into: the static tables
 // and the settings that change what a tick computes (not the thread count).
