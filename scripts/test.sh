@@ -10,21 +10,25 @@ jobs=$(nproc)
 ctest_args=(--output-on-failure -j "$jobs" --timeout 900)
 [[ "${CROWDDB_SLOW_TESTS:-0}" == 1 ]] || ctest_args+=(-LE slow)
 
-echo "== Release build and tests"
+# Each stage says how long the suite has run so far, to see where CI's time goes.
+stage() { echo "== $1 ($((SECONDS / 60)) min $((SECONDS % 60)) s so far)"; }
+stage "Release build"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DCROWDDB_WERROR=ON >/dev/null
 cmake --build build -j "$jobs"
+stage "Release tests"
 ctest --test-dir build "${ctest_args[@]}"
-echo "== install, and the C++ example built against the installed package"
+stage "install, and the C++ example built against the installed package"
 bash scripts/test-install.sh build
 
-echo "== ASan+UBSan build and tests"
+stage "ASan+UBSan build"
 # -g1 (line tables only): sanitizer reports keep file:line, and the build is much lighter than -g.
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" \
   -DCROWDDB_SANITIZE=ON -DCROWDDB_WERROR=ON -DCROWDDB_BUILD_BENCHMARKS=OFF -DCROWDDB_BUILD_PYTHON=OFF >/dev/null
 cmake --build build-asan -j "$jobs"
+stage "ASan+UBSan tests"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
   LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp" \
   ctest --test-dir build-asan "${ctest_args[@]}" -LE "slow|nosan"
-echo "== fuzzing (clang, libFuzzer, ASan+UBSan)"
+stage "fuzzing (clang, libFuzzer, ASan+UBSan)"
 bash scripts/fuzz.sh
-echo "== all tests passed"
+stage "all tests passed"
