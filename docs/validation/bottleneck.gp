@@ -9,5 +9,5 @@ set yrange [0:*]
 set grid
 set key top left
 plot 1.9 * x with lines lw 2 dt 2 lc rgb 'black' title 'J = 1.9 b (specific flow as usually quoted for the Juelich experiments)', \
-     'bottleneck.csv' using (strcol(1) eq 'orca' ? $2 : 1/0):3 skip 1 with linespoints pt 5 ps 1.5 title 'orca', \
-     'bottleneck.csv' using (strcol(1) eq 'cfsm' ? $2 : 1/0):3 skip 1 with linespoints pt 6 ps 1.5 title 'cfsm'
+     'bottleneck.csv' using (strcol(1) eq 'orca' ? $2 : 1/0):3:8:9 skip 1 with yerrorlines pt 5 ps 1.5 title 'orca', \
+     'bottleneck.csv' using (strcol(1) eq 'cfsm' ? $2 : 1/0):3:8:9 skip 1 with yerrorlines pt 6 ps 1.5 title 'cfsm'

@@ -19,6 +19,7 @@ struct Options {
   bool quick = false;
   int threads = 1;
   uint64_t seed = 1;
+  int seeds = 1;  // experiments that average over seeds: seed, seed + 1, ..., seed + seeds - 1
   std::ostream* log = nullptr;  // progress lines; may be null
   // Experiments that run scenario documents (fd, bottleneck): the steering models to run (empty:
   // every model the experiment compares) and fields to set in each document before it is read
@@ -32,6 +33,7 @@ struct Experiment {
   std::string description;  // one line for --help
   std::function<void(const Options&)> run;
   bool runs_scenarios = false;  // takes Options::models and Options::overrides
+  bool averages_seeds = false;  // takes Options::seeds
 };
 
 // All registered experiments, in name order. Add new ones in registry.cpp.

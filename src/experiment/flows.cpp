@@ -205,70 +205,98 @@ void run_bottleneck(const Options& opt) {
   const std::vector<double> widths =
       opt.quick ? std::vector<double>{1.0, 2.0} : std::vector<double>{0.8, 1.0, 1.2, 1.6, 2.0, 2.5};
   const int people = opt.quick ? 60 : 150;
-  const std::string cols[] = {"model",  "width",  "flow",   "specific_flow",
-                              "people", "passed", "seconds"};
+  const std::string cols[] = {"model",  "width",   "flow",     "specific_flow", "people",
+                              "passed", "seconds", "flow_min", "flow_max",      "seeds"};
   CsvWriter csv(opt.out_dir / "bottleneck.csv", cols);
   std::ostringstream table;
   table << "Flow through a bottleneck 4 m long, " << people
-        << " people from a 10 x 10 m room (10th to 90th percentile of the crossings)\n"
+        << " people from a 10 x 10 m room (10th to 90th percentile of the crossings)";
+  if (opt.seeds > 1)
+    table << "; the mean over seeds " << opt.seed << "-" << opt.seed + opt.seeds - 1
+          << " and its range";
+  table << "\n"
         << machine_note(opt.threads) << "\n\n"
         << std::setw(8) << "model" << std::setw(10) << "b [m]" << std::setw(12) << "J [1/s]"
-        << std::setw(14) << "J/b [1/(m s)]"
-        << "\n";
+        << std::setw(14) << "J/b [1/(m s)]" << (opt.seeds > 1 ? "   J min-max [1/s]" : "") << "\n";
+  // One run: the flow between the 10th and the 90th percentile of the crossings of x = 14 m.
+  struct Run {
+    double flow = 0;
+    std::size_t passed = 0;
+    double seconds = 0;
+  };
+  auto run_once = [&](const std::string& model, double b, uint64_t seed) {
+    const double y0 = 5 - b / 2, y1 = 5 + b / 2, x_exit = 14;
+    json d = {
+        {"bounds", {0, 0, 20, 10}},
+        {"dt", 0.1},
+        {"seed", seed},
+        {"threads", opt.threads},
+        {"duration", 400},
+        {"steering", {{"model", model}}},
+        {"obstacles",
+         {{{"type", "polygon"}, {"vertices", {{10, 0}, {14, 0}, {14, y0}, {10, y0}}}},
+          {{"type", "polygon"}, {"vertices", {{10, y1}, {14, y1}, {14, 10}, {10, 10}}}}}},
+        {"goals", {{{"name", "out"}, {"area", {{19, 0}, {20, 0}, {20, 10}, {19, 10}}}}}},
+        {"groups",
+         {{{"count", people},
+           {"placement", {{"type", "uniform"}, {"region", {0.3, 0.3, 9.7, 9.7}}, {"gap", 0.05}}},
+           {"radius", {0.2, 0.25}},
+           {"pref_speed", {1.2, 1.5}},
+           {"goal", "out"}}}},
+        {"navigation", json::object()}};
+    Scenario sc = read(d, opt, "bottleneck");
+    const uint64_t ticks = sc.ticks;
+    Simulation sim(std::move(sc.world), sc.config);
+    std::unordered_map<uint64_t, double> last_x;
+    std::vector<double> crossings;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (uint64_t k = 1; k <= ticks && sim.world().agents().size(); ++k) {
+      sim.step();
+      const AgentTable& t = sim.world().agents();
+      for (std::size_t i = 0; i < t.size(); ++i) {
+        auto [it, fresh] = last_x.try_emplace(t.id[i], t.x[i]);
+        if (!fresh && it->second < x_exit && t.x[i] >= x_exit)
+          crossings.push_back(static_cast<double>(k) * sc.config.dt);
+        it->second = t.x[i];
+      }
+    }
+    Run r;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r.passed = crossings.size();
+    std::sort(crossings.begin(), crossings.end());
+    if (crossings.size() >= 10) {
+      const std::size_t a = crossings.size() / 10, z = crossings.size() * 9 / 10;
+      r.flow = static_cast<double>(z - a) / (crossings[z] - crossings[a]);
+    }
+    return r;
+  };
   for (const std::string& model : models(opt))
     for (double b : widths) {
-      const double y0 = 5 - b / 2, y1 = 5 + b / 2, x_exit = 14;
-      json d = {
-          {"bounds", {0, 0, 20, 10}},
-          {"dt", 0.1},
-          {"seed", opt.seed},
-          {"threads", opt.threads},
-          {"duration", 400},
-          {"steering", {{"model", model}}},
-          {"obstacles",
-           {{{"type", "polygon"}, {"vertices", {{10, 0}, {14, 0}, {14, y0}, {10, y0}}}},
-            {{"type", "polygon"}, {"vertices", {{10, y1}, {14, y1}, {14, 10}, {10, 10}}}}}},
-          {"goals", {{{"name", "out"}, {"area", {{19, 0}, {20, 0}, {20, 10}, {19, 10}}}}}},
-          {"groups",
-           {{{"count", people},
-             {"placement", {{"type", "uniform"}, {"region", {0.3, 0.3, 9.7, 9.7}}, {"gap", 0.05}}},
-             {"radius", {0.2, 0.25}},
-             {"pref_speed", {1.2, 1.5}},
-             {"goal", "out"}}}},
-          {"navigation", json::object()}};
-      Scenario sc = read(d, opt, "bottleneck");
-      const uint64_t ticks = sc.ticks;
-      Simulation sim(std::move(sc.world), sc.config);
-      std::unordered_map<uint64_t, double> last_x;
-      std::vector<double> crossings;
-      const auto t0 = std::chrono::steady_clock::now();
-      for (uint64_t k = 1; k <= ticks && sim.world().agents().size(); ++k) {
-        sim.step();
-        const AgentTable& t = sim.world().agents();
-        for (std::size_t i = 0; i < t.size(); ++i) {
-          auto [it, fresh] = last_x.try_emplace(t.id[i], t.x[i]);
-          if (!fresh && it->second < x_exit && t.x[i] >= x_exit)
-            crossings.push_back(static_cast<double>(k) * sc.config.dt);
-          it->second = t.x[i];
-        }
+      double sum = 0, lo = INFINITY, hi = -INFINITY, secs = 0;
+      std::size_t passed = 0;
+      for (int s = 0; s < opt.seeds; ++s) {
+        const Run r = run_once(model, b, opt.seed + static_cast<uint64_t>(s));
+        sum += r.flow;
+        lo = std::min(lo, r.flow);
+        hi = std::max(hi, r.flow);
+        passed += r.passed;
+        secs += r.seconds;
+        if (opt.log)
+          *opt.log << "bottleneck: " << model << " b " << b << " m, seed "
+                   << opt.seed + static_cast<uint64_t>(s) << ": J " << r.flow << " /s, " << r.passed
+                   << " of " << people << " passed (" << r.seconds << " s)\n"
+                   << std::flush;
       }
-      const double secs =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      std::sort(crossings.begin(), crossings.end());
-      double flow = 0;
-      if (crossings.size() >= 10) {
-        const std::size_t a = crossings.size() / 10, z = crossings.size() * 9 / 10;
-        flow = static_cast<double>(z - a) / (crossings[z] - crossings[a]);
-      }
-      csv.row(std::vector<std::string>{model, std::to_string(b), std::to_string(flow),
-                                       std::to_string(flow / b), std::to_string(people),
-                                       std::to_string(crossings.size()), std::to_string(secs)});
+      const double flow = sum / opt.seeds;
+      const std::size_t everyone = static_cast<std::size_t>(people) * opt.seeds;
+      csv.row(std::vector<std::string>{
+          model, std::to_string(b), std::to_string(flow), std::to_string(flow / b),
+          std::to_string(everyone), std::to_string(passed), std::to_string(secs),
+          std::to_string(lo), std::to_string(hi), std::to_string(opt.seeds)});
       table << std::setw(8) << model << std::setw(10) << b << std::fixed << std::setprecision(2)
-            << std::setw(12) << flow << std::setw(14) << flow / b << std::defaultfloat << "\n";
-      if (opt.log)
-        *opt.log << "bottleneck: " << model << " b " << b << " m: J " << flow << " /s, "
-                 << crossings.size() << " of " << people << " passed (" << secs << " s)\n"
-                 << std::flush;
+            << std::setw(12) << flow << std::setw(14) << flow / b;
+      if (opt.seeds > 1) table << std::setw(12) << lo << "-" << hi;
+      table << std::defaultfloat << "\n";
     }
   csv.close();
   {
@@ -286,9 +314,10 @@ void run_bottleneck(const Options& opt) {
       "quoted for the Juelich experiments)'";
   int pt = 5;
   for (const std::string& m : models(opt))
-    script += ", \\\n     'bottleneck.csv' using (strcol(1) eq '" + m +
-              "' ? $2 : 1/0):3 skip 1 with linespoints pt " + std::to_string(pt++) +
-              " ps 1.5 title '" + m + "'";
+    // With several seeds, bars from the smallest to the largest flow.
+    script += ", \\\n     'bottleneck.csv' using (strcol(1) eq '" + m + "' ? $2 : 1/0):3" +
+              (opt.seeds > 1 ? ":8:9 skip 1 with yerrorlines" : " skip 1 with linespoints") +
+              " pt " + std::to_string(pt++) + " ps 1.5 title '" + m + "'";
   plot(opt.out_dir, "bottleneck", script + "\n");
 }
 

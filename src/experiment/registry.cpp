@@ -16,7 +16,7 @@ const std::vector<Experiment>& registry() {
       {"bottleneck",
        "flow through a bottleneck of 0.8-2.5 m per steering model, beside the Juelich specific "
        "flow",
-       run_bottleneck, true},
+       run_bottleneck, true, true},
       {"e1",
        "first-to-collide scaling: index build/query vs naive, n = 1,000..15,000 (and 10^6 at E1 "
        "density)",

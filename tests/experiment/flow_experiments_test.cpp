@@ -3,6 +3,7 @@
 // has the full runs).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <sstream>
 
 #include "support/cli.hpp"
@@ -75,6 +76,40 @@ TEST(FlowExperiments, ModelAndSetReachTheRuns) {
       run_cli("experiment fd --quick --set steering.model=cfsm --out " + (dir / "m").string(), dir);
   EXPECT_EQ(model.status, 2);
   EXPECT_NE(model.err.find("pick models with --model"), std::string::npos) << model.err;
+}
+
+// --seeds K runs every case with K seeds and reports the mean flow and its range: the mean of
+// seeds 1 and 2 is the mean of the two single-seed runs, and only the bottleneck takes it.
+TEST(FlowExperiments, BottleneckAveragesOverSeeds) {
+  TempDir dir;
+  auto run = [&](const std::string& args, const std::string& out) {
+    const CliResult r = run_cli(
+        "experiment bottleneck --quick --model orca " + args + " --out " + (dir / out).string(),
+        dir);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return csv_rows(dir / out / "bottleneck.csv");
+  };
+  const auto one = run("--seed 1", "s1"), two = run("--seed 2", "s2");
+  const auto both = run("--seed 1 --seeds 2", "both");
+  ASSERT_EQ(both.size(), 3u);  // header + widths (1, 2 m)
+  EXPECT_EQ(both[0][7], "flow_min");
+  for (std::size_t i = 1; i < both.size(); ++i) {
+    const double a = std::stod(one[i][2]), b = std::stod(two[i][2]);
+    EXPECT_NEAR(std::stod(both[i][2]), (a + b) / 2, 1e-5) << "width " << both[i][1];
+    EXPECT_NEAR(std::stod(both[i][7]), std::min(a, b), 1e-5);
+    EXPECT_NEAR(std::stod(both[i][8]), std::max(a, b), 1e-5);
+    EXPECT_EQ(both[i][4], "120");  // 60 people x 2 seeds
+    EXPECT_EQ(both[i][9], "2");
+  }
+  const CliResult fd =
+      run_cli("experiment fd --quick --seeds 2 --out " + (dir / "fd").string(), dir);
+  EXPECT_EQ(fd.status, 2);
+  EXPECT_NE(fd.err.find("--seeds applies to the bottleneck experiment"), std::string::npos)
+      << fd.err;
+  const CliResult zero =
+      run_cli("experiment bottleneck --quick --seeds 0 --out " + (dir / "z").string(), dir);
+  EXPECT_EQ(zero.status, 2);
+  EXPECT_NE(zero.err.find("--seeds"), std::string::npos) << zero.err;
 }
 
 }  // namespace

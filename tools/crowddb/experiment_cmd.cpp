@@ -26,6 +26,10 @@ void add_experiment_command(CLI::App& app, Action& action) {
   sub->add_flag("--quick", opts.quick, "small sizes, for tests and a first look");
   sub->add_option("--threads", opts.threads, "threads")->check(cli_checks::whole(1, 256));
   sub->add_option("--seed", opts.seed, "base seed");
+  sub->add_option("--seeds", opts.seeds,
+                  "bottleneck: run each case with this many seeds from --seed on and report the "
+                  "mean flow and its range (default 1)")
+      ->check(cli_checks::whole(1, 1000));
   sub->add_option("--model", opts.models,
                   "fd, bottleneck: run only this steering model (repeatable; default: every model "
                   "but thesis)");
@@ -38,6 +42,9 @@ void add_experiment_command(CLI::App& app, Action& action) {
                     "--model and --set apply to the experiments that run scenarios (fd, "
                     "bottleneck), not to " +
                         name);
+      if (!e.averages_seeds && opts.seeds != 1)
+        throw Error(Error::Kind::usage,
+                    "--seeds applies to the bottleneck experiment, not to " + name);
       for (const std::string& m : opts.models) steer::find_model(m);
       for (const std::string& s : opts.overrides)
         if (s.rfind("steering.model=", 0) == 0)
