@@ -30,7 +30,7 @@ targets=(scenario_fuzz csv_fuzz steersuite_fuzz menge_fuzz vadere_fuzz overrides
   checkpoint_fuzz runfile_fuzz)
 
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCROWDDB_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCROWDDB_BUILD_TESTS=OFF \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_UNITY_BUILD=ON -DCROWDDB_BUILD_TESTS=OFF \
   -DCROWDDB_BUILD_BENCHMARKS=OFF -DCROWDDB_BUILD_PYTHON=OFF >/dev/null
 cmake --build build-fuzz -j "$jobs" --target "${targets[@]}"
 

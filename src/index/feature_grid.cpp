@@ -9,7 +9,7 @@
 namespace crowddb::index {
 namespace {
 
-constexpr std::size_t kGrain = 64;
+constexpr std::size_t kFeatureGrain = 64;
 
 struct Box {
   double x0, y0, x1, y1;
@@ -90,12 +90,12 @@ void FeatureGrid::run(const DiscView& p, std::span<const double> reach, const St
     stats.build_seconds += sw.seconds();
     sw.restart();
   }
-  const std::size_t chunks = (p.n + kGrain - 1) / kGrain;
+  const std::size_t chunks = (p.n + kFeatureGrain - 1) / kFeatureGrain;
   ListChunks lists;
   lists.reset(chunks);
   std::vector<uint64_t> tests(chunks, 0);
-  ex.for_each_chunk(p.n, kGrain, [&](std::size_t b, std::size_t e) {
-    const std::size_t c = b / kGrain;
+  ex.for_each_chunk(p.n, kFeatureGrain, [&](std::size_t b, std::size_t e) {
+    const std::size_t c = b / kFeatureGrain;
     std::vector<uint32_t> cand;
     for (std::size_t i = b; i < e; ++i) {
       const double px = p.x[i], py = p.y[i], r = reach[i];

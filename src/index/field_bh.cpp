@@ -42,11 +42,11 @@ namespace crowddb {
 namespace {
 
 constexpr std::size_t kLeafSize = 8;
-constexpr uint32_t kNone = UINT32_MAX;
+constexpr uint32_t kNoDisc = UINT32_MAX;
 
 struct Source {
   double x, y, w;
-  uint32_t row;  // disc row, or kNone for a scene point
+  uint32_t row;  // disc row, or kNoDisc for a scene point
 };
 
 struct Monopole {
@@ -79,25 +79,25 @@ double metric_distance(const PairKernel& k, double dx, double dy) {
 class Tree {
  public:
   Tree(std::vector<Source> sources, std::size_t rows, const PairKernel& kernel)
-      : src_(std::move(sources)), kernel_(kernel), where_(rows, kNone) {
+      : src_(std::move(sources)), kernel_(kernel), where_(rows, kNoDisc) {
     nodes_.reserve(2 * src_.size() / kLeafSize + 2);
     if (!src_.empty()) build(0, static_cast<uint32_t>(src_.size()));
     for (uint32_t i = 0; i < src_.size(); ++i)
-      if (src_[i].row != kNone) where_[src_[i].row] = i;
+      if (src_[i].row != kNoDisc) where_[src_[i].row] = i;
   }
 
-  // Potential and gradient at (px, py) of every source but the disc `self` (kNone: none).
+  // Potential and gradient at (px, py) of every source but the disc `self` (kNoDisc: none).
   void sum(double px, double py, uint32_t self, double& pot, double& gx, double& gy,
            uint64_t& pairs, uint64_t& visited, std::vector<uint32_t>& stack) const {
     pot = gx = gy = 0;
     if (nodes_.empty()) return;
-    const uint32_t self_pos = self == kNone ? kNone : where_[self];
+    const uint32_t self_pos = self == kNoDisc ? kNoDisc : where_[self];
     stack.assign(1, 0);
     while (!stack.empty()) {
       const Node& n = nodes_[stack.back()];
       stack.pop_back();
       ++visited;
-      const bool holds_self = self_pos != kNone && self_pos >= n.begin && self_pos < n.end;
+      const bool holds_self = self_pos != kNoDisc && self_pos >= n.begin && self_pos < n.end;
       if (n.left == 0) {
         for (uint32_t i = n.begin; i < n.end; ++i) {
           if (i == self_pos) continue;
@@ -197,7 +197,7 @@ std::vector<Source> gather(const DiscView& d, const StaticScene& scene) {
     if (d.charge[i] != 0) s.push_back({d.x[i], d.y[i], d.charge[i], static_cast<uint32_t>(i)});
   const auto px = scene.point_x(), py = scene.point_y(), pc = scene.point_charge();
   for (std::size_t j = 0; j < px.size(); ++j)
-    if (pc[j] != 0) s.push_back({px[j], py[j], pc[j], kNone});
+    if (pc[j] != 0) s.push_back({px[j], py[j], pc[j], kNoDisc});
   for (const Source& q : s)
     if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.w))
       throw Error(Error::Kind::input, "field bh: a point or charge is not finite");
@@ -281,7 +281,7 @@ void FieldBarnesHut::probe(std::span<const Vec2> points, const DiscView& sources
       [&](std::size_t i, double& x, double& y, uint32_t& self, double& scale) {
         x = points[i].x;
         y = points[i].y;
-        self = kNone;
+        self = kNoDisc;
         scale = spec.A;
       },
       tree, spec, out, ex, stats);

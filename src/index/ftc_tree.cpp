@@ -22,7 +22,7 @@ using Kind = Collider::Kind;
 // times carry errors of order sqrt(eps) * M in position for near-grazing pairs; 1e-6 leaves a
 // margin of more than ten.
 constexpr double kSlack = 1e-6;
-constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+constexpr uint32_t kNoRow = std::numeric_limits<uint32_t>::max();
 
 // The time axis every tree of one build shares.
 struct Frame {
@@ -40,12 +40,12 @@ struct Slice {
   double slo_x, slo_y, shi_x, shi_y;
 };
 
-struct Node {
+struct TreeNode {
   double rmax;          // largest member radius
   uint64_t min_key;     // smallest member key (agent id or obstacle row)
   uint32_t begin, end;  // members: perm[begin, end)
   uint32_t right;       // right child; the left child is this node + 1; 0 for a leaf
-  uint32_t parent;      // kNone for the root
+  uint32_t parent;      // kNoRow for the root
   bool leaf() const { return right == 0; }
 };
 
@@ -59,7 +59,7 @@ struct Cell {
 struct Probe {
   double ax, ay, avx, avy, ar;  // the query row's columns, untouched
   double fx, fy;                // position in the frame
-  uint32_t self;                // own row in the agent tree, or kNone
+  uint32_t self;                // own row in the agent tree, or kNoRow
 };
 
 // The running answer, ordered lexicographically by (time, kind, key, row): the naive loop keeps
@@ -149,13 +149,13 @@ struct Member {
   uint32_t row;
 };
 
-struct Scratch {
+struct ProbeScratch {
   std::vector<Entry> heap;
   // The overlap phase of one leaf of the agent tree (see leaf_overlaps()): its candidates'
-  // columns, a per-candidate buffer, and each member's answer (a row, or kNone).
+  // columns, a per-candidate buffer, and each member's answer (a row, or kNoRow).
   std::vector<double> cx, cy, cr, cc;
   std::vector<uint32_t> cpos, pick, hit;  // candidates' positions in tree order
-  uint32_t leaf = kNone;
+  uint32_t leaf = kNoRow;
   std::size_t ncand = 0;      // candidates of that leaf (the member itself included)
   bool crowded = false;       // more than the join's cap: that leaf uses the tree search
   uint64_t join_visited = 0;  // nodes its walk visited
@@ -224,18 +224,18 @@ class KineticTree {
   void build(const Src& src, const Frame& f, std::size_t leaf_size);
   using Order = FtcIndexOptions::Order;
   // Adds this tree's members to `best`. self_pos: the query's position in tree order (it is
-  // skipped as a member, and its leaf is scanned first), or kNone.
+  // skipped as a member, and its leaf is scanned first), or kNoRow.
   // OverlapOnly: only the members that overlap the query now (pair time 0) count; the bounds
   // and the pair tests shrink to the t = 0 checks (see "Overlaps first" in ftc_tree.hpp).
   template <bool OverlapOnly>
-  void search(const Probe& q, double horizon, Best& best, Scratch& sc, Counters& c, Order order,
-              uint32_t self_pos, bool seed) const;
+  void search(const Probe& q, double horizon, Best& best, ProbeScratch& sc, Counters& c,
+              Order order, uint32_t self_pos, bool seed) const;
   std::string validate(const Frame& f) const;
   // The overlap phase for all members of `leaf` at once: sc.hit[i] is the row of the smallest
-  // (key, row) member overlapping member begin + i at t = 0, or kNone. The candidates are the
+  // (key, row) member overlapping member begin + i at t = 0, or kNoRow. The candidates are the
   // members of every leaf whose t = 0 box comes within reach of `leaf`'s (Chebyshev gap <= the
   // two leaves' largest radii summed): every member that can overlap is among them.
-  void leaf_overlaps(uint32_t leaf, Scratch& sc) const;
+  void leaf_overlaps(uint32_t leaf, ProbeScratch& sc) const;
 
   bool empty() const { return nodes_.empty(); }
   std::size_t node_count() const { return nodes_.size(); }
@@ -265,7 +265,7 @@ class KineticTree {
   const Src* src_ = nullptr;
   const Frame* f_ = nullptr;
   std::size_t leaf_size_ = 8;
-  std::vector<Node> nodes_;
+  std::vector<TreeNode> nodes_;
   // Slice j of node k at [j * nodes + k]: slice 0 of all nodes (the one most searches need)
   // lies together.
   std::vector<Slice> slices_;
@@ -325,7 +325,7 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
   slices_.resize(stride_ * static_cast<std::size_t>(f.slices()));
   raw_.reserve(most * (f.chord ? f.knots.size() : 2));
   cells_.reserve(most);
-  build_node(0, n, kNone, {x0, y0, x1, y1});
+  build_node(0, n, kNoRow, {x0, y0, x1, y1});
   for (uint32_t i = 0; i < n; ++i) perm_[i] = items_[i].row;
   for (uint32_t i = 0; i < n; ++i) pos_of_[perm_[i]] = i;
   for (uint32_t k = 0; k < nodes_.size(); ++k)
@@ -431,7 +431,7 @@ void KineticTree<Src>::select_median(uint32_t b, uint32_t e, uint32_t k) {
 
 template <class Src>
 void KineticTree<Src>::leaf_bounds(uint32_t node) {
-  Node& nd = nodes_[node];
+  TreeNode& nd = nodes_[node];
   const Frame& f = *f_;
   const std::size_t per = f.chord ? f.knots.size() : 2;
   Raw* raw = &raw_[node * per];
@@ -511,7 +511,7 @@ template <class Src>
 template <bool OverlapOnly>
 void KineticTree<Src>::scan(uint32_t node, const Probe& q, double horizon, Best& best,
                             Counters& c) const {
-  const Node& nd = nodes_[node];
+  const TreeNode& nd = nodes_[node];
   for (uint32_t i = nd.begin; i < nd.end; ++i) {
     const Member& m = items_[i];
     // Leaves are sorted by key: once the answer beats (t = 0, key), it beats the rest too.
@@ -528,8 +528,8 @@ void KineticTree<Src>::scan(uint32_t node, const Probe& q, double horizon, Best&
 
 template <class Src>
 template <bool OverlapOnly>
-void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratch& sc, Counters& c,
-                              Order order, uint32_t self_pos, bool seed) const {
+void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, ProbeScratch& sc,
+                              Counters& c, Order order, uint32_t self_pos, bool seed) const {
   if (nodes_.empty()) return;
   const Frame& f = *f_;
   constexpr Kind kind = Src::kind;
@@ -556,16 +556,16 @@ void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratc
   };
   // Searches the subtree at `start` (not pruned when called). Any visiting order is exact: a
   // node is skipped only when the answer so far beats its bound, and the answer only improves.
-  // start == kNone: continue with the queue as it is.
+  // start == kNoRow: continue with the queue as it is.
   auto explore = [&](uint32_t start, double start_bound, uint32_t skip_leaf) {
-    if (start != kNone) sc.heap.clear();
+    if (start != kNoRow) sc.heap.clear();
     uint32_t node = start;
     if (order == Order::best_first) {
       push(start_bound, start);
-      node = kNone;
+      node = kNoRow;
     }
     for (;;) {
-      if (node == kNone) {
+      if (node == kNoRow) {
         if (sc.heap.empty()) return;
         std::pop_heap(sc.heap.begin(), sc.heap.end(), Later{});
         const Entry e = sc.heap.back();
@@ -574,20 +574,20 @@ void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratc
         if (pruned(e.bound, e.key)) return;  // the smallest bound left cannot win: nothing can
         node = e.node;
       }
-      const Node& nd = nodes_[node];
+      const TreeNode& nd = nodes_[node];
       if (nd.leaf()) {
         if (node != skip_leaf) {
           ++c.visited;
           scan<OverlapOnly>(node, q, horizon, best, c);
         }
-        node = kNone;
+        node = kNoRow;
         continue;
       }
       ++c.visited;
       const uint32_t l = node + 1, r = nd.right;
       const double bl = bound_of(l), br = bound_of(r);
       const bool keep_l = !pruned(bl, nodes_[l].min_key), keep_r = !pruned(br, nodes_[r].min_key);
-      node = kNone;
+      node = kNoRow;
       if (order == Order::best_first) {
         if (keep_l) push(bl, l);
         if (keep_r) push(br, r);
@@ -605,13 +605,13 @@ void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratc
 
   // The query's own leaf first: its neighbours give an early best time.
   sc.heap.clear();
-  uint32_t leaf = kNone;
-  if (self_pos != kNone && (seed || order == Order::bottom_up || order == Order::leaf_queue)) {
+  uint32_t leaf = kNoRow;
+  if (self_pos != kNoRow && (seed || order == Order::bottom_up || order == Order::leaf_queue)) {
     leaf = leaf_at_[self_pos];
     ++c.visited;
     scan<OverlapOnly>(leaf, q, horizon, best, c);
   }
-  if ((order == Order::bottom_up || order == Order::leaf_queue) && leaf != kNone) {
+  if ((order == Order::bottom_up || order == Order::leaf_queue) && leaf != kNoRow) {
     // Then the siblings of the path to the root, nearest (deepest) first. Once every position
     // from which a member could still reach the query before the answer so far lies strictly
     // inside the cell below, no sibling further up can hold a winner: stop.
@@ -631,11 +631,11 @@ void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratc
       const double b = bound_of(sib);
       if (pruned(b, nodes_[sib].min_key)) continue;
       if (order == Order::bottom_up)
-        explore(sib, b, kNone);  // searched at once, deepest sibling first
+        explore(sib, b, kNoRow);  // searched at once, deepest sibling first
       else
         push(b, sib);  // searched below in bound order
     }
-    if (order == Order::leaf_queue) explore(kNone, 0, kNone);
+    if (order == Order::leaf_queue) explore(kNoRow, 0, kNoRow);
     return;
   }
   const double b0 = bound_of(0);
@@ -643,7 +643,7 @@ void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, Scratc
 }
 
 template <class Src>
-void KineticTree<Src>::leaf_overlaps(uint32_t leaf, Scratch& sc) const {
+void KineticTree<Src>::leaf_overlaps(uint32_t leaf, ProbeScratch& sc) const {
   std::size_t n = 0;  // candidates so far, in sc.cx[0, n) etc.
   sc.join_visited = 0;
   sc.crowded = false;
@@ -667,7 +667,7 @@ void KineticTree<Src>::leaf_overlaps(uint32_t leaf, Scratch& sc) const {
     ++sc.join_visited;
     if (b.lo_x - L.hi_x > R || L.lo_x - b.hi_x > R || b.lo_y - L.hi_y > R || L.lo_y - b.hi_y > R)
       continue;
-    const Node& nd = nodes_[k];
+    const TreeNode& nd = nodes_[k];
     if (!nd.leaf()) {
       stack.push_back({0, 0, nd.right});
       stack.push_back({0, 0, k + 1});
@@ -704,8 +704,8 @@ void KineticTree<Src>::leaf_overlaps(uint32_t leaf, Scratch& sc) const {
     sc.cy[j] = m.y;
     sc.cr[j] = m.r;
   }
-  const Node& nl = nodes_[leaf];
-  sc.hit.assign(nl.end - nl.begin, kNone);
+  const TreeNode& nl = nodes_[leaf];
+  sc.hit.assign(nl.end - nl.begin, kNoRow);
   const double* cx = sc.cx.data();  // (the member itself is among the candidates)
   const double* cy = sc.cy.data();
   const double* cr = sc.cr.data();
@@ -720,15 +720,15 @@ void KineticTree<Src>::leaf_overlaps(uint32_t leaf, Scratch& sc) const {
       pick[m] = static_cast<uint32_t>(j);
       m += cc[j] < 0;
     }
-    uint32_t best = kNone;
+    uint32_t best = kNoRow;
     for (std::size_t h = 0; h < m; ++h) {
       const uint32_t j = sc.cpos[pick[h]];  // a position in tree order
       if (j == i) continue;                 // the member itself
-      if (best == kNone || items_[j].key < items_[best].key ||
+      if (best == kNoRow || items_[j].key < items_[best].key ||
           (items_[j].key == items_[best].key && items_[j].row < items_[best].row))
         best = j;
     }
-    if (best != kNone) sc.hit[i - nl.begin] = items_[best].row;
+    if (best != kNoRow) sc.hit[i - nl.begin] = items_[best].row;
   }
 }
 
@@ -741,12 +741,12 @@ std::string KineticTree<Src>::validate(const Frame& f) const {
     if (row >= seen.size() || seen[row]++) return "perm is not a permutation";
   }
   for (uint32_t k = 0; k < nodes_.size(); ++k) {
-    const Node& nd = nodes_[k];
+    const TreeNode& nd = nodes_[k];
     if (nd.begin >= nd.end || nd.end > perm_.size())
       return "node " + std::to_string(k) + ": bad range";
     if (!nd.leaf()) {
-      const Node& l = nodes_[k + 1];
-      const Node& r = nodes_[nd.right];
+      const TreeNode& l = nodes_[k + 1];
+      const TreeNode& r = nodes_[nd.right];
       if (l.parent != k || r.parent != k)
         return "node " + std::to_string(k) + ": wrong parent links";
       if (l.begin != nd.begin || l.end != r.begin || r.end != nd.end)
@@ -802,11 +802,11 @@ struct FtcIndex::Impl {
   KineticTree<AgentSource> agent_tree;
   KineticTree<CircleSource> circle_tree;
   std::vector<Slice> polygon_boxes;  // one static slice per polygon (frustum form)
-  mutable Scratch scratch;           // for query()
+  mutable ProbeScratch scratch;      // for query()
 
   void make_frame();
   // The answer for one row; pos: its position in the agent tree's order.
-  FtcHit probe(uint32_t row, uint32_t pos, Scratch& sc, Counters& c) const;
+  FtcHit probe(uint32_t row, uint32_t pos, ProbeScratch& sc, Counters& c) const;
 };
 
 void FtcIndex::Impl::make_frame() {
@@ -858,7 +858,7 @@ void FtcIndex::Impl::make_frame() {
   }
 }
 
-FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, Scratch& sc, Counters& c) const {
+FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, ProbeScratch& sc, Counters& c) const {
   const Member& a = agent_tree.member(pos);  // the row's own values, in tree order
   Probe q{a.x, a.y, a.vx, a.vy, a.r, a.x - frame.ox, a.y - frame.oy, row};
   Best best;
@@ -881,7 +881,7 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, Scratch& sc, Counters& 
     } else {
       c.pair_tests += sc.ncand - 1;
       const uint32_t hit = sc.hit[pos - begin];
-      if (hit != kNone) return {{Kind::agent, hit}, 0.0};
+      if (hit != kNoRow) return {{Kind::agent, hit}, 0.0};
     }
   } else if (opt.overlaps_first) {
     // The same answer through the tree search in the chosen order, t = 0 checks only.
@@ -889,8 +889,8 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, Scratch& sc, Counters& 
     if (best.kind != Kind::none) return {{best.kind, best.row}, best.t};
   }
   agent_tree.search<false>(q, horizon, best, sc, c, opt.order, pos, opt.seed_own_leaf);
-  q.self = kNone;
-  circle_tree.search<false>(q, horizon, best, sc, c, opt.order, kNone, false);
+  q.self = kNoRow;
+  circle_tree.search<false>(q, horizon, best, sc, c, opt.order, kNoRow, false);
   const auto polys = scene->polygons();
   const auto boxes = scene->polygon_boxes();
   for (std::size_t p = 0; p < polys.size(); ++p) {
@@ -923,7 +923,7 @@ FtcIndex::~FtcIndex() = default;
 
 void FtcIndex::build(const DiscView& discs, const StaticScene& scene, double horizon) {
   Impl& m = *impl_;
-  if (discs.n >= kNone) throw Error(Error::Kind::input, "first-to-collide index: too many discs");
+  if (discs.n >= kNoRow) throw Error(Error::Kind::input, "first-to-collide index: too many discs");
   for (std::size_t i = 0; i < discs.n; ++i) {
     const char* bad = !std::isfinite(discs.x[i])        ? "x"
                       : !std::isfinite(discs.y[i])      ? "y"
@@ -939,7 +939,7 @@ void FtcIndex::build(const DiscView& discs, const StaticScene& scene, double hor
     throw Error(Error::Kind::input, "first-to-collide index: horizon is NaN");
   m.discs = discs;
   m.scene = &scene;
-  m.scratch.leaf = kNone;
+  m.scratch.leaf = kNoRow;
   m.horizon = horizon;
   m.make_frame();
   m.agents.d = &m.discs;
@@ -960,7 +960,7 @@ void FtcIndex::query_all(std::span<FtcHit> out, Executor& ex, QueryStats& stats)
   std::mutex mu;
   Counters total;
   ex.for_each_chunk(order.size(), 256, [&](std::size_t begin, std::size_t end) {
-    Scratch sc;
+    ProbeScratch sc;
     Counters c;
     for (std::size_t i = begin; i < end; ++i) {
       const auto pos = static_cast<uint32_t>(i);

@@ -19,22 +19,12 @@
 // tick. Both agents of a pair keep to their half, so no move of the model overlaps.
 #include <cmath>
 #include <map>
-#include <sstream>
 
 #include "plan/access_path.hpp"
 #include "steer/model.hpp"
 
 namespace crowddb::steer {
 namespace {
-
-constexpr std::size_t kGrain = 128;
-constexpr double kSkin = 1e-6;  // [m] kept clear of touching, against rounding
-
-std::string num(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 // Do segments [a, b] and [c, d] intersect (touching counts)?
 bool segments_cross(double ax, double ay, double bx, double by, const Vec2& c, const Vec2& d) {
@@ -96,19 +86,20 @@ class CfsmModel final : public Model {
     const CfsmParams& p = in.cfg.steering.cfsm;
     const std::size_t n = in.agents.size();
     const NeighbourMethod& nm = neighbour_method(in.cfg.access.neighbours, n);
-    os << "  " << step++ << " CFSM neighbours    every agent within " << num(p.cutoff) << " m ("
-       << n << " rows)\n       access path: " << nm.info.name << " (" << nm.info.description
-       << ")\n";
+    os << "  " << step++ << " CFSM neighbours    every agent within " << explain_number(p.cutoff)
+       << " m (" << n << " rows)\n       access path: " << nm.info.name << " ("
+       << nm.info.description << ")\n";
     if (in.scene.feature_count() > 0) {
       const FeatureMethod& fm = feature_method(in.cfg.access.edges, in.scene.feature_count());
-      os << "  " << step++ << " CFSM obstacles     obstacle features within " << num(p.cutoff)
-         << " m\n       access path: " << fm.info.name << " (" << fm.info.description << ")\n";
+      os << "  " << step++ << " CFSM obstacles     obstacle features within "
+         << explain_number(p.cutoff) << " m\n       access path: " << fm.info.name << " ("
+         << fm.info.description << ")\n";
     }
-    os << "  " << step++
-       << " CFSM rule          direction from exponential repulsion (a=" << num(p.strength_neighbor)
-       << ", D=" << num(p.range_neighbor) << " m; walls a=" << num(p.strength_geometry)
-       << ", D=" << num(p.range_geometry)
-       << " m); speed min(max(s/T, 0), v0), T=" << num(p.time_gap) << " s\n";
+    os << "  " << step++ << " CFSM rule          direction from exponential repulsion (a="
+       << explain_number(p.strength_neighbor) << ", D=" << explain_number(p.range_neighbor)
+       << " m; walls a=" << explain_number(p.strength_geometry)
+       << ", D=" << explain_number(p.range_geometry)
+       << " m); speed min(max(s/T, 0), v0), T=" << explain_number(p.time_gap) << " s\n";
   }
 
  private:

@@ -25,6 +25,15 @@
 
 namespace crowddb::steer {
 
+// Rows per parallel chunk of orca's and cfsm's per-agent loops.
+inline constexpr std::size_t kGrain = 128;
+// [m] Contact planes and headways keep this much more than touching distance, so that rounding of
+// the new positions cannot turn an exact touch into an overlap the backoff would freeze.
+inline constexpr double kSkin = 1e-6;
+
+// A parameter as EXPLAIN prints it (shortest of ostream's default formatting).
+std::string explain_number(double v);
+
 // What a model reads in one tick.
 struct TickInput {
   const AgentTable& agents;

@@ -90,7 +90,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <sstream>
 
 #include "plan/access_path.hpp"
 #include "sim/stages.hpp"
@@ -103,16 +102,6 @@ namespace crowddb::steer {
 namespace {
 
 constexpr double kSameWay = 0.5;  // cos 60 degrees: the headway's "same way"
-constexpr std::size_t kGrain = 128;
-// [m] Contact and obstacle planes keep this much more than touching distance, so that rounding of
-// the new positions cannot turn an exact touch into an overlap the backoff would freeze.
-constexpr double kSkin = 1e-6;
-
-std::string num(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 // The half-plane agent i gets from neighbour j (relative position p = p_j - p_i, relative
 // velocity v = v_i - v_j, combined radius r), with agent i's velocity (vix, viy).
@@ -294,23 +283,23 @@ class OrcaModel final : public Model {
     const std::size_t n = in.agents.size();
     const NeighbourMethod& nm = neighbour_method(in.cfg.access.neighbours, n);
     os << "  " << step++ << " ORCA neighbours    the " << p.max_neighbors
-       << " nearest agents within " << num(p.neighbor_dist) << " m (" << n
+       << " nearest agents within " << explain_number(p.neighbor_dist) << " m (" << n
        << " rows)\n       access path: " << nm.info.name << " (" << nm.info.description << ")\n";
     if (in.scene.feature_count() > 0) {
       const FeatureMethod& fm = feature_method(in.cfg.access.edges, in.scene.feature_count());
       os << "  " << step++ << " ORCA obstacles     obstacle features (" << in.scene.feature_count()
-         << ": circles and polygon edges) within " << num(p.time_horizon_obst)
+         << ": circles and polygon edges) within " << explain_number(p.time_horizon_obst)
          << " s x max_speed + radius\n       access path: " << fm.info.name << " ("
          << fm.info.description << ")\n";
     }
-    os << "  " << step++
-       << " ORCA linear programs per row: half-planes from neighbours (tau=" << num(p.time_horizon)
+    os << "  " << step++ << " ORCA linear programs per row: half-planes from neighbours (tau="
+       << explain_number(p.time_horizon)
        << " s, or until the sooner of the pair arrives) and obstacles (tau_obst="
-       << num(p.time_horizon_obst) << " s), 2-D incremental LP towards v_pref";
+       << explain_number(p.time_horizon_obst) << " s), 2-D incremental LP towards v_pref";
     if (p.time_gap > 0)
-      os << " capped at spacing / " << num(p.time_gap)
+      os << " capped at spacing / " << explain_number(p.time_gap)
          << " s to the agent ahead going the same way";
-    os << ", backwards at most " << num(p.max_retreat) << " x pref_speed";
+    os << ", backwards at most " << explain_number(p.max_retreat) << " x pref_speed";
     os << ", 3-D fallback when infeasible\n";
   }
 

@@ -1,9 +1,17 @@
 // The catalogue of steering models. Adding a model means adding one entry here; no stage of the
 // tick changes.
+#include <sstream>
+
 #include "crowddb/error.hpp"
 #include "steer/model.hpp"
 
 namespace crowddb::steer {
+
+std::string explain_number(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
 
 std::unique_ptr<Model> make_thesis_model();
 std::unique_ptr<Model> make_orca_model();

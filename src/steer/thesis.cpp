@@ -14,7 +14,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <sstream>
 
 #include "plan/access_path.hpp"
 #include "steer/model.hpp"
@@ -23,13 +22,7 @@
 namespace crowddb::steer {
 namespace {
 
-constexpr std::size_t kGrain = 256;
-
-std::string num(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
+constexpr std::size_t kThesisGrain = 256;
 
 const char* kernel_name(Kernel k) {
   return k == Kernel::exp ? "exp" : "inv";
@@ -62,7 +55,7 @@ class ThesisModel final : public Model {
       sim::OperatorStats& op = log.at("Q2 inner avoidance");
       log.timed("Q2 inner avoidance", n, [&] {
         path(field_paths_, m).run(view, in.scene, p.potential, field_, ex, op.query);
-        ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
+        ex.for_each_chunk(n, kThesisGrain, [&](std::size_t b, std::size_t e) {
           for (std::size_t i = b; i < e; ++i) {
             fx_[i] = -p.w_apf * field_.grad_x[i];
             fy_[i] = -p.w_apf * field_.grad_y[i];
@@ -93,21 +86,22 @@ class ThesisModel final : public Model {
   void explain(std::ostream& os, const TickInput& in, int& step) const override {
     const ThesisParams& p = in.cfg.steering.thesis;
     const std::size_t n = in.agents.size();
-    os << "  " << step++ << " Q1 attraction      c_goal (v_pref - v) / tau, tau=" << num(p.tau)
-       << " s\n";
+    os << "  " << step++
+       << " Q1 attraction      c_goal (v_pref - v) / tau, tau=" << explain_number(p.tau) << " s\n";
     if (p.w_apf > 0) {
       const FieldMethod& m = field_method(in);
       os << "  " << step++ << " Q2 inner avoidance potential field "
          << kernel_name(p.potential.kernel) << "-" << metric_name(p.potential.metric)
-         << " A=" << num(p.potential.A) << " k=" << num(p.potential.k) << " w_apf=" << num(p.w_apf)
-         << " over the other agents"
+         << " A=" << explain_number(p.potential.A) << " k=" << explain_number(p.potential.k)
+         << " w_apf=" << explain_number(p.w_apf) << " over the other agents"
          << (p.obstacle_repulsion == ThesisParams::ObstacleRepulsion::charges
                  ? " and the obstacles' charged points"
                  : "")
          << "\n       access path: " << m.info.name << " (" << m.info.description << ")\n";
       if (p.obstacle_repulsion == ThesisParams::ObstacleRepulsion::nearest) {
         const FeatureMethod& fm = feature_method(in.cfg.access.edges, in.scene.feature_count());
-        os << "       obstacles: the nearest obstacle feature within " << num(p.obstacle_cutoff)
+        os << "       obstacles: the nearest obstacle feature within "
+           << explain_number(p.obstacle_cutoff)
            << " m pushes along its normal with the kernel's slope\n       access path: "
            << fm.info.name << " (" << fm.info.description << ")\n";
       }
@@ -116,9 +110,10 @@ class ThesisModel final : public Model {
     }
     if (p.w_ftc > 0) {
       const FtcMethod& m = ftc_method(in);
-      os << "  " << step++ << " Q3 outer avoidance first-to-collide, horizon=" << num(p.horizon)
-         << " s w_ftc=" << num(p.w_ftc) << "\n       access path: " << m.info.name << " ("
-         << m.info.description << ")\n";
+      os << "  " << step++
+         << " Q3 outer avoidance first-to-collide, horizon=" << explain_number(p.horizon)
+         << " s w_ftc=" << explain_number(p.w_ftc) << "\n       access path: " << m.info.name
+         << " (" << m.info.description << ")\n";
     } else {
       os << "  " << step++ << " Q3 outer avoidance off (w_ftc = 0)\n";
     }
@@ -148,7 +143,7 @@ class ThesisModel final : public Model {
   void attraction(const TickInput& in, Executor& ex) {
     const AgentTable& t = in.agents;
     const double tau = in.cfg.steering.thesis.tau;
-    ex.for_each_chunk(t.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    ex.for_each_chunk(t.size(), kThesisGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         if (standing(t.state[i])) continue;
         const double c = in.goals[t.goal[i]].charge;
@@ -169,7 +164,7 @@ class ThesisModel final : public Model {
     if (!fpath) fpath = fm.make();
     fpath->run(view, reach_, in.scene, features_, ex, qs);
     const std::size_t circles = in.scene.circles().size();
-    ex.for_each_chunk(t.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    ex.for_each_chunk(t.size(), kThesisGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         const uint32_t lo = features_.offset[i], hi = features_.offset[i + 1];
         if (lo == hi) continue;
@@ -199,7 +194,7 @@ class ThesisModel final : public Model {
     const AgentTable& t = in.agents;
     const StaticScene& scene = in.scene;
     const double w = in.cfg.steering.thesis.w_ftc, horizon = in.cfg.steering.thesis.horizon;
-    ex.for_each_chunk(t.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    ex.for_each_chunk(t.size(), kThesisGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         const FtcHit& h = hits_[i];
         if (h.with.kind == Collider::Kind::none || standing(t.state[i])) continue;
@@ -244,7 +239,7 @@ class ThesisModel final : public Model {
   void combine(const TickInput& in, std::span<double> vxo, std::span<double> vyo, Executor& ex) {
     const AgentTable& t = in.agents;
     const double dt = in.cfg.dt;
-    ex.for_each_chunk(t.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    ex.for_each_chunk(t.size(), kThesisGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         if (standing(t.state[i])) {
           // Idle: still, unless the goal stage moves it off a goal area others need.

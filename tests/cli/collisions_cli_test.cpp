@@ -11,7 +11,7 @@
 namespace crowddb::test {
 namespace {
 
-int lines(const std::string& s) {
+int line_count(const std::string& s) {
   return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
 }
 
@@ -47,7 +47,7 @@ TEST(CollisionsCli, EveryMethodOnTheContractExample) {
   // nn needs equal radii: a usage error, one line, nothing on stdout.
   const CliResult nn = run_cli("query collisions --agents " + f.string() + " --method nn", dir);
   EXPECT_EQ(nn.status, 2);
-  EXPECT_EQ(lines(nn.err), 1) << nn.err;
+  EXPECT_EQ(line_count(nn.err), 1) << nn.err;
   EXPECT_NE(nn.err.find("same radius"), std::string::npos) << nn.err;
   EXPECT_TRUE(nn.out.empty());
   const CliResult bogus =
@@ -106,7 +106,7 @@ TEST(RunCli, ExplainShowsTheCollisionPlanAndTheSummaryReportsGridlock) {
   const CliResult nn = run_cli(
       "run " + source_path("scenarios/bottleneck.json") + " --collisions nn --no-output", dir);
   EXPECT_EQ(nn.status, 2) << nn.err;
-  EXPECT_EQ(lines(nn.err), 1) << nn.err;
+  EXPECT_EQ(line_count(nn.err), 1) << nn.err;
 }
 
 }  // namespace

@@ -178,11 +178,11 @@ TEST(Navigation, ExplainShowsThePathService) {
 
 // One person of radius `radius` from (x, y) to goal 0 of `w`, with the default model and
 // navigation on, for at most `ticks` ticks: the arrivals and EXPLAIN ANALYZE at the end.
-struct Walk {
+struct NavWalk {
   std::size_t arrived;
   std::string analyze;
 };
-Walk walk_alone(World w, double x, double y, double radius, int ticks) {
+NavWalk walk_alone(World w, double x, double y, double radius, int ticks) {
   AgentSpec s;
   s.x = x;
   s.y = y;
@@ -203,7 +203,7 @@ TEST(Navigation, AWidePersonFindsANarrowDoorWithTheDefaults) {
   w.add_goal({"behind", 16, 2, 1, 0.5, {}});
   w.add_obstacle(PolygonObstacle{{{9.5, 0}, {10.5, 0}, {10.5, 8.1}, {9.5, 8.1}}, 0.1});
   w.add_obstacle(PolygonObstacle{{{9.5, 9.0}, {10.5, 9.0}, {10.5, 10}, {9.5, 10}}, 0.1});
-  const Walk walk = walk_alone(std::move(w), 4, 2, 0.3, 400);  // 40 s
+  const NavWalk walk = walk_alone(std::move(w), 4, 2, 0.3, 400);  // 40 s
   EXPECT_EQ(walk.arrived, 1u);
   // "... N searches on a narrow mesh, M of them reaching the goal": M >= 1.
   const std::string key = "on a narrow mesh, ";

@@ -336,10 +336,10 @@ struct Picked {
   std::string origin;  // the <Goal>, or the selector that made the goal for the agent
 };
 
-class Reader {
+class MengeReader {
  public:
-  Reader(std::string_view scene, const std::string& scene_name, std::string_view behavior,
-         const std::string& behavior_name, const ProjectSettings& settings)
+  MengeReader(std::string_view scene, const std::string& scene_name, std::string_view behavior,
+              const std::string& behavior_name, const ProjectSettings& settings)
       : scene_(scene, scene_name), bfsm_(behavior, behavior_name), set_(settings) {}
 
   Imported run() {
@@ -1722,7 +1722,7 @@ class Reader {
 Imported import_menge_pair(std::string_view scene_text, const std::string& scene_name,
                            std::string_view behavior_text, const std::string& behavior_name,
                            const ProjectSettings& settings) {
-  return Reader(scene_text, scene_name, behavior_text, behavior_name, settings).run();
+  return MengeReader(scene_text, scene_name, behavior_text, behavior_name, settings).run();
 }
 
 namespace {

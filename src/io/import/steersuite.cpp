@@ -35,7 +35,7 @@ struct Bounds2 {  // an x-z box
   double x0 = 0, x1 = 0, z0 = 0, z1 = 0;
 };
 
-struct Goal {
+struct TargetSpec {
   xml_node node;
   bool box = false;  // seekAxisAlignedBoxRegion
   Xyz target;
@@ -51,7 +51,7 @@ struct RawAgent {
   std::optional<Xyz> direction;
   double radius = kDefaultRadius;
   double speed = 0;
-  std::vector<Goal> goals;
+  std::vector<TargetSpec> goals;
 };
 
 // SteerSuite's MTRand::rand(n): a real in [0, n].
@@ -64,9 +64,9 @@ class SteerRng {
   std::mt19937 mt_;
 };
 
-class Reader {
+class SteerSuiteReader {
  public:
-  Reader(const std::filesystem::path& path, std::string_view text, std::size_t max_agents)
+  SteerSuiteReader(const std::filesystem::path& path, std::string_view text, std::size_t max_agents)
       : f_(text, path.string()), rng_(2), goal_rng_(2), max_agents_(max_agents) {}
 
   Imported run() {
@@ -96,7 +96,8 @@ class Reader {
       } else if (n == "polygonObstacle") {
         polygon_obstacle(c);
       } else if (n == "orientedWallObstacle") {
-        f_.fail(c, "not supported (SteerSuite's own reader asserts on it and no test case uses it)");
+        f_.fail(c,
+                "not supported (SteerSuite's own reader asserts on it and no test case uses it)");
       } else if (n == "obstacleRegion") {
         regions_of_obstacles.push_back(c);
       } else if (n == "agent") {
@@ -175,8 +176,8 @@ class Reader {
     for (xml_node c = n.first_child(); c; c = c.next_sibling()) {
       if (c.type() != pugi::node_element) continue;
       const std::string_view name = XmlFile::local(c);
-      if (name != "xmin" && name != "xmax" && name != "ymin" && name != "ymax" &&
-          name != "zmin" && name != "zmax")
+      if (name != "xmin" && name != "xmax" && name != "ymin" && name != "ymax" && name != "zmin" &&
+          name != "zmax")
         f_.fail(c, "unknown element (a box has <xmin> <xmax> <ymin> <ymax> <zmin> <zmax>)");
     }
     double v[6];
@@ -367,14 +368,15 @@ class Reader {
     a.region = bounding_box(rb, true, "regionBounds");
     if (!a.random_position)
       b_.warn("region-position",
-              f_.where(n) + ": a <position> in a region's initial conditions puts every agent of "
-                            "the region on that point (as in SteerSuite)");
+              f_.where(n) +
+                  ": a <position> in a region's initial conditions puts every agent of "
+                  "the region on that point (as in SteerSuite)");
     for (std::size_t k = 0; k < static_cast<std::size_t>(*count); ++k) out.push_back(a);
   }
 
-  Goal read_goal(const xml_node& g) {
+  TargetSpec read_goal(const xml_node& g) {
     const std::string_view type = XmlFile::local(g);
-    Goal out;
+    TargetSpec out;
     out.node = g;
     if (type == "seekAxisAlignedBoxRegion") {
       out.box = true;
@@ -391,8 +393,9 @@ class Reader {
     } else if (type == "fleeStaticTarget" || type == "seekDynamicTarget" ||
                type == "fleeDynamicTarget" || type == "flowStaticDirection" ||
                type == "flowDynamicDirection" || type == "idle" || type == "groupTarget") {
-      f_.fail(g, "goal type not supported (SteerSuite's own steering modules reject it too; "
-                 "seekStaticTarget and seekAxisAlignedBoxRegion are)");
+      f_.fail(g,
+              "goal type not supported (SteerSuite's own steering modules reject it too; "
+              "seekStaticTarget and seekAxisAlignedBoxRegion are)");
     } else {
       f_.fail(g, "unknown goal type");
     }
@@ -425,8 +428,8 @@ class Reader {
   }
 
   void place(RawAgent& a) {
-    const Vec2 p = random_spot(a.region, a.radius, a.node,
-                               "agent " + std::to_string(b_.agent_count() + 1));
+    const Vec2 p =
+        random_spot(a.region, a.radius, a.node, "agent " + std::to_string(b_.agent_count() + 1));
     a.position = {p.x, 0, p.y, false};
   }
 
@@ -443,7 +446,7 @@ class Reader {
     std::optional<double> speed;
     Vec2 first_target{};
     for (std::size_t k = 0; k < a.goals.size(); ++k) {
-      const Goal& g = a.goals[k];
+      const TargetSpec& g = a.goals[k];
       std::string name;
       if (g.box) {
         name = b_.area_goal({{g.region.x0, g.region.z0},
@@ -475,8 +478,7 @@ class Reader {
       speed = kDefaultSpeed;
     }
     if (!a.direction) {
-      b_.warn("no-direction", f_.where(a.node) +
-                                  ": no initial <direction>: facing the first goal");
+      b_.warn("no-direction", f_.where(a.node) + ": no initial <direction>: facing the first goal");
       dir = {first_target.x - a.position.x, first_target.y - a.position.z};
     }
     const double len = std::hypot(dir.x, dir.y);
@@ -506,25 +508,26 @@ class Reader {
     double x0 = world_.x0, y0 = world_.z0, x1 = world_.x1, y1 = world_.z1;
     const bool degenerate = !(x1 > x0 && y1 > y0);
     if (!e.empty() && (degenerate || e.x0 < x0 || e.y0 < y0 || e.x1 > x1 || e.y1 > y1)) {
-      constexpr double kMargin = 1;
+      constexpr double kBoundsMargin = 1;
       if (!degenerate) {
         b_.warn("world", f_.where(world_node_) +
                              ": the scene extends beyond worldBounds (SteerSuite does not clip "
                              "to them): the world is grown to hold it, with a 1 m margin");
-        x0 = std::min(x0, e.x0 - kMargin);
-        y0 = std::min(y0, e.y0 - kMargin);
-        x1 = std::max(x1, e.x1 + kMargin);
-        y1 = std::max(y1, e.y1 + kMargin);
+        x0 = std::min(x0, e.x0 - kBoundsMargin);
+        y0 = std::min(y0, e.y0 - kBoundsMargin);
+        x1 = std::max(x1, e.x1 + kBoundsMargin);
+        y1 = std::max(y1, e.y1 + kBoundsMargin);
       } else {
-        x0 = e.x0 - kMargin;
-        y0 = e.y0 - kMargin;
-        x1 = e.x1 + kMargin;
-        y1 = e.y1 + kMargin;
+        x0 = e.x0 - kBoundsMargin;
+        y0 = e.y0 - kBoundsMargin;
+        x1 = e.x1 + kBoundsMargin;
+        y1 = e.y1 + kBoundsMargin;
       }
     }
     if (heights_)
-      b_.warn("heights", f_.source() + ": heights (y) are ignored: the ground plane x-z is the "
-                                       "world's x-y");
+      b_.warn("heights", f_.source() +
+                             ": heights (y) are ignored: the ground plane x-z is the "
+                             "world's x-y");
     nlohmann::json& d = b_.doc();
     d["name"] = name_.empty() ? std::filesystem::path(f_.source()).stem().string() : name_;
     d["description"] = "SteerSuite test case " + f_.source() +
@@ -555,15 +558,16 @@ Imported import_steersuite(const std::filesystem::path& path, std::string_view t
                            const LoadOptions& options) {
   if (!options.behavior.empty())
     throw Error(Error::Kind::usage,
-                path.string() + ": a behaviour file goes with a Menge scene, not a SteerSuite "
-                                "test case");
-  return Reader(path, text, kMaxAgents).run();
+                path.string() +
+                    ": a behaviour file goes with a Menge scene, not a SteerSuite "
+                    "test case");
+  return SteerSuiteReader(path, text, kMaxAgents).run();
 }
 
 Imported import_steersuite(const std::filesystem::path& path, std::string_view text,
                            const LoadOptions& options, std::size_t max_agents) {
   if (!options.behavior.empty()) return import_steersuite(path, text, options);
-  return Reader(path, text, std::min(max_agents, kMaxAgents)).run();
+  return SteerSuiteReader(path, text, std::min(max_agents, kMaxAgents)).run();
 }
 
 }  // namespace crowddb::io

@@ -42,7 +42,7 @@ constexpr double kFinishTime = 500;        // [s] AttributesSimulation
 constexpr double kStepLength = 0.4;        // [s] AttributesSimulation
 constexpr double kMaxDt = 0.1;             // [s] crowddb's tick for Vadere's larger model steps
 constexpr double kBurstRate = 1e9;         // [1/s] one spawn event: all its agents due at once
-constexpr double kMaxAgents = 1e7;         // the scenario reader's bound per source
+constexpr double kMaxSourceAgents = 1e7;   // the scenario reader's bound per source
 constexpr double kMinSpeed = 0.05;         // [m/s] lowest preferred speed of a speed range
 constexpr int kCircleSides = 32;           // a CIRCLE source as a polygon
 
@@ -246,7 +246,7 @@ struct Val {
 
 // -- geometry -----------------------------------------------------------------------------------
 
-struct Shape {
+struct VadereShape {
   enum class Kind { rectangle, polygon, circle };
   Kind kind = Kind::polygon;
   std::vector<Vec2> points;  // a rectangle's four corners, a polygon's points (implicitly closed)
@@ -389,8 +389,8 @@ std::string exact(double v) {
 }
 
 // A key equal for equal obstacles, whatever the starting vertex and orientation.
-std::string obstacle_key(const Shape& s) {
-  if (s.kind == Shape::Kind::circle)
+std::string obstacle_key(const VadereShape& s) {
+  if (s.kind == VadereShape::Kind::circle)
     return "c " + exact(s.centre.x) + " " + exact(s.centre.y) + " " + exact(s.radius);
   std::vector<Vec2> v = s.points;
   if (signed_area(v) < 0) std::reverse(v.begin(), v.end());
@@ -422,7 +422,7 @@ struct AgentAttrs {
 struct Target {
   Val where;
   int64_t id = -1;
-  Shape shape;
+  VadereShape shape;
   bool absorbing = true;
   double deletion = kDeletionDistance;
   json wait;         // the goal's "wait" (null: none)
@@ -493,9 +493,9 @@ constexpr std::string_view kAgentKeys =
 
 // -- the reader ---------------------------------------------------------------------------------
 
-class Reader {
+class VadereReader {
  public:
-  Reader(const std::filesystem::path& path, std::string_view text)
+  VadereReader(const std::filesystem::path& path, std::string_view text)
       : file_(path.string()), text_(text) {}
 
   Imported run() {
@@ -824,12 +824,12 @@ class Reader {
     }
   }
 
-  Shape shape(const Val& owner) {
+  VadereShape shape(const Val& owner) {
     const auto sv = object(owner, "shape");
     if (!sv) fail(owner, "missing \"shape\"");
     const std::string type = string(*sv, "type", std::nullopt);
     const Val tv = *get(*sv, "type");
-    Shape s;
+    VadereShape s;
     if (type == "RECTANGLE") {
       known(*sv, "type x y width height");
       const double x = required_number(*sv, "x"), y = required_number(*sv, "y");
@@ -837,7 +837,7 @@ class Reader {
       if (!(w > 0 && h > 0))
         fail(*sv,
              "a rectangle needs width > 0 and height > 0 (got " + fmt(w) + " x " + fmt(h) + ")");
-      s.kind = Shape::Kind::rectangle;
+      s.kind = VadereShape::Kind::rectangle;
       s.points = {{x, y}, {x + w, y}, {x + w, y + h}, {x, y + h}};
     } else if (type == "POLYGON") {
       known(*sv, "type points");
@@ -856,11 +856,11 @@ class Reader {
       if (s.points.size() < 3)
         fail(*pts, "a polygon needs at least 3 distinct points (got " +
                        std::to_string(s.points.size()) + ")");
-      s.kind = Shape::Kind::polygon;
+      s.kind = VadereShape::Kind::polygon;
     } else if (type == "CIRCLE") {
       known(*sv, "type center radius");
       const Val c = required_object(*sv, "center");
-      s.kind = Shape::Kind::circle;
+      s.kind = VadereShape::Kind::circle;
       s.centre = {required_number(c, "x"), required_number(c, "y")};
       s.radius = required_number(*sv, "radius");
       if (!(s.radius > 0)) fail(*get(*sv, "radius"), "must be > 0 (got " + fmt(s.radius) + ")");
@@ -888,7 +888,7 @@ class Reader {
       const Val o = item(*obs, k);
       if (!o.j->is_object()) fail(o, "expected an object");
       known(o, kObstacleKeys);
-      const Shape s = shape(o);
+      const VadereShape s = shape(o);
       bool in_border = false;
       for (const Rect& r : strips_) in_border |= r.contains(s.box, 1e-9);
       if (in_border) {
@@ -902,7 +902,7 @@ class Reader {
         continue;
       }
       ++explicit_obstacles_;
-      if (s.kind == Shape::Kind::circle) {
+      if (s.kind == VadereShape::Kind::circle) {
         b_.circle(s.centre, s.radius, where(o));
         continue;
       }
@@ -1029,14 +1029,14 @@ class Reader {
     return t.goal;
   }
   void make_goal(Target& t) {
-    const Shape& s = t.shape;
+    const VadereShape& s = t.shape;
     const std::string origin = where(t.where);
     const std::string world = "[" + fmt(world_.x0) + ", " + fmt(world_.y0) + ", " + fmt(world_.x1) +
                               ", " + fmt(world_.y1) + "]";
     if (world_.misses(s.box))
       fail(t.where, "a target outside the world: target " + std::to_string(t.id) +
                         " lies outside the bounds " + world);
-    if (s.kind == Shape::Kind::circle) {
+    if (s.kind == VadereShape::Kind::circle) {
       if (!world_.contains(s.centre))
         fail(t.where, "a target outside the world: the centre of target " + std::to_string(t.id) +
                           " lies outside the bounds " + world);
@@ -1103,8 +1103,8 @@ class Reader {
     return best;
   }
 
-  static double distance(const Shape& s, Vec2 p) {
-    if (s.kind == Shape::Kind::circle)
+  static double distance(const VadereShape& s, Vec2 p) {
+    if (s.kind == VadereShape::Kind::circle)
       return std::max(0.0, std::hypot(p.x - s.centre.x, p.y - s.centre.y) - s.radius);
     return point_in_polygon(s.points, p.x, p.y) ? 0
                                                 : std::sqrt(dist2_to_boundary(s.points, p.x, p.y));
@@ -1255,7 +1255,7 @@ class Reader {
       if (++explicit_ > kMaxScenarioAgents)
         fail(p, "more than " + std::to_string(kMaxScenarioAgents) +
                     " pedestrians placed at the start (crowddb's limit per scenario)");
-      if (++agents_ > kMaxAgents) fail(p, "more than 10^7 agents");
+      if (++agents_ > kMaxSourceAgents) fail(p, "more than 10^7 agents");
       b_.agent(std::move(row), where(p));
       b_.occupy(x, y, a.radius);
       count_arrival(r, 1, p);
@@ -1397,7 +1397,7 @@ class Reader {
   void read_source(const Val& s, const AgentAttrs& defaults) {
     if (!s.j->is_object()) fail(s, "expected an object");
     known(s, kSourceKeys);
-    const Shape sh = shape(s);
+    const VadereShape sh = shape(s);
     const int64_t id = get(s, "id") ? whole(*get(s, "id")) : -1;
     // The schedule, in 2.4's names (older names in brackets).
     const auto spawner = object(s, "spawner");
@@ -1466,7 +1466,7 @@ class Reader {
     double people = events * n * group;
     if (max >= 0) people = std::min(people, max);
     people = std::round(people);
-    if (people > kMaxAgents || agents_ + people > kMaxAgents)
+    if (people > kMaxSourceAgents || agents_ + people > kMaxSourceAgents)
       fail(s, "would spawn " + fmt(people) + " agents, more than 10^7 in all");
     if (people < 1) {
       warn("no-spawn", s, "spawns nobody before finishTime " + fmt(finish_time_) + " s: dropped");
@@ -1516,9 +1516,9 @@ class Reader {
     count_arrival(r, people, s);
   }
 
-  void source_area(const Val& s, const Shape& sh, json& src) {
+  void source_area(const Val& s, const VadereShape& sh, json& src) {
     std::vector<Vec2> area = sh.points;
-    if (sh.kind == Shape::Kind::circle) {
+    if (sh.kind == VadereShape::Kind::circle) {
       for (int k = 0; k < kCircleSides; ++k) {
         const double t = 2 * std::numbers::pi * k / kCircleSides;
         area.push_back(
@@ -1532,7 +1532,7 @@ class Reader {
       if (area.empty()) fail(s, "a source outside the world (outside the bounds)");
       warn("source-clipped", s, "the part of the source outside the bounds is dropped");
     }
-    if (sh.kind == Shape::Kind::rectangle) {
+    if (sh.kind == VadereShape::Kind::rectangle) {
       Box b;
       for (const Vec2& p : area) b.add(p.x, p.y);
       src["area"] = {b.x0, b.y0, b.x1, b.y1};
@@ -1617,7 +1617,7 @@ Imported import_vadere(const std::filesystem::path& path, std::string_view text,
     throw Error(
         Error::Kind::usage,
         path.string() + ": a behaviour file goes with a Menge scene, not a Vadere scenario");
-  return Reader(path, text).run();
+  return VadereReader(path, text).run();
 }
 
 }  // namespace crowddb::io

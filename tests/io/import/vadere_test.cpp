@@ -118,7 +118,7 @@ std::string join(const std::vector<std::string>& members) {
 }
 
 // 1-based line of the first occurrence of `needle`.
-int line_of(const std::string& text, const std::string& needle) {
+int vadere_line_of(const std::string& text, const std::string& needle) {
   const auto at = text.find(needle);
   EXPECT_NE(at, std::string::npos) << needle;
   return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
@@ -190,8 +190,9 @@ TEST(VadereImport, Release24File) {
                           "t.scenario:6: /scenario/mainModel: Vadere's "
                           "OptimalStepsModel (OSM) is not available"))
       << all(im.warnings);
-  EXPECT_EQ(im.origins.at("/goals/0"), "t.scenario:" + std::to_string(line_of(v24(s), kExit)) +
-                                           ": /scenario/topography/targets/0");
+  EXPECT_EQ(im.origins.at("/goals/0"),
+            "t.scenario:" + std::to_string(vadere_line_of(v24(s), kExit)) +
+                ": /scenario/topography/targets/0");
 }
 
 // 2.0 to 2.3: the source's fields sit on the source, the distribution has a short name and its
@@ -557,11 +558,12 @@ TEST(VadereImport, ZeroIntervalIsAnError) {
   s.topography = join({list("targets", {kExit}),
                        list("sources", {source(1, rect(1, 1, 1, 1), "[1]", 0, 10, 1, 0)})});
   const std::string text = v24(s);
-  EXPECT_EQ(error_of(text),
-            "t.scenario:" + std::to_string(line_of(text, "\"id\": 1, \"shape\": {\"x\": 1,")) +
-                ": /scenario/topography/sources/0/spawner/distribution: "
-                "updateFrequency 0: must be > 0 when constraintsTimeEnd != "
-                "constraintsTimeStart (Vadere would loop for ever)");
+  EXPECT_EQ(
+      error_of(text),
+      "t.scenario:" + std::to_string(vadere_line_of(text, "\"id\": 1, \"shape\": {\"x\": 1,")) +
+          ": /scenario/topography/sources/0/spawner/distribution: "
+          "updateFrequency 0: must be > 0 when constraintsTimeEnd != "
+          "constraintsTimeStart (Vadere would loop for ever)");
 }
 
 // Spawned agents: spawner.eventElement, else topography.attributesPedestrian; a speed
@@ -582,9 +584,9 @@ TEST(VadereImport, SourceWithoutTargetsIsAnError) {
   Spec s;
   s.topography = join({list("targets", {kExit}), list("sources", {src})});
   const std::string text = v24(s);
-  EXPECT_EQ(
-      error_of(text).substr(0, error_of(text).find(": a source")),
-      "t.scenario:" + std::to_string(line_of(text, src)) + ": /scenario/topography/sources/0");
+  EXPECT_EQ(error_of(text).substr(0, error_of(text).find(": a source")),
+            "t.scenario:" + std::to_string(vadere_line_of(text, src)) +
+                ": /scenario/topography/sources/0");
 }
 
 // -- pedestrians ------------------------------------------------------------------------------
@@ -808,7 +810,7 @@ TEST(VadereImport, BadInputNamesFileAndLine) {
     const std::string expected =
         std::isdigit(static_cast<unsigned char>(c.message[0]))  // line:column of a syntax error
             ? "t.scenario:" + c.message
-            : "t.scenario:" + std::to_string(line_of(c.text, c.marker)) + ": " + c.message;
+            : "t.scenario:" + std::to_string(vadere_line_of(c.text, c.marker)) + ": " + c.message;
     EXPECT_EQ(error_of(c.text), expected);
   }
 }
@@ -872,7 +874,7 @@ TEST(VadereImport, WarningsForUnsupportedElements) {
   const std::string text = v24(s);
   const io::Imported im = import(text);
   const auto at = [&](const std::string& marker, const std::string& pointer) {
-    return "t.scenario:" + std::to_string(line_of(text, marker)) + ": " + pointer + ": ";
+    return "t.scenario:" + std::to_string(vadere_line_of(text, marker)) + ": " + pointer + ": ";
   };
   const std::vector<std::string> expected = {
       at("\"mainModel\"", "/scenario/mainModel") +
