@@ -94,9 +94,11 @@ std::vector<Case> make_cases() {
 
   {  // RiMEA 6: 20 people turn a left corner in a 2 m wide L; nobody crosses the walls.
     json d = base({0, 0, 12, 12}, 60, 6);
-    d["obstacles"] = {wall(0, 2, 10, 12)};  // the inner block: the L is the rest of the square
+    // The inner block: the L is the rest of the square. (json::array: a braced list of one json
+    // value is that value under clang, an array of it under GCC.)
+    d["obstacles"] = json::array({wall(0, 2, 10, 12)});
     d["goals"] = {{{"name", "top"}, {"area", box(10, 11, 12, 12)}}};
-    d["groups"] = {group("walkers", 20, {0, 0, 6, 2}, "top", 0.05)};
+    d["groups"] = json::array({group("walkers", 20, {0, 0, 6, 2}, "top", 0.05)});
     d["navigation"] = json::object();
     all.push_back({"rimea-06-corner",
                    "RiMEA 6",
@@ -135,10 +137,10 @@ std::vector<Case> make_cases() {
                   {{"name", "W"}, {"area", box(0, 8, 1, 16)}},
                   {{"name", "N"}, {"area", box(8, 23, 16, 24)}},
                   {{"name", "S"}, {"area", box(8, 0, 16, 1)}}};
-    d["groups"] = {group("eastbound", 8, {0.5, 9, 4, 15}, "E"),
-                   group("westbound", 8, {20, 9, 23.5, 15}, "W"),
-                   group("northbound", 8, {9, 0.5, 15, 4}, "N"),
-                   group("southbound", 8, {9, 20, 15, 23.5}, "S")};
+    d["groups"] = json::array({group("eastbound", 8, {0.5, 9, 4, 15}, "E"),
+                               group("westbound", 8, {20, 9, 23.5, 15}, "W"),
+                               group("northbound", 8, {9, 0.5, 15, 4}, "N"),
+                               group("southbound", 8, {9, 20, 15, 23.5}, "S")});
     all.push_back({"four-way-crossing",
                    "SteerSuite group interactions (4-way-confusion)",
                    "four groups of 8 cross a 24 m square from its four sides at once",
@@ -164,8 +166,8 @@ std::vector<Case> make_cases() {
     json d = base({0, 0, 30, 4}, 120, 7);
     d["goals"] = {{{"name", "E"}, {"area", box(29, 0, 30, 4)}},
                   {{"name", "W"}, {"area", box(0, 0, 1, 4)}}};
-    d["groups"] = {group("eastbound", 20, {0.5, 0, 8, 4}, "E", 0.05),
-                   group("westbound", 20, {22, 0, 29.5, 4}, "W", 0.05)};
+    d["groups"] = json::array({group("eastbound", 20, {0.5, 0, 8, 4}, "E", 0.05),
+                               group("westbound", 20, {22, 0, 29.5, 4}, "W", 0.05)});
     all.push_back({"hallway-two-way",
                    "SteerSuite corridors (hallway-two-way)",
                    "counter-flow: 20 + 20 people meet head-on in a 4 m wide hallway",
@@ -176,7 +178,7 @@ std::vector<Case> make_cases() {
     json d = base({0, 0, 16, 10}, 200, 8);
     d["obstacles"] = {wall(10, 0, 10.3, 4.4), wall(10, 5.6, 10.3, 10)};
     d["goals"] = {{{"name", "out"}, {"area", box(15, 0, 16, 10)}}};
-    d["groups"] = {group("occupants", 80, {0.3, 0.3, 9.7, 9.7}, "out")};
+    d["groups"] = json::array({group("occupants", 80, {0.3, 0.3, 9.7, 9.7}, "out")});
     d["navigation"] = json::object();
     all.push_back(
         {"bottleneck-evacuation",
@@ -213,7 +215,7 @@ std::vector<Case> make_cases() {
     d["obstacles"] = {wall(6, 0, 6.5, 11), wall(12, 4, 12.5, 15), wall(18, 0, 18.5, 11),
                       wall(24, 4, 24.5, 15)};
     d["goals"] = {{{"name", "exit"}, {"x", 27.5}, {"y", 7.5}, {"arrival_radius", 1}}};
-    d["groups"] = {group("walkers", 8, {1, 4, 5, 11}, "exit", 0.3)};
+    d["groups"] = json::array({group("walkers", 8, {1, 4, 5, 11}, "exit", 0.3)});
     d["navigation"] = json::object();
     all.push_back({"serpentine",
                    "SteerSuite obstacles (curves)",
@@ -236,7 +238,7 @@ std::vector<Case> make_cases() {
                          {15.5, 5},
                          {10, 5}}}}};
     d["goals"] = {{{"name", "goal"}, {"x", 21.5}, {"y", 10}, {"arrival_radius", 1}}};
-    d["groups"] = {group("walkers", 8, {1, 6.5, 6, 13.5}, "goal", 0.3)};
+    d["groups"] = json::array({group("walkers", 8, {1, 6.5, 6, 13.5}, "goal", 0.3)});
     d["navigation"] = json::object();
     all.push_back({"u-trap",
                    "SteerSuite obstacles (local minimum)",
@@ -254,7 +256,7 @@ std::vector<Case> make_cases() {
     json g = group("occupants", 40, {0.5, 0.5, 12, 9.5}, "south exit");
     g.erase("goal");
     g["goals"] = {{"assign", "nearest"}};
-    d["groups"] = {g};
+    d["groups"] = json::array({g});
     d["navigation"] = json::object();
     all.push_back({"exit-choice",
                    "RiMEA 10/11 (route choice)",
@@ -289,7 +291,7 @@ std::vector<Case> make_cases() {
       json g = group("occupants", 1000, {0.3, 0.3, 29.7, 19.7}, "S1", 0.02);
       g.erase("goal");
       g["goals"] = {{"assign", "nearest"}};
-      d["groups"] = {g};
+      d["groups"] = json::array({g});
       d["navigation"] = json::object();
       return d.dump();
     };
@@ -314,7 +316,7 @@ std::vector<Case> make_cases() {
       json d = base({0, 0, 16, 10}, 200, 12);
       d["obstacles"] = {wall(10, 0, 10.3, 5 - b / 2), wall(10, 5 + b / 2, 10.3, 10)};
       d["goals"] = {{{"name", "out"}, {"area", box(15, 0, 16, 10)}}};
-      d["groups"] = {group("occupants", 60, {0.3, 0.3, 9.7, 9.7}, "out")};
+      d["groups"] = json::array({group("occupants", 60, {0.3, 0.3, 9.7, 9.7}, "out")});
       d["navigation"] = json::object();
       return d.dump();
     };

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "support/cli.hpp"
+#include "support/sanitizers.hpp"
 #include "support/sqlite_query.hpp"
 
 extern char** environ;
@@ -24,7 +25,7 @@ using test::query;
 using test::TempDir;
 
 // Sanitizer builds run the same check on fewer kills (each run is several times slower).
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(CROWDDB_TEST_ASAN)
 constexpr int kKills = 4;
 #else
 constexpr int kKills = 20;

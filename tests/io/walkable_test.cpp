@@ -111,7 +111,7 @@ TEST(WalkableArea, InvalidGeometryIsNamed) {
       {"", "expected a WKT POLYGON or MULTIPOLYGON"},
   };
   for (const auto& [wkt, needle] : cases) {
-    const std::string msg = error_of([&] { io::WalkableArea::parse(wkt); });
+    const std::string msg = error_of([&, &wkt = wkt] { io::WalkableArea::parse(wkt); });
     EXPECT_NE(msg.find(needle), std::string::npos) << wkt << " -> " << msg;
     EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
   }
@@ -182,7 +182,7 @@ TEST(ScenarioGeometry, ErrorsNameTheFileAndField) {
        "t.json: /navigation: cannot be combined with \"via\" waypoints"},
   };
   for (const auto& [text, needle] : cases) {
-    const std::string msg = error_of([&] { parse_scenario(text, "t.json"); });
+    const std::string msg = error_of([&, &text = text] { parse_scenario(text, "t.json"); });
     EXPECT_NE(msg.find(needle), std::string::npos) << text << "\n -> " << msg;
     EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
   }

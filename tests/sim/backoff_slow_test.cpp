@@ -72,15 +72,15 @@ TEST(BackoffSlow, AirportAtHighDensity) {
                  j["groups"][0]["count"] = 2000;
                }},
               {"grid", "naive", "sweep"});
-  run_variant({"airport", 1000, [](nlohmann::json& j) { thesis_model(j, 0); }},
-              {"sweep", "grid"});
+  run_variant({"airport", 1000, [](nlohmann::json& j) { thesis_model(j, 0); }}, {"sweep", "grid"});
 }
 
 TEST(BackoffSlow, CircleAtThreeDensities) {
   // More agents on the same ring need smaller discs to start apart (spacing 2 pi 12 m / count).
-  for (auto [count, radius, seed] : {std::tuple{150, 0.24, 7}, {200, 0.18, 8}, {250, 0.14, 9}})
+  for (auto [n, r, s] : {std::tuple{150, 0.24, 7}, {200, 0.18, 8}, {250, 0.14, 9}})
     run_variant({"circle", 600,
-                 [=](nlohmann::json& j) {
+                 // clang 14 cannot capture structured bindings: copied into the capture list.
+                 [count = n, radius = r, seed = s](nlohmann::json& j) {
                    set_count(static_cast<std::size_t>(count), static_cast<uint64_t>(seed))(j);
                    j["groups"][0]["radius"] = radius;
                  }},

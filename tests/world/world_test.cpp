@@ -201,9 +201,10 @@ TEST(World, ApiRefusesBadBoundsDuplicateGoalsAndAgentsOutsideTheWalkableArea) {
   EXPECT_EQ(w.pending_changes(), 0u);  // nothing was stored
   // The boundary is walkable (an agent may stand against a wall or obstacle), and so is every
   // point of the bounds.
-  for (const auto& [x, y] : std::vector<std::pair<double, double>>{
+  for (const auto& p : std::vector<std::pair<double, double>>{
            {55, 50}, {20, 25}, {30, 30}, {0, 0}, {100, 100}, {31, 25}, {10, 90}})
-    EXPECT_EQ(field_of([&] { w.insert(spec_at(x, y)); }), "accepted") << x << ", " << y;
+    EXPECT_EQ(field_of([&] { w.insert(spec_at(p.first, p.second)); }), "accepted")
+        << p.first << ", " << p.second;
 
   // Without walls the bounds do not bound agents; turning walls on checks the agents there.
   World open = world_with_goals();

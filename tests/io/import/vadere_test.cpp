@@ -15,6 +15,7 @@
 #include "crowddb/scenario.hpp"
 #include "sim/sources.hpp"
 #include "support/cli.hpp"
+#include "support/sanitizers.hpp"
 
 namespace crowddb {
 namespace {
@@ -825,7 +826,7 @@ TEST(VadereImport, DeeplyNestedValuesCostLinearMemory) {
   const std::string text = "{\"name\": \"x\", \"description\": " + std::string(depth, '[') +
                            std::string(depth, ']') + "}";
   const std::string expected = "t.scenario:1: /description: expected a string, got array";
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(CROWDDB_TEST_ASAN)
   EXPECT_EQ(error_of(text), expected);
 #else
   GTEST_FLAG_SET(death_test_style, "threadsafe");
