@@ -32,14 +32,14 @@ targets=(scenario_fuzz csv_fuzz steersuite_fuzz menge_fuzz vadere_fuzz overrides
 
 # FUZZ_TREE: a build tree already configured with CROWDDB_FUZZ=ON (scripts/test.sh's sanitizer
 # tree, which holds the tests too); by default build-fuzz, configured here with the fuzz targets only.
-tree=${FUZZ_TREE:-build-fuzz}
 if [[ -z ${FUZZ_TREE:-} ]]; then
-  CC=clang CXX=clang++ cmake -S . -B "$tree" -DCROWDDB_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  FUZZ_TREE=build-fuzz
+  CC=clang CXX=clang++ cmake -S . -B "$FUZZ_TREE" -DCROWDDB_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_UNITY_BUILD=ON -DCROWDDB_BUILD_TESTS=OFF \
     -DCROWDDB_BUILD_BENCHMARKS=OFF -DCROWDDB_BUILD_PYTHON=OFF >/dev/null
 fi
-cmake --build "$tree" -j "$jobs" --target "${targets[@]}"
-export FUZZ_TREE=$tree
+export FUZZ_TREE
+cmake --build "$FUZZ_TREE" -j "$jobs" --target "${targets[@]}"
 
 rm -rf "$FUZZ_TREE"/findings "$FUZZ_TREE"/corpus "$FUZZ_TREE"/logs
 mkdir -p "$FUZZ_TREE"/findings "$FUZZ_TREE"/corpus "$FUZZ_TREE"/logs

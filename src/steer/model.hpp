@@ -31,7 +31,7 @@ inline constexpr std::size_t kGrain = 128;
 // the new positions cannot turn an exact touch into an overlap the backoff would freeze.
 inline constexpr double kSkin = 1e-6;
 
-// A parameter as EXPLAIN prints it (shortest of ostream's default formatting).
+// A parameter as EXPLAIN prints it (ostream's default formatting, as every model printed it).
 std::string explain_number(double v);
 
 // What a model reads in one tick.
