@@ -10,9 +10,11 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -131,8 +133,12 @@ class Graph {
   const std::string& actor_name(ActorId a) const { return actor_names_[a]; }
   const Channel& channel(ChannelId c) const { return channels_[c]; }
   std::span<const Channel> channels() const { return channels_; }
-  // A view into the graph, valid until the graph changes.
-  std::string_view channel_name(ChannelId c) const { return channel_names_[c]; }
+  // A view into the graph, valid until the graph changes. Default names are made when the first
+  // one is asked for (see ChannelNames below); that is safe under concurrent const use.
+  std::string_view channel_name(ChannelId c) const {
+    make_names();
+    return names_.column[c];
+  }
   // SDF3 port names, kept so that a file read and written again keeps them; empty when the
   // channel came from elsewhere (the writer then invents unique ones). Views as channel_name.
   std::string_view src_port(ChannelId c) const {
@@ -186,7 +192,6 @@ class Graph {
   std::vector<uint64_t> actor_times_;  // kNoTime = unset
   static constexpr uint64_t kNoTime = UINT64_MAX;
   std::vector<Channel> channels_;
-  detail::NameColumn channel_names_;
   // Sized to the channels only once a port name is set.
   detail::NameColumn src_ports_, dst_ports_;
   // Flat open-addressing tables of ids (the names live in actor_names_ / channels_): no node
@@ -205,21 +210,57 @@ class Graph {
   static void flat_insert(FlatIndex& t, uint32_t id, uint64_t hash, KeyOf&& key_of);
   template <class KeyOf>
   static void flat_rehash(FlatIndex& t, size_t capacity, KeyOf&& key_of);
-  FlatIndex actor_index_, channel_index_;
-  // (src, dst) -> number of channels so far, for the default names `src->dst#k`. Built at the
-  // first channel that needs a default name (a graph whose channels are all named, as SDF3's
-  // are, never pays for it) and kept up to date from then on.
-  bool pairs_live_ = false;
-  void make_pairs_live();
+  FlatIndex actor_index_;
   struct PairCount {
     uint64_t key;  // UINT64_MAX = free ((src, dst) are never both 2^32 - 1)
     uint64_t count;
   };
-  std::vector<PairCount> pairs_;
-  size_t pair_size_ = 0;
-  void pair_rehash(size_t capacity);
-  void reserve_tables(size_t actors, size_t channels);
-  size_t pair_slot(uint64_t pair);  // the pair's slot, created with count 0 if new
+  // The channels' names, their index, and the (src, dst) counts of the default names.
+  //
+  // A graph whose channels all have default names (the JSON form, usually) makes none of them
+  // until one is asked for (channel_name, find_channel) or a named channel is added: on a large
+  // graph each costs cache misses (both actor names, a pair count, an index slot) and its bytes,
+  // a third of the time and memory of loading a 10^6-actor graph for its repetitions vector.
+  // Unmade, they are still unique: while no actor name contains "->", `src->dst#k` reads back as
+  // exactly one (src, dst, k), and k counts the channels of each pair. They are made all at once,
+  // from a const accessor too: under the lock, once (`made` tells readers it is done), and a
+  // copy locks the source. Before that nothing reads the column, so no reader races the making.
+  struct ChannelNames {
+    detail::NameColumn column;  // every channel's name once made; empty before
+    FlatIndex index;            // over the column
+    // (src, dst) -> number of channels so far, for `src->dst#k`. Built at the first channel that
+    // needs a default name once the names are made (a graph whose channels are all named, as
+    // SDF3's are, never pays for it) and kept up to date from then on.
+    bool pairs_live = false;
+    std::vector<PairCount> pairs;
+    size_t pair_size = 0;
+    std::atomic<bool> made{true};  // false: the channels' default names are not made yet
+    mutable std::mutex lock;
+
+    ChannelNames() = default;
+    ChannelNames(const ChannelNames& o) { *this = o; }
+    ChannelNames(ChannelNames&& o) noexcept { *this = std::move(o); }
+    ChannelNames& operator=(const ChannelNames& o);
+    ChannelNames& operator=(ChannelNames&& o) noexcept;
+    void pair_rehash(size_t capacity);
+    size_t pair_slot(uint64_t pair);  // the pair's slot, created with count 0 if new
+  };
+  mutable ChannelNames names_;
+  bool arrow_in_actor_name_ = false;  // some actor name contains "->": names are made at once
+  size_t channel_reserve_ = 0;        // reserve()'s channel count, for the tables when made
+  void make_names() const {
+    if (!names_.made.load(std::memory_order_acquire)) make_default_names();
+  }
+  void make_default_names() const;
+  // Whether channels with default names can be added without making their names (and then the
+  // graph is in that state).
+  bool defer_default_names();
+  void note_actor_name(std::string_view actor);
+  void make_pairs_live() const;
+  void reserve_actor_table(size_t actors);
+  // Room in the name column, the index and the pair counts (when live) for this many channels
+  // (at least reserve()'s count), so that adding them rehashes nothing.
+  void reserve_channel_tables(size_t channels) const;
   void default_name(ActorId src, ActorId dst, uint64_t k, std::string& out) const;
 };
 

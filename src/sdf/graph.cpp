@@ -98,35 +98,109 @@ void Graph::flat_insert(FlatIndex& t, uint32_t id, uint64_t hash, KeyOf&& key_of
   ++t.size;
 }
 
-void Graph::pair_rehash(size_t capacity) {
-  std::vector<PairCount> old = std::move(pairs_);
-  pairs_.assign(capacity, PairCount{UINT64_MAX, 0});
+Graph::ChannelNames& Graph::ChannelNames::operator=(const ChannelNames& o) {
+  if (this == &o) return *this;
+  const std::lock_guard hold(o.lock);  // o may be making its names (a const use)
+  column = o.column;
+  index = o.index;
+  pairs_live = o.pairs_live;
+  pairs = o.pairs;
+  pair_size = o.pair_size;
+  made.store(o.made.load(std::memory_order_relaxed), std::memory_order_relaxed);
+  return *this;
+}
+
+Graph::ChannelNames& Graph::ChannelNames::operator=(ChannelNames&& o) noexcept {
+  if (this == &o) return *this;
+  column = std::move(o.column);
+  index = std::move(o.index);
+  pairs_live = o.pairs_live;
+  pairs = std::move(o.pairs);
+  pair_size = o.pair_size;
+  made.store(o.made.load(std::memory_order_relaxed), std::memory_order_relaxed);
+  return *this;
+}
+
+void Graph::ChannelNames::pair_rehash(size_t capacity) {
+  std::vector<PairCount> old = std::move(pairs);
+  pairs.assign(capacity, PairCount{UINT64_MAX, 0});
   for (const PairCount& p : old) {
     if (p.key == UINT64_MAX) continue;
     size_t i = mix64(p.key) & (capacity - 1);
-    while (pairs_[i].key != UINT64_MAX) i = (i + 1) & (capacity - 1);
-    pairs_[i] = p;
+    while (pairs[i].key != UINT64_MAX) i = (i + 1) & (capacity - 1);
+    pairs[i] = p;
   }
 }
 
-void Graph::make_pairs_live() {
-  if (pairs_live_) return;
-  pairs_live_ = true;
-  pair_rehash(table_size_for(channels_.size()));
-  for (const Channel& c : channels_)
-    ++pairs_[pair_slot((static_cast<uint64_t>(c.src) << 32) | c.dst)].count;
-}
-
-size_t Graph::pair_slot(uint64_t pair) {
-  if (2 * (pair_size_ + 1) > pairs_.size()) pair_rehash(std::max<size_t>(16, pairs_.size() * 2));
-  const size_t mask = pairs_.size() - 1;
+size_t Graph::ChannelNames::pair_slot(uint64_t pair) {
+  if (2 * (pair_size + 1) > pairs.size()) pair_rehash(std::max<size_t>(16, pairs.size() * 2));
+  const size_t mask = pairs.size() - 1;
   size_t i = mix64(pair) & mask;
-  while (pairs_[i].key != UINT64_MAX && pairs_[i].key != pair) i = (i + 1) & mask;
-  if (pairs_[i].key == UINT64_MAX) {
-    pairs_[i].key = pair;
-    ++pair_size_;
+  while (pairs[i].key != UINT64_MAX && pairs[i].key != pair) i = (i + 1) & mask;
+  if (pairs[i].key == UINT64_MAX) {
+    pairs[i].key = pair;
+    ++pair_size;
   }
   return i;
+}
+
+void Graph::make_pairs_live() const {
+  if (names_.pairs_live) return;
+  names_.pairs_live = true;
+  names_.pair_rehash(table_size_for(std::max(channels_.size(), channel_reserve_)));
+  for (const Channel& c : channels_)
+    ++names_.pairs[names_.pair_slot((static_cast<uint64_t>(c.src) << 32) | c.dst)].count;
+}
+
+bool Graph::defer_default_names() {
+  if (!names_.made.load(std::memory_order_relaxed)) return true;
+  if (!channels_.empty() || arrow_in_actor_name_) return false;
+  names_.made.store(false, std::memory_order_relaxed);
+  return true;
+}
+
+void Graph::note_actor_name(std::string_view actor) {
+  if (arrow_in_actor_name_ || actor.find("->") == std::string_view::npos) return;
+  arrow_in_actor_name_ = true;
+  make_names();  // from now on default names could collide unless checked one by one
+}
+
+// Three passes over the channels, each with its misses overlapped by prefetching: the parallel
+// index k of each (src, dst); the names; the index over them.
+void Graph::make_default_names() const {
+  const std::lock_guard hold(names_.lock);
+  if (names_.made.load(std::memory_order_relaxed)) return;
+  const size_t n = channels_.size();
+  reserve_channel_tables(n);
+  names_.pairs_live = true;
+  names_.pair_rehash(table_size_for(std::max(n, channel_reserve_)));
+  constexpr size_t kAhead = 8;
+  auto pair_of = [&](size_t c) {
+    return (static_cast<uint64_t>(channels_[c].src) << 32) | channels_[c].dst;
+  };
+  std::vector<uint64_t> scratch(n);  // k, then the names' hashes
+  for (size_t c = 0; c < n; ++c) {
+    if (c + kAhead < n)
+      prefetch(names_.pairs.data() + (mix64(pair_of(c + kAhead)) & (names_.pairs.size() - 1)));
+    scratch[c] = names_.pairs[names_.pair_slot(pair_of(c))].count++;
+  }
+  std::string made_name;
+  for (size_t c = 0; c < n; ++c) {
+    if (c + kAhead < n) {
+      prefetch(&actor_names_[channels_[c + kAhead].src]);
+      prefetch(&actor_names_[channels_[c + kAhead].dst]);
+    }
+    default_name(channels_[c].src, channels_[c].dst, scratch[c], made_name);
+    names_.column.push_back(made_name);
+    scratch[c] = hash_of(made_name);
+  }
+  auto name_of = [this](uint32_t c) -> std::string_view { return names_.column[c]; };
+  const size_t size = names_.index.slots.size();
+  for (size_t c = 0; c < n; ++c) {
+    if (c + kAhead < n) prefetch(&names_.index.slots[home(size, scratch[c + kAhead])]);
+    flat_insert(names_.index, static_cast<uint32_t>(c), scratch[c], name_of);
+  }
+  names_.made.store(true, std::memory_order_release);
 }
 
 void Graph::default_name(ActorId src, ActorId dst, uint64_t k, std::string& out) const {
@@ -152,19 +226,24 @@ void check_length(std::string_view s, const char* what) {
 void Graph::reserve(size_t actors, size_t channels) {
   actor_names_.reserve(actors);
   channels_.reserve(channels);
-  channel_names_.reserve(channels, 0);
-  reserve_tables(actors, channels);
+  channel_reserve_ = channels;  // the channel tables wait: their names may never be made
+  reserve_actor_table(actors);
 }
 
-void Graph::reserve_tables(size_t actors, size_t channels) {
+void Graph::reserve_actor_table(size_t actors) {
   auto actor_name = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
-  auto channel_name = [this](uint32_t c) -> std::string_view { return channel_names_[c]; };
   if (table_size_for(actors) > actor_index_.slots.size())
     flat_rehash(actor_index_, table_size_for(actors), actor_name);
-  if (table_size_for(channels) > channel_index_.slots.size())
-    flat_rehash(channel_index_, table_size_for(channels), channel_name);
-  if (pairs_live_ && table_size_for(channels) > pairs_.size())
-    pair_rehash(table_size_for(channels));
+}
+
+void Graph::reserve_channel_tables(size_t channels) const {
+  channels = std::max(channels, channel_reserve_);
+  auto channel_name = [this](uint32_t c) -> std::string_view { return names_.column[c]; };
+  names_.column.reserve(channels, 0);
+  if (table_size_for(channels) > names_.index.slots.size())
+    flat_rehash(names_.index, table_size_for(channels), channel_name);
+  if (names_.pairs_live && table_size_for(channels) > names_.pairs.size())
+    names_.pair_rehash(table_size_for(channels));
 }
 
 ActorId Graph::add_actor(std::string actor_name) {
@@ -175,13 +254,14 @@ ActorId Graph::add_actor(std::string actor_name) {
   const uint64_t h = hash_of(actor_name);
   if (flat_find(actor_index_, actor_name, h, name_of) >= 0)
     throw Error(Error::Kind::input, "duplicate actor name '" + actor_name + "'");
+  note_actor_name(actor_name);
   actor_names_.push_back(std::move(actor_name));
   flat_insert(actor_index_, id, h, name_of);
   return id;
 }
 
 size_t Graph::add_actors(std::span<const std::string_view> names) {
-  reserve_tables(actor_names_.size() + names.size(), channels_.size());  // no rehash below
+  reserve_actor_table(actor_names_.size() + names.size());  // no rehash below
   auto name_of = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
   constexpr size_t kAhead = 8;
   uint64_t hashes[kAhead];
@@ -197,6 +277,7 @@ size_t Graph::add_actors(std::span<const std::string_view> names) {
         flat_find(actor_index_, names[i], h, name_of) >= 0)
       return i;
     const auto id = static_cast<ActorId>(actor_names_.size());
+    note_actor_name(names[i]);
     actor_names_.emplace_back(names[i]);
     flat_insert(actor_index_, id, h, name_of);
   }
@@ -211,27 +292,50 @@ ChannelId Graph::add_channel(ActorId src, ActorId dst, uint64_t prd, uint64_t cn
   if (channels_.size() >= UINT32_MAX) throw Error(Error::Kind::input, "too many channels");
   const uint64_t pair = (static_cast<uint64_t>(src) << 32) | dst;
   check_length(channel_name, "channel name");
-  if (channel_name.empty()) make_pairs_live();
-  const size_t slot = pairs_live_ ? pair_slot(pair) : 0;
-  if (channel_name.empty()) default_name(src, dst, pairs_[slot].count, channel_name);
   const auto id = static_cast<ChannelId>(channels_.size());
-  auto name_of = [this](uint32_t c) -> std::string_view { return channel_names_[c]; };
+  if (channel_name.empty() && defer_default_names()) {
+    channels_.push_back({src, dst, prd, cns, delay});
+    return id;
+  }
+  make_names();
+  if (channel_name.empty()) make_pairs_live();
+  const size_t slot = names_.pairs_live ? names_.pair_slot(pair) : 0;
+  if (channel_name.empty()) default_name(src, dst, names_.pairs[slot].count, channel_name);
+  auto name_of = [this](uint32_t c) -> std::string_view { return names_.column[c]; };
   const uint64_t h = hash_of(channel_name);
-  if (flat_find(channel_index_, channel_name, h, name_of) >= 0)
+  if (flat_find(names_.index, channel_name, h, name_of) >= 0)
     throw Error(Error::Kind::input, "duplicate channel name '" + channel_name + "'");
-  if (pairs_live_) ++pairs_[slot].count;
+  if (names_.pairs_live) ++names_.pairs[slot].count;
   channels_.push_back({src, dst, prd, cns, delay});
-  channel_names_.push_back(channel_name);
-  flat_insert(channel_index_, id, h, name_of);
+  names_.column.push_back(channel_name);
+  flat_insert(names_.index, id, h, name_of);
   return id;
 }
 
 size_t Graph::add_channels(std::span<const NewChannel> cs) {
-  if (!pairs_live_ &&
+  auto valid = [&](const NewChannel& c) {
+    return c.src < actor_count() && c.dst < actor_count() && c.prd != 0 && c.cns != 0 &&
+           c.name.size() <= detail::NameColumn::kMaxLength;
+  };
+  const bool all_default =
+      std::all_of(cs.begin(), cs.end(), [](const NewChannel& c) { return c.name.empty(); });
+  if (all_default && defer_default_names()) {
+    for (size_t i = 0; i < cs.size(); ++i) {
+      if (!valid(cs[i]) || channels_.size() >= UINT32_MAX) return i;
+      channels_.push_back({cs[i].src, cs[i].dst, cs[i].prd, cs[i].cns, cs[i].delay});
+    }
+    return cs.size();
+  }
+  make_names();
+  if (!names_.pairs_live &&
       std::any_of(cs.begin(), cs.end(), [](const NewChannel& c) { return c.name.empty(); }))
     make_pairs_live();
-  reserve_tables(actor_names_.size(), channels_.size() + cs.size());  // no rehash below
-  auto name_of = [this](uint32_t c) -> std::string_view { return channel_names_[c]; };
+  reserve_channel_tables(channels_.size() + cs.size());  // no rehash below
+  // The pair table too: a refused channel leaves its pair's slot behind (count 0), so the pairs
+  // can outnumber the channels, and a rehash would move the slots the undo below decrements.
+  if (names_.pairs_live && 2 * (names_.pair_size + cs.size()) > names_.pairs.size())
+    names_.pair_rehash(table_size_for(names_.pair_size + cs.size()));
+  auto name_of = [this](uint32_t c) -> std::string_view { return names_.column[c]; };
   // Three stages kAhead channels apart, each in channel order: prefetch the (src, dst) slot;
   // take the parallel index k from it (so the name is known), hash the name and prefetch its
   // slot; insert. A channel that fails is reached by the last stage after the middle stage has
@@ -244,14 +348,11 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
   };
   Pending ring[kRing];
   const size_t n = cs.size();
-  auto valid = [&](const NewChannel& c) {
-    return c.src < actor_count() && c.dst < actor_count() && c.prd != 0 && c.cns != 0 &&
-           c.name.size() <= detail::NameColumn::kMaxLength;
-  };
   auto pair_of = [](const NewChannel& c) { return (static_cast<uint64_t>(c.src) << 32) | c.dst; };
   auto stage1 = [&](size_t i) {
     if (!valid(cs[i])) return;
-    if (pairs_live_) prefetch(pairs_.data() + (mix64(pair_of(cs[i])) & (pairs_.size() - 1)));
+    if (names_.pairs_live)
+      prefetch(names_.pairs.data() + (mix64(pair_of(cs[i])) & (names_.pairs.size() - 1)));
     if (cs[i].name.empty()) {  // the default name is made of the two actor names
       prefetch(&actor_names_[cs[i].src]);
       prefetch(&actor_names_[cs[i].dst]);
@@ -263,9 +364,9 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
     if (!valid(cs[i])) return false;
     Pending& p = ring[i % kRing];
     uint64_t k = 0;
-    if (pairs_live_) {
-      p.pair_slot = pair_slot(pair_of(cs[i]));
-      k = pairs_[p.pair_slot].count++;
+    if (names_.pairs_live) {
+      p.pair_slot = names_.pair_slot(pair_of(cs[i]));
+      k = names_.pairs[p.pair_slot].count++;
     }
     counted = i + 1;
     if (cs[i].name.empty()) {
@@ -274,12 +375,12 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
       p.name.assign(cs[i].name);
     }
     p.hash = hash_of(p.name);
-    prefetch(&channel_index_.slots[home(channel_index_.slots.size(), p.hash)]);
+    prefetch(&names_.index.slots[home(names_.index.slots.size(), p.hash)]);
     return true;
   };
   auto undo = [&](size_t from) {
-    if (pairs_live_)
-      for (size_t j = from; j < counted; ++j) --pairs_[ring[j % kRing].pair_slot].count;
+    if (names_.pairs_live)
+      for (size_t j = from; j < counted; ++j) --names_.pairs[ring[j % kRing].pair_slot].count;
   };
   for (size_t i = 0; i < std::min(n, 2 * kAhead); ++i) stage1(i);
   bool stage2_open = true;
@@ -290,14 +391,14 @@ size_t Graph::add_channels(std::span<const NewChannel> cs) {
       return i;
     }
     Pending& p = ring[i % kRing];
-    if (flat_find(channel_index_, p.name, p.hash, name_of) >= 0) {
+    if (flat_find(names_.index, p.name, p.hash, name_of) >= 0) {
       undo(i);
       return i;
     }
     const auto id = static_cast<ChannelId>(channels_.size());
     channels_.push_back({cs[i].src, cs[i].dst, cs[i].prd, cs[i].cns, cs[i].delay});
-    channel_names_.push_back(p.name);
-    flat_insert(channel_index_, id, p.hash, name_of);
+    names_.column.push_back(p.name);
+    flat_insert(names_.index, id, p.hash, name_of);
     if (i + 2 * kAhead < n) stage1(i + 2 * kAhead);
     if (stage2_open && i + kAhead < n) stage2_open = stage2(i + kAhead);
   }
@@ -383,8 +484,9 @@ void Graph::find_actors(std::span<const std::string_view> names, std::span<int64
 }
 
 std::optional<ChannelId> Graph::find_channel(std::string_view channel_name) const {
-  const int64_t c = flat_find(channel_index_, channel_name,
-                              [this](uint32_t i) -> std::string_view { return channel_names_[i]; });
+  make_names();
+  const int64_t c = flat_find(names_.index, channel_name,
+                              [this](uint32_t i) -> std::string_view { return names_.column[i]; });
   if (c < 0) return std::nullopt;
   return static_cast<ChannelId>(c);
 }

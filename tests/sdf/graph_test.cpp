@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+#include <random>
+#include <thread>
+
 #include "helpers.hpp"
 
 namespace sdf {
@@ -63,6 +67,136 @@ TEST(Graph, NameColumnsKeepEveryName) {
   EXPECT_EQ(copy.dst_port(1), "i2");
   EXPECT_EQ(copy.channel_name(1), "B->A#0");
   EXPECT_EQ(copy.actor_type(1), "a-long-type-name-beyond-any-small-buffer");
+}
+
+// The oracle of the channel names: every accepted channel's name (given, or src->dst#k with k
+// the number of earlier channels from src to dst), names unique, kept in plain maps.
+struct NameOracle {
+  std::vector<std::string> actors, names;
+  std::map<std::pair<ActorId, ActorId>, uint64_t> pairs;
+  std::map<std::string, ChannelId> index;
+  // The name the channel would get, or "" when it would be refused as a duplicate.
+  std::string name_of(ActorId src, ActorId dst, const std::string& given) const {
+    std::string n = given;
+    if (n.empty()) {
+      const auto it = pairs.find({src, dst});
+      n = actors[src] + "->" + actors[dst] + "#" +
+          std::to_string(it == pairs.end() ? 0 : it->second);
+    }
+    return index.count(n) ? std::string() : n;
+  }
+  void add(ActorId src, ActorId dst, const std::string& n) {
+    index[n] = static_cast<ChannelId>(names.size());
+    names.push_back(n);
+    ++pairs[{src, dst}];
+  }
+};
+
+// Default names are made only when asked for (or when a named channel or an actor whose name
+// has "->" comes): whatever the order of additions, bulk and single, and of the reads in
+// between, the names, the lookups and the refusals are those of the oracle. The actor names
+// are chosen so that "->" in them makes default names collide (a->b->c#0 from a to b->c and
+// from a->b to c), and some given names equal default names.
+TEST(Graph, DeferredDefaultNamesAgreeWithTheOracle) {
+  const std::vector<std::string> pool = {"a", "b", "c", "b->c", "a->b", "c#1", "x"};
+  const std::vector<std::string> given = {"a->b#0", "a->b->c#0", "b->a#1", "q", "c->c#0", "x->a#0"};
+  std::mt19937_64 rng(20261129);
+  for (int trial = 0; trial < 3000; ++trial) {
+    Graph g;
+    NameOracle o;
+    std::vector<std::string> actors = pool;
+    std::shuffle(actors.begin(), actors.end(), rng);
+    const size_t first_actors = 2 + rng() % 3;
+    auto add_actor = [&](size_t i) {
+      g.add_actor(actors[i]);
+      o.actors.push_back(actors[i]);
+    };
+    for (size_t i = 0; i < first_actors; ++i) add_actor(i);
+    const bool named_ever = rng() % 2 == 0;
+    for (int step = 0; step < 12; ++step) {
+      const uint64_t r = rng() % 10;
+      if (r == 0 && o.actors.size() < actors.size()) {
+        add_actor(o.actors.size());
+        continue;
+      }
+      if (r == 1) {  // a read in between makes the names
+        if (!o.names.empty()) {
+          const auto c = static_cast<ChannelId>(rng() % o.names.size());
+          ASSERT_EQ(g.channel_name(c), o.names[c]) << trial;
+        }
+        continue;
+      }
+      const size_t count = 1 + rng() % 4;
+      std::vector<Graph::NewChannel> batch;
+      std::vector<std::string> names;  // the given names, kept alive for the batch's views
+      names.reserve(count);
+      for (size_t i = 0; i < count; ++i) {
+        const auto src = static_cast<ActorId>(rng() % o.actors.size());
+        const auto dst = static_cast<ActorId>(rng() % o.actors.size());
+        names.push_back(named_ever && rng() % 4 == 0 ? given[rng() % given.size()] : "");
+        batch.push_back({src, dst, 1, 1, 0, names.back()});
+      }
+      if (r < 6) {  // single additions
+        for (size_t i = 0; i < count; ++i) {
+          const std::string n = o.name_of(batch[i].src, batch[i].dst, names[i]);
+          if (n.empty()) {
+            EXPECT_THROW(g.add_channel(batch[i].src, batch[i].dst, 1, 1, 0, names[i]), Error)
+                << trial;
+          } else {
+            ASSERT_EQ(g.add_channel(batch[i].src, batch[i].dst, 1, 1, 0, names[i]), o.names.size())
+                << trial;
+            o.add(batch[i].src, batch[i].dst, n);
+          }
+        }
+      } else {  // in bulk: up to the first refusal
+        size_t expect = 0;
+        for (; expect < count; ++expect) {
+          const std::string n = o.name_of(batch[expect].src, batch[expect].dst, names[expect]);
+          if (n.empty()) break;
+          o.add(batch[expect].src, batch[expect].dst, n);
+        }
+        ASSERT_EQ(g.add_channels(batch), expect) << trial;
+      }
+    }
+    ASSERT_EQ(g.channel_count(), o.names.size());
+    for (ChannelId c = 0; c < g.channel_count(); ++c) {
+      ASSERT_EQ(g.channel_name(c), o.names[c]) << trial << " channel " << c;
+      ASSERT_EQ(g.find_channel(o.names[c]), c) << trial;
+    }
+    EXPECT_FALSE(g.find_channel("a->a#99"));
+  }
+}
+
+// Names made under concurrent const use (and copies taken meanwhile) are made once and agree.
+TEST(Graph, DeferredDefaultNamesAreMadeOnceUnderConcurrentReads) {
+  Graph g;
+  constexpr uint32_t kActors = 300;
+  for (uint32_t a = 0; a < kActors; ++a) g.add_actor("actor" + std::to_string(a));
+  std::vector<Graph::NewChannel> cs;
+  for (uint32_t i = 0; i < 20000; ++i)
+    cs.push_back({i % kActors, (i * 7919) % kActors, 1, 1, 0, {}});
+  ASSERT_EQ(g.add_channels(cs), cs.size());
+  const Graph& view = g;
+  std::vector<std::vector<std::string>> seen(4);
+  std::vector<Graph> copies(4);
+  std::vector<std::thread> readers;
+  for (size_t t = 0; t < seen.size(); ++t)
+    readers.emplace_back([&, t] {
+      if (t % 2) copies[t] = view;
+      for (ChannelId c = 0; c < view.channel_count(); ++c)
+        seen[t].emplace_back(view.channel_name(c));
+      if (t % 2 == 0) copies[t] = view;
+    });
+  for (std::thread& r : readers) r.join();
+  for (size_t t = 0; t < seen.size(); ++t) {
+    EXPECT_EQ(seen[t], seen[0]);
+    ASSERT_EQ(copies[t].channel_count(), cs.size());
+    for (ChannelId c = 0; c < cs.size(); c += 997) EXPECT_EQ(copies[t].channel_name(c), seen[0][c]);
+  }
+  // Channel i goes from i mod 300 to 119 i mod 300 (7919 = 119 mod 300): the pair repeats every
+  // 300 channels, so k = i div 300. 7920 = 26 * 300 + 120, and 120 * 119 = 180 mod 300.
+  EXPECT_EQ(seen[0][7920], "actor120->actor180#26");
+  EXPECT_EQ(g.find_channel("actor120->actor180#26"), 7920u);
 }
 
 TEST(Graph, RejectsDuplicatesAndZeroRates) {
