@@ -210,7 +210,22 @@ class Graph {
   static void flat_insert(FlatIndex& t, uint32_t id, uint64_t hash, KeyOf&& key_of);
   template <class KeyOf>
   static void flat_rehash(FlatIndex& t, size_t capacity, KeyOf&& key_of);
-  FlatIndex actor_index_;
+  // The actors' table keeps a short name (up to 7 bytes) in the slot itself, beside its length:
+  // a lookup of such a name reads one cache line instead of two (the slot, then the name), and
+  // resolving a channel's two actors is most of loading a large graph. Longer names compare
+  // their first 7 bytes in the slot before reading the name.
+  struct ActorSlot {
+    uint64_t meta = 0;  // as FlatIndex's slots: hash tag | id + 1, 0 = empty
+    uint64_t word = 0;  // short_word(name)
+  };
+  struct ActorIndex {
+    std::vector<ActorSlot> slots;
+    size_t size = 0;
+  };
+  ActorIndex actor_index_;
+  int64_t actor_find(std::string_view key, uint64_t hash) const;
+  void actor_insert(ActorId id, uint64_t hash, std::string_view key);
+  void actor_rehash(size_t capacity);
   struct PairCount {
     uint64_t key;  // UINT64_MAX = free ((src, dst) are never both 2^32 - 1)
     uint64_t count;

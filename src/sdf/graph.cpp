@@ -47,6 +47,19 @@ size_t home(size_t size, uint64_t hash) {
   return static_cast<size_t>(hash >> (64 - std::countr_zero(size)));
 }
 
+// A name's first 7 bytes (byte i at bits 8i) and, in the top byte, its length, or 0xff when it
+// is longer: two names of at most 7 bytes are equal exactly when their words are.
+uint64_t short_word(std::string_view s) {
+  uint64_t w = 0;
+  const size_t n = std::min<size_t>(s.size(), 7);
+  for (size_t i = 0; i < n; ++i) w |= static_cast<uint64_t>(static_cast<uint8_t>(s[i])) << (8 * i);
+  return w | (static_cast<uint64_t>(s.size() <= 7 ? s.size() : 0xff) << 56);
+}
+
+bool short_name(uint64_t word) {
+  return (word >> 56) != 0xff;
+}
+
 size_t table_size_for(size_t entries) {
   size_t cap = 16;
   while (cap < 2 * entries) cap *= 2;  // load factor at most 1/2
@@ -230,10 +243,47 @@ void Graph::reserve(size_t actors, size_t channels) {
   reserve_actor_table(actors);
 }
 
+int64_t Graph::actor_find(std::string_view key, uint64_t hash) const {
+  const std::vector<ActorSlot>& slots = actor_index_.slots;
+  if (slots.empty()) return -1;
+  const size_t mask = slots.size() - 1;
+  const uint64_t tag = tag_of(hash), word = short_word(key);
+  for (size_t i = home(slots.size(), hash);; i = (i + 1) & mask) {
+    const ActorSlot& s = slots[i];
+    if (s.meta == 0) return -1;
+    if (tag_of(s.meta) != tag || s.word != word) continue;
+    const auto id = static_cast<uint32_t>(s.meta) - 1;
+    if (short_name(word) || same(actor_names_[id], key)) return id;
+  }
+}
+
+void Graph::actor_rehash(size_t capacity) {
+  std::vector<ActorSlot> old = std::move(actor_index_.slots);
+  actor_index_.slots.assign(capacity, ActorSlot{});
+  const size_t mask = capacity - 1;
+  const bool tags_suffice = capacity <= (uint64_t{1} << 32);
+  for (const ActorSlot& s : old) {
+    if (s.meta == 0) continue;
+    const uint64_t h =
+        tags_suffice ? s.meta : hash_of(actor_names_[static_cast<uint32_t>(s.meta) - 1]);
+    size_t i = home(capacity, h);
+    while (actor_index_.slots[i].meta != 0) i = (i + 1) & mask;
+    actor_index_.slots[i] = s;
+  }
+}
+
+void Graph::actor_insert(ActorId id, uint64_t hash, std::string_view key) {
+  if (2 * (actor_index_.size + 1) > actor_index_.slots.size())
+    actor_rehash(std::max<size_t>(16, actor_index_.slots.size() * 2));
+  const size_t mask = actor_index_.slots.size() - 1;
+  size_t i = home(actor_index_.slots.size(), hash);
+  while (actor_index_.slots[i].meta != 0) i = (i + 1) & mask;
+  actor_index_.slots[i] = {tag_of(hash) | (static_cast<uint64_t>(id) + 1), short_word(key)};
+  ++actor_index_.size;
+}
+
 void Graph::reserve_actor_table(size_t actors) {
-  auto actor_name = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
-  if (table_size_for(actors) > actor_index_.slots.size())
-    flat_rehash(actor_index_, table_size_for(actors), actor_name);
+  if (table_size_for(actors) > actor_index_.slots.size()) actor_rehash(table_size_for(actors));
 }
 
 void Graph::reserve_channel_tables(size_t channels) const {
@@ -250,19 +300,17 @@ ActorId Graph::add_actor(std::string actor_name) {
   if (actor_name.empty()) throw Error(Error::Kind::input, "actor name is empty");
   if (actor_names_.size() >= UINT32_MAX) throw Error(Error::Kind::input, "too many actors");
   const auto id = static_cast<ActorId>(actor_names_.size());
-  auto name_of = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
   const uint64_t h = hash_of(actor_name);
-  if (flat_find(actor_index_, actor_name, h, name_of) >= 0)
+  if (actor_find(actor_name, h) >= 0)
     throw Error(Error::Kind::input, "duplicate actor name '" + actor_name + "'");
   note_actor_name(actor_name);
+  actor_insert(id, h, actor_name);
   actor_names_.push_back(std::move(actor_name));
-  flat_insert(actor_index_, id, h, name_of);
   return id;
 }
 
 size_t Graph::add_actors(std::span<const std::string_view> names) {
   reserve_actor_table(actor_names_.size() + names.size());  // no rehash below
-  auto name_of = [this](uint32_t a) -> std::string_view { return actor_names_[a]; };
   constexpr size_t kAhead = 8;
   uint64_t hashes[kAhead];
   auto ahead = [&](size_t i) {
@@ -273,13 +321,12 @@ size_t Graph::add_actors(std::span<const std::string_view> names) {
   for (size_t i = 0; i < names.size(); ++i) {
     const uint64_t h = hashes[i % kAhead];
     if (i + kAhead < names.size()) ahead(i + kAhead);
-    if (names[i].empty() || actor_names_.size() >= UINT32_MAX ||
-        flat_find(actor_index_, names[i], h, name_of) >= 0)
+    if (names[i].empty() || actor_names_.size() >= UINT32_MAX || actor_find(names[i], h) >= 0)
       return i;
     const auto id = static_cast<ActorId>(actor_names_.size());
     note_actor_name(names[i]);
+    actor_insert(id, h, names[i]);
     actor_names_.emplace_back(names[i]);
-    flat_insert(actor_index_, id, h, name_of);
   }
   return names.size();
 }
@@ -449,20 +496,18 @@ void Graph::set_port_names(ChannelId c, std::string_view src_port, std::string_v
 }
 
 std::optional<ActorId> Graph::find_actor(std::string_view actor) const {
-  const int64_t a = flat_find(actor_index_, actor,
-                              [this](uint32_t i) -> std::string_view { return actor_names_[i]; });
+  const int64_t a = actor_find(actor, hash_of(actor));
   if (a < 0) return std::nullopt;
   return static_cast<ActorId>(a);
 }
 
 void Graph::find_actors(std::span<const std::string_view> names, std::span<int64_t> ids) const {
-  auto name_of = [this](uint32_t i) -> std::string_view { return actor_names_[i]; };
   if (actor_index_.slots.empty()) {
     std::fill(ids.begin(), ids.end(), -1);
     return;
   }
   // Three stages, kAhead names apart: hash and prefetch the slot; read the slot and prefetch the
-  // name it points to; probe (now mostly from cache).
+  // name it points to, if the name is too long to be in the slot; probe (now mostly from cache).
   constexpr size_t kAhead = 8, kRing = 32;
   uint64_t hashes[kRing];
   const size_t n = names.size(), size = actor_index_.slots.size();
@@ -471,7 +516,8 @@ void Graph::find_actors(std::span<const std::string_view> names, std::span<int64
     prefetch(&actor_index_.slots[home(size, hashes[i % kRing])]);
   };
   auto stage2 = [&](size_t i) {
-    const uint64_t v = actor_index_.slots[home(size, hashes[i % kRing])];
+    if (names[i].size() <= 7) return;
+    const uint64_t v = actor_index_.slots[home(size, hashes[i % kRing])].meta;
     if (v != 0) prefetch(&actor_names_[static_cast<uint32_t>(v) - 1]);
   };
   for (size_t i = 0; i < std::min(n, 2 * kAhead); ++i) stage1(i);
@@ -479,7 +525,7 @@ void Graph::find_actors(std::span<const std::string_view> names, std::span<int64
   for (size_t i = 0; i < n; ++i) {
     if (i + 2 * kAhead < n) stage1(i + 2 * kAhead);
     if (i + kAhead < n) stage2(i + kAhead);
-    ids[i] = flat_find(actor_index_, names[i], hashes[i % kRing], name_of);
+    ids[i] = actor_find(names[i], hashes[i % kRing]);
   }
 }
 
