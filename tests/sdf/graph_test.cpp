@@ -199,6 +199,59 @@ TEST(Graph, DeferredDefaultNamesAreMadeOnceUnderConcurrentReads) {
   EXPECT_EQ(g.find_channel("actor120->actor180#26"), 7920u);
 }
 
+// The actors' table keeps names of up to 7 bytes in its slots and compares longer ones in part
+// there: names around that length, sharing prefixes, with NUL bytes, against a plain map, through
+// the single and bulk additions and lookups (the table grows through several rehashes).
+TEST(Graph, ActorLookupsAgreeWithAMap) {
+  std::mt19937_64 rng(7);
+  auto random_name = [&] {
+    std::string s(1 + rng() % 10, 'a');
+    for (char& c : s) c = "ab\0"[rng() % 3];
+    return s;
+  };
+  for (int trial = 0; trial < 20; ++trial) {
+    Graph g;
+    std::map<std::string, ActorId> oracle;
+    for (int step = 0; step < 200; ++step) {
+      std::vector<std::string> names(1 + rng() % 20);
+      for (std::string& n : names) n = random_name();
+      if (rng() % 2) {
+        for (const std::string& n : names) {
+          if (oracle.count(n)) {
+            EXPECT_THROW(g.add_actor(n), Error);
+          } else {
+            oracle[n] = g.add_actor(n);
+          }
+        }
+      } else {
+        const std::vector<std::string_view> views(names.begin(), names.end());
+        size_t expect = 0;
+        std::map<std::string, ActorId> batch;
+        for (; expect < names.size(); ++expect) {
+          if (oracle.count(names[expect]) || batch.count(names[expect])) break;
+          batch[names[expect]] = static_cast<ActorId>(g.actor_count() + expect);
+        }
+        ASSERT_EQ(g.add_actors(views), expect);
+        oracle.insert(batch.begin(), batch.end());
+      }
+      std::vector<std::string> probes(30);
+      for (std::string& p : probes) p = random_name();
+      const std::vector<std::string_view> views(probes.begin(), probes.end());
+      std::vector<int64_t> ids(probes.size());
+      g.find_actors(views, ids);
+      for (size_t i = 0; i < probes.size(); ++i) {
+        const auto it = oracle.find(probes[i]);
+        const int64_t want = it == oracle.end() ? int64_t{-1} : int64_t{it->second};
+        ASSERT_EQ(ids[i], want) << trial;
+        ASSERT_EQ(g.find_actor(probes[i]),
+                  it == oracle.end() ? std::nullopt : std::optional(it->second));
+      }
+    }
+    ASSERT_EQ(g.actor_count(), oracle.size());
+    for (const auto& [n, a] : oracle) ASSERT_EQ(g.actor_name(a), n);
+  }
+}
+
 TEST(Graph, RejectsDuplicatesAndZeroRates) {
   Graph g;
   g.add_actor("A");
