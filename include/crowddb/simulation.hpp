@@ -94,6 +94,12 @@ struct AccessChoice {
   std::string collisions = "auto";
   std::string neighbours = "auto";
   std::string edges = "auto";
+  // The agents' rows: "curve" puts them in Z-curve order of their positions every 2 s, so that
+  // neighbours sit together in memory (src/sim/row_order.hpp); "none" keeps insertion order;
+  // "auto" is "curve" from 4096 agents on under orca and cfsm, where only the row order changes,
+  // never a result; the thesis model's potential field sums charges in row order, so there the
+  // rounding of its sums would change, and "auto" keeps insertion order.
+  std::string row_order = "auto";
 };
 
 // The path service (DESIGN.md §6): a Recast/Detour navigation mesh per agent-radius class, path

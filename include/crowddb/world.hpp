@@ -231,6 +231,12 @@ class World {
   AgentTable& agents_for_tick() { return agents_; }
   // Removes a row by swapping the last row into it; the handle of the removed agent dies.
   void remove_row(std::size_t row);
+  // Removes these rows (distinct). The freed handles are reused in the order of their slots,
+  // whatever the rows' order, so the ids of agents inserted later do not depend on it.
+  void remove_rows(std::vector<std::size_t> rows);
+  // Puts the rows in the order `order` (order[new row] = old row, a permutation of the rows);
+  // every agent keeps its handle and its values. Throws std::invalid_argument otherwise.
+  void permute_rows(std::span<const uint32_t> order);
   // The current waypoint of a row: next route point, else the nearest point of its goal area.
   // Restarts the row's progress watch because the waypoint may have changed.
   void refresh_target(std::size_t row);

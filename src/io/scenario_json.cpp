@@ -1027,6 +1027,7 @@ Scenario parse_document(std::string_view text, const std::string& source, const 
     cfg.access.collisions = a.string("collisions", "auto");
     cfg.access.neighbours = a.string("neighbours", "auto");
     cfg.access.edges = a.string("edges", "auto");
+    cfg.access.row_order = a.choice("row_order", {"auto", "curve", "none"}, "auto");
     a.finish();
   }
   if (root.has("output")) {

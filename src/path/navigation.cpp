@@ -168,6 +168,14 @@ std::size_t Navigation::apply_results(World& world, uint64_t tick) {
 std::size_t Navigation::request_paths(World& world, uint64_t tick) {
   AgentTable& t = world.agents_for_tick();
   std::size_t made = 0;
+  // Requests are numbered and queued in agent id order, not row order: who is served first
+  // within the budget must not depend on where a row happens to sit (src/sim/row_order.hpp).
+  struct Due {
+    uint64_t id;
+    std::size_t row;
+    bool narrow;
+  };
+  std::vector<Due> due;
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (standing(t.state[i])) continue;  // idle or waiting at its goal
     // The progress watch (stalemate.cpp) counts the ticks without progress since the last request.
@@ -180,10 +188,14 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
       ++stats_.replans;
     }
     t.path_goal[i] = t.goal[i];
-    t.path_ticket[i] = ++next_ticket_;
     // A re-plan for the same goal searches where the route came from: an agent on a narrow
     // route keeps to the narrow mesh (the class mesh has no way there).
-    queue_.push_back({t.path_ticket[i], t.id[i], !new_goal && narrow_routes_.count(t.id[i]) > 0});
+    due.push_back({t.id[i], i, !new_goal && narrow_routes_.count(t.id[i]) > 0});
+  }
+  std::sort(due.begin(), due.end(), [](const Due& a, const Due& b) { return a.id < b.id; });
+  for (const Due& d : due) {
+    t.path_ticket[d.row] = ++next_ticket_;
+    queue_.push_back({t.path_ticket[d.row], d.id, d.narrow});
     ++stats_.requests;
     ++made;
   }

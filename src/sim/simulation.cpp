@@ -10,6 +10,7 @@
 
 #include "path/navigation.hpp"
 #include "sim/oplog.hpp"
+#include "sim/row_order.hpp"
 #include "sim/sources.hpp"
 #include "sim/stages.hpp"
 #include "sim/stalemate.hpp"
@@ -32,6 +33,13 @@ std::string num(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
+}
+
+// Does the tick put the rows in curve order (AccessChoice::row_order)?
+bool reorders(const SimConfig& cfg, std::size_t rows) {
+  return cfg.access.row_order == "curve" ||
+         (cfg.access.row_order == "auto" && rows >= sim::kReorderMinRows &&
+          cfg.steering.model != "thesis");  // its field sums the charges in row order
 }
 
 }  // namespace
@@ -80,6 +88,8 @@ void SimConfig::validate() const {
   require(std::isfinite(steering.perturbation) && steering.perturbation >= 0,
           "steering/perturbation", "must be >= 0");
   require(threads >= 1 && threads <= 256, "threads", "must be in 1..256");
+  require(access.row_order == "auto" || access.row_order == "curve" || access.row_order == "none",
+          "access/row_order", "must be \"auto\", \"curve\" or \"none\"");
   require(std::isfinite(gridlock_time) && gridlock_time > 0, "gridlock_time", "must be > 0");
   require(std::isfinite(nudge_after) && nudge_after >= 0, "nudge_after", "must be >= 0");
   require(std::isfinite(waypoint_radius) && waypoint_radius >= 0, "waypoint_radius",
@@ -437,6 +447,9 @@ const TickMetrics& Simulation::step() {
     log.timed("path results", 0, [&] { routes = e.nav->apply_results(world_, m.tick); });
     log.at("path results").rows += routes;
   }
+  if (reorders(cfg, world_.agents().size()) && m.tick % cfg.ticks_for(sim::kReorderInterval) == 0)
+    log.timed("reorder rows", world_.agents().size(),
+              [&] { world_.permute_rows(sim::curve_order(world_.agents())); });
   e.refresh_scene(world_, cfg);
   const TickPlan plan = e.plan(world_, cfg);
   AgentTable& t = world_.agents_for_tick();
@@ -592,8 +605,7 @@ const TickMetrics& Simulation::step() {
       m.arrived += c.arrived;
       leaving.insert(leaving.end(), c.leaving.begin(), c.leaving.end());
     }
-    // Descending rows: each swap-remove moves in a row that is staying (or already handled).
-    for (auto it = leaving.rbegin(); it != leaving.rend(); ++it) world_.remove_row(*it);
+    world_.remove_rows(std::move(leaving));
   });
 
   // 6. stalemates: progress watch, then an action for each agent stalled without one
@@ -642,6 +654,9 @@ std::string Simulation::explain() const {
      << " pending)";
   if (!world_.sources().empty())
     os << "; sources let agents in at free spots (" << waiting_to_enter() << " still to enter)";
+  if (reorders(cfg, world_.agents().size()))
+    os << "; rows put in Z-curve order of their positions every " << num(sim::kReorderInterval)
+       << " s (neighbours together in memory)";
   os << "\n";
   const NavigationParams& nv = cfg.navigation;
   const uint64_t latency = cfg.ticks_for(nv.latency);

@@ -303,6 +303,65 @@ void World::push_row(AgentId id, const AgentSpec& s) {
   slots_[id.index].pending = false;
 }
 
+// Every column is moved by remove_row and permute_rows and saved by columns(): a new one must be
+// added to all three.
+static_assert(sizeof(AgentTable) == 27 * sizeof(std::vector<double>));
+
+void World::permute_rows(std::span<const uint32_t> order) {
+  AgentTable& t = agents_;
+  const std::size_t n = t.size();
+  if (order.size() != n) throw std::invalid_argument("permute_rows: not one entry per row");
+  std::vector<uint8_t> seen(n, 0);
+  for (uint32_t r : order) {
+    if (r >= n || seen[r]) throw std::invalid_argument("permute_rows: not a permutation");
+    seen[r] = 1;
+  }
+  auto gather = [&](auto& column) {
+    std::remove_reference_t<decltype(column)> out;
+    out.reserve(n);
+    for (uint32_t r : order) out.push_back(std::move(column[r]));
+    column.swap(out);
+  };
+  gather(t.x);
+  gather(t.y);
+  gather(t.vx);
+  gather(t.vy);
+  gather(t.radius);
+  gather(t.pref_speed);
+  gather(t.max_speed);
+  gather(t.max_accel);
+  gather(t.charge);
+  gather(t.target_x);
+  gather(t.target_y);
+  gather(t.goal);
+  gather(t.state);
+  gather(t.frozen_ticks);
+  gather(t.progress_best);
+  gather(t.stall_ticks);
+  gather(t.id);
+  gather(t.route);
+  gather(t.then);
+  gather(t.stall_action);
+  gather(t.stall_until);
+  gather(t.stall_dir_x);
+  gather(t.stall_dir_y);
+  gather(t.path_goal);
+  gather(t.path_ticket);
+  gather(t.replan_ticks);
+  gather(t.wait_until);
+  for (std::size_t r = 0; r < n; ++r)
+    slots_[AgentId::from_value(t.id[r]).index].row = static_cast<uint32_t>(r);
+}
+
+void World::remove_rows(std::vector<std::size_t> rows) {
+  // Descending rows: each swap-remove moves in a row that is staying (or already handled).
+  std::sort(rows.begin(), rows.end(), std::greater<>());
+  for (std::size_t row : rows) remove_row(row);
+  // insert() takes the last free slot first: the lowest of these.
+  std::sort(free_slots_.end() - static_cast<std::ptrdiff_t>(rows.size()), free_slots_.end(),
+            std::greater<>());
+}
+
 void World::remove_row(std::size_t row) {
   AgentTable& t = agents_;
   const std::size_t last = t.size() - 1;

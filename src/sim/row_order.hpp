@@ -1,0 +1,27 @@
+// The order of the agents' rows. The tick's queries and the steering read the columns of each
+// row's neighbours; with rows in insertion order those reads land anywhere in the columns, and
+// from 10^5 agents on, where the columns outgrow the caches, each is a miss. So the tick puts the
+// rows in the order of a space-filling curve now and then (Simulation, "reorder rows"): agents
+// move a fraction of a metre per tick, and neighbours in space stay near each other in memory
+// for seconds. Nothing but the row order changes: every stage breaks ties by agent id, not by
+// row (tests/sim/row_order_test.cpp runs scenarios with and without it and compares every
+// agent's trajectory).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "crowddb/world.hpp"
+
+namespace crowddb::sim {
+
+// [s] How often the rows are put in curve order (at least every tick).
+inline constexpr double kReorderInterval = 2.0;
+// Below this many rows the columns stay in cache anyway: no reordering.
+inline constexpr std::size_t kReorderMinRows = 4096;
+
+// The rows in Morton (Z-curve) order of their positions in cells of 1 m from the table's lowest
+// corner, ties by agent id: order[new row] = old row, for World::permute_rows. O(n log n).
+std::vector<uint32_t> curve_order(const AgentTable& t);
+
+}  // namespace crowddb::sim
