@@ -447,7 +447,8 @@ const TickMetrics& Simulation::step() {
     log.timed("path results", 0, [&] { routes = e.nav->apply_results(world_, m.tick); });
     log.at("path results").rows += routes;
   }
-  if (reorders(cfg, world_.agents().size()) && m.tick % cfg.ticks_for(sim::kReorderInterval) == 0)
+  if (reorders(cfg, world_.agents().size()) &&
+      (m.tick - 1) % cfg.ticks_for(sim::kReorderInterval) == 0)
     log.timed("reorder rows", world_.agents().size(),
               [&] { world_.permute_rows(sim::curve_order(world_.agents())); });
   e.refresh_scene(world_, cfg);
