@@ -415,10 +415,13 @@ PYBIND11_MODULE(_core, m) {
       .def("__enter__", [](py::object self) { return self; })
       .def("__exit__", [](PySimulation& p, py::object, py::object, py::object) { close(p); });
 
-  py::class_<Agents> agents(m, "Agents",
-                            "The agents table of a Simulation, one row per agent. Every column is "
-                            "a read-only numpy view of the simulation's memory (no copy): valid "
-                            "until the next step(), insert or erase; copy it to keep it.");
+  py::class_<Agents> agents(
+      m, "Agents",
+      "The agents table of a Simulation, one row per agent. Every column is "
+      "a read-only numpy view of the simulation's memory (no copy): valid "
+      "until the next step(), insert or erase; copy it to keep it. Rows change "
+      "order between steps (arrivals; from 4096 agents the Z-curve order "
+      "every 2 s, access.row_order): match agents across steps by id.");
   agents.def("__len__", [](const Agents& a) { return a.table().size(); });
 #define CROWDDB_COLUMN(name, doc) \
   agents.def_property_readonly(   \

@@ -33,7 +33,10 @@ class World:
     def agent_count(self) -> int: ...
 
 class Agents:
-    """The agents table; every column a read-only view valid until the next step."""
+    """The agents table; every column a read-only view valid until the next step.
+
+    Rows change order between steps (arrivals; the Z-curve order every 2 s from 4096 agents):
+    match agents across steps by ``id``."""
     def __len__(self) -> int: ...
     @property
     def x(self) -> npt.NDArray[np.float64]: ...
