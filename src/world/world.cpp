@@ -303,9 +303,43 @@ void World::push_row(AgentId id, const AgentSpec& s) {
   slots_[id.index].pending = false;
 }
 
-// Every column is moved by remove_row and permute_rows and saved by columns(): a new one must be
-// added to all three.
+namespace {
+
+// Every column of the agents table, for the row moves (remove_row, permute_rows). A new column
+// goes here and into columns() (checkpoints); the assertion catches one forgotten.
+template <class F>
+void each_column(AgentTable& t, F&& f) {
+  f(t.x);
+  f(t.y);
+  f(t.vx);
+  f(t.vy);
+  f(t.radius);
+  f(t.pref_speed);
+  f(t.max_speed);
+  f(t.max_accel);
+  f(t.charge);
+  f(t.target_x);
+  f(t.target_y);
+  f(t.goal);
+  f(t.state);
+  f(t.frozen_ticks);
+  f(t.progress_best);
+  f(t.stall_ticks);
+  f(t.id);
+  f(t.route);
+  f(t.then);
+  f(t.stall_action);
+  f(t.stall_until);
+  f(t.stall_dir_x);
+  f(t.stall_dir_y);
+  f(t.path_goal);
+  f(t.path_ticket);
+  f(t.replan_ticks);
+  f(t.wait_until);
+}
 static_assert(sizeof(AgentTable) == 27 * sizeof(std::vector<double>));
+
+}  // namespace
 
 void World::permute_rows(std::span<const uint32_t> order) {
   AgentTable& t = agents_;
@@ -322,33 +356,7 @@ void World::permute_rows(std::span<const uint32_t> order) {
     for (uint32_t r : order) out.push_back(std::move(column[r]));
     column.swap(out);
   };
-  gather(t.x);
-  gather(t.y);
-  gather(t.vx);
-  gather(t.vy);
-  gather(t.radius);
-  gather(t.pref_speed);
-  gather(t.max_speed);
-  gather(t.max_accel);
-  gather(t.charge);
-  gather(t.target_x);
-  gather(t.target_y);
-  gather(t.goal);
-  gather(t.state);
-  gather(t.frozen_ticks);
-  gather(t.progress_best);
-  gather(t.stall_ticks);
-  gather(t.id);
-  gather(t.route);
-  gather(t.then);
-  gather(t.stall_action);
-  gather(t.stall_until);
-  gather(t.stall_dir_x);
-  gather(t.stall_dir_y);
-  gather(t.path_goal);
-  gather(t.path_ticket);
-  gather(t.replan_ticks);
-  gather(t.wait_until);
+  each_column(t, gather);
   for (std::size_t r = 0; r < n; ++r)
     slots_[AgentId::from_value(t.id[r]).index].row = static_cast<uint32_t>(r);
 }
@@ -370,33 +378,7 @@ void World::remove_row(std::size_t row) {
     if (row != last) column[row] = std::move(column[last]);
     column.pop_back();
   };
-  move_last(t.x);
-  move_last(t.y);
-  move_last(t.vx);
-  move_last(t.vy);
-  move_last(t.radius);
-  move_last(t.pref_speed);
-  move_last(t.max_speed);
-  move_last(t.max_accel);
-  move_last(t.charge);
-  move_last(t.target_x);
-  move_last(t.target_y);
-  move_last(t.goal);
-  move_last(t.state);
-  move_last(t.frozen_ticks);
-  move_last(t.progress_best);
-  move_last(t.stall_ticks);
-  move_last(t.id);
-  move_last(t.route);
-  move_last(t.then);
-  move_last(t.stall_action);
-  move_last(t.stall_until);
-  move_last(t.stall_dir_x);
-  move_last(t.stall_dir_y);
-  move_last(t.path_goal);
-  move_last(t.path_ticket);
-  move_last(t.replan_ticks);
-  move_last(t.wait_until);
+  each_column(t, move_last);
   if (row != last) slots_[AgentId::from_value(t.id[row]).index].row = static_cast<uint32_t>(row);
   Slot& s = slots_[dead.index];
   s.row = kNoRow;
