@@ -132,13 +132,13 @@ class Sdf3Reader {
              (text_[after] == '/' || text_[after] == '>' || text_[after] == ' ' ||
               text_[after] == '\t' || text_[after] == '\n' || text_[after] == '\r');
     };
-    for (size_t at = text_.find('<'); at != std::string_view::npos; at = text_.find('<', at + 1)) {
+    detail::for_each_lt(text_, [&](size_t at) {
       actors += named(at, "actor");
       channels += named(at, "channel");
       // The count reads the whole text: what it has passed is dropped as it goes (the scan
       // faults it in again from the page cache), so the file is never resident at once.
       if (release_ && at >= released_ + kReleaseStep) (*release_)(released_ = at);
-    }
+    });
     if (release_) (*release_)(text_.size());
     released_ = 0;
     g_.reserve(std::min(actors, text_.size() / 17), std::min(channels, text_.size() / 60));
@@ -275,7 +275,7 @@ class Sdf3Reader {
                                        std::string(attr) + "'");
     const std::string_view v = trim(keep(*a));
     if (v.empty()) fail_after_pending(t.offset, "attribute '" + std::string(attr) + "' is empty");
-    if (!valid_utf8(v))
+    if (!(a->plain && a->ascii) && !valid_utf8(v))
       fail_after_pending(t.offset, "attribute '" + std::string(attr) + "' is not valid UTF-8");
     return v;
   }

@@ -99,6 +99,26 @@ TEST(Sdf3Reader, RejectsNamesThatAreNotUtf8) {
   EXPECT_NE(sdf3_error(sdf3("<actor name='\xc0\x80'/>\n")).find("not valid UTF-8"),
             std::string::npos);                                            // overlong
   EXPECT_EQ(sdf3_error(sdf3("<actor name='\xc3\xa9t\xc3\xa9'/>\n")), "");  // "été"
+  // The scanner notes bytes above 0x7F 16 bytes at a time: a bad byte at every place of a long
+  // name, with a stop ('&', a tab, the other quote) before or after it, and a bad byte just
+  // after the closing quote, which belongs to the next value.
+  for (const std::string stop : {"", "&amp;", "\t", "\""})
+    for (size_t at = 0; at <= 40; ++at) {
+      std::string name(40, 'n');
+      name.insert(at, "\xff");
+      for (const std::string& value : {stop + name, name + stop}) {
+        const std::string text = sdf3("<actor name='" + value + "'/>\n");
+        EXPECT_NE(sdf3_error(text).find("f.xml:5: attribute 'name' is not valid UTF-8"),
+                  std::string::npos)
+            << at;
+      }
+      name.erase(at, 1);
+      EXPECT_EQ(sdf3_error(sdf3("<actor name='" + name + "' type='\xc3\xa9'/>\n")), "") << at;
+      EXPECT_NE(sdf3_error(sdf3("<actor name='" + name + "' type='\xff'/>\n"))
+                    .find("f.xml:5: attribute 'type' is not valid UTF-8"),
+                std::string::npos)
+          << at;
+    }
 }
 
 TEST(Sdf3Reader, ElementOrderDoesNotMatter) {
