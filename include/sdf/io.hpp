@@ -19,7 +19,10 @@
 // or "FILE: channels[3].prd: message" (JSON fields). Loading is O(size) for both formats: names
 // resolve through hash maps, ports through a per-actor list.
 //
-// Thread-safety: pure functions.
+// Thread-safety: pure functions. read_sdf3 (and read_graph_file on SDF3) scans a text of a
+// megabyte or more on a second thread of its own while the calling thread builds the graph, when
+// the machine has two cores or more; it joins it before returning or throwing. The graph and the
+// first error are the same as on one thread.
 #pragma once
 
 #include <string>

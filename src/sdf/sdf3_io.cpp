@@ -3,12 +3,19 @@
 // search: O(P log P) for P ports, never the quadratic scan that makes SDF3's own loader take
 // minutes on 10^5 actors. Line numbers are computed only for an error message.
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <charconv>
+#include <condition_variable>
 #include <cstring>
 #include <deque>
+#include <exception>
+#include <mutex>
+#include <optional>
 #include <pugixml.hpp>
 #include <sstream>
+#include <system_error>
+#include <thread>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -101,29 +108,179 @@ struct ChannelRecord {
   size_t offset;
 };
 
-// One pass over the text with XmlScanner, no document tree. Actors are added in blocks (their
-// ids are their order in the file, so ports can refer to them before the block is added); each
-// actor's ports are sorted by name when its element closes. Channels are resolved in blocks as
-// they come; once a channel names an actor not seen yet (SDF3 does not fix the element order),
-// it and every later channel wait for the end of the document, so channels keep their file
-// order. <sdfProperties> is cut out of the text and parsed on its own (pugixml: it is small next
-// to the graph). Errors come in file order as far as the text read tells them: a pending block,
-// and the waiting channels whose actors have been seen, are resolved before a later mistake is
-// reported; what only the end of the document decides (a port left unconnected, a channel
-// naming an actor that never comes, <sdfProperties>, parsed last) is reported there.
+// An <actor> as read, added to the graph with the next hand-over.
+struct ActorRecord {
+  std::string_view name;
+  size_t offset;
+  bool typed;
+  std::string_view type;
+};
+
+// What the scan hands to the graph builder: the actors closed since the last hand-over, with
+// their ports (each actor's sorted by name); the channels read since the last hand-over that
+// included channels; and whether a mistake or the end of the text follows them.
+struct Segment {
+  std::vector<ActorRecord> actors;
+  std::vector<Port> ports;
+  std::vector<uint32_t> port_counts;  // per actor
+  std::vector<ChannelRecord> channels;
+  bool failed = false;  // the scan found a mistake after these: error at error_offset
+  size_t error_offset = 0;
+  std::string error;
+  std::exception_ptr exception;  // something else the scan threw (out of memory)
+  bool last = false;             // the scan has ended
+
+  // The first offset in the text that these records point into (SIZE_MAX: none).
+  size_t first_offset() const {
+    size_t at = SIZE_MAX;
+    if (!actors.empty()) at = actors.front().offset;
+    if (!channels.empty()) at = std::min(at, channels.front().offset);
+    return at;
+  }
+  void clear() {  // keeps the capacity
+    actors.clear();
+    ports.clear();
+    port_counts.clear();
+    channels.clear();
+    failed = last = false;
+    error.clear();
+    exception = nullptr;
+  }
+};
+
+// Thrown on the scan's thread to end it: the builder has given up, or has the scan's mistake.
+struct StopScan {};
+
+// The hand-over between the scan (one thread) and the builder (another): a short queue of
+// segments in file order, and their spent buffers coming back.
+class SegmentPipe {
+ public:
+  // Scan side. Waits while the queue is full; throws StopScan once the builder has stopped.
+  void push(Segment&& s) {
+    std::unique_lock lock(m_);
+    changed_.wait(lock, [&] { return full_.size() < kDepth || stopped_; });
+    if (stopped_) throw StopScan{};
+    full_.push_back(std::move(s));
+    changed_.notify_all();
+  }
+  Segment fresh() {
+    const std::lock_guard lock(m_);
+    if (spent_.empty()) return {};
+    Segment s = std::move(spent_.back());
+    spent_.pop_back();
+    return s;
+  }
+  bool stopped() const { return stopped_flag_.load(std::memory_order_relaxed); }
+  // The first offset a queued or building segment still points into (SIZE_MAX: none).
+  size_t needed_from() const {
+    const std::lock_guard lock(m_);
+    size_t at = building_;
+    for (const Segment& s : full_) at = std::min(at, s.first_offset());
+    return at;
+  }
+
+  // Build side.
+  Segment pop() {
+    std::unique_lock lock(m_);
+    changed_.wait(lock, [&] { return !full_.empty(); });
+    Segment s = std::move(full_.front());
+    full_.pop_front();
+    building_ = s.first_offset();
+    changed_.notify_all();
+    return s;
+  }
+  void recycle(Segment&& s) {
+    s.clear();
+    const std::lock_guard lock(m_);
+    building_ = SIZE_MAX;
+    spent_.push_back(std::move(s));
+  }
+  void stop() {
+    const std::lock_guard lock(m_);
+    stopped_ = true;
+    stopped_flag_.store(true, std::memory_order_relaxed);
+    changed_.notify_all();
+  }
+
+ private:
+  static constexpr size_t kDepth = 4;
+  mutable std::mutex m_;
+  std::condition_variable changed_;
+  std::deque<Segment> full_;
+  std::vector<Segment> spent_;
+  size_t building_ = SIZE_MAX;
+  bool stopped_ = false;
+  std::atomic<bool> stopped_flag_{false};  // stopped_, read without the lock between tokens
+};
+
+// One pass over the text with XmlScanner, no document tree, in two parts that can run on two
+// threads: the scan (tokens, attributes, each actor's ports sorted by name) and the builder
+// (the graph). The scan hands over segments: the actors of a block of `block` as its element
+// closes, and the channels with them once `block` channels have been read. Actor ids are their
+// order in the file, so ports can refer to them before their block is added. Channels are
+// resolved as they are handed over; once a channel names an actor not seen yet (SDF3 does not
+// fix the element order), it and every later channel wait for the end of the document, so
+// channels keep their file order. <sdfProperties> is cut out of the text and parsed on its own
+// (pugixml: it is small next to the graph). Errors come in file order as far as the text read
+// tells them: the actors and channels read before a mistake of the scan, and the waiting
+// channels whose actors have been seen, are resolved before it is reported; what only the end
+// of the document decides (a port left unconnected, a channel naming an actor that never comes,
+// <sdfProperties>, parsed last) is reported there. On two threads the builder does exactly what
+// it does on one, in the same order, so the graph and the first error are the same.
 class Sdf3Reader {
  public:
   Sdf3Reader(std::string_view text, const std::string& source,
-             const std::function<void(size_t)>* release = nullptr)
-      : text_(text), source_(source), scan_(text), release_(release) {}
+             const std::function<void(size_t)>* release, size_t block, bool two_threads)
+      : text_(text),
+        source_(source),
+        scan_(text),
+        release_(release),
+        block_(std::max<size_t>(1, block)),
+        two_threads_(two_threads) {}
 
   Graph read() {
-    // Room for as many actors and channels as the text has tags named like theirs (a quick
-    // count: the graph's arrays and tables then never grow). The count also finds such tags in
-    // comments or outside <sdf>, so it is capped at what a valid file of this size could hold:
-    // the shortest actor element, <actor name='A'/>, has 17 bytes, and a channel's four
-    // required attributes make it 60. A malformed file then costs no more before its first
-    // error than a valid one of its size.
+    reserve();
+    bool scanned = false;
+    if (two_threads_) {
+      SegmentPipe pipe;
+      std::thread scanner;
+      try {
+        scanner = std::thread([&] { run_scan(&pipe); });
+      } catch (const std::system_error&) {  // no thread to be had: read on this one
+      }
+      if (scanner.joinable()) {
+        struct Join {  // also when the builder throws: stop the scan and wait for it
+          SegmentPipe& pipe;
+          std::thread& thread;
+          ~Join() {
+            pipe.stop();
+            thread.join();
+          }
+        } join{pipe, scanner};
+        for (bool last = false; !last;) {
+          Segment s = pipe.pop();
+          last = s.last;
+          build(s);
+          pipe.recycle(std::move(s));
+        }
+        scanned = true;
+      }
+    }
+    if (!scanned) run_scan(nullptr);
+    finish();
+    return std::move(g_);
+  }
+
+ private:
+  enum class Where { outside, sdf3, app, sdf, actor, other };
+
+  // Room for as many actors and channels as the text has tags named like theirs (a quick
+  // count: the graph's arrays and tables then never grow). The count also finds such tags in
+  // comments or outside <sdf>, so it is capped at what a valid file of this size could hold:
+  // the shortest actor element, <actor name='A'/>, has 17 bytes, and a channel's four
+  // required attributes make it 60. A malformed file then costs no more before its first
+  // error than a valid one of its size.
+  void reserve() {
     size_t actors = 0, channels = 0;
     auto named = [&](size_t at, std::string_view name) {
       if (!same(text_.substr(at + 1, name.size()), name)) return false;
@@ -141,26 +298,35 @@ class Sdf3Reader {
     });
     if (release_) (*release_)(text_.size());
     released_ = 0;
+    release_at_ = kReleaseStep;
     g_.reserve(std::min(actors, text_.size() / 17), std::min(channels, text_.size() / 60));
-    try {
-      scan();
-    } catch (const detail::XmlError& e) {
-      fail_after_pending(e.offset, e.message);
-    }
-    flush_actors();
-    flush_channels();
-    resolve(deferred_, true);
-    for (ActorId a = 0; a < g_.actor_count(); ++a)
-      for (uint32_t i = port_begin_[a]; i < port_begin_[a + 1]; ++i)
-        if (ports_[i].channel == UINT32_MAX)
-          fail(ports_[i].offset(), "port '" + std::string(ports_[i].name()) + "' of actor '" +
-                                       g_.actor_name(a) + "' is not connected to a channel");
-    if (!props_.empty()) read_properties();
-    return std::move(g_);
+    // Every channel connects two ports, and a port element, <port name='a' type='in'
+    // rate='1'/>, has at least 35 bytes.
+    ports_.reserve(std::min(2 * channels, text_.size() / 35));
   }
 
- private:
-  enum class Where { outside, sdf3, app, sdf, actor, other };
+  // ---- The scan (on its own thread when `pipe` is given, else it builds as it goes) ----
+
+  void run_scan(SegmentPipe* pipe) {
+    pipe_ = pipe;
+    try {
+      try {
+        scan();
+      } catch (const detail::XmlError& e) {
+        scan_fail(e.offset, e.message);
+      }
+    } catch (const StopScan&) {  // the builder has the mistake, or has stopped
+    } catch (...) {
+      if (!pipe_) throw;  // on one thread: the builder's error, thrown through the scan
+      cur_.clear();
+      cur_.exception = std::current_exception();
+      cur_.last = true;
+      try {
+        pipe_->push(std::move(cur_));
+      } catch (const StopScan&) {
+      }
+    }
+  }
 
   void scan() {
     std::vector<Where> stack;
@@ -168,7 +334,8 @@ class Sdf3Reader {
     for (;;) {
       const detail::XmlScanner::Token t = scan_.next();
       if (t.kind == detail::XmlScanner::Kind::eof) break;
-      if (release_ && t.offset >= released_ + kReleaseStep) release_behind(t.offset);
+      if (pipe_ && pipe_->stopped()) throw StopScan{};
+      if (release_ && t.offset >= release_at_) release_behind(t.offset);
       if (t.kind == detail::XmlScanner::Kind::end) {
         if (stack.back() == Where::actor) close_actor();
         stack.pop_back();
@@ -181,8 +348,8 @@ class Sdf3Reader {
         here = Where::sdf3;
         const std::string_view type = value("type");
         if (!type.empty() && type != "sdf")
-          fail(t.offset,
-               "graph type '" + std::string(type) + "' is not supported (only type=\"sdf\")");
+          scan_fail(t.offset,
+                    "graph type '" + std::string(type) + "' is not supported (only type=\"sdf\")");
         root_offset_ = t.offset;
       } else if (parent == Where::sdf3 && same(t.name, "applicationGraph") && !seen_app) {
         seen_app = true;
@@ -191,10 +358,10 @@ class Sdf3Reader {
       } else if (parent == Where::app && same(t.name, "sdf") && !seen_sdf) {
         seen_sdf = true;
         here = Where::sdf;
-        g_.name = value("name");
-        if (!valid_utf8(g_.name)) fail(t.offset, "attribute 'name' is not valid UTF-8");
-        g_.type = value("type");
-        if (!valid_utf8(g_.type)) fail(t.offset, "attribute 'type' is not valid UTF-8");
+        graph_name_ = value("name");
+        if (!valid_utf8(graph_name_)) scan_fail(t.offset, "attribute 'name' is not valid UTF-8");
+        graph_type_ = value("type");
+        if (!valid_utf8(graph_type_)) scan_fail(t.offset, "attribute 'type' is not valid UTF-8");
       } else if (parent == Where::app && same(t.name, "sdfProperties") && props_.empty()) {
         props_offset_ = t.offset;
         size_t end = t.end;
@@ -225,35 +392,55 @@ class Sdf3Reader {
         close_actor();
       }
     }
-    if (!seen_sdf3) fail(0, "no <sdf3> root element");
-    if (!seen_app) fail(root_offset_, "<sdf3> has no <applicationGraph>");
-    if (!seen_sdf) fail(app_offset_, "<applicationGraph> has no <sdf>");
+    if (!seen_sdf3) scan_fail(0, "no <sdf3> root element");
+    if (!seen_app) scan_fail(root_offset_, "<sdf3> has no <applicationGraph>");
+    if (!seen_sdf) scan_fail(app_offset_, "<applicationGraph> has no <sdf>");
+    cur_.last = true;
+    hand_over(true);
   }
 
-  // Everything before `offset` that no pending actor or channel still points into.
-  void release_behind(size_t offset) {
-    if (!block_.empty()) offset = std::min(offset, block_.front().offset);
-    if (!pending_.empty()) offset = std::min(offset, pending_.front().offset);
-    if (offset < released_ + kReleaseStep) return;
+  // Hands over the closed actors, and the channels read if `channels`, to the builder.
+  void hand_over(bool channels) {
+    if (channels) std::swap(cur_.channels, channels_);  // cur_.channels is empty
+    Segment next = pipe_ ? pipe_->fresh() : std::move(spare_);
+    next.clear();
+    std::swap(next, cur_);
+    if (pipe_) {
+      pipe_->push(std::move(next));
+    } else {
+      build(next);
+      spare_ = std::move(next);
+      spare_.clear();
+    }
+  }
+
+  // A mistake at `offset`: what was read before it goes to the builder first (its own mistakes
+  // come first), with the message; an actor whose element is still open is left out (its ports
+  // are not all read).
+  [[noreturn]] void scan_fail(size_t offset, const std::string& msg) {
+    size_t closed = 0;
+    for (uint32_t n : cur_.port_counts) closed += n;
+    cur_.ports.resize(closed);
+    cur_.failed = true;
+    cur_.error_offset = offset;
+    cur_.error = msg;
+    hand_over(true);  // on one thread this throws the error
+    throw StopScan{};
+  }
+
+  // Releases the text before `at` that no record still points into.
+  void release_behind(const size_t at) {
+    size_t offset = std::min(at, cur_.first_offset());
+    if (actor_open_) offset = std::min(offset, open_.offset);
+    if (!channels_.empty()) offset = std::min(offset, channels_.front().offset);
+    if (pipe_) offset = std::min(offset, pipe_->needed_from());
+    if (offset < released_ + kReleaseStep) {  // the builder is behind: try again a little later
+      release_at_ = at + kReleaseStep / 16;
+      return;
+    }
     (*release_)(offset);
     released_ = offset;
-  }
-
-  // Reports a mistake at `offset` after the pending blocks, whose own mistakes come first, and
-  // after the waiting channels whose actors have been seen by now (a channel naming an actor
-  // not seen yet cannot be judged before the end of the document, which is not read).
-  [[noreturn]] void fail_after_pending(size_t offset, const std::string& msg) {
-    flush_actors();
-    flush_channels();
-    std::vector<ChannelRecord> waiting;
-    waiting.swap(deferred_);
-    resolve(waiting, false);  // those from the first unknown actor on wait again
-    fail(offset, msg);
-  }
-  [[noreturn]] void fail(size_t offset, const std::string& msg) const {
-    throw Error(Error::Kind::input, source_ + ":" +
-                                        std::to_string(LineIndex(text_).line_of(offset)) + ": " +
-                                        msg);  // the line index only for the one error
+    release_at_ = released_ + kReleaseStep;
   }
 
   // The decoded value of an attribute of the current tag ("" when absent), kept alive as long
@@ -271,20 +458,24 @@ class Sdf3Reader {
   std::string_view required(const detail::XmlScanner::Token& t, std::string_view attr) {
     const detail::XmlAttribute* a = scan_.attribute(attr);
     if (!a)
-      fail_after_pending(t.offset, "<" + std::string(t.name) + "> lacks the attribute '" +
-                                       std::string(attr) + "'");
+      scan_fail(t.offset,
+                "<" + std::string(t.name) + "> lacks the attribute '" + std::string(attr) + "'");
     const std::string_view v = trim(keep(*a));
-    if (v.empty()) fail_after_pending(t.offset, "attribute '" + std::string(attr) + "' is empty");
+    if (v.empty()) scan_fail(t.offset, "attribute '" + std::string(attr) + "' is empty");
     if (!(a->plain && a->ascii) && !valid_utf8(v))
-      fail_after_pending(t.offset, "attribute '" + std::string(attr) + "' is not valid UTF-8");
+      scan_fail(t.offset, "attribute '" + std::string(attr) + "' is not valid UTF-8");
     return v;
   }
   uint64_t number(size_t offset, const char* attr, std::string_view text, bool positive) {
+    const std::optional<uint64_t> v = count(text, positive);
+    if (!v) scan_fail(offset, not_an_integer(attr, text, positive));
+    return *v;
+  }
+  static std::optional<uint64_t> count(std::string_view text, bool positive) {
     uint64_t v = 0;
     const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ec != std::errc() || ptr != text.data() + text.size() || (positive && v == 0)) {
-      fail_after_pending(offset, not_an_integer(attr, text, positive));
-    }
+    if (ec != std::errc() || ptr != text.data() + text.size() || (positive && v == 0))
+      return std::nullopt;
     return v;
   }
 
@@ -294,9 +485,10 @@ class Sdf3Reader {
     const bool typed = scan_.attribute("type") != nullptr;
     if (typed) {
       type = value("type");
-      if (!valid_utf8(type)) fail_after_pending(t.offset, "attribute 'type' is not valid UTF-8");
+      if (!valid_utf8(type)) scan_fail(t.offset, "attribute 'type' is not valid UTF-8");
     }
-    block_.push_back({name, t.offset, typed, type});
+    open_ = {name, t.offset, typed, type};
+    open_ports_ = cur_.ports.size();
     actor_open_ = true;
   }
 
@@ -305,50 +497,28 @@ class Sdf3Reader {
     p.set_name(required(t, "name"));
     const std::string_view type = required(t, "type");
     if (!same(type, "in") && !same(type, "out"))
-      fail_after_pending(t.offset,
-                         "port type '" + std::string(type) + "' is neither 'in' nor 'out'");
+      scan_fail(t.offset, "port type '" + std::string(type) + "' is neither 'in' nor 'out'");
     p.out = same(type, "out");
     p.rate = number(t.offset, "rate", required(t, "rate"), true);
     p.set_offset(t.offset);
-    ports_.push_back(p);
+    cur_.ports.push_back(p);
   }
 
-  // The actor's ports are ports_[port_begin_.back(), end): sorted by name, then closed off.
+  // The open actor's ports are cur_.ports[open_ports_, end): sorted by name, then closed off.
   void close_actor() {
-    const auto first = ports_.begin() + port_begin_.back();
-    std::sort(first, ports_.end(),
+    const auto first = cur_.ports.begin() + static_cast<ptrdiff_t>(open_ports_);
+    std::sort(first, cur_.ports.end(),
               [](const Port& a, const Port& b) { return a.name() < b.name(); });
     // Indices, not iterators: `first + 1` on an empty vector's null data is undefined (UBSan).
-    for (size_t i = port_begin_.back(); i + 1 < ports_.size(); ++i)
-      if (ports_[i].name() == ports_[i + 1].name())
-        fail_after_pending(std::max(ports_[i].offset(), ports_[i + 1].offset()),
-                           "duplicate port '" + std::string(ports_[i].name()) + "' on actor '" +
-                               std::string(block_.back().name) + "'");
-    port_begin_.push_back(static_cast<uint32_t>(ports_.size()));
+    for (size_t i = open_ports_; i + 1 < cur_.ports.size(); ++i)
+      if (cur_.ports[i].name() == cur_.ports[i + 1].name())
+        scan_fail(std::max(cur_.ports[i].offset(), cur_.ports[i + 1].offset()),
+                  "duplicate port '" + std::string(cur_.ports[i].name()) + "' on actor '" +
+                      std::string(open_.name) + "'");
+    cur_.actors.push_back(open_);
+    cur_.port_counts.push_back(static_cast<uint32_t>(cur_.ports.size() - open_ports_));
     actor_open_ = false;
-    if (block_.size() >= kBlock) flush_actors();
-  }
-
-  // Adds the actors of the block (a duplicate name is the first mistake of the block), except
-  // one whose element is still open (its ports are not all read: a mistake inside it is being
-  // reported, and only earlier ones come first).
-  void flush_actors() {
-    const size_t count = block_.size() - (actor_open_ ? 1 : 0);
-    if (count == 0) return;
-    names_.clear();
-    for (size_t i = 0; i < count; ++i) names_.push_back(block_[i].name);
-    const auto base = static_cast<ActorId>(g_.actor_count());
-    const size_t ok = g_.add_actors(names_);
-    for (size_t i = 0; i < ok; ++i)
-      if (block_[i].typed) g_.set_actor_type(base + static_cast<ActorId>(i), block_[i].type);
-    if (ok < count) {
-      try {
-        g_.add_actor(std::string(block_[ok].name));  // throws "duplicate actor name '...'"
-      } catch (const Error& e) {
-        fail(block_[ok].offset, e.what());
-      }
-    }
-    block_.erase(block_.begin(), block_.begin() + static_cast<ptrdiff_t>(count));
+    if (cur_.actors.size() >= block_) hand_over(false);
   }
 
   void read_channel(const detail::XmlScanner::Token& t) {
@@ -357,8 +527,8 @@ class Sdf3Reader {
     if (const detail::XmlAttribute* a = scan_.attribute("name")) {
       r.has_name = true;
       r.name = trim(keep(*a));
-      if (r.name.empty()) fail_after_pending(t.offset, "attribute 'name' is empty");
-      if (!valid_utf8(r.name)) fail_after_pending(t.offset, "attribute 'name' is not valid UTF-8");
+      if (r.name.empty()) scan_fail(t.offset, "attribute 'name' is empty");
+      if (!valid_utf8(r.name)) scan_fail(t.offset, "attribute 'name' is not valid UTF-8");
     }
     r.src = required(t, "srcActor");
     r.dst = required(t, "dstActor");
@@ -366,18 +536,68 @@ class Sdf3Reader {
     r.dst_port = required(t, "dstPort");
     if (const detail::XmlAttribute* a = scan_.attribute("initialTokens"))
       r.delay = number(t.offset, "initialTokens", trim(keep(*a)), false);
-    (deferred_.empty() ? pending_ : deferred_).push_back(r);  // once one waits, all later do
-    if (pending_.size() >= kBlock) flush_channels();
+    channels_.push_back(r);
+    if (channels_.size() >= block_) hand_over(true);
   }
 
-  void flush_channels() {
-    if (pending_.empty()) return;
-    flush_actors();
-    std::vector<ChannelRecord> records;
-    records.swap(pending_);  // a mistake found while resolving must not resolve them again
-    resolve(records, false);
-    records.clear();
-    records.swap(pending_);  // keep the capacity
+  // ---- The builder (on the calling thread) ----
+
+  // Adds a segment: its actors (a duplicate name is the first mistake), then its channels
+  // (resolved, or waiting behind those that already wait), then the scan's mistake if any,
+  // after the waiting channels whose actors have been seen by now (one naming an actor not
+  // seen yet cannot be judged before the end of the document, which is not read).
+  void build(Segment& s) {
+    if (s.exception) std::rethrow_exception(s.exception);
+    add_actors(s);
+    if (!s.channels.empty()) {
+      if (!deferred_.empty())  // once one waits, all later do
+        deferred_.insert(deferred_.end(), s.channels.begin(), s.channels.end());
+      else
+        resolve(s.channels, false);
+    }
+    if (s.failed) {
+      std::vector<ChannelRecord> waiting;
+      waiting.swap(deferred_);
+      resolve(waiting, false);  // those from the first unknown actor on wait again
+      fail(s.error_offset, s.error);
+    }
+  }
+
+  void add_actors(const Segment& s) {
+    if (s.actors.empty()) return;
+    names_.clear();
+    for (const ActorRecord& a : s.actors) names_.push_back(a.name);
+    const auto base = static_cast<ActorId>(g_.actor_count());
+    const size_t ok = g_.add_actors(names_);
+    for (size_t i = 0; i < ok; ++i)
+      if (s.actors[i].typed) g_.set_actor_type(base + static_cast<ActorId>(i), s.actors[i].type);
+    if (ok < s.actors.size()) {
+      try {
+        g_.add_actor(std::string(s.actors[ok].name));  // throws "duplicate actor name '...'"
+      } catch (const Error& e) {
+        fail(s.actors[ok].offset, e.what());
+      }
+    }
+    ports_.insert(ports_.end(), s.ports.begin(), s.ports.end());
+    for (uint32_t n : s.port_counts) port_begin_.push_back(port_begin_.back() + n);
+  }
+
+  void finish() {
+    resolve(deferred_, true);
+    for (ActorId a = 0; a < g_.actor_count(); ++a)
+      for (uint32_t i = port_begin_[a]; i < port_begin_[a + 1]; ++i)
+        if (ports_[i].channel == UINT32_MAX)
+          fail(ports_[i].offset(), "port '" + std::string(ports_[i].name()) + "' of actor '" +
+                                       g_.actor_name(a) + "' is not connected to a channel");
+    g_.name = graph_name_;
+    g_.type = graph_type_;
+    if (!props_.empty()) read_properties();
+  }
+
+  [[noreturn]] void fail(size_t offset, const std::string& msg) const {
+    throw Error(Error::Kind::input, source_ + ":" +
+                                        std::to_string(LineIndex(text_).line_of(offset)) + ": " +
+                                        msg);  // the line index only for the one error
   }
 
   // Adds the channels of `records` in order. `last_chance`: an unknown actor is a mistake;
@@ -515,38 +735,46 @@ class Sdf3Reader {
           if (!a) fail(at(n), "<" + std::string(n.name()) + "> lacks the attribute '" + attr + "'");
           const std::string_view v = trim(a.value());
           if (v.empty()) fail(at(n), "attribute '" + std::string(attr) + "' is empty");
-          return number(at(n), attr, v, false);
+          const std::optional<uint64_t> x = count(v, false);
+          if (!x) fail(at(n), not_an_integer(attr, v, false));
+          return *x;
         },
         false);
   }
 
-  static constexpr size_t kBlock = 4096;
   static constexpr size_t kReleaseStep = size_t{16} << 20;
   std::string_view text_;
   const std::string& source_;
+
+  // The scan's.
   detail::XmlScanner scan_;
   const std::function<void(size_t)>* release_;
   size_t released_ = 0;
-  Graph g_;
+  size_t release_at_ = 0;  // the offset at which to try releasing again
+  const size_t block_;
+  const bool two_threads_;
+  SegmentPipe* pipe_ = nullptr;
+  Segment cur_;    // closed actors and their ports (and the open actor's), not handed over
+  Segment spare_;  // on one thread: the last segment built, for its buffers
+  std::vector<ChannelRecord> channels_;  // read, not handed over
+  ActorRecord open_{};
+  size_t open_ports_ = 0;  // where the open actor's ports begin in cur_.ports
+  bool actor_open_ = false;
   std::string scratch_;
   std::deque<std::string> decoded_;  // attribute values that entities or white space changed
-  struct ActorRecord {
-    std::string_view name;
-    size_t offset;
-    bool typed;
-    std::string_view type;
-  };
-  std::vector<ActorRecord> block_;  // actors read, not yet added to the graph
+  std::string graph_name_, graph_type_;
+  std::string_view props_;
+  size_t props_offset_ = 0, root_offset_ = 0, app_offset_ = 0;
+
+  // The builder's.
+  Graph g_;
   std::vector<Port> ports_;
   // Actor a's ports are ports_[port_begin_[a], port_begin_[a + 1]), sorted by name; the last
   // entry is where the next actor's begin.
   std::vector<uint32_t> port_begin_{0};
-  std::vector<ChannelRecord> pending_, deferred_;
-  bool actor_open_ = false;
+  std::vector<ChannelRecord> deferred_;
   std::vector<std::string_view> names_;
   std::vector<int64_t> ids_;
-  std::string_view props_;
-  size_t props_offset_ = 0, root_offset_ = 0, app_offset_ = 0;
 };
 
 // Port names for writing: the ones read, else "in<k>"/"out<k>" avoiding names already taken.
@@ -646,15 +874,24 @@ void read_sdf3_properties(Graph& g, std::string_view xml, const std::string& sou
 }  // namespace detail
 
 Graph read_sdf3(std::string_view text, const std::string& source) {
-  Sdf3Reader reader(text, source);
-  return reader.read();
+  return detail::read_sdf3_with(text, source, nullptr, 4096, detail::ScanThread::automatic);
 }
 
 namespace detail {
 
 Graph read_sdf3_released(std::string_view text, const std::string& source,
                          const std::function<void(size_t)>& release) {
-  Sdf3Reader reader(text, source, &release);
+  return read_sdf3_with(text, source, &release, 4096, ScanThread::automatic);
+}
+
+Graph read_sdf3_with(std::string_view text, const std::string& source,
+                     const std::function<void(size_t)>* release, size_t block, ScanThread scan) {
+  // A thread of its own pays from about a megabyte of text (some 10^4 actors) on.
+  constexpr size_t kOwnThreadBytes = size_t{1} << 20;
+  const bool own =
+      scan == ScanThread::own || (scan == ScanThread::automatic && text.size() >= kOwnThreadBytes &&
+                                  std::thread::hardware_concurrency() > 1);
+  Sdf3Reader reader(text, source, release, block, own);
   return reader.read();
 }
 

@@ -429,6 +429,47 @@ TEST(Sdf3Reader, EarlierMistakesComeFirst) {
             "f.xml:6: duplicate actor name 'A'");
 }
 
+// Texts of a megabyte and more are scanned on a thread of their own beside the builder: a
+// mistake the builder finds early (a duplicate actor) stops the scan, one only the end decides
+// (a port left unconnected) waits for it, and either is reported as on one thread.
+TEST(Sdf3Reader, AScanOnItsOwnThreadReportsAsOnOne) {
+  crowddb::Rng rng(5);
+  gen::Spec spec;
+  spec.shape = gen::Shape::dag;
+  spec.actors = 20000;
+  const std::string text = write_sdf3(gen::generate(spec, rng).graph);
+  ASSERT_GT(text.size(), size_t{1} << 20);  // so that read_sdf3 takes a thread
+  const size_t second = text.find("<actor", text.find("<actor") + 1);
+  const size_t last_channel = text.rfind("<channel");
+  for (const std::string& bad :
+       {text.substr(0, second) + "<actor name='a0'/>\n" + text.substr(second),
+        text.substr(0, last_channel) + text.substr(text.find('\n', last_channel) + 1), text}) {
+    std::string one;
+    try {
+      (void)detail::read_sdf3_with(bad, "f.xml", nullptr, 4096, detail::ScanThread::caller);
+    } catch (const Error& e) {
+      one = e.what();
+    }
+    EXPECT_EQ(sdf3_error(bad), one);
+    for (size_t block : {64, 4096})
+      EXPECT_EQ(
+          test::outcome([&] {
+            return detail::read_sdf3_with(bad, "f.xml", nullptr, block, detail::ScanThread::own);
+          }),
+          test::outcome([&] {
+            return detail::read_sdf3_with(bad, "f.xml", nullptr, block, detail::ScanThread::caller);
+          }))
+          << block;
+  }
+  EXPECT_NE(sdf3_error(text.substr(0, second) + "<actor name='a0'/>\n" + text.substr(second))
+                .find("duplicate actor name 'a0'"),
+            std::string::npos);
+  EXPECT_NE(
+      sdf3_error(text.substr(0, last_channel) + text.substr(text.find('\n', last_channel) + 1))
+          .find("is not connected to a channel"),
+      std::string::npos);
+}
+
 TEST(Writers, RoundTripRandomGraphsThroughBothFormats) {
   crowddb::Rng rng(7);
   for (int i = 0; i < 60; ++i) {

@@ -8,6 +8,7 @@
 
 #include "sdf/generate.hpp"
 #include "sdf/io.hpp"
+#include "sdf/json_detail.hpp"
 #include "sdf/naive.hpp"
 
 namespace sdf::test {
@@ -95,6 +96,23 @@ inline void streaming_reader_agrees(uint64_t seed, int count) {
     }
     const std::string stream = outcome([&] { return read_sdf3(text, "f.xml"); });
     const std::string dom = outcome([&] { return naive::read_sdf3(text, "f.xml"); });
+    // The scan on a thread of its own, handing over a few actors or channels at a time: the
+    // same graph, or the same first error, as on the calling thread with the same blocks (the
+    // block size may change which of two mistakes is found first, the thread may not).
+    const size_t block = 1 + static_cast<size_t>(i % 3);
+    const std::string caller = outcome([&] {
+      return detail::read_sdf3_with(text, "f.xml", nullptr, block, detail::ScanThread::caller);
+    });
+    EXPECT_EQ(outcome([&] {
+                return detail::read_sdf3_with(text, "f.xml", nullptr, block,
+                                              detail::ScanThread::own);
+              }),
+              caller)
+        << text;
+    EXPECT_EQ(caller.rfind("error: ", 0) == 0, stream.rfind("error: ", 0) == 0) << text;
+    if (caller.rfind("error: ", 0) != 0) {
+      EXPECT_EQ(caller, stream) << text;
+    }
     const bool stream_failed = stream.rfind("error: ", 0) == 0;
     const bool dom_failed = dom.rfind("error: ", 0) == 0;
     if (stream_failed && dom_failed) {
