@@ -53,8 +53,8 @@ struct RateChangeResult {
   std::vector<uint64_t> tokens_at_change;
   // Static: `returns` or `deadlock`; online paths: run_online's outcome after the change.
   Outcome outcome = Outcome::returns;
-  std::vector<ActorId> stuck;           // deadlock after the change (static path)
-  std::optional<ChannelId> channel;     // unbounded after the change
+  std::vector<ActorId> stuck;        // deadlock after the change: actors below their count (sorted)
+  std::optional<ChannelId> channel;  // unbounded after the change
   uint64_t firings_until_periodic = 0;  // after the change
   uint64_t period_firings = 0;          // firings in one period / cycle after the change
   uint64_t period_decisions = 0;

@@ -45,7 +45,7 @@ Graph read_sdf3_released(std::string_view text, const std::string& source,
 // and more on a machine with two or more cores. The graph and the first error are the same.
 enum class ScanThread { automatic, caller, own };
 // read_sdf3 with its knobs: release as read_sdf3_released (may be null); the scan hands the
-// builder `block` actors or channels at a time (4096 in read_sdf3).
+// builder `block` actors or channels at a time (1024 in read_sdf3).
 Graph read_sdf3_with(std::string_view text, const std::string& source,
                      const std::function<void(size_t)>* release, size_t block, ScanThread scan);
 

@@ -82,9 +82,15 @@ std::vector<uint64_t> cycle_buffers(const Graph& g, std::span<const uint64_t> q,
 RateChangeResult simulate_rate_change(const Graph& g, Policy policy, const RateChange& change,
                                       const OnlineRunOptions& options) {
   if (change.actor >= g.actor_count()) throw Error(Error::Kind::input, "unknown actor");
+  std::vector<bool> given(g.channel_count(), false);
   for (const ChannelRates& r : change.rates) {
     if (r.channel >= g.channel_count())
       throw Error(Error::Kind::input, "rate change: unknown channel");
+    if (given[r.channel])
+      throw Error(
+          Error::Kind::input,
+          "rate change: channel '" + std::string(g.channel_name(r.channel)) + "' is given twice");
+    given[r.channel] = true;
     const Channel& ch = g.channel(r.channel);
     if (ch.src != change.actor && ch.dst != change.actor)
       throw Error(Error::Kind::input,
@@ -165,6 +171,15 @@ RateChangeResult simulate_rate_change(const Graph& g, Policy policy, const RateC
   const OnlineRun after = run_online(g2, out.q_after, s, opts);
   out.outcome = after.outcome;
   out.channel = after.channel;
+  if (after.outcome == Outcome::deadlock) {
+    // The actors below their count in the iteration under way when nothing can fire, as the
+    // static path reports them: the run is replayed to where it stopped.
+    OnlineScheduler r = s;
+    for (uint64_t i = 0; i <= after.decisions_explored && r.step(); ++i) {
+    }
+    for (ActorId a = 0; a < g2.actor_count(); ++a)
+      if (r.iteration_counts()[a] < out.q_after[a]) out.stuck.push_back(a);
+  }
   if (after.outcome == Outcome::returns || after.outcome == Outcome::periodic) {
     out.firings_until_periodic = after.transient_firings;
     out.period_firings = after.cycle_firings;

@@ -742,7 +742,7 @@ class Sdf3Reader {
         false);
   }
 
-  static constexpr size_t kReleaseStep = size_t{16} << 20;
+  static constexpr size_t kReleaseStep = size_t{4} << 20;  // 4 MiB of text resident at most
   std::string_view text_;
   const std::string& source_;
 
@@ -873,15 +873,20 @@ void read_sdf3_properties(Graph& g, std::string_view xml, const std::string& sou
 
 }  // namespace detail
 
+// Actors or channels per hand-over from the scan to the builder: small enough that the segments
+// in flight between two threads stay near a megabyte, large enough that the hand-overs cost
+// nothing measurable.
+constexpr size_t kSdf3Block = 1024;
+
 Graph read_sdf3(std::string_view text, const std::string& source) {
-  return detail::read_sdf3_with(text, source, nullptr, 4096, detail::ScanThread::automatic);
+  return detail::read_sdf3_with(text, source, nullptr, kSdf3Block, detail::ScanThread::automatic);
 }
 
 namespace detail {
 
 Graph read_sdf3_released(std::string_view text, const std::string& source,
                          const std::function<void(size_t)>& release) {
-  return read_sdf3_with(text, source, &release, 4096, ScanThread::automatic);
+  return read_sdf3_with(text, source, &release, kSdf3Block, ScanThread::automatic);
 }
 
 Graph read_sdf3_with(std::string_view text, const std::string& source,

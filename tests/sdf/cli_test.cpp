@@ -195,6 +195,31 @@ TEST(SdfschedCli, SimulateTextAgreesWithJsonAfterADeadlock) {
       << t.out;
 }
 
+// A deadlock after the change names the actors below their count under every policy (the online
+// ones used to give an empty list): A's rates tripled, B waits for tokens A cannot send.
+TEST(SdfschedCli, SimulateNamesTheStuckActorsUnderEveryPolicy) {
+  const std::string g = test::temp_path("cyc3.json");
+  {
+    std::ofstream f(g);
+    f << R"({"actors": [{"name": "A"}, {"name": "B"}, {"name": "C"}], "channels": [
+          {"src": "A", "dst": "B", "prd": 1, "cns": 1},
+          {"src": "B", "dst": "A", "prd": 1, "cns": 1, "delay": 1},
+          {"src": "C", "dst": "A", "prd": 1, "cns": 1}]})";
+  }
+  for (const char* policy : {"static", "online-bounded"}) {
+    const std::string args =
+        "simulate '" + g + "' --rate-change 'B*3/1@0' --policy " + std::string(policy);
+    const test::Cli j = test::sdfsched(args + " --json");
+    const test::Cli t = test::sdfsched(args);
+    EXPECT_EQ(j.status, 1) << policy;
+    const json r = json::parse(j.out);
+    EXPECT_EQ(r["outcome"], "deadlock") << policy;
+    EXPECT_EQ(r["stuck"], json({"A", "B"})) << policy;
+    EXPECT_NE(t.out.find("stuck: A B\n"), std::string::npos) << policy << t.out;
+  }
+  std::remove(g.c_str());
+}
+
 TEST(SdfschedCli, ConvertRoundTrips) {
   const std::string out = test::temp_path("g.xml");
   const test::Cli x =

@@ -446,12 +446,12 @@ TEST(Sdf3Reader, AScanOnItsOwnThreadReportsAsOnOne) {
         text.substr(0, last_channel) + text.substr(text.find('\n', last_channel) + 1), text}) {
     std::string one;
     try {
-      (void)detail::read_sdf3_with(bad, "f.xml", nullptr, 4096, detail::ScanThread::caller);
+      (void)detail::read_sdf3_with(bad, "f.xml", nullptr, 1024, detail::ScanThread::caller);
     } catch (const Error& e) {
       one = e.what();
     }
     EXPECT_EQ(sdf3_error(bad), one);
-    for (size_t block : {64, 4096})
+    for (size_t block : {64, 1024})
       EXPECT_EQ(
           test::outcome([&] {
             return detail::read_sdf3_with(bad, "f.xml", nullptr, block, detail::ScanThread::own);

@@ -519,9 +519,13 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
   if (parsed.form == "uniform") change["prd"] = parsed.prd, change["cns"] = parsed.cns;
   if (parsed.form == "factor")
     change["factor"] = std::to_string(parsed.num) + "/" + std::to_string(parsed.den);
+  // Appended directly, as in keyed(): each channel once (operator[] would search linearly).
   Json rates = Json::object();
+  auto& members = static_cast<Json::object_t::Container&>(rates.get_ref<Json::object_t&>());
+  members.reserve(rc.rates.size());
   for (const sdf::ChannelRates& cr : rc.rates)
-    rates[std::string(g.channel_name(cr.channel))] = {{"prd", cr.prd}, {"cns", cr.cns}};
+    members.emplace_back(std::string(g.channel_name(cr.channel)),
+                         Json{{"prd", cr.prd}, {"cns", cr.cns}});
   change["rates"] = std::move(rates);
   change["at_firing"] = rc.at_firing;
   j["change"] = std::move(change);
