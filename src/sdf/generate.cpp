@@ -81,7 +81,13 @@ Generated generate(const Spec& spec, crowddb::Rng& rng) {
     case Shape::dag:
     case Shape::cyclic:
     case Shape::cyclic_random: {
-      for (uint32_t p = 1; p < n; ++p) connect(static_cast<uint32_t>(rng.below(p)), p, 0);
+      // parent[p]: the spanning tree's channel into position p (positions 1 on).
+      std::vector<uint32_t> parent(n, 0), depth(n, 0);
+      for (uint32_t p = 1; p < n; ++p) {
+        parent[p] = static_cast<uint32_t>(rng.below(p));
+        depth[p] = depth[parent[p]] + 1;
+        connect(parent[p], p, 0);
+      }
       if (n >= 2) {
         const uint64_t extra = uint64_t{n} * spec.extra_percent / 100;
         for (uint64_t i = 0; i < extra; ++i) {
@@ -91,11 +97,14 @@ Generated generate(const Spec& spec, crowddb::Rng& rng) {
           connect(x, y, 0);
         }
         if (spec.shape != Shape::dag) {
+          // Each back channel goes from a position to one of its ancestors in the spanning tree,
+          // so that it closes a cycle (to any earlier position it would close none unless that
+          // one happened to be upstream: a quarter of 8-actor graphs had no cycle at all).
           const uint64_t back = std::max<uint64_t>(1, uint64_t{n} * spec.back_percent / 100);
           for (uint64_t i = 0; i < back; ++i) {
-            auto x = static_cast<uint32_t>(rng.below(n)), y = static_cast<uint32_t>(rng.below(n));
-            if (x == y) continue;
-            if (x < y) std::swap(x, y);
+            const auto x = static_cast<uint32_t>(1 + rng.below(n - 1));
+            uint32_t y = x;
+            for (uint64_t up = 1 + rng.below(depth[x]); up > 0; --up) y = parent[y];
             connect(x, y, back_delay());
           }
         }
