@@ -36,8 +36,9 @@ Generated generate(const Spec& spec, crowddb::Rng& rng) {
   std::vector<uint64_t> q(n, 1);
   // Tables cut at the spec's maxima (the defaults keep them whole, and the graphs as before).
   size_t q_choices = 0, m_choices = 0;
-  while (q_choices < std::size(kQ) && kQ[q_choices] <= std::max<uint32_t>(spec.max_q, 1))
-    ++q_choices;
+  const uint32_t q_cap =
+      std::max<uint32_t>(1, spec.max_rate ? std::min(spec.max_q, spec.max_rate) : spec.max_q);
+  while (q_choices < std::size(kQ) && kQ[q_choices] <= q_cap) ++q_choices;
   while (m_choices < std::size(kMult) &&
          kMult[m_choices] <= std::max<uint32_t>(spec.max_multiplier, 1))
     ++m_choices;
@@ -55,7 +56,9 @@ Generated generate(const Spec& spec, crowddb::Rng& rng) {
     uint64_t prd = 1, cns = 1;
     if (spec.multirate) {
       const uint64_t gcd = std::gcd(q[u], q[v]);
-      const uint64_t m = kMult[rng.below(m_choices)];
+      uint64_t m = kMult[rng.below(m_choices)];
+      // The larger rate is max(q_u, q_v) / gcd * m; q <= max_rate keeps m = 1 within the cap.
+      if (spec.max_rate) m = std::min<uint64_t>(m, spec.max_rate * gcd / std::max(q[u], q[v]));
       prd = q[v] / gcd * m;
       cns = q[u] / gcd * m;
     }

@@ -32,6 +32,9 @@ struct Spec {
   uint32_t back_percent = 30;   // cyclic: back channels, % of the actor count (at least one)
   uint32_t max_q = 12;          // multi-rate: repetition counts drawn from those up to this
   uint32_t max_multiplier = 3;  // multi-rate: rate multipliers m drawn from those up to this
+  // > 0: every rate at most this (the repetition counts drawn up to it too, and a multiplier
+  // that would pass it lowered to the largest that does not). 0: no cap beyond the above.
+  uint32_t max_rate = 0;
 };
 
 struct Generated {

@@ -111,6 +111,30 @@ TEST(Repetitions, RandomGraphsBuiltFromAChosenVector) {
   }
 }
 
+// `generate --max-rate R`: every rate at most R, the graph still built from its vector, and R
+// reached where the other caps allow (a cap that is never approached would pass vacuously).
+TEST(Repetitions, GeneratedRatesStayWithinTheirCap) {
+  crowddb::Rng rng(4242);
+  uint64_t at_cap = 0;
+  for (int i = 0; i < 600; ++i) {
+    gen::Spec spec;
+    spec.shape = static_cast<gen::Shape>(i % 6);
+    spec.actors = 2 + static_cast<uint32_t>(rng.below(20));
+    spec.max_rate = 1 + static_cast<uint32_t>(rng.below(15));
+    spec.max_q = 1 + static_cast<uint32_t>(rng.below(12));
+    spec.max_multiplier = 1 + static_cast<uint32_t>(rng.below(3));
+    const gen::Generated gg = gen::generate(spec, rng);
+    uint64_t top = 0;
+    for (const Channel& c : gg.graph.channels()) top = std::max({top, c.prd, c.cns});
+    EXPECT_LE(top, spec.max_rate) << i;
+    at_cap += top == spec.max_rate;
+    const Repetitions r = compute_repetitions(gg.graph);
+    ASSERT_TRUE(r.consistent) << i;
+    EXPECT_EQ(r.q, gg.q) << i;
+  }
+  EXPECT_GT(at_cap, 100u);
+}
+
 TEST(Repetitions, PerturbedRandomGraphsAreInconsistentAtACycle) {
   crowddb::Rng rng(43);
   int inconsistent = 0;

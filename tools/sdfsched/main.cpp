@@ -811,7 +811,7 @@ struct GenerateFlags {
   std::string shape = "dag";
   uint32_t actors = 8;
   bool homogeneous = false, self_loops = false;
-  uint32_t max_q = 12, max_multiplier = 3, extra_percent = 50, back_percent = 30;
+  uint32_t max_q = 12, max_multiplier = 3, extra_percent = 50, back_percent = 30, max_rate = 0;
   std::string times;  // LO:HI
   uint64_t seed = 1;
   std::string format;  // json | sdf3; default by the output's extension, else json
@@ -830,6 +830,7 @@ int cmd_generate(const GenerateFlags& f, const std::string& out) {
   spec.self_loops = f.self_loops;
   spec.max_q = f.max_q;
   spec.max_multiplier = f.max_multiplier;
+  spec.max_rate = f.max_rate;
   spec.extra_percent = f.extra_percent;
   spec.back_percent = f.back_percent;
   uint64_t lo = 0, hi = 0;
@@ -1108,6 +1109,9 @@ int main(int argc, char** argv) {
   gen->add_option("--max-multiplier", gf.max_multiplier,
                   "rates are (q_dst, q_src)/gcd times a multiplier from {1,2,3} up to this")
       ->check(crowddb::cli_checks::whole(1, 3));
+  gen->add_option("--max-rate", gf.max_rate,
+                  "every rate at most this (rates are 1 to 36 without it; 1: homogeneous)")
+      ->check(crowddb::cli_checks::whole(1, 1'000'000));
   gen->add_option("--extra-percent", gf.extra_percent,
                   "dag/cyclic: extra forward channels, % of the actors")
       ->check(crowddb::cli_checks::whole(0, 1000));
