@@ -40,6 +40,10 @@ void read_sdf3_properties(Graph& g, std::string_view xml, const std::string& sou
 Graph read_sdf3_released(std::string_view text, const std::string& source,
                          const std::function<void(size_t)>& release);
 
+// write_sdf3 through a pugixml document tree, printed whole: the streaming writer's twin (the
+// same bytes), and its fallback for <sdfProperties> nested too deep to indent.
+std::string write_sdf3_tree(const Graph& g);
+
 // Where read_sdf3 runs its scan of the text: on a thread of its own beside the graph builder
 // (`own`), on the calling thread (`caller`), or (`automatic`) on its own for texts of a megabyte
 // and more on a machine with two or more cores. The graph and the first error are the same.

@@ -902,7 +902,46 @@ Graph read_sdf3_with(std::string_view text, const std::string& source,
 
 }  // namespace detail
 
-std::string write_sdf3(const Graph& g) {
+namespace {
+
+// An attribute as pugixml's default format writes it: double quotes; &, <, " and control
+// characters escaped (the latter as two-digit references); '>' is not.
+void put_attribute(std::string& out, std::string_view name, std::string_view v) {
+  out += ' ';
+  out += name;
+  out += "=\"";
+  for (const char ch : v) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c >= 32 && c != '&' && c != '<' && c != '"') {
+      out += ch;
+    } else if (c == '&') {
+      out += "&amp;";
+    } else if (c == '<') {
+      out += "&lt;";
+    } else if (c == '"') {
+      out += "&quot;";
+    } else {
+      out += "&#";
+      out += static_cast<char>('0' + c / 10);
+      out += static_cast<char>('0' + c % 10);
+      out += ';';
+    }
+  }
+  out += '"';
+}
+
+void put_number(std::string& out, std::string_view name, uint64_t v) {
+  char buf[24];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  put_attribute(out, name, std::string_view(buf, static_cast<size_t>(end - buf)));
+}
+
+}  // namespace
+
+// The element tree of write_sdf3, built with pugixml and printed as a whole: the twin of the
+// streaming writer below (tests compare them byte for byte), and the writer for <sdfProperties>
+// nested too deep to indent.
+std::string detail::write_sdf3_tree(const Graph& g) {
   const auto ports = port_names(g);
   const Adjacency adj(g);
   pugi::xml_document doc;
@@ -963,6 +1002,101 @@ std::string write_sdf3(const Graph& g) {
   std::ostringstream out;
   doc.save(out, "  ", depth.deep ? pugi::format_raw : pugi::format_default, pugi::encoding_utf8);
   return out.str();
+}
+
+// Streams the elements into the text (the document tree of 10^6 actors took about 2 GB), with
+// only <sdfProperties> built as a tree (it is small, and times are merged into it). Port names
+// invented for a graph without any are counted per actor as port_names() does, without strings.
+std::string write_sdf3(const Graph& g) {
+  pugi::xml_document kept;
+  pugi::xml_node app = kept.append_child("applicationGraph");
+  write_properties(g, app);
+  const pugi::xml_node props = app.child("sdfProperties");
+  constexpr int kIndentDepth = 32;  // as in write_sdf3_tree
+  struct Depth : pugi::xml_tree_walker {
+    bool deep = false;
+    bool for_each(pugi::xml_node&) override {
+      deep = depth() > kIndentDepth;
+      return !deep;
+    }
+  } depth;
+  app.traverse(depth);
+  if (depth.deep) return detail::write_sdf3_tree(g);
+
+  bool any_named = false;
+  for (ChannelId c = 0; c < g.channel_count() && !any_named; ++c)
+    any_named = !g.src_port(c).empty() || !g.dst_port(c).empty();
+  std::vector<std::pair<std::string, std::string>> named;  // only when some ports are named
+  std::vector<uint32_t> out_k, in_k;                       // otherwise "out<k>" / "in<k>"
+  if (any_named) {
+    named = port_names(g);
+  } else {
+    out_k.resize(g.channel_count());
+    in_k.resize(g.channel_count());
+    std::vector<uint32_t> next(g.actor_count(), 0);
+    for (ChannelId c = 0; c < g.channel_count(); ++c) {
+      out_k[c] = next[g.channel(c).src]++;
+      in_k[c] = next[g.channel(c).dst]++;
+    }
+  }
+  std::string scratch;
+  auto port = [&](ChannelId c, bool out) -> std::string_view {
+    if (any_named) return out ? named[c].first : named[c].second;
+    scratch = out ? "out" : "in";
+    scratch += std::to_string(out ? out_k[c] : in_k[c]);
+    return scratch;
+  };
+
+  const Adjacency adj(g);
+  std::string out;
+  // Generous: reserved pages that are never written are never resident, while growing the
+  // string would copy it (a channel with its two ports takes about 250 bytes at 10^6 actors).
+  out.reserve(4096 + g.actor_count() * 96 + g.channel_count() * 384);
+  out += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<sdf3 type=\"sdf\" version=\"1.0\">\n";
+  const std::string name = g.name.empty() ? "graph" : g.name;
+  out += "  <applicationGraph";
+  put_attribute(out, "name", name);
+  out += ">\n    <sdf";
+  put_attribute(out, "name", name);
+  put_attribute(out, "type", g.type.empty() ? name : g.type);
+  out += g.actor_count() == 0 ? " />\n" : ">\n";  // no actors, no channels: an empty element
+  for (ActorId a = 0; a < g.actor_count(); ++a) {
+    out += "      <actor";
+    put_attribute(out, "name", g.actor_name(a));
+    const std::string_view type = g.actor_type(a);
+    put_attribute(out, "type", type.empty() ? std::string_view(g.actor_name(a)) : type);
+    if (adj.inputs(a).empty() && adj.outputs(a).empty()) {
+      out += " />\n";
+      continue;
+    }
+    out += ">\n";
+    for (const bool output : {false, true})
+      for (ChannelId c : output ? adj.outputs(a) : adj.inputs(a)) {
+        out += "        <port";
+        put_attribute(out, "name", port(c, output));
+        put_attribute(out, "type", output ? "out" : "in");
+        put_number(out, "rate", output ? g.channel(c).prd : g.channel(c).cns);
+        out += " />\n";
+      }
+    out += "      </actor>\n";
+  }
+  for (ChannelId c = 0; c < g.channel_count(); ++c) {
+    const Channel& ch = g.channel(c);
+    out += "      <channel";
+    put_attribute(out, "name", g.channel_name(c));
+    put_attribute(out, "srcActor", g.actor_name(ch.src));
+    put_attribute(out, "srcPort", port(c, true));
+    put_attribute(out, "dstActor", g.actor_name(ch.dst));
+    put_attribute(out, "dstPort", port(c, false));
+    if (ch.delay != 0) put_number(out, "initialTokens", ch.delay);
+    out += " />\n";
+  }
+  if (g.actor_count() != 0) out += "    </sdf>\n";
+  std::ostringstream p;
+  props.print(p, "  ", pugi::format_default, pugi::encoding_utf8, 2);
+  out += p.str();
+  out += "  </applicationGraph>\n</sdf3>\n";
+  return out;
 }
 
 }  // namespace sdf

@@ -487,6 +487,62 @@ TEST(Writers, RoundTripRandomGraphsThroughBothFormats) {
   }
 }
 
+// The streaming SDF3 writer against its twin, the document tree printed by pugixml: the same
+// bytes on random graphs with names of every awkward kind (markup characters, quotes, control
+// characters, non-ASCII), actor types, times, delays, actors without ports, and ports named on
+// all, some or none of the channels (invented names must avoid the given ones).
+TEST(Writers, StreamingSdf3WriterMatchesTheTreeWriter) {
+  crowddb::Rng rng(31);
+  const char* pieces[] = {"a",    "&",    "<",        ">", "\"", "'", "\t",  "\n",   "\r",
+                          "\x01", "\x1f", "\xc3\xa9", " ", "->", "#", "in0", "out1", "]]>"};
+  auto word = [&] {
+    std::string w = "x";
+    for (uint64_t k = rng.below(4); k > 0; --k) w += pieces[rng.below(std::size(pieces))];
+    return w;
+  };
+  for (int i = 0; i < 400; ++i) {
+    gen::Spec spec;
+    spec.shape = static_cast<gen::Shape>(i % 6);
+    spec.actors = 1 + static_cast<uint32_t>(rng.below(10));
+    spec.self_loops = i % 4 == 0;
+    const Graph base = gen::generate(spec, rng).graph;
+    Graph g;
+    if (i % 3 == 0) g.name = word();
+    if (i % 5 == 0) g.type = word();
+    std::vector<ActorId> ids;
+    for (ActorId a = 0; a < base.actor_count(); ++a)
+      ids.push_back(g.add_actor(i % 2 ? base.actor_name(a) + word() : base.actor_name(a)));
+    if (i % 7 == 0) g.add_actor("lonely");  // no ports: a self-closing element
+    for (ActorId a = 0; a < base.actor_count(); ++a) {
+      if (rng.below(3) == 0) g.set_actor_type(a, word());
+      if (rng.below(2) == 0) g.set_actor_time(a, rng.below(1000));
+    }
+    const int naming = i % 3;  // 0: no port names, 1: all, 2: some
+    for (ChannelId c = 0; c < base.channel_count(); ++c) {
+      const Channel& ch = base.channel(c);
+      const ChannelId id = g.add_channel(ids[ch.src], ids[ch.dst], ch.prd, ch.cns,
+                                         rng.below(3) == 0 ? rng.below(50) : 0,
+                                         i % 4 == 1 ? word() + std::to_string(c) : std::string());
+      if (naming == 1 || (naming == 2 && rng.below(2) == 0))
+        g.set_port_names(id, "out" + std::to_string(c % 3) + word() + std::to_string(c),
+                         "in" + std::to_string(c % 2) + word() + std::to_string(c));
+    }
+    ASSERT_EQ(write_sdf3(g), detail::write_sdf3_tree(g)) << i;
+  }
+  int files = 0;  // and every graph file of the tests (kept <sdfProperties>, SDF3 port names)
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(test::data(""))) {
+    Graph g;
+    try {
+      g = read_graph_file(entry.path().string());
+    } catch (const Error&) {
+      continue;  // the files that test errors
+    }
+    EXPECT_EQ(write_sdf3(g), detail::write_sdf3_tree(g)) << entry.path();
+    ++files;
+  }
+  EXPECT_GT(files, 10);
+}
+
 // Everything read comes back: names, ports, actor types, execution times and the rest of
 // <sdfProperties>, through SDF3, JSON and JSON-then-SDF3, for every graph file of the tests.
 TEST(Writers, ConvertLosesNothingOnEveryDataFile) {
