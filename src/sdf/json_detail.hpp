@@ -40,6 +40,9 @@ void read_sdf3_properties(Graph& g, std::string_view xml, const std::string& sou
 Graph read_sdf3_released(std::string_view text, const std::string& source,
                          const std::function<void(size_t)>& release);
 
+// write_json through an nlohmann document, dumped whole: the streaming writer's twin.
+std::string write_json_tree(const Graph& g);
+
 // write_sdf3 through a pugixml document tree, printed whole: the streaming writer's twin (the
 // same bytes), and its fallback for <sdfProperties> nested too deep to indent.
 std::string write_sdf3_tree(const Graph& g);

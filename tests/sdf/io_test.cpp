@@ -487,14 +487,16 @@ TEST(Writers, RoundTripRandomGraphsThroughBothFormats) {
   }
 }
 
-// The streaming SDF3 writer against its twin, the document tree printed by pugixml: the same
-// bytes on random graphs with names of every awkward kind (markup characters, quotes, control
-// characters, non-ASCII), actor types, times, delays, actors without ports, and ports named on
-// all, some or none of the channels (invented names must avoid the given ones).
-TEST(Writers, StreamingSdf3WriterMatchesTheTreeWriter) {
+// The streaming writers against their twins, the documents built with pugixml and nlohmann and
+// printed whole: the same bytes on random graphs with names of every awkward kind (markup
+// characters, quotes, backslashes, control characters, non-ASCII), actor types, times, delays,
+// kept <sdfProperties>, actors without ports, and ports named on all, some or none of the
+// channels (invented names must avoid the given ones).
+TEST(Writers, StreamingWritersMatchTheirTrees) {
   crowddb::Rng rng(31);
-  const char* pieces[] = {"a",    "&",    "<",        ">", "\"", "'", "\t",  "\n",   "\r",
-                          "\x01", "\x1f", "\xc3\xa9", " ", "->", "#", "in0", "out1", "]]>"};
+  const char* pieces[] = {"a",  "&",    "<",    ">",   "\"",   "'",  "\t",   "\n",
+                          "\r", "\x01", "\x1f", "\\",  "\b",   "\f", "\x7f", "\xc3\xa9",
+                          " ",  "->",   "#",    "in0", "out1", "]]>"};
   auto word = [&] {
     std::string w = "x";
     for (uint64_t k = rng.below(4); k > 0; --k) w += pieces[rng.below(std::size(pieces))];
@@ -513,6 +515,7 @@ TEST(Writers, StreamingSdf3WriterMatchesTheTreeWriter) {
     for (ActorId a = 0; a < base.actor_count(); ++a)
       ids.push_back(g.add_actor(i % 2 ? base.actor_name(a) + word() : base.actor_name(a)));
     if (i % 7 == 0) g.add_actor("lonely");  // no ports: a self-closing element
+    if (i % 6 == 0) g.sdf3_properties = "<sdfProperties>" + word() + "</sdfProperties>";
     for (ActorId a = 0; a < base.actor_count(); ++a) {
       if (rng.below(3) == 0) g.set_actor_type(a, word());
       if (rng.below(2) == 0) g.set_actor_time(a, rng.below(1000));
@@ -528,7 +531,9 @@ TEST(Writers, StreamingSdf3WriterMatchesTheTreeWriter) {
                          "in" + std::to_string(c % 2) + word() + std::to_string(c));
     }
     ASSERT_EQ(write_sdf3(g), detail::write_sdf3_tree(g)) << i;
+    ASSERT_EQ(write_json(g), detail::write_json_tree(g)) << i;
   }
+  EXPECT_EQ(write_json(Graph{}), detail::write_json_tree(Graph{}));
   int files = 0;  // and every graph file of the tests (kept <sdfProperties>, SDF3 port names)
   for (const auto& entry : std::filesystem::recursive_directory_iterator(test::data(""))) {
     Graph g;
@@ -538,6 +543,7 @@ TEST(Writers, StreamingSdf3WriterMatchesTheTreeWriter) {
       continue;  // the files that test errors
     }
     EXPECT_EQ(write_sdf3(g), detail::write_sdf3_tree(g)) << entry.path();
+    EXPECT_EQ(write_json(g), detail::write_json_tree(g)) << entry.path();
     ++files;
   }
   EXPECT_GT(files, 10);
