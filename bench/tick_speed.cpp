@@ -34,6 +34,7 @@
 #include "airport_scenario.hpp"
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
+#include "util/rng.hpp"
 
 using namespace crowddb;
 using Clock = std::chrono::steady_clock;
@@ -69,11 +70,8 @@ void insert_lattice(World& w, std::size_t n) {
   const double cell = side / static_cast<double>(per_row);
   const double jitter = cell / 2 - spec.radius - 0.01;
   uint64_t state = 3;
-  auto uniform = [&] {  // splitmix64 in [-1, 1)
-    uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-52 - 1;
+  auto uniform = [&] {  // in [-1, 1)
+    return static_cast<double>(splitmix64(state) >> 11) * 0x1.0p-52 - 1;
   };
   const auto goals = static_cast<uint32_t>(w.goals().size());
   for (std::size_t k = 0; k < n; ++k) {

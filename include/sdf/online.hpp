@@ -165,8 +165,9 @@ struct OnlineRun {
   bool runs_listed = false;
   std::vector<uint64_t> cycle_fired;  // per actor, firings in the period / cycle
   std::optional<ChannelId> channel;   // `unbounded`: the channel past its cap
-  uint64_t decisions_explored = 0;    // decisions taken by the detection pass
-  Metrics metrics;                    // buffers and fairness over the window
+  std::vector<ActorId> stuck;  // `deadlock`: actors below their count in the iteration (sorted)
+  uint64_t decisions_explored = 0;  // decisions taken by the detection pass
+  Metrics metrics;                  // buffers and fairness over the window
 };
 
 // q: the repetitions vector (for caps, bounded mode and metrics). start: the scheduler to run

@@ -766,111 +766,75 @@ std::string write_json(const Graph& g) {
   std::string out;
   // Generous: pages reserved and never written are never resident.
   out.reserve(4096 + g.actor_count() * 64 + g.channel_count() * 192 + g.sdf3_properties.size() * 2);
-  const char* sep = "\n";  // before each member of the top-level object
-  out += '{';
-  auto key = [&](const char* indent, const char* k) {
+  // A member of an object: its separator (a line break, after a comma but for the first), its
+  // indentation and its key. `first` is the object's own flag.
+  auto field = [&](bool& first, const char* indent, const char* k) {
+    out += first ? "\n" : ",\n";
+    first = false;
     out += indent;
     out += '"';
     out += k;
     out += "\": ";
   };
-  if (!g.name.empty()) {
-    out += sep;
-    key(" ", "name");
-    put_json_string(out, g.name);
-    sep = ",\n";
-  }
-  if (!g.type.empty() && g.type != g.name) {
-    out += sep;
-    key(" ", "type");
-    put_json_string(out, g.type);
-    sep = ",\n";
-  }
-  char digits[24];
-  auto number = [&](uint64_t v) {
+  auto text = [&](bool& first, const char* indent, const char* k, std::string_view v) {
+    field(first, indent, k);
+    put_json_string(out, v);
+  };
+  auto number = [&](bool& first, const char* k, uint64_t v) {
+    field(first, "   ", k);
+    char digits[24];
     const auto [end, ec] = std::to_chars(digits, digits + sizeof digits, v);
     out.append(digits, end);
   };
-  out += sep;
-  key(" ", "actors");
-  if (g.actor_count() == 0) {
-    out += "[]";
-  } else {
+  // An array of objects, one per index, each written by `element`.
+  auto array = [&](bool& top, const char* k, size_t n, auto&& element) {
+    field(top, " ", k);
+    if (n == 0) {
+      out += "[]";
+      return;
+    }
     out += '[';
-    for (ActorId a = 0; a < g.actor_count(); ++a) {
-      out += a == 0 ? "\n  {\n" : ",\n  {\n";
-      key("   ", "name");
-      put_json_string(out, g.actor_name(a));
-      if (!g.actor_type(a).empty()) {
-        out += ",\n";
-        key("   ", "type");
-        put_json_string(out, g.actor_type(a));
-      }
-      if (const auto t = g.actor_time(a)) {
-        out += ",\n";
-        key("   ", "time");
-        number(*t);
-      }
+    for (size_t i = 0; i < n; ++i) {
+      out += i == 0 ? "\n  {" : ",\n  {";
+      bool first = true;
+      element(i, first);
       out += "\n  }";
     }
     out += "\n ]";
-  }
-  out += ",\n";
-  key(" ", "channels");
-  if (g.channel_count() == 0) {
-    out += "[]";
-  } else {
-    out += '[';
-    std::unordered_map<uint64_t, uint32_t> parallel;
-    std::string default_name;
-    for (ChannelId id = 0; id < g.channel_count(); ++id) {
-      const Channel& c = g.channel(id);
-      out += id == 0 ? "\n  {\n" : ",\n  {\n";
-      key("   ", "src");
-      put_json_string(out, g.actor_name(c.src));
-      out += ",\n";
-      key("   ", "dst");
-      put_json_string(out, g.actor_name(c.dst));
-      out += ",\n";
-      key("   ", "prd");
-      number(c.prd);
-      out += ",\n";
-      key("   ", "cns");
-      number(c.cns);
-      out += ",\n";
-      key("   ", "delay");
-      number(c.delay);
-      const uint32_t k = parallel[(static_cast<uint64_t>(c.src) << 32) | c.dst]++;
-      default_name = g.actor_name(c.src);
-      default_name += "->";
-      default_name += g.actor_name(c.dst);
-      default_name += '#';
-      default_name += std::to_string(k);
-      const std::string_view name = g.channel_name(id);
-      if (name != default_name) {
-        out += ",\n";
-        key("   ", "name");
-        put_json_string(out, name);
-      }
-      if (!g.src_port(id).empty()) {
-        out += ",\n";
-        key("   ", "src_port");
-        put_json_string(out, g.src_port(id));
-      }
-      if (!g.dst_port(id).empty()) {
-        out += ",\n";
-        key("   ", "dst_port");
-        put_json_string(out, g.dst_port(id));
-      }
-      out += "\n  }";
-    }
-    out += "\n ]";
-  }
-  if (!g.sdf3_properties.empty()) {
-    out += ",\n";
-    key(" ", "sdf3_properties");
-    put_json_string(out, g.sdf3_properties);
-  }
+  };
+
+  bool top = true;
+  out += '{';
+  if (!g.name.empty()) text(top, " ", "name", g.name);
+  if (!g.type.empty() && g.type != g.name) text(top, " ", "type", g.type);
+  array(top, "actors", g.actor_count(), [&](size_t i, bool& first) {
+    const auto a = static_cast<ActorId>(i);
+    text(first, "   ", "name", g.actor_name(a));
+    if (!g.actor_type(a).empty()) text(first, "   ", "type", g.actor_type(a));
+    if (const auto t = g.actor_time(a)) number(first, "time", *t);
+  });
+  std::unordered_map<uint64_t, uint32_t> parallel;
+  std::string default_name;
+  array(top, "channels", g.channel_count(), [&](size_t i, bool& first) {
+    const auto id = static_cast<ChannelId>(i);
+    const Channel& c = g.channel(id);
+    text(first, "   ", "src", g.actor_name(c.src));
+    text(first, "   ", "dst", g.actor_name(c.dst));
+    number(first, "prd", c.prd);
+    number(first, "cns", c.cns);
+    number(first, "delay", c.delay);
+    const uint32_t k = parallel[(static_cast<uint64_t>(c.src) << 32) | c.dst]++;
+    default_name = g.actor_name(c.src);
+    default_name += "->";
+    default_name += g.actor_name(c.dst);
+    default_name += '#';
+    default_name += std::to_string(k);
+    const std::string_view name = g.channel_name(id);
+    if (name != default_name) text(first, "   ", "name", name);
+    if (!g.src_port(id).empty()) text(first, "   ", "src_port", g.src_port(id));
+    if (!g.dst_port(id).empty()) text(first, "   ", "dst_port", g.dst_port(id));
+  });
+  if (!g.sdf3_properties.empty()) text(top, " ", "sdf3_properties", g.sdf3_properties);
   out += "\n}\n";
   return out;
 }

@@ -472,6 +472,8 @@ OnlineRun run_online(const Graph& g, std::span<const uint64_t> q, const OnlineSc
     }
     if (!s.step()) {
       out.outcome = Outcome::deadlock;
+      for (ActorId a = 0; a < g.actor_count(); ++a)
+        if (s.iteration_counts()[a] < q[a]) out.stuck.push_back(a);
       break;
     }
     if (s.exceeded_channel()) {

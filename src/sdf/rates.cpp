@@ -171,15 +171,7 @@ RateChangeResult simulate_rate_change(const Graph& g, Policy policy, const RateC
   const OnlineRun after = run_online(g2, out.q_after, s, opts);
   out.outcome = after.outcome;
   out.channel = after.channel;
-  if (after.outcome == Outcome::deadlock) {
-    // The actors below their count in the iteration under way when nothing can fire, as the
-    // static path reports them: the run is replayed to where it stopped.
-    OnlineScheduler r = s;
-    for (uint64_t i = 0; i <= after.decisions_explored && r.step(); ++i) {
-    }
-    for (ActorId a = 0; a < g2.actor_count(); ++a)
-      if (r.iteration_counts()[a] < out.q_after[a]) out.stuck.push_back(a);
-  }
+  out.stuck = after.stuck;
   if (after.outcome == Outcome::returns || after.outcome == Outcome::periodic) {
     out.firings_until_periodic = after.transient_firings;
     out.period_firings = after.cycle_firings;

@@ -904,6 +904,22 @@ Graph read_sdf3_with(std::string_view text, const std::string& source,
 
 namespace {
 
+// Whether <sdfProperties> nests deeper than any real file. The writers indent unless it does:
+// indentation grows with the depth on every line, so a 2.1 MB file of 300,000 nested elements
+// would have been written as tens of gigabytes; unindented, the output stays in proportion.
+bool too_deep_to_indent(pugi::xml_node props) {
+  constexpr int kIndentDepth = 32;
+  struct Depth : pugi::xml_tree_walker {
+    bool deep = false;
+    bool for_each(pugi::xml_node&) override {
+      deep = depth() > kIndentDepth;
+      return !deep;  // stops the walk
+    }
+  } walk;
+  props.traverse(walk);  // iterative in pugixml: no recursion
+  return walk.deep;
+}
+
 // An attribute as pugixml's default format writes it: double quotes; &, <, " and control
 // characters escaped (the latter as two-digit references); '>' is not.
 void put_attribute(std::string& out, std::string_view name, std::string_view v) {
@@ -987,20 +1003,10 @@ std::string detail::write_sdf3_tree(const Graph& g) {
       e.append_attribute("initialTokens") = static_cast<unsigned long long>(ch.delay);
   }
   write_properties(g, app);
-  // Indented, unless <sdfProperties> nests deeper than any real file: indentation grows with
-  // the depth on every line, so a 2.1 MB file of 300,000 nested elements would have been written
-  // as tens of gigabytes. Unindented, the output stays in proportion to the graph.
-  constexpr int kIndentDepth = 32;
-  struct Depth : pugi::xml_tree_walker {
-    bool deep = false;
-    bool for_each(pugi::xml_node&) override {
-      deep = depth() > kIndentDepth;
-      return !deep;  // stops the walk
-    }
-  } depth;
-  app.child("sdfProperties").traverse(depth);  // iterative in pugixml: no recursion
   std::ostringstream out;
-  doc.save(out, "  ", depth.deep ? pugi::format_raw : pugi::format_default, pugi::encoding_utf8);
+  doc.save(out, "  ",
+           too_deep_to_indent(app.child("sdfProperties")) ? pugi::format_raw : pugi::format_default,
+           pugi::encoding_utf8);
   return out.str();
 }
 
@@ -1012,16 +1018,7 @@ std::string write_sdf3(const Graph& g) {
   pugi::xml_node app = kept.append_child("applicationGraph");
   write_properties(g, app);
   const pugi::xml_node props = app.child("sdfProperties");
-  constexpr int kIndentDepth = 32;  // as in write_sdf3_tree
-  struct Depth : pugi::xml_tree_walker {
-    bool deep = false;
-    bool for_each(pugi::xml_node&) override {
-      deep = depth() > kIndentDepth;
-      return !deep;
-    }
-  } depth;
-  app.traverse(depth);
-  if (depth.deep) return detail::write_sdf3_tree(g);
+  if (too_deep_to_indent(props)) return detail::write_sdf3_tree(g);
 
   bool any_named = false;
   for (ChannelId c = 0; c < g.channel_count() && !any_named; ++c)
