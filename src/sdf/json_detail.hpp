@@ -49,8 +49,11 @@ std::string write_sdf3_tree(const Graph& g);
 
 // Where read_sdf3 runs its scan of the text: on a thread of its own beside the graph builder
 // (`own`), on the calling thread (`caller`), or (`automatic`) on its own for texts of a megabyte
-// and more on a machine with two or more cores. The graph and the first error are the same.
-enum class ScanThread { automatic, caller, own };
+// and more on a machine with two or more cores. On its own thread the scan also looks up the
+// channels' actors and ports when the builder falls behind; `own_resolving` makes it do so
+// whenever it safely can, so that tests reach that path whatever the timing. The graph and the
+// first error are the same.
+enum class ScanThread { automatic, caller, own, own_resolving };
 // read_sdf3 with its knobs: release as read_sdf3_released (may be null); the scan hands the
 // builder `block` actors or channels at a time (1024 in read_sdf3).
 Graph read_sdf3_with(std::string_view text, const std::string& source,

@@ -100,12 +100,18 @@ struct Port {
 static_assert(sizeof(Port) == 32);
 static_assert(std::endian::native == std::endian::little);
 
-// A <channel> as read, resolved when its actors are known.
+// A <channel> as read, resolved when its actors are known. On two threads the scan looks up
+// its actors and ports ahead of the builder where it safely can (see pre_resolve): then `ids`
+// and `ports` hold them, else kUnresolved.
 struct ChannelRecord {
+  static constexpr uint32_t kUnresolved = UINT32_MAX;
   std::string_view name, src, src_port, dst, dst_port;
   bool has_name = false;
   uint64_t delay = 0;
   size_t offset;
+  uint32_t ids[2] = {kUnresolved, kUnresolved};    // source, destination actor
+  uint32_t ports[2] = {kUnresolved, kUnresolved};  // their ports, indices into the builder's ports_
+  bool resolved() const { return ports[1] != kUnresolved; }
 };
 
 // An <actor> as read, added to the graph with the next hand-over.
@@ -171,6 +177,11 @@ class SegmentPipe {
     return s;
   }
   bool stopped() const { return stopped_flag_.load(std::memory_order_relaxed); }
+  // How many segments wait for the builder.
+  size_t queued() const {
+    const std::lock_guard lock(m_);
+    return full_.size();
+  }
   // The first offset a queued or building segment still points into (SIZE_MAX: none).
   size_t needed_from() const {
     const std::lock_guard lock(m_);
@@ -230,13 +241,15 @@ class SegmentPipe {
 class Sdf3Reader {
  public:
   Sdf3Reader(std::string_view text, const std::string& source,
-             const std::function<void(size_t)>* release, size_t block, bool two_threads)
+             const std::function<void(size_t)>* release, size_t block, bool two_threads,
+             bool always_resolve)
       : text_(text),
         source_(source),
         scan_(text),
         release_(release),
         block_(std::max<size_t>(1, block)),
-        two_threads_(two_threads) {}
+        two_threads_(two_threads),
+        always_resolve_(always_resolve) {}
 
   Graph read() {
     reserve();
@@ -281,7 +294,9 @@ class Sdf3Reader {
   // required attributes make it 60. A malformed file then costs no more before its first
   // error than a valid one of its size.
   void reserve() {
-    size_t actors = 0, channels = 0;
+    struct Count {
+      size_t actors = 0, channels = 0;
+    };
     auto named = [&](size_t at, std::string_view name) {
       if (!same(text_.substr(at + 1, name.size()), name)) return false;
       const size_t after = at + 1 + name.size();
@@ -289,13 +304,42 @@ class Sdf3Reader {
              (text_[after] == '/' || text_[after] == '>' || text_[after] == ' ' ||
               text_[after] == '\t' || text_[after] == '\n' || text_[after] == '\r');
     };
-    detail::for_each_lt(text_, [&](size_t at) {
-      actors += named(at, "actor");
-      channels += named(at, "channel");
-      // The count reads the whole text: what it has passed is dropped as it goes (the scan
-      // faults it in again from the page cache), so the file is never resident at once.
-      if (release_ && at >= released_ + kReleaseStep) (*release_)(released_ = at);
-    });
+    // Counts the tags that begin in [from, to); `release`: drops what it has passed.
+    auto count_tags = [&](size_t from, size_t to, bool release) {
+      Count c;
+      detail::for_each_lt(text_.substr(from, to - from), [&](size_t i) {
+        c.actors += named(from + i, "actor");
+        c.channels += named(from + i, "channel");
+        // The count reads the whole text: what it has passed is dropped as it goes (the scan
+        // faults it in again from the page cache), so the file is never resident at once.
+        if (release && release_ && from + i >= released_ + kReleaseStep)
+          (*release_)(released_ = from + i);
+      });
+      return c;
+    };
+    // On two threads the second half is counted beside the first. Only the first half's count
+    // drops pages as it goes (the release callback runs on one thread at a time): the second
+    // half stays resident until both are done, while nothing else is allocated yet.
+    constexpr size_t kSplitBytes = size_t{16} << 20;
+    Count first, second;
+    const size_t half =
+        two_threads_ && text_.size() >= kSplitBytes ? text_.size() / 2 : text_.size();
+    std::thread helper;
+    struct Join {
+      std::thread& t;
+      ~Join() {
+        if (t.joinable()) t.join();
+      }
+    } join{helper};
+    if (half < text_.size()) {
+      try {
+        helper = std::thread([&] { second = count_tags(half, text_.size(), false); });
+      } catch (const std::system_error&) {  // no thread: one count
+      }
+    }
+    first = count_tags(0, helper.joinable() ? half : text_.size(), true);
+    if (helper.joinable()) helper.join();
+    const size_t actors = first.actors + second.actors, channels = first.channels + second.channels;
     if (release_) (*release_)(text_.size());
     released_ = 0;
     release_at_ = kReleaseStep;
@@ -401,11 +445,15 @@ class Sdf3Reader {
 
   // Hands over the closed actors, and the channels read if `channels`, to the builder.
   void hand_over(bool channels) {
-    if (channels) std::swap(cur_.channels, channels_);  // cur_.channels is empty
+    if (channels) {
+      pre_resolve(channels_);
+      std::swap(cur_.channels, channels_);  // cur_.channels is empty
+    }
     Segment next = pipe_ ? pipe_->fresh() : std::move(spare_);
     next.clear();
     std::swap(next, cur_);
     if (pipe_) {
+      actors_pushed_ += next.actors.size();
       pipe_->push(std::move(next));
     } else {
       build(next);
@@ -426,6 +474,60 @@ class Sdf3Reader {
     cur_.error = msg;
     hand_over(true);  // on one thread this throws the error
     throw StopScan{};
+  }
+
+  // Among the channels the builder has the larger share of the work, most of it looking up
+  // each channel's two actors and their ports: cache misses in tables of 10^6 entries. When the
+  // builder falls behind (kBehind segments wait for it), the scan does those lookups for a block
+  // of channels before handing it over, so the two threads share the work as it comes. It may
+  // only while no actor it has handed over is still being added (actors_built_ ==
+  // actors_pushed_): then the actor table,
+  // port_begin_ and the ports' names, types and rates stay as they are until the scan hands
+  // over its next actors, so reading them here races with nothing (the builder still writes
+  // the ports' `channel`, a field of its own). It only finds: what it cannot find (an actor not
+  // added yet, a port that is not there) stays unresolved for the builder, which also makes
+  // every check, so the graph and the first error are those of one thread.
+  static constexpr size_t kBehind = 2;
+  void pre_resolve(std::vector<ChannelRecord>& records) {
+    if (!pipe_ || records.empty() || (!always_resolve_ && pipe_->queued() < kBehind) ||
+        actors_built_.load(std::memory_order_acquire) != actors_pushed_)
+      return;
+    const size_t n = records.size();
+    scan_names_.resize(2 * n);
+    scan_ids_.resize(2 * n);
+    for (size_t i = 0; i < n; ++i)
+      scan_names_[2 * i] = records[i].src, scan_names_[2 * i + 1] = records[i].dst;
+    g_.find_actors(scan_names_, scan_ids_);
+    auto ahead = [&](size_t k, int stage) {  // as in resolve
+      if (k >= n) return;
+      for (size_t side = 0; side < 2; ++side) {
+        const int64_t a = scan_ids_[2 * k + side];
+        if (a < 0) continue;
+        const auto id = static_cast<size_t>(a);
+        if (stage == 0) {
+          detail::prefetch(&port_begin_[id]);
+        } else if (port_begin_[id] != port_begin_[id + 1]) {
+          const Port& p = ports_[port_begin_[id]];
+          if (stage == 1)
+            detail::prefetch(&p);
+          else
+            detail::prefetch(p.name().data());
+        }
+      }
+    };
+    for (size_t i = 0; i < n; ++i) {
+      ahead(i + 24, 0);
+      ahead(i + 16, 1);
+      ahead(i + 8, 2);
+      ChannelRecord& r = records[i];
+      const int64_t s = scan_ids_[2 * i], d = scan_ids_[2 * i + 1];
+      if (s < 0 || d < 0) continue;
+      const uint32_t sp = port_index(static_cast<ActorId>(s), r.src_port);
+      const uint32_t dp = port_index(static_cast<ActorId>(d), r.dst_port);
+      if (sp == ChannelRecord::kUnresolved || dp == ChannelRecord::kUnresolved) continue;
+      r.ids[0] = static_cast<uint32_t>(s), r.ids[1] = static_cast<uint32_t>(d);
+      r.ports[0] = sp, r.ports[1] = dp;
+    }
   }
 
   // Releases the text before `at` that no record still points into.
@@ -580,6 +682,7 @@ class Sdf3Reader {
     }
     ports_.insert(ports_.end(), s.ports.begin(), s.ports.end());
     for (uint32_t n : s.port_counts) port_begin_.push_back(port_begin_.back() + n);
+    actors_built_.store(g_.actor_count(), std::memory_order_release);  // see pre_resolve
   }
 
   void finish() {
@@ -604,17 +707,29 @@ class Sdf3Reader {
   // otherwise the channels from the first one naming an unknown actor on are deferred.
   void resolve(std::vector<ChannelRecord>& records, bool last_chance) {
     if (records.empty()) return;
-    names_.resize(2 * records.size());
+    // The actors of the channels the scan has not resolved, looked up in one batch.
+    names_.clear();
+    for (const ChannelRecord& r : records)
+      if (!r.resolved()) names_.push_back(r.src), names_.push_back(r.dst);
+    found_.resize(names_.size());
+    g_.find_actors(names_, found_);
     ids_.resize(2 * records.size());
-    for (size_t i = 0; i < records.size(); ++i)
-      names_[2 * i] = records[i].src, names_[2 * i + 1] = records[i].dst;
-    g_.find_actors(names_, ids_);
+    for (size_t i = 0, u = 0; i < records.size(); ++i) {
+      const ChannelRecord& r = records[i];
+      for (size_t side = 0; side < 2; ++side)
+        ids_[2 * i + side] = r.resolved() ? int64_t{r.ids[side]} : found_[u++];
+    }
     std::vector<Graph::NewChannel> batch;
     batch.reserve(records.size());
     // The ports of random actors are cache misses: the port ranges, then the first ports, then
     // their names are fetched ahead, overlapping the misses of later channels.
     auto ahead = [&](size_t k, int stage) {
       if (k >= records.size()) return;
+      if (records[k].resolved()) {  // only the two ports, for their `channel`
+        if (stage == 0)
+          for (const uint32_t p : records[k].ports) detail::prefetch(&ports_[p]);
+        return;
+      }
       for (size_t side = 0; side < 2; ++side) {
         const int64_t a = ids_[2 * k + side];
         if (a < 0) continue;
@@ -645,8 +760,10 @@ class Sdf3Reader {
              "channel refers to an unknown actor '" + std::string(s < 0 ? r.src : r.dst) + "'");
       }
       const auto src = static_cast<ActorId>(s), dst = static_cast<ActorId>(d);
-      Port& sp = find_port_or_flush(records, batch, r, src, r.src_port);
-      Port& dp = find_port_or_flush(records, batch, r, dst, r.dst_port);
+      Port& sp = r.resolved() ? ports_[r.ports[0]]
+                              : find_port_or_flush(records, batch, r, src, r.src_port);
+      Port& dp = r.resolved() ? ports_[r.ports[1]]
+                              : find_port_or_flush(records, batch, r, dst, r.dst_port);
       if (!sp.out)
         fail_in_batch(records, batch, r,
                       "srcPort '" + std::string(sp.name()) + "' is an input port");
@@ -674,19 +791,28 @@ class Sdf3Reader {
   Port& find_port_or_flush(std::vector<ChannelRecord>& records,
                            std::vector<Graph::NewChannel>& batch, const ChannelRecord& r,
                            ActorId actor, std::string_view name) {
-    const auto first = ports_.begin() + port_begin_[actor];
-    const auto last = ports_.begin() + port_begin_[actor + 1];
-    auto it = first;
-    if (last - first <= 8) {  // most actors have a few ports: a scan, no calls to memcmp
-      while (it != last && !same(it->name(), name)) ++it;
-    } else {
-      it = std::lower_bound(first, last, name,
-                            [](const Port& p, std::string_view k) { return p.name() < k; });
-    }
-    if (it == last || !same(it->name(), name))
+    const uint32_t i = port_index(actor, name);
+    if (i == ChannelRecord::kUnresolved)
       fail_in_batch(records, batch, r,
                     "actor '" + g_.actor_name(actor) + "' has no port '" + std::string(name) + "'");
-    return *it;
+    return ports_[i];
+  }
+
+  // The index in ports_ of the actor's port of that name, or kUnresolved. Reads only the ports'
+  // names (the scan calls it too, see pre_resolve).
+  uint32_t port_index(ActorId actor, std::string_view name) const {
+    const uint32_t first = port_begin_[actor], last = port_begin_[actor + 1];
+    uint32_t i = first;
+    if (last - first <= 8) {  // most actors have a few ports: a scan, no calls to memcmp
+      while (i != last && !same(ports_[i].name(), name)) ++i;
+    } else {
+      i = static_cast<uint32_t>(
+          std::lower_bound(ports_.begin() + first, ports_.begin() + last, name,
+                           [](const Port& p, std::string_view k) { return p.name() < k; }) -
+          ports_.begin());
+    }
+    if (i == last || !same(ports_[i].name(), name)) return ChannelRecord::kUnresolved;
+    return i;
   }
 
   // A mistake in channel r: the channels before it in the batch are added first (one of them
@@ -753,6 +879,7 @@ class Sdf3Reader {
   size_t release_at_ = 0;  // the offset at which to try releasing again
   const size_t block_;
   const bool two_threads_;
+  const bool always_resolve_;  // pre_resolve whenever it may, not only when the builder is behind
   SegmentPipe* pipe_ = nullptr;
   Segment cur_;    // closed actors and their ports (and the open actor's), not handed over
   Segment spare_;  // on one thread: the last segment built, for its buffers
@@ -774,7 +901,13 @@ class Sdf3Reader {
   std::vector<uint32_t> port_begin_{0};
   std::vector<ChannelRecord> deferred_;
   std::vector<std::string_view> names_;
-  std::vector<int64_t> ids_;
+  std::vector<int64_t> found_, ids_;
+  // Between the two: how many actors the builder has added (it writes, the scan reads), and
+  // the scan's count of actors handed over; see pre_resolve.
+  std::atomic<size_t> actors_built_{0};
+  size_t actors_pushed_ = 0;
+  std::vector<std::string_view> scan_names_;  // pre_resolve's
+  std::vector<int64_t> scan_ids_;
 };
 
 // Port names for writing: the ones read, else "in<k>"/"out<k>" avoiding names already taken.
@@ -893,10 +1026,10 @@ Graph read_sdf3_with(std::string_view text, const std::string& source,
                      const std::function<void(size_t)>* release, size_t block, ScanThread scan) {
   // A thread of its own pays from about a megabyte of text (some 10^4 actors) on.
   constexpr size_t kOwnThreadBytes = size_t{1} << 20;
-  const bool own =
-      scan == ScanThread::own || (scan == ScanThread::automatic && text.size() >= kOwnThreadBytes &&
-                                  std::thread::hardware_concurrency() > 1);
-  Sdf3Reader reader(text, source, release, block, own);
+  const bool own = scan == ScanThread::own || scan == ScanThread::own_resolving ||
+                   (scan == ScanThread::automatic && text.size() >= kOwnThreadBytes &&
+                    std::thread::hardware_concurrency() > 1);
+  Sdf3Reader reader(text, source, release, block, own, scan == ScanThread::own_resolving);
   return reader.read();
 }
 

@@ -6,6 +6,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <regex>
 
 #include "helpers.hpp"
 #include "sdf/generate.hpp"
@@ -441,9 +442,20 @@ TEST(Sdf3Reader, AScanOnItsOwnThreadReportsAsOnOne) {
   ASSERT_GT(text.size(), size_t{1} << 20);  // so that read_sdf3 takes a thread
   const size_t second = text.find("<actor", text.find("<actor") + 1);
   const size_t last_channel = text.rfind("<channel");
+  // Mistakes in a channel half way through the channels, where the scan looks up actors and
+  // ports ahead of the builder: a port that is not there, and a port connected twice.
+  const size_t mid = text.find("<channel", (text.find("<channel") + last_channel) / 2);
+  const size_t mid_end = text.find('\n', mid) + 1;
+  const std::string mid_line = text.substr(mid, mid_end - mid);
+  std::string no_port = text;
+  no_port.insert(no_port.find("dstPort=\"", mid) + 9, "no-");
+  std::string twice = text;
+  twice.insert(mid_end,
+               std::regex_replace(mid_line, std::regex("name=\"[^\"]*\""), "name=\"again\""));
   for (const std::string& bad :
        {text.substr(0, second) + "<actor name='a0'/>\n" + text.substr(second),
-        text.substr(0, last_channel) + text.substr(text.find('\n', last_channel) + 1), text}) {
+        text.substr(0, last_channel) + text.substr(text.find('\n', last_channel) + 1), no_port,
+        twice, text}) {
     std::string one;
     try {
       (void)detail::read_sdf3_with(bad, "f.xml", nullptr, 1024, detail::ScanThread::caller);
@@ -452,14 +464,15 @@ TEST(Sdf3Reader, AScanOnItsOwnThreadReportsAsOnOne) {
     }
     EXPECT_EQ(sdf3_error(bad), one);
     for (size_t block : {64, 1024})
-      EXPECT_EQ(
-          test::outcome([&] {
-            return detail::read_sdf3_with(bad, "f.xml", nullptr, block, detail::ScanThread::own);
-          }),
-          test::outcome([&] {
-            return detail::read_sdf3_with(bad, "f.xml", nullptr, block, detail::ScanThread::caller);
-          }))
-          << block;
+      for (const detail::ScanThread own :
+           {detail::ScanThread::own, detail::ScanThread::own_resolving})
+        EXPECT_EQ(test::outcome(
+                      [&] { return detail::read_sdf3_with(bad, "f.xml", nullptr, block, own); }),
+                  test::outcome([&] {
+                    return detail::read_sdf3_with(bad, "f.xml", nullptr, block,
+                                                  detail::ScanThread::caller);
+                  }))
+            << block;
   }
   EXPECT_NE(sdf3_error(text.substr(0, second) + "<actor name='a0'/>\n" + text.substr(second))
                 .find("duplicate actor name 'a0'"),
@@ -468,6 +481,9 @@ TEST(Sdf3Reader, AScanOnItsOwnThreadReportsAsOnOne) {
       sdf3_error(text.substr(0, last_channel) + text.substr(text.find('\n', last_channel) + 1))
           .find("is not connected to a channel"),
       std::string::npos);
+  EXPECT_NE(sdf3_error(no_port).find("has no port 'no-"), std::string::npos) << sdf3_error(no_port);
+  EXPECT_NE(sdf3_error(twice).find("is already connected to channel"), std::string::npos)
+      << sdf3_error(twice);
 }
 
 TEST(Writers, RoundTripRandomGraphsThroughBothFormats) {

@@ -103,12 +103,11 @@ inline void streaming_reader_agrees(uint64_t seed, int count) {
     const std::string caller = outcome([&] {
       return detail::read_sdf3_with(text, "f.xml", nullptr, block, detail::ScanThread::caller);
     });
-    EXPECT_EQ(outcome([&] {
-                return detail::read_sdf3_with(text, "f.xml", nullptr, block,
-                                              detail::ScanThread::own);
-              }),
-              caller)
-        << text;
+    for (const detail::ScanThread own :
+         {detail::ScanThread::own, detail::ScanThread::own_resolving})
+      EXPECT_EQ(outcome([&] { return detail::read_sdf3_with(text, "f.xml", nullptr, block, own); }),
+                caller)
+          << text;
     EXPECT_EQ(caller.rfind("error: ", 0) == 0, stream.rfind("error: ", 0) == 0) << text;
     if (caller.rfind("error: ", 0) != 0) {
       EXPECT_EQ(caller, stream) << text;

@@ -20,10 +20,11 @@ std::string error_of(std::string_view text, sdf::detail::ScanThread scan) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   sdf::fuzz::exercise(&sdf::read_sdf3, text);
-  // The scan on a thread of its own, two actors or channels per hand-over: the same outcome as
-  // on the calling thread.
-  if (error_of(text, sdf::detail::ScanThread::own) !=
-      error_of(text, sdf::detail::ScanThread::caller))
+  // The scan on a thread of its own, two actors or channels per hand-over, also looking up the
+  // channels' actors and ports itself: the same outcome as on the calling thread.
+  const std::string caller = error_of(text, sdf::detail::ScanThread::caller);
+  if (error_of(text, sdf::detail::ScanThread::own) != caller ||
+      error_of(text, sdf::detail::ScanThread::own_resolving) != caller)
     std::abort();
   return 0;
 }
