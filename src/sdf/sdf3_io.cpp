@@ -100,6 +100,16 @@ struct Port {
 static_assert(sizeof(Port) == 32);
 static_assert(std::endian::native == std::endian::little);
 
+// Names in std::string_view's order (bytes as unsigned), without a call to memcmp: ports are
+// sorted and searched by their short names.
+int compare_names(std::string_view a, std::string_view b) {
+  const size_t n = std::min(a.size(), b.size());
+  for (size_t i = 0; i < n; ++i)
+    if (a[i] != b[i])
+      return static_cast<unsigned char>(a[i]) < static_cast<unsigned char>(b[i]) ? -1 : 1;
+  return a.size() < b.size() ? -1 : a.size() > b.size() ? 1 : 0;
+}
+
 // A <channel> as read, resolved when its actors are known. On two threads the scan looks up
 // its actors and ports ahead of the builder where it safely can (see pre_resolve): then `ids`
 // and `ports` hold them, else kUnresolved.
@@ -547,7 +557,7 @@ class Sdf3Reader {
 
   // The decoded value of an attribute of the current tag ("" when absent), kept alive as long
   // as the reader.
-  std::string_view value(std::string_view attr) {
+  std::string_view value(detail::AttrName attr) {
     const detail::XmlAttribute* a = scan_.attribute(attr);
     return a ? keep(*a) : std::string_view{};
   }
@@ -557,17 +567,21 @@ class Sdf3Reader {
     if (v.data() != scratch_.data()) return v;  // a view into the text
     return decoded_.emplace_back(scratch_);     // a deque: earlier views stay valid
   }
-  std::string_view required(const detail::XmlScanner::Token& t, std::string_view attr) {
+  std::string_view required(const detail::XmlScanner::Token& t, detail::AttrName attr) {
     const detail::XmlAttribute* a = scan_.attribute(attr);
     if (!a)
-      scan_fail(t.offset,
-                "<" + std::string(t.name) + "> lacks the attribute '" + std::string(attr) + "'");
-    const std::string_view v = trim(keep(*a));
-    if (v.empty()) scan_fail(t.offset, "attribute '" + std::string(attr) + "' is empty");
+      scan_fail(t.offset, "<" + std::string(t.name) + "> lacks the attribute '" +
+                              std::string(attr.name) + "'");
+    std::string_view v = keep(*a);
+    if (v.empty() || padded_end(v.front()) || padded_end(v.back())) {  // rare: no call otherwise
+      v = trim(v);
+      if (v.empty()) scan_fail(t.offset, "attribute '" + std::string(attr.name) + "' is empty");
+    }
     if (!(a->plain && a->ascii) && !valid_utf8(v))
-      scan_fail(t.offset, "attribute '" + std::string(attr) + "' is not valid UTF-8");
+      scan_fail(t.offset, "attribute '" + std::string(attr.name) + "' is not valid UTF-8");
     return v;
   }
+  static bool padded_end(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
   uint64_t number(size_t offset, const char* attr, std::string_view text, bool positive) {
     const std::optional<uint64_t> v = count(text, positive);
     if (!v) scan_fail(offset, not_an_integer(attr, text, positive));
@@ -608,15 +622,21 @@ class Sdf3Reader {
 
   // The open actor's ports are cur_.ports[open_ports_, end): sorted by name, then closed off.
   void close_actor() {
-    const auto first = cur_.ports.begin() + static_cast<ptrdiff_t>(open_ports_);
-    std::sort(first, cur_.ports.end(),
-              [](const Port& a, const Port& b) { return a.name() < b.name(); });
+    // Ports are mostly written in name order: one pass finds that (and so no duplicates).
     // Indices, not iterators: `first + 1` on an empty vector's null data is undefined (UBSan).
-    for (size_t i = open_ports_; i + 1 < cur_.ports.size(); ++i)
-      if (cur_.ports[i].name() == cur_.ports[i + 1].name())
-        scan_fail(std::max(cur_.ports[i].offset(), cur_.ports[i + 1].offset()),
-                  "duplicate port '" + std::string(cur_.ports[i].name()) + "' on actor '" +
-                      std::string(open_.name) + "'");
+    size_t i = open_ports_;
+    while (i + 1 < cur_.ports.size() &&
+           compare_names(cur_.ports[i].name(), cur_.ports[i + 1].name()) < 0)
+      ++i;
+    if (i + 1 < cur_.ports.size()) {
+      std::sort(cur_.ports.begin() + static_cast<ptrdiff_t>(open_ports_), cur_.ports.end(),
+                [](const Port& a, const Port& b) { return compare_names(a.name(), b.name()) < 0; });
+      for (i = open_ports_; i + 1 < cur_.ports.size(); ++i)
+        if (same(cur_.ports[i].name(), cur_.ports[i + 1].name()))
+          scan_fail(std::max(cur_.ports[i].offset(), cur_.ports[i + 1].offset()),
+                    "duplicate port '" + std::string(cur_.ports[i].name()) + "' on actor '" +
+                        std::string(open_.name) + "'");
+    }
     cur_.actors.push_back(open_);
     cur_.port_counts.push_back(static_cast<uint32_t>(cur_.ports.size() - open_ports_));
     actor_open_ = false;
@@ -807,8 +827,9 @@ class Sdf3Reader {
       while (i != last && !same(ports_[i].name(), name)) ++i;
     } else {
       i = static_cast<uint32_t>(
-          std::lower_bound(ports_.begin() + first, ports_.begin() + last, name,
-                           [](const Port& p, std::string_view k) { return p.name() < k; }) -
+          std::lower_bound(
+              ports_.begin() + first, ports_.begin() + last, name,
+              [](const Port& p, std::string_view k) { return compare_names(p.name(), k) < 0; }) -
           ports_.begin());
     }
     if (i == last || !same(ports_[i].name(), name)) return ChannelRecord::kUnresolved;

@@ -28,11 +28,21 @@ namespace sdf::detail {
 
 // The first eight bytes of a name, zero-padded, as one word: attribute lookups compare names by
 // this key and their length first (every attribute name SDF3 uses but one fits in it).
-inline uint64_t name_key(std::string_view name) {
+// Byte i goes to bits 8i..8i+7: on a little-endian machine, the word a load of the name gives.
+constexpr uint64_t name_key(std::string_view name) {
   uint64_t key = 0;
-  std::memcpy(&key, name.data(), std::min<size_t>(name.size(), sizeof key));
+  for (size_t i = 0; i < name.size() && i < sizeof key; ++i)
+    key |= uint64_t{static_cast<unsigned char>(name[i])} << (8 * i);
   return key;
 }
+
+// An attribute name the reader looks for, with its key made at compile time (a key built at run
+// time went through the stack and stalled every lookup).
+struct AttrName {
+  std::string_view name;
+  uint64_t key;
+  consteval AttrName(const char* literal) : name(literal), key(name_key(name)) {}
+};
 
 struct XmlAttribute {
   std::string_view name;
@@ -63,11 +73,11 @@ class XmlScanner {
   // The next start or end tag, or eof (only once every element is closed). Throws XmlError.
   Token next();
   // An attribute of the last start tag (a repeated name: the first counts), or null.
-  const XmlAttribute* attribute(std::string_view name) const {
-    const uint64_t key = name_key(name);
+  const XmlAttribute* attribute(AttrName n) const {
     for (const XmlAttribute& a : attributes_)
-      if (a.key == key && a.name.size() == name.size() &&
-          (name.size() <= sizeof key || a.name.substr(sizeof key) == name.substr(sizeof key)))
+      if (a.key == n.key && a.name.size() == n.name.size() &&
+          (n.name.size() <= sizeof n.key ||
+           a.name.substr(sizeof n.key) == n.name.substr(sizeof n.key)))
         return &a;
     return nullptr;
   }

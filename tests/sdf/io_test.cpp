@@ -190,6 +190,34 @@ TEST(Sdf3Reader, NamesTheLineOfEachMistake) {
             std::string::npos);
 }
 
+// Ports are looked up by name in each actor's ports sorted by name: written in any order, with
+// more than eight (a binary search) or fewer (a scan), and a name given twice, in order or not.
+TEST(Sdf3Reader, FindsPortsWrittenInAnyOrder) {
+  for (const int n : {3, 12}) {
+    std::string a = "<actor name='A'>", b = "<actor name='B'>", channels;
+    for (int k = n - 1; k >= 0; --k) {  // backwards: z11 ... z0, out of name order
+      const std::string p = "z" + std::to_string(k);
+      a += "<port name='" + p + "' type='out' rate='" + std::to_string(k + 1) + "'/>";
+      b += "<port name='" + p + "' type='in' rate='1'/>";
+      channels += "<channel name='c" + std::to_string(k) + "' srcActor='A' srcPort='" + p +
+                  "' dstActor='B' dstPort='" + p + "'/>\n";
+    }
+    const Graph g = read_sdf3(sdf3(a + "</actor>\n" + b + "</actor>\n" + channels), "f.xml");
+    ASSERT_EQ(g.channel_count(), static_cast<size_t>(n));
+    for (ChannelId c = 0; c < g.channel_count(); ++c)  // channel c_k carries rate k + 1
+      EXPECT_EQ(std::to_string(g.channel(c).prd - 1), std::string(g.channel_name(c)).substr(1))
+          << n;
+  }
+  for (const char* ports :
+       {"<port name='p' type='out' rate='1'/><port name='p' type='out' rate='1'/>",
+        "<port name='q' type='out' rate='1'/><port name='p' type='out' rate='1'/>"
+        "<port name='q' type='in' rate='1'/>"})
+    EXPECT_NE(sdf3_error(sdf3("<actor name='A'>\n" + std::string(ports) + "</actor>\n"))
+                  .find("f.xml:6: duplicate port '"),
+              std::string::npos)
+        << ports;
+}
+
 TEST(JsonReader, ReadsTheDesignForm) {
   const Graph g = read_graph_file(test::data("cd2dat.json"));
   EXPECT_EQ(g.actor_count(), 6u);
