@@ -20,6 +20,27 @@ uint64_t mix64(uint64_t z) {
   return z ^ (z >> 31);
 }
 
+// Bytes p[0, n), n < 8, as a word with byte i at bits 8i, by at most two loads each way (no
+// call to memcpy with a run-time size, whose bytes went through the stack: a stall on every
+// hash, and names are short).
+uint64_t tail_word(const char* p, size_t n) {
+  if (n >= 4) {
+    uint32_t lo, hi;  // bytes [0, 4) and [n - 4, n); the overlap is the same bytes twice
+    std::memcpy(&lo, p, 4);
+    std::memcpy(&hi, p + n - 4, 4);
+    if constexpr (std::endian::native == std::endian::big) {
+      lo = __builtin_bswap32(lo);
+      hi = __builtin_bswap32(hi);
+    }
+    return lo | (static_cast<uint64_t>(hi) << (8 * (n - 4)));
+  }
+  if (n == 0) return 0;
+  auto byte = [&](size_t i) {
+    return static_cast<uint64_t>(static_cast<uint8_t>(p[i])) << (8 * i);
+  };
+  return byte(0) | byte(n / 2) | byte(n - 1);
+}
+
 // Names are short: eight bytes at a time, then the tail, then a full mix (low bits index the
 // table, high bits are the slot's tag).
 uint64_t hash_of(std::string_view s) {
@@ -31,9 +52,7 @@ uint64_t hash_of(std::string_view s) {
     h = (h ^ w) * 0xff51afd7ed558ccdull;
     h ^= h >> 32;
   }
-  uint64_t w = 0;
-  if (i < s.size()) std::memcpy(&w, s.data() + i, s.size() - i);
-  return mix64(h ^ w);
+  return mix64(h ^ tail_word(s.data() + i, s.size() - i));
 }
 
 constexpr uint64_t tag_of(uint64_t hash) {
@@ -50,9 +69,7 @@ size_t home(size_t size, uint64_t hash) {
 // A name's first 7 bytes (byte i at bits 8i) and, in the top byte, its length, or 0xff when it
 // is longer: two names of at most 7 bytes are equal exactly when their words are.
 uint64_t short_word(std::string_view s) {
-  uint64_t w = 0;
-  const size_t n = std::min<size_t>(s.size(), 7);
-  for (size_t i = 0; i < n; ++i) w |= static_cast<uint64_t>(static_cast<uint8_t>(s[i])) << (8 * i);
+  const uint64_t w = tail_word(s.data(), std::min<size_t>(s.size(), 7));
   return w | (static_cast<uint64_t>(s.size() <= 7 ? s.size() : 0xff) << 56);
 }
 
