@@ -62,8 +62,14 @@ struct RateChangeResult {
   // period_checked is false when the cycle was too long to list (max_listed_runs).
   bool period_checked = false;
   bool period_valid = false;
-  std::vector<uint64_t> buffers_before;  // over one period of the original graph
-  std::vector<uint64_t> buffers_after;   // over one period / cycle after the change
+  // The original graph's run: `returns` for the static policy; under the online policies
+  // run_online's outcome (the rule may let a channel grow without bound, or deadlock, on a
+  // graph that has a static schedule).
+  Outcome outcome_before = Outcome::returns;
+  std::optional<ChannelId> channel_before;  // the growing channel when unbounded before
+  // Over one period of the original graph; empty when its run never becomes periodic.
+  std::vector<uint64_t> buffers_before;
+  std::vector<uint64_t> buffers_after;  // over one period / cycle after the change
 };
 
 // The original graph must be consistent and live (throws Error(input) naming the problem

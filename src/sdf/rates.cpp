@@ -154,7 +154,12 @@ RateChangeResult simulate_rate_change(const Graph& g, Policy policy, const RateC
   opts.scheduler = sched;
   const OnlineScheduler fresh(g, rep.q, sched);
   const OnlineRun before = run_online(g, rep.q, fresh, opts);
-  out.buffers_before = cycle_buffers(g, rep.q, fresh, before, sched.bounded);
+  out.outcome_before = before.outcome;
+  out.channel_before = before.channel;
+  // Buffers over one period only if there is one: a window of a run that never repeats (the
+  // online rule letting a channel grow) measures nothing.
+  if (before.outcome == Outcome::returns || before.outcome == Outcome::periodic)
+    out.buffers_before = cycle_buffers(g, rep.q, fresh, before, sched.bounded);
   OnlineScheduler s = fresh;
   while (s.firings() < change.at_firing) {
     if (s.decisions() >= options.max_decisions)

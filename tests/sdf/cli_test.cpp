@@ -174,6 +174,30 @@ TEST(SdfschedCli, SimulateRateChangeForms) {
   EXPECT_TRUE(one_line(half.err));
 }
 
+// The online rule lets S->X grow on starved_cycle before any change: there is no period to
+// measure buffers over, before or after (the text printed a window of the growing run).
+TEST(SdfschedCli, SimulateHasNoBuffersBeforeWhenTheOriginalRunIsUnbounded) {
+  const std::string args =
+      "simulate " + graph("starved_cycle.json") + " --rate-change 'S*2@1' --policy online";
+  const test::Cli j = test::sdfsched(args + " --json");
+  const test::Cli t = test::sdfsched(args);
+  EXPECT_EQ(j.status, 3);
+  EXPECT_EQ(t.status, 3);
+  const json r = json::parse(j.out);
+  EXPECT_EQ(r["outcome_before"], "unbounded");
+  EXPECT_EQ(r["channel_before"], "S->X#0");
+  EXPECT_TRUE(r["buffers_before"].is_null());
+  EXPECT_NE(t.out.find("outcome before the change: unbounded (growing channel 'S->X#0'"),
+            std::string::npos)
+      << t.out;
+  EXPECT_NE(t.out.find("buffers: S->X#0=?->?"), std::string::npos) << t.out;
+  // A periodic original run has its buffers and says nothing of its outcome in the text.
+  const test::Cli p = test::sdfsched("simulate " + graph("cd2dat.json") +
+                                     " --rate-change C:4/3@100 --policy online");
+  EXPECT_EQ(p.out.find("outcome before"), std::string::npos) << p.out;
+  EXPECT_EQ(p.out.find("=?"), std::string::npos) << p.out;
+}
+
 // After a deadlock the text says there is no period, as the JSON form says null.
 TEST(SdfschedCli, SimulateTextAgreesWithJsonAfterADeadlock) {
   const std::string g = test::temp_path("cyc.json");

@@ -483,6 +483,12 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
       std::cout << (i ? ", " : "") << std::string(g.channel_name(rc.rates[i].channel)) << " "
                 << rc.rates[i].prd << ":" << rc.rates[i].cns;
     std::cout << ") after firing " << rc.at_firing << "\n";
+    if (r.outcome_before != sdf::Outcome::returns && r.outcome_before != sdf::Outcome::periodic) {
+      std::cout << "outcome before the change: " << sdf::outcome_name(r.outcome_before);
+      if (r.channel_before)
+        std::cout << " (growing channel " << describe_channel(g, *r.channel_before) << ")";
+      std::cout << "\n";
+    }
     if (!r.after.consistent) {
       std::cerr << "sdfsched: the changed graph is inconsistent: channel "
                 << describe_channel(g2, r.after.channel) << "\n";
@@ -506,7 +512,10 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
       std::cout << "firings until periodic again: none (not periodic)\nperiod after: none\n";
     std::cout << "buffers:";
     for (sdf::ChannelId ch = 0; ch < g.channel_count(); ++ch) {
-      std::cout << " " << std::string(g.channel_name(ch)) << "=" << r.buffers_before[ch] << "->";
+      std::cout << " " << std::string(g.channel_name(ch)) << "="
+                << (r.buffers_before.empty() ? std::string("?")
+                                             : std::to_string(r.buffers_before[ch]))
+                << "->";
       std::cout << (r.buffers_after.empty() ? std::string("?")
                                             : std::to_string(r.buffers_after[ch]));
     }
@@ -531,7 +540,9 @@ int cmd_simulate(const std::string& path, const std::string& policy_text,
   j["change"] = std::move(change);
   j["repetitions_before"] = per_actor(g, r.q_before);
   j["tokens_at_change"] = per_channel(g, r.tokens_at_change);
-  j["buffers_before"] = per_channel(g, r.buffers_before);
+  j["outcome_before"] = sdf::outcome_name(r.outcome_before);
+  if (r.channel_before) j["channel_before"] = std::string(g.channel_name(*r.channel_before));
+  j["buffers_before"] = r.buffers_before.empty() ? Json(nullptr) : per_channel(g, r.buffers_before);
   j["consistent_after"] = r.after.consistent;
   if (!r.after.consistent) {
     j["channel"] = std::string(g2.channel_name(r.after.channel));
