@@ -17,6 +17,30 @@ uint64_t cell_key(int64_t cx, int64_t cy) {
 
 }  // namespace
 
+uint32_t SteerBench::open_track(uint64_t id, Track tr) {
+  tr.id = id;
+  tr.live = true;
+  uint32_t slot;
+  if (!free_slots_.empty()) {
+    slot = free_slots_.back();
+    free_slots_.pop_back();
+    tracks_[slot] = tr;
+  } else {
+    slot = static_cast<uint32_t>(tracks_.size());
+    tracks_.push_back(tr);
+  }
+  active_.emplace(id, slot);
+  return slot;
+}
+
+void SteerBench::close_track(uint32_t slot) {
+  Track& tr = tracks_[slot];
+  scores_[tr.score].arrived = true;
+  active_.erase(tr.id);
+  tr.live = false;
+  free_slots_.push_back(slot);
+}
+
 void SteerBench::start(const World& world) {
   tick_ = 0;
   const AgentTable& t = world.agents();
@@ -24,29 +48,37 @@ void SteerBench::start(const World& world) {
     if (t.state[i] == AgentState::arrived) continue;
     scores_.push_back({.id = t.id[i]});
     known_.insert(t.id[i]);
-    active_.emplace(t.id[i], Track{scores_.size() - 1, t.x[i], t.y[i]});
+    open_track(t.id[i], Track{scores_.size() - 1, t.x[i], t.y[i]});
   }
 }
 
 void SteerBench::tick(const World& world, const TickMetrics& m) {
   ++tick_;
   const AgentTable& t = world.agents();
+  row_id_.resize(t.size(), 0);
+  row_slot_.resize(t.size(), kNoSlot);
   for (std::size_t i = 0; i < t.size(); ++i) {
     const uint64_t id = t.id[i];
-    auto it = active_.find(id);
-    if (it == active_.end()) {
+    uint32_t slot = row_slot_[i];
+    if (row_id_[i] != id || slot == kNoSlot || !tracks_[slot].live || tracks_[slot].id != id) {
+      const auto it = active_.find(id);
+      slot = it == active_.end() ? kNoSlot : it->second;
+      row_id_[i] = id;
+      row_slot_[i] = slot;
+    }
+    if (slot == kNoSlot) {
       // New in the table (a source, an insert): measured from here on. An agent measured before
       // and closed on arrival stays closed.
       if (t.state[i] == AgentState::arrived || !known_.insert(id).second) continue;
       scores_.push_back({.id = id});
-      active_.emplace(id, Track{scores_.size() - 1, t.x[i], t.y[i], 0, 0, false, tick_});
+      row_slot_[i] = open_track(id, Track{scores_.size() - 1, t.x[i], t.y[i], 0, 0, false, tick_});
       continue;
     }
-    Track& tr = it->second;
+    Track& tr = tracks_[slot];
     AgentScore& s = scores_[tr.score];
     if (t.state[i] == AgentState::arrived) {  // arrived in this tick: the tick is not counted
-      s.arrived = true;
-      active_.erase(it);
+      close_track(slot);
+      row_slot_[i] = kNoSlot;
       continue;
     }
     tr.seen = tick_;
@@ -66,14 +98,8 @@ void SteerBench::tick(const World& world, const TickMetrics& m) {
     tr.has_v = true;
   }
   // Agents no longer in the table left it on arrival (or were deleted).
-  for (auto it = active_.begin(); it != active_.end();) {
-    if (it->second.seen != tick_) {
-      scores_[it->second.score].arrived = true;
-      it = active_.erase(it);
-    } else {
-      ++it;
-    }
-  }
+  for (uint32_t slot = 0; slot < tracks_.size(); ++slot)
+    if (tracks_[slot].live && tracks_[slot].seen != tick_) close_track(slot);
   if (m.overlapping_pairs > 0 || m.obstacle_overlaps > 0 || !open_pairs_.empty() ||
       !open_obstacles_.empty())
     collisions(world);
@@ -132,7 +158,7 @@ void SteerBench::collisions(const World& world) {
   }
   auto count = [&](uint64_t id) {
     const auto it = active_.find(id);
-    if (it != active_.end()) ++scores_[it->second.score].collisions;
+    if (it != active_.end()) ++scores_[tracks_[it->second].score].collisions;
   };
   for (const auto& p : pairs)
     if (!open_pairs_.count(p)) {
@@ -184,7 +210,7 @@ void SteerBench::save(ByteWriter& out) const {
   std::sort(ids.begin(), ids.end());
   out.u64(ids.size());
   for (uint64_t id : ids) {
-    const Track& tr = active_.at(id);
+    const Track& tr = tracks_[active_.at(id)];
     out.u64(id);
     out.u64(tr.score);
     for (double v : {tr.x, tr.y, tr.vx, tr.vy}) out.f64(v);
@@ -216,6 +242,10 @@ void SteerBench::restore(ByteReader& in) {
     a.arrived = in.u8() != 0;
   }
   active_.clear();
+  tracks_.clear();
+  free_slots_.clear();
+  row_id_.clear();
+  row_slot_.clear();
   for (uint64_t k = 0, n = in.count(57); k < n; ++k) {
     const uint64_t id = in.u64();
     Track tr{};
@@ -224,7 +254,8 @@ void SteerBench::restore(ByteReader& in) {
     for (double* v : {&tr.x, &tr.y, &tr.vx, &tr.vy}) *v = in.f64();
     tr.has_v = in.u8() != 0;
     tr.seen = in.u64();
-    active_[id] = tr;
+    if (active_.count(id)) in.fail("steerbench: a track twice");
+    open_track(id, tr);
   }
   std::vector<uint64_t> known;
   in.vec(known);

@@ -70,14 +70,27 @@ class SteerBench {
     double x, y, vx = 0, vy = 0;
     bool has_v = false;
     uint64_t seen = 0;  // tick it was last in the table
+    uint64_t id = 0;
+    bool live = true;  // false: the slot is free
   };
+  static constexpr uint32_t kNoSlot = UINT32_MAX;
+  uint32_t open_track(uint64_t id, Track tr);
+  void close_track(uint32_t slot);
   void collisions(const World& world);
 
   double dt_;
   bool walls_;
   uint64_t tick_ = 0;
   std::vector<AgentScore> scores_;
-  std::unordered_map<uint64_t, Track> active_;             // by agent id
+  // The agents measured now: their tracks in slots (reused once closed), found by id. Each tick
+  // visits every row, so a row remembers the id it held and its slot: rows change only when the
+  // table reorders them or agents leave or enter, and the hash lookup (a cache miss per agent at
+  // 10^5 agents and more) is left for those.
+  std::vector<Track> tracks_;
+  std::vector<uint32_t> free_slots_;
+  std::unordered_map<uint64_t, uint32_t> active_;  // agent id -> slot in tracks_
+  std::vector<uint64_t> row_id_;
+  std::vector<uint32_t> row_slot_;
   std::unordered_set<uint64_t> known_;                     // every id measured so far
   std::set<std::pair<uint64_t, uint64_t>> open_pairs_;     // agent ids, smaller first
   std::set<std::pair<uint64_t, int64_t>> open_obstacles_;  // id, obstacle (-1..-4: walls)
