@@ -1,6 +1,7 @@
 #include "index/neighbour_grid.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "query/naive_paths.hpp"
@@ -10,7 +11,8 @@ namespace crowddb::index {
 namespace {
 
 constexpr std::size_t kGrain = 64;
-constexpr std::size_t kCopyGrain = 4096;  // rows per chunk of the lists' compaction
+constexpr std::size_t kCopyGrain = 4096;   // rows per chunk of the lists' compaction
+constexpr std::size_t kBuildGrain = 8192;  // rows per chunk of the grid's build
 
 }  // namespace
 
@@ -24,13 +26,28 @@ int64_t NeighbourGrid::row(double y) const {
   return c < 0 ? 0 : (c >= static_cast<double>(H_) ? H_ - 1 : static_cast<int64_t>(c));
 }
 
-void NeighbourGrid::build(const DiscView& d, double range, uint32_t k) {
+// The counting sort's passes over the rows run in chunks on every thread (the bounding box, each
+// row's cell, the copies in cell order); the count, its prefix sum and the placement, a few
+// instructions per row, stay in one pass in row order, so the layout is that of one thread.
+void NeighbourGrid::build(const DiscView& d, double range, uint32_t k, Executor& ex) {
+  const std::size_t chunks = (d.n + kBuildGrain - 1) / kBuildGrain;
+  std::vector<std::array<double, 4>> box(chunks);  // min x, min y, -max x, -max y
+  ex.for_each_chunk(d.n, kBuildGrain, [&](std::size_t b, std::size_t e) {
+    std::array<double, 4> m = {INFINITY, INFINITY, INFINITY, INFINITY};
+    for (std::size_t i = b; i < e; ++i) {
+      m[0] = std::min(m[0], d.x[i]);
+      m[1] = std::min(m[1], d.y[i]);
+      m[2] = std::min(m[2], -d.x[i]);
+      m[3] = std::min(m[3], -d.y[i]);
+    }
+    box[b / kBuildGrain] = m;
+  });
   double xmin = INFINITY, ymin = INFINITY, xmax = -INFINITY, ymax = -INFINITY;
-  for (std::size_t i = 0; i < d.n; ++i) {
-    xmin = std::min(xmin, d.x[i]);
-    xmax = std::max(xmax, d.x[i]);
-    ymin = std::min(ymin, d.y[i]);
-    ymax = std::max(ymax, d.y[i]);
+  for (const auto& m : box) {  // min and max are exact: the order of the chunks is immaterial
+    xmin = std::min(xmin, m[0]);
+    ymin = std::min(ymin, m[1]);
+    xmax = std::max(xmax, -m[2]);
+    ymax = std::max(ymax, -m[3]);
   }
   const double w = std::max(xmax - xmin, 1e-9), h = std::max(ymax - ymin, 1e-9);
   const auto n = static_cast<double>(std::max<std::size_t>(d.n, 1));
@@ -47,29 +64,32 @@ void NeighbourGrid::build(const DiscView& d, double range, uint32_t k) {
   const auto cells = static_cast<std::size_t>(W_ * H_);
   start_.assign(cells + 1, 0);
   cell_of_.resize(d.n);
-  for (std::size_t i = 0; i < d.n; ++i) {
-    cell_of_[i] = row(d.y[i]) * W_ + col(d.x[i]);
-    ++start_[static_cast<std::size_t>(cell_of_[i]) + 1];
-  }
+  ex.for_each_chunk(d.n, kBuildGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) cell_of_[i] = row(d.y[i]) * W_ + col(d.x[i]);
+  });
+  for (std::size_t i = 0; i < d.n; ++i) ++start_[static_cast<std::size_t>(cell_of_[i]) + 1];
   for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
   rows_.resize(d.n);
   x_.resize(d.n);
   y_.resize(d.n);
   id_.resize(d.n);
-  std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
-  for (std::size_t i = 0; i < d.n; ++i) {
-    const uint32_t at = fill[static_cast<std::size_t>(cell_of_[i])]++;
-    rows_[at] = static_cast<uint32_t>(i);
-    x_[at] = d.x[i];
-    y_[at] = d.y[i];
-    id_[at] = d.id[i];
-  }
+  fill_.assign(start_.begin(), start_.end() - 1);
+  for (std::size_t i = 0; i < d.n; ++i)
+    rows_[fill_[static_cast<std::size_t>(cell_of_[i])]++] = static_cast<uint32_t>(i);
+  ex.for_each_chunk(d.n, kBuildGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t a = b; a < e; ++a) {
+      const uint32_t i = rows_[a];
+      x_[a] = d.x[i];
+      y_[a] = d.y[i];
+      id_[a] = d.id[i];
+    }
+  });
 }
 
 void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, double range,
                         uint32_t k, NeighbourLists& out, Executor& ex, QueryStats& stats) {
   Stopwatch sw;
-  build(d, range, k);
+  build(d, range, k, ex);
   stats.build_seconds += sw.seconds();
   sw.restart();
   const std::size_t q = queries.empty() ? d.n : queries.size();

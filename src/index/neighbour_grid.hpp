@@ -31,7 +31,7 @@ class NeighbourGrid final : public NeighbourPath {
            NeighbourLists& out, Executor& ex, QueryStats& stats) override;
 
  private:
-  void build(const DiscView& d, double range, uint32_t k);
+  void build(const DiscView& d, double range, uint32_t k, Executor& ex);
   int64_t col(double x) const;
   int64_t row(double y) const;
 
@@ -42,6 +42,7 @@ class NeighbourGrid final : public NeighbourPath {
   std::vector<double> x_, y_;    // their positions, copied in cell order
   std::vector<uint64_t> id_;
   std::vector<int64_t> cell_of_;                 // scratch: cell per row
+  std::vector<uint32_t> fill_;                   // scratch: next free place per cell
   std::vector<uint32_t> slot_count_, slot_row_;  // scratch: per-row lists of k (spatial order)
   std::vector<double> slot_d2_;
 };
