@@ -103,12 +103,16 @@ uint64_t CellIndex::for_each_candidate(F&& fn) const {
       for (std::size_t b = b0; b < b1; ++b) fn(a, b);
     count += (a1 - a0) * (b1 - b0);
   };
-  std::size_t next_row = 0;  // first entry with key >= (this key + W - 1): monotone in this key
+  std::size_t next_row = 0;      // first entry with key >= (this key + W - 1): monotone in this key
+  uint64_t cy = 0, row_key = 0;  // the current key's row of cells and that row's first key
   for (std::size_t i = 0; i < n;) {
     const uint64_t k = key_[i];
     std::size_t e = i + 1;
     while (e < n && key_[e] == k) ++e;
-    const uint64_t cx = k % W, cy = k / W;
+    // Keys ascend: the row changes at most once per occupied row, so divide only then (two
+    // divisions per cell were most of this loop's time on a sparse grid).
+    if (k >= row_key + W) cy = k / W, row_key = cy * W;
+    const uint64_t cx = k - row_key;
     for (std::size_t a = i; a < e; ++a)  // within the cell
       for (std::size_t b = a + 1; b < e; ++b) fn(a, b);
     count += (e - i) * (e - i - 1) / 2;
@@ -135,11 +139,13 @@ void CellIndex::for_each_block(F&& fn) const {
   const auto W = static_cast<uint64_t>(W_), H = static_cast<uint64_t>(H_);
   std::size_t ptr[3] = {0, 0, 0};  // per row offset: first entry with key >= block's low key
   std::size_t nb[3][2];
+  uint64_t cy = 0, row_key = 0;  // as in for_each_candidate
   for (std::size_t i = 0; i < n;) {
     const uint64_t k = key_[i];
     std::size_t e = i + 1;
     while (e < n && key_[e] == k) ++e;
-    const uint64_t cx = k % W, cy = k / W;
+    if (k >= row_key + W) cy = k / W, row_key = cy * W;
+    const uint64_t cx = k - row_key;
     for (int d = 0; d < 3; ++d) {
       nb[d][0] = nb[d][1] = 0;
       if ((d == 0 && cy == 0) || (d == 2 && cy + 1 >= H)) continue;
