@@ -39,13 +39,13 @@ Vec2 heading(const AgentTable& t, std::span<const Goal> goals, std::size_t i) {
 // first), nor against walls. One pass over the chains: O(looked_at).
 std::vector<uint8_t> jammed_ahead(const AgentTable& t, std::span<const Goal> goals,
                                   std::span<const uint32_t> looked_at,
-                                  std::span<const int64_t> blocker, std::span<const int64_t> pos,
+                                  std::span<const int64_t> blocker, std::span<const int64_t> bpos,
                                   std::span<const uint8_t> queueing, std::span<const Vec2> dir) {
   const std::size_t m = looked_at.size();
   std::vector<int64_t> next(m, -1);
   for (std::size_t q = 0; q < m; ++q) {
     if (queueing[q] || blocker[q] < 0) continue;
-    const int64_t p = pos[static_cast<std::size_t>(blocker[q])];
+    const int64_t p = bpos[q];
     if (p >= 0 && !queueing[static_cast<std::size_t>(p)]) next[q] = p;
   }
   enum : uint8_t { kUnseen, kOnPath, kDone };
@@ -99,8 +99,11 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   // 1. progress watch: each row on its own (in chunks, on every thread), then the stalled rows
   // collected in row order, so the result does not depend on the thread count.
   std::vector<uint8_t> look(t.size(), 0);
+  std::vector<double> chunk_rmax((t.size() + kWatchGrain - 1) / kWatchGrain, 0);
   ex.for_each_chunk(t.size(), kWatchGrain, [&](std::size_t b, std::size_t e) {
+    double& rm = chunk_rmax[b / kWatchGrain];
     for (std::size_t i = b; i < e; ++i) {
+      rm = std::max(rm, t.radius[i]);
       if (standing(t.state[i])) {
         t.stall_ticks[i] = 0;
         t.stall_action[i] = StallAction::none;
@@ -123,12 +126,11 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
       look[i] = t.stall_ticks[i] >= after;
     }
   });
-  std::vector<uint32_t> looked_at;
-  double rmax = 0;
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    rmax = std::max(rmax, t.radius[i]);
+  std::vector<uint32_t> looked_at;  // in row order
+  for (std::size_t i = 0; i < t.size(); ++i)
     if (look[i]) looked_at.push_back(static_cast<uint32_t>(i));
-  }
+  double rmax = 0;
+  for (double r : chunk_rmax) rmax = std::max(rmax, r);
   if (looked_at.empty()) return c;
   // 2. blockers, queueing
   NeighbourLists nb;
@@ -136,8 +138,12 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   std::vector<int64_t> blocker(looked_at.size(), -1);
   std::vector<Vec2> dir(looked_at.size());
   std::vector<uint8_t> same_way(looked_at.size(), 0), queueing(looked_at.size(), 0);
-  std::vector<int64_t> pos(t.size(), -1);
-  for (std::size_t q = 0; q < looked_at.size(); ++q) pos[looked_at[q]] = static_cast<int64_t>(q);
+  std::vector<int64_t> bpos(looked_at.size(), -1);  // the blocker's place in looked_at, or -1
+  // Where a row is in looked_at (sorted), -1 if not looked at: a search, not a table of every row.
+  auto pos = [&](std::size_t j) -> int64_t {
+    const auto it = std::lower_bound(looked_at.begin(), looked_at.end(), j);
+    return it != looked_at.end() && *it == j ? it - looked_at.begin() : -1;
+  };
   for (std::size_t q = 0; q < looked_at.size(); ++q) {
     const uint32_t i = looked_at[q];
     dir[q] = heading(t, goals, i);
@@ -154,6 +160,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     const Vec2 dj = heading(t, goals, j);
     same_way[q] = standing(t.state[j]) || t.goal[j] == t.goal[i] ||
                   dj.x * dir[q].x + dj.y * dir[q].y >= kSameWay;
+    bpos[q] = pos(j);
   }
   // A queue ends in someone who moves: an agent waits in one when its same-way blocker is
   // progressing (not looked at) or waits in one itself. Chains resolve outwards from a moving
@@ -163,7 +170,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     for (std::size_t q = 0; q < looked_at.size(); ++q) {
       if (queueing[q] || !same_way[q]) continue;
       const auto j = static_cast<std::size_t>(blocker[q]);
-      if (standing(t.state[j]) || pos[j] < 0 || queueing[static_cast<std::size_t>(pos[j])]) {
+      if (standing(t.state[j]) || bpos[q] < 0 || queueing[static_cast<std::size_t>(bpos[q])]) {
         queueing[q] = 1;
         changed = true;
       }
@@ -187,7 +194,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   }
   if (!cfg.stall.resolve) return c;
   const std::vector<uint8_t> jammed =
-      jammed_ahead(t, goals, looked_at, blocker, pos, queueing, dir);
+      jammed_ahead(t, goals, looked_at, blocker, bpos, queueing, dir);
   // 3. actions for the stalled ones that have none running
   for (std::size_t q = 0; q < looked_at.size(); ++q) {
     const uint32_t i = looked_at[q];
@@ -200,7 +207,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     if (blocker[q] < 0 && t.vx[i] * dx + t.vy[i] * dy >= kFreeWalk * t.pref_speed[i]) continue;
     const auto j = static_cast<std::size_t>(blocker[q]);
     const bool blocker_stalled = blocker[q] >= 0 && t.stall_ticks[j] >= after &&
-                                 !(pos[j] >= 0 && queueing[static_cast<std::size_t>(pos[j])]);
+                                 !(bpos[q] >= 0 && queueing[static_cast<std::size_t>(bpos[q])]);
     // The one with less of its path left goes first (at a clogged door: the one nearest to
     // getting through), as in orca's right of way; ties by the seeded rank.
     const double li = path_left(t, goals, i), lj = blocker_stalled ? path_left(t, goals, j) : 0;
