@@ -44,9 +44,11 @@ class CellIndex {
 
   // Calls fn(a, b) for every pair of entries (positions in key order) in the same or adjacent
   // cells, each pair once: a cell with itself and with its east, north-west, north and
-  // north-east neighbours. Returns the number of pairs.
+  // north-east neighbours. Returns the number of pairs. With [from, to): only the pairs whose
+  // first entry's cell begins in it (a cell is owned by the range its first entry falls in), so
+  // ranges that cover [0, size()) share the pairs out, each pair once.
   template <class F>
-  uint64_t for_each_candidate(F&& fn) const;
+  uint64_t for_each_candidate(F&& fn, std::size_t from = 0, std::size_t to = SIZE_MAX) const;
 
   // Calls fn(begin, end, nb) for every non-empty cell in key order, where [begin, end) are its
   // entries and nb[0..2] the entry ranges {first, last} of the 3 x 3 block around it, one per
@@ -94,8 +96,16 @@ void CellIndex::for_each_near(double qx, double qy, double qr, F&& fn) const {
 }
 
 template <class F>
-uint64_t CellIndex::for_each_candidate(F&& fn) const {
+uint64_t CellIndex::for_each_candidate(F&& fn, std::size_t from, std::size_t to) const {
   const std::size_t n = key_.size();
+  // Both ends moved forward to a cell's first entry.
+  auto cell_start = [&](std::size_t p) {
+    p = std::min(p, n);
+    while (p > 0 && p < n && key_[p] == key_[p - 1]) ++p;
+    return p;
+  };
+  from = cell_start(from);
+  to = cell_start(to);
   const auto W = static_cast<uint64_t>(W_), H = static_cast<uint64_t>(H_);
   uint64_t count = 0;
   auto block = [&](std::size_t a0, std::size_t a1, std::size_t b0, std::size_t b1) {
@@ -103,9 +113,9 @@ uint64_t CellIndex::for_each_candidate(F&& fn) const {
       for (std::size_t b = b0; b < b1; ++b) fn(a, b);
     count += (a1 - a0) * (b1 - b0);
   };
-  std::size_t next_row = 0;      // first entry with key >= (this key + W - 1): monotone in this key
+  std::size_t next_row = from;   // first entry with key >= (this key + W - 1): monotone in it
   uint64_t cy = 0, row_key = 0;  // the current key's row of cells and that row's first key
-  for (std::size_t i = 0; i < n;) {
+  for (std::size_t i = from; i < to;) {
     const uint64_t k = key_[i];
     std::size_t e = i + 1;
     while (e < n && key_[e] == k) ++e;

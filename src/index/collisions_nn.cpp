@@ -7,6 +7,7 @@ namespace crowddb::index {
 namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
+constexpr std::size_t kParallelEntries = 4096;  // below, one pass: the merge would not pay
 
 }  // namespace
 
@@ -33,24 +34,51 @@ void CollisionNn::run(const DiscView& d, const StaticScene& scene, CollisionPair
   // the order of updates does not matter, (distance, row) is a total order.
   const double rsum = R + R, limit = rsum * rsum;
   const std::size_t m = cells_.size();
-  best_.assign(m, limit);
-  best_row_.assign(m, kNone);
-  auto offer = [&](std::size_t k, double d2, uint32_t row) {
-    if (d2 < best_[k] || (d2 == best_[k] && best_row_[k] != kNone && row < best_row_[k])) {
-      best_[k] = d2;
-      best_row_[k] = row;
-    }
-  };
-  uint64_t tests = cells_.for_each_candidate([&](std::size_t a, std::size_t b) {
-    const double dx = cells_.x(b) - cells_.x(a), dy = cells_.y(b) - cells_.y(a);
-    const double d2 = dx * dx + dy * dy;  // as discs_overlap computes it
-    if (d2 < limit) {
-      offer(a, d2, cells_.row(b));
-      offer(b, d2, cells_.row(a));
-    }
+  // On several threads each takes the cells of one range of entries and keeps its own nearest
+  // per entry (a pair may touch an entry of the other range); the lists are merged by the same
+  // total order, (distance, row), so the result is that of one pass.
+  const std::size_t parts = ex.threads() > 1 && m >= kParallelEntries ? 2 : 1;
+  best_.resize(parts);
+  best_row_.resize(parts);
+  std::vector<uint64_t> part_tests(parts, 0);
+  ex.for_each_chunk(parts, 1, [&](std::size_t p, std::size_t) {
+    std::vector<double>& best = best_[p];
+    std::vector<uint32_t>& best_row = best_row_[p];
+    best.assign(m, limit);
+    best_row.assign(m, kNone);
+    auto offer = [&](std::size_t k, double d2, uint32_t row) {
+      if (d2 < best[k] || (d2 == best[k] && best_row[k] != kNone && row < best_row[k])) {
+        best[k] = d2;
+        best_row[k] = row;
+      }
+    };
+    part_tests[p] = cells_.for_each_candidate(
+        [&](std::size_t a, std::size_t b) {
+          const double dx = cells_.x(b) - cells_.x(a), dy = cells_.y(b) - cells_.y(a);
+          const double d2 = dx * dx + dy * dy;  // as discs_overlap computes it
+          if (d2 < limit) {
+            offer(a, d2, cells_.row(b));
+            offer(b, d2, cells_.row(a));
+          }
+        },
+        m * p / parts, m * (p + 1) / parts);
   });
+  uint64_t tests = 0;
+  for (uint64_t t : part_tests) tests += t;
+  std::vector<double>& best = best_[0];
+  std::vector<uint32_t>& best_row = best_row_[0];
+  for (std::size_t p = 1; p < parts; ++p)
+    for (std::size_t k = 0; k < m; ++k) {
+      const double d2 = best_[p][k];
+      const uint32_t row = best_row_[p][k];
+      if (row == kNone) continue;
+      if (best_row[k] == kNone || d2 < best[k] || (d2 == best[k] && row < best_row[k])) {
+        best[k] = d2;
+        best_row[k] = row;
+      }
+    }
   for (std::size_t k = 0; k < m; ++k)
-    if (best_row_[k] != kNone) out.agents.push_back(ordered(cells_.row(k), best_row_[k]));
+    if (best_row[k] != kNone) out.agents.push_back(ordered(cells_.row(k), best_row[k]));
   finish_pairs(out.agents);
   if (!scene.empty()) {
     obstacles_.build(scene, frame);

@@ -32,8 +32,10 @@ class CollisionNn final : public CollisionPath {
  private:
   CellIndex cells_;
   ObstacleIndex obstacles_;
-  std::vector<double> best_;  // per entry: squared distance to its nearest neighbour so far
-  std::vector<uint32_t> best_row_;
+  // Per part of the entries (one per thread): per entry, the squared distance to its nearest
+  // neighbour so far, and that neighbour's row.
+  std::vector<std::vector<double>> best_;
+  std::vector<std::vector<uint32_t>> best_row_;
 };
 
 }  // namespace crowddb::index

@@ -56,6 +56,37 @@ TEST(CollisionNn, SetEqualsNaiveAndPairsAreNearestNeighbours) {
   EXPECT_GE(cases, 18u);
 }
 
+// Tables large enough to be split between threads (each thread takes the cells of one range of
+// entries and the nearest neighbours are merged): the pairs are those of one thread and of the
+// brute force, ties (a lattice at exactly equal distances) included.
+TEST(CollisionNn, ThreadsSplittingTheCellsChangeNothing) {
+  for (int shape = 0; shape < 3; ++shape) {
+    DiscTable t;
+    if (shape == 2) {  // a lattice: every disc overlaps its four neighbours at the same distance
+      for (int i = 0; i < 80; ++i)
+        for (int j = 0; j < 80; ++j)
+          t.push_back(static_cast<uint64_t>(i * 80 + j), i * 1.5, j * 1.5, 0, 0, 1);
+    } else {
+      t = build::uniform(6000, {0, 0, shape == 0 ? 120.0 : 60.0, 120}, 1, 1, 1, 17 + shape);
+    }
+    const DiscView d = t.view();
+    std::vector<std::pair<uint32_t, uint32_t>> expect;
+    for (std::size_t i = 0; i < d.n; ++i)
+      if (const int64_t j = brute_nn(d, i); j >= 0)
+        expect.push_back(index::ordered(static_cast<uint32_t>(i), static_cast<uint32_t>(j)));
+    finish_pairs(expect);
+    ASSERT_GT(expect.size(), 100u) << shape;
+    for (int threads : {1, 2, 3}) {
+      CollisionNn nn;
+      Executor ex(threads);
+      QueryStats st;
+      CollisionPairs got;
+      nn.run(d, StaticScene(), got, ex, st);
+      EXPECT_EQ(got.agents, expect) << "shape " << shape << ", threads " << threads;
+    }
+  }
+}
+
 TEST(CollisionNn, ReportsNearestNeighbourPairsNotEveryPair) {
   // Three discs in a row: 0-1 at 1.0, 1-2 at 0.9, 0-2 at 1.9 all overlap (R = 1), but nobody's
   // nearest neighbour pairs 0 with 2. The set {0, 1, 2} is still exact.
