@@ -55,15 +55,13 @@ void SteerBench::start(const World& world) {
 void SteerBench::tick(const World& world, const TickMetrics& m) {
   ++tick_;
   const AgentTable& t = world.agents();
-  row_id_.resize(t.size(), 0);
   row_slot_.resize(t.size(), kNoSlot);
   for (std::size_t i = 0; i < t.size(); ++i) {
     const uint64_t id = t.id[i];
     uint32_t slot = row_slot_[i];
-    if (row_id_[i] != id || slot == kNoSlot || !tracks_[slot].live || tracks_[slot].id != id) {
+    if (slot == kNoSlot || !tracks_[slot].live || tracks_[slot].id != id) {
       const auto it = active_.find(id);
       slot = it == active_.end() ? kNoSlot : it->second;
-      row_id_[i] = id;
       row_slot_[i] = slot;
     }
     if (slot == kNoSlot) {
@@ -244,7 +242,6 @@ void SteerBench::restore(ByteReader& in) {
   active_.clear();
   tracks_.clear();
   free_slots_.clear();
-  row_id_.clear();
   row_slot_.clear();
   for (uint64_t k = 0, n = in.count(57); k < n; ++k) {
     const uint64_t id = in.u64();

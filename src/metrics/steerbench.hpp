@@ -84,12 +84,12 @@ class SteerBench {
   std::vector<AgentScore> scores_;
   // The agents measured now: their tracks in slots (reused once closed), found by id. Each tick
   // visits every row, so a row remembers the id it held and its slot: rows change only when the
-  // table reorders them or agents leave or enter, and the hash lookup (a cache miss per agent at
-  // 10^5 agents and more) is left for those.
+  // table reorders them or agents leave or enter (then the slot's track is closed or another
+  // agent's), and the hash lookup (a cache miss per agent at 10^5 agents and more) is left for
+  // those.
   std::vector<Track> tracks_;
   std::vector<uint32_t> free_slots_;
   std::unordered_map<uint64_t, uint32_t> active_;  // agent id -> slot in tracks_
-  std::vector<uint64_t> row_id_;
   std::vector<uint32_t> row_slot_;
   std::unordered_set<uint64_t> known_;                     // every id measured so far
   std::set<std::pair<uint64_t, uint64_t>> open_pairs_;     // agent ids, smaller first

@@ -508,22 +508,9 @@ class Sdf3Reader {
     for (size_t i = 0; i < n; ++i)
       scan_names_[2 * i] = records[i].src, scan_names_[2 * i + 1] = records[i].dst;
     g_.find_actors(scan_names_, scan_ids_);
-    auto ahead = [&](size_t k, int stage) {  // as in resolve
+    auto ahead = [&](size_t k, int stage) {
       if (k >= n) return;
-      for (size_t side = 0; side < 2; ++side) {
-        const int64_t a = scan_ids_[2 * k + side];
-        if (a < 0) continue;
-        const auto id = static_cast<size_t>(a);
-        if (stage == 0) {
-          detail::prefetch(&port_begin_[id]);
-        } else if (port_begin_[id] != port_begin_[id + 1]) {
-          const Port& p = ports_[port_begin_[id]];
-          if (stage == 1)
-            detail::prefetch(&p);
-          else
-            detail::prefetch(p.name().data());
-        }
-      }
+      for (size_t side = 0; side < 2; ++side) prefetch_ports(scan_ids_[2 * k + side], stage);
     };
     for (size_t i = 0; i < n; ++i) {
       ahead(i + 24, 0);
@@ -750,21 +737,7 @@ class Sdf3Reader {
           for (const uint32_t p : records[k].ports) detail::prefetch(&ports_[p]);
         return;
       }
-      for (size_t side = 0; side < 2; ++side) {
-        const int64_t a = ids_[2 * k + side];
-        if (a < 0) continue;
-        if (stage == 0) {
-          detail::prefetch(&port_begin_[static_cast<size_t>(a)]);
-        } else {
-          const auto first = port_begin_[static_cast<size_t>(a)];
-          if (first == port_begin_[static_cast<size_t>(a) + 1]) continue;  // an actor without ports
-          const Port& p = ports_[first];
-          if (stage == 1)
-            detail::prefetch(&p);
-          else
-            detail::prefetch(p.name().data());
-        }
-      }
+      for (size_t side = 0; side < 2; ++side) prefetch_ports(ids_[2 * k + side], stage);
     };
     size_t i = 0;
     for (; i < records.size(); ++i) {
@@ -816,6 +789,22 @@ class Sdf3Reader {
       fail_in_batch(records, batch, r,
                     "actor '" + g_.actor_name(actor) + "' has no port '" + std::string(name) + "'");
     return ports_[i];
+  }
+
+  // Fetches ahead what a port lookup of actor `a` (< 0: none) reads, one stage per call, several
+  // channels apart: its port range (stage 0), its first port (1), that port's name (2).
+  void prefetch_ports(int64_t a, int stage) const {
+    if (a < 0) return;
+    const auto id = static_cast<size_t>(a);
+    if (stage == 0) {
+      detail::prefetch(&port_begin_[id]);
+    } else if (port_begin_[id] != port_begin_[id + 1]) {  // an actor without ports: nothing
+      const Port& p = ports_[port_begin_[id]];
+      if (stage == 1)
+        detail::prefetch(&p);
+      else
+        detail::prefetch(p.name().data());
+    }
   }
 
   // The index in ports_ of the actor's port of that name, or kUnresolved. Reads only the ports'

@@ -514,14 +514,20 @@ TEST(Sdf3Reader, AScanOnItsOwnThreadReportsAsOnOne) {
       << sdf3_error(twice);
 }
 
+// The i-th of a series of small generated graphs: every shape in turn, 1 to max_actors actors,
+// self-loops on every fourth.
+Graph small_graph(int i, uint64_t max_actors, crowddb::Rng& rng) {
+  gen::Spec spec;
+  spec.shape = static_cast<gen::Shape>(i % 6);
+  spec.actors = 1 + static_cast<uint32_t>(rng.below(max_actors));
+  spec.self_loops = i % 4 == 0;
+  return gen::generate(spec, rng).graph;
+}
+
 TEST(Writers, RoundTripRandomGraphsThroughBothFormats) {
   crowddb::Rng rng(7);
   for (int i = 0; i < 60; ++i) {
-    gen::Spec spec;
-    spec.shape = static_cast<gen::Shape>(i % 6);
-    spec.actors = 1 + static_cast<uint32_t>(rng.below(12));
-    spec.self_loops = i % 4 == 0;
-    const Graph g = gen::generate(spec, rng).graph;
+    const Graph g = small_graph(i, 12, rng);
     const Graph j = read_json(write_json(g));
     EXPECT_TRUE(same_graph(g, j)) << i;
     const Graph x = read_sdf3(write_sdf3(g));
@@ -547,11 +553,7 @@ TEST(Writers, StreamingWritersMatchTheirTrees) {
     return w;
   };
   for (int i = 0; i < 400; ++i) {
-    gen::Spec spec;
-    spec.shape = static_cast<gen::Shape>(i % 6);
-    spec.actors = 1 + static_cast<uint32_t>(rng.below(10));
-    spec.self_loops = i % 4 == 0;
-    const Graph base = gen::generate(spec, rng).graph;
+    const Graph base = small_graph(i, 10, rng);
     Graph g;
     if (i % 3 == 0) g.name = word();
     if (i % 5 == 0) g.type = word();
