@@ -1,21 +1,32 @@
 // The indexed neighbour query: a uniform grid over disc centres, rebuilt each tick (counting
-// sort, O(n)), with a ring-by-ring k-nearest search.
+// sort, O(n)), with a ring-by-ring k-nearest search seeded by the lists of the call before.
 //
-// Search: the 3 x 3 block around the query's cell is scanned first, as three runs of adjacent
-// cells; when the k-th best so far (or the range) is strictly nearer than the block's nearest
-// outside edge, nothing beyond can contribute. Otherwise the rings beyond are visited outwards:
-// every disc in ring
-// rho (Chebyshev cell distance rho) is at least (rho - 1) * cell away from the query, so once the
-// list holds k entries whose worst distance is below that bound, or the bound reaches the range,
-// no further ring can contribute; within a ring, a cell whose nearest point is farther than the
-// k-th best so far is skipped. Candidates are offered to the same NearestK selection as the
-// naive scan, computing the same squared distance from the same doubles, so both give identical
-// lists. The bound is lowered by a relative 1e-9 to stay conservative under rounding of the cell
-// coordinates (bucketing decides only which candidates are looked at, never the answer).
+// Hints (k nearest of every row, the steering models' query, asked once per tick): each row's
+// list of the last such call is kept and offered first, in its old order. Between two ticks a
+// list hardly changes, so the hints arrive nearly sorted (cheap insertions) and fill the list
+// with a tight bound on the k-th distance at once. Any rows would do as hints: the answer is the
+// best k of all candidates in whatever order they come, so stale hints (rows reordered, removed,
+// or another table) cost time, never exactness; the scans skip the hinted rows, so no candidate
+// is offered twice (test: NeighbourGrid.ListsOfTheCallBeforeChangeNothing).
 //
-// Cell side: about 2k discs per 3 x 3 block at the table's mean density (k = 0: half the range),
-// never larger than the range, and never more than ~4 cells per disc (sparse or huge worlds).
-// Query O(k + candidates of the rings visited).
+// Search: with a full list whose k-th distance is within 1.5 cells (the usual case with hints),
+// the cells meeting the disc of that radius are scanned row by row, each row's chord of the
+// disc as one run of adjacent cells, and nothing beyond. Otherwise the 3 x 3 block around the
+// query's cell is scanned first, as three runs; when the k-th best so far (or the range) is
+// strictly nearer than the block's nearest outside edge, nothing beyond can contribute. Else the
+// rings beyond are visited outwards: every disc in ring rho (Chebyshev cell distance rho) is at
+// least (rho - 1) * cell away from the query, so once the list holds k entries whose worst
+// distance is below that bound, or the bound reaches the range, no further ring can contribute;
+// within a ring, a cell whose nearest point is farther than the k-th best so far is skipped.
+// Each run's candidates within the bound are picked without a branch, then offered to the same
+// NearestK selection as the naive scan, computing the same squared distance from the same
+// doubles, so both give identical lists. Cell tests are widened by a relative 1e-9 to stay
+// conservative under rounding of the cell coordinates (bucketing decides only which candidates
+// are looked at, never the answer).
+//
+// Cell side: about 6k discs per 3 x 3 block at the table's mean density (k = 0: half the range;
+// measured in neighbour_grid.cpp), never larger than the range, and never more than ~4 cells per
+// disc (sparse or huge worlds). Query O(k + candidates of the cells visited).
 #pragma once
 
 #include <cstdint>
@@ -45,6 +56,7 @@ class NeighbourGrid final : public NeighbourPath {
   std::vector<uint32_t> fill_;                   // scratch: next free place per cell
   std::vector<uint32_t> slot_count_, slot_row_;  // scratch: per-row lists of k (spatial order)
   std::vector<double> slot_d2_;
+  uint32_t hint_k_ = 0;  // k of the last call when its lists are in the slots (hints), else 0
 };
 
 }  // namespace crowddb::index

@@ -88,6 +88,87 @@ TEST(NeighbourGrid, HugeAndSparseWorlds) {
   }
 }
 
+// One grid queried again and again as its table changes, as a tick does: each call is seeded
+// with the lists of the call before (the hints), which must change nothing. Small moves (the
+// usual tick), jumps across the world, rows swapped and shuffled (the hints then name other
+// discs), rows removed and added, discs stacked on one point (ties on distance and on the hints'
+// own distances), k changed, and calls for a subset of rows in between (no hints).
+TEST(NeighbourGrid, ListsOfTheCallBeforeChangeNothing) {
+  Rng rng(17);
+  NeighbourNaive naive;
+  NeighbourGrid grid;
+  for (int c = 0; c < 8; ++c) {
+    DiscTable t = build::uniform(200 + rng.below(1500), {0, 0, 40, 40}, 1.3, 0.25, 0.25,
+                                 300 + static_cast<uint64_t>(c));
+    uint32_t k = static_cast<uint32_t>(1 + rng.below(16));
+    const double range = rng.uniform(1, 8);
+    const int threads = 1 + static_cast<int>(rng.below(3));
+    uint64_t next_id = 1'000'000;
+    for (int call = 0; call < 40; ++call) {
+      SCOPED_TRACE("case " + std::to_string(c) + " call " + std::to_string(call) + " n " +
+                   std::to_string(t.size()) + " k " + std::to_string(k));
+      const NeighbourLists want = run(naive, t.view(), range, k);
+      expect_same(run(grid, t.view(), range, k, {}, threads), want);
+      if (::testing::Test::HasFailure()) return;
+      const std::size_t n = t.size();
+      for (std::size_t i = 0; i < n; ++i) {  // a tick's walk
+        t.x[i] += rng.uniform(-0.13, 0.13);
+        t.y[i] += rng.uniform(-0.13, 0.13);
+      }
+      switch (rng.below(8)) {
+        case 0:  // a few jump anywhere
+          for (int j = 0; j < 10; ++j) {
+            const std::size_t i = rng.below(n);
+            t.x[i] = rng.uniform(0, 40);
+            t.y[i] = rng.uniform(0, 40);
+          }
+          break;
+        case 1:  // rows swapped: the hints of both now name other discs
+          for (int j = 0; j < 50; ++j) {
+            const std::size_t a = rng.below(n), b = rng.below(n);
+            std::swap(t.x[a], t.x[b]);
+            std::swap(t.y[a], t.y[b]);
+            std::swap(t.id[a], t.id[b]);
+          }
+          break;
+        case 2:  // rows removed from the end and the middle
+          for (int j = 0; j < 30 && t.size() > 20; ++j) {
+            const std::size_t i = rng.below(t.size());
+            for (auto* col : {&t.x, &t.y, &t.vx, &t.vy, &t.radius, &t.charge}) {
+              (*col)[i] = col->back();
+              col->pop_back();
+            }
+            t.id[i] = t.id.back();
+            t.id.pop_back();
+          }
+          break;
+        case 3:  // rows added
+          for (int j = 0; j < 30; ++j)
+            t.push_back(next_id++, rng.uniform(0, 40), rng.uniform(0, 40), 0, 0, 0.25);
+          break;
+        case 4:  // a stack of discs on one point, and their neighbours at equal distances
+          for (int j = 0; j < 12; ++j) {
+            const std::size_t i = rng.below(n);
+            t.x[i] = 20 + (j % 3 == 0 ? 0.5 : 0);
+            t.y[i] = 20;
+          }
+          break;
+        case 5:  // another k: the slots no longer hold lists of this k
+          k = static_cast<uint32_t>(1 + rng.below(16));
+          break;
+        case 6: {  // a subset of rows in between
+          std::vector<uint32_t> q;
+          for (std::size_t i = 0; i < t.size(); i += 3) q.push_back(static_cast<uint32_t>(i));
+          expect_same(run(grid, t.view(), range, k, q), run(naive, t.view(), range, k, q));
+          break;
+        }
+        default:
+          break;
+      }
+    }
+  }
+}
+
 TEST(NeighbourQuery, PublicFunctionChecksItsArguments) {
   const DiscTable t = build::uniform(10, {0, 0, 10, 10}, 1, 0.2, 0.3, 1);
   EXPECT_THROW(neighbours(t.view(), 0, 3), Error);
