@@ -64,7 +64,7 @@ class NearestK {
     if (!full()) return INFINITY;
     return small_ ? sd2_[n_ - 1] : d2_.back();
   }
-  void offer(uint32_t row, uint64_t id, double d2) {
+  [[gnu::always_inline]] void offer(uint32_t row, uint64_t id, double d2) {
     if (small_) {
       offer_into(srows_, sd2_, sids_, n_, row, id, d2);
       return;
