@@ -97,6 +97,28 @@ void NeighbourGrid::build(const DiscView& d, double range, uint32_t k, Executor&
   });
 }
 
+void NeighbourGrid::rows_permuted(std::span<const uint32_t> order) {
+  const uint32_t k = hint_k_;
+  if (k == 0) return;
+  // Rows removed or added since the last call (arrivals, sources) do not stop this: the hints of
+  // the rows they touched name the wrong discs, which costs time, never exactness.
+  const std::size_t n = order.size(), last_n = slot_count_.size();
+  std::vector<uint32_t> new_of(n);
+  for (std::size_t r = 0; r < n; ++r) new_of[order[r]] = static_cast<uint32_t>(r);
+  std::vector<uint32_t> count(n, 0), rows(n * k);
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::size_t old = order[r];
+    if (old >= last_n) continue;
+    for (uint32_t u = 0; u < slot_count_[old]; ++u) {
+      const uint32_t e = slot_row_[old * k + u];
+      if (e < n) rows[r * k + count[r]++] = new_of[e];
+    }
+  }
+  slot_count_.swap(count);
+  slot_row_.swap(rows);
+  slot_d2_.resize(n * k);  // (only a call's own compaction reads it)
+}
+
 void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, double range,
                         uint32_t k, NeighbourLists& out, Executor& ex, QueryStats& stats) {
   Stopwatch sw;
@@ -149,7 +171,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         const uint32_t count = slot_count_[i];
         for (uint32_t u = 0; u < count; ++u) {
           const uint32_t j = last[u];
-          if (j >= d.n) continue;  // (a row's own list never holds the row)
+          if (j >= d.n || j == i) continue;
           const double dx = d.x[j] - px, dy = d.y[j] - py;
           const double d2 = dx * dx + dy * dy;
           if (d2 >= r2) continue;

@@ -40,6 +40,9 @@ class NeighbourGrid final : public NeighbourPath {
  public:
   void run(const DiscView& discs, std::span<const uint32_t> queries, double range, uint32_t k,
            NeighbourLists& out, Executor& ex, QueryStats& stats) override;
+  // Carries the hints along: each row's list moves to the row's new place and names the new
+  // rows of its entries.
+  void rows_permuted(std::span<const uint32_t> order) override;
 
  private:
   void build(const DiscView& d, double range, uint32_t k, Executor& ex);

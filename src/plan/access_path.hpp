@@ -55,6 +55,9 @@ class NeighbourPath {
   // nearest other discs strictly within `range` (all when k = 0), nearest first, ties by id.
   virtual void run(const DiscView& discs, std::span<const uint32_t> queries, double range,
                    uint32_t k, NeighbourLists& out, Executor& ex, QueryStats& stats) = 0;
+  // The table's rows were permuted (order[new row] = old row) since the last run: a method that
+  // keeps per-row state across runs (the grid's hints) carries it along. Never changes a result.
+  virtual void rows_permuted(std::span<const uint32_t> /*order*/) {}
 };
 
 class FeaturePath {

@@ -449,8 +449,11 @@ const TickMetrics& Simulation::step() {
   }
   if (reorders(cfg, world_.agents().size()) &&
       (m.tick - 1) % cfg.ticks_for(sim::kReorderInterval) == 0)
-    log.timed("reorder rows", world_.agents().size(),
-              [&] { world_.permute_rows(sim::curve_order(world_.agents())); });
+    log.timed("reorder rows", world_.agents().size(), [&] {
+      const std::vector<uint32_t> order = sim::curve_order(world_.agents());
+      world_.permute_rows(order);
+      e.model->rows_permuted(order);
+    });
   e.refresh_scene(world_, cfg);
   const TickPlan plan = e.plan(world_, cfg);
   AgentTable& t = world_.agents_for_tick();

@@ -54,6 +54,9 @@ class Model {
                           Executor& ex, sim::OpLog& log) = 0;
   // EXPLAIN: one line per operator the model runs, numbered from `step` (advanced).
   virtual void explain(std::ostream& os, const TickInput& in, int& step) const = 0;
+  // The agents' rows were permuted (order[new row] = old row) since the last tick; passed on to
+  // access paths that keep per-row state across ticks. Never changes a result.
+  virtual void rows_permuted(std::span<const uint32_t> /*order*/) {}
 };
 
 struct ModelInfo {

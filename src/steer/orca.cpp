@@ -303,6 +303,10 @@ class OrcaModel final : public Model {
     os << ", 3-D fallback when infeasible\n";
   }
 
+  void rows_permuted(std::span<const uint32_t> order) override {
+    for (auto& [name, path] : neighbour_paths_) path->rows_permuted(order);
+  }
+
  private:
   // The headway (see the head comment): caps the wish (px, py) of agent i at s / time_gap.
   void cap_by_headway(const TickInput& in, std::size_t i, double& px, double& py) const {

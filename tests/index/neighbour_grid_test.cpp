@@ -92,7 +92,8 @@ TEST(NeighbourGrid, HugeAndSparseWorlds) {
 // with the lists of the call before (the hints), which must change nothing. Small moves (the
 // usual tick), jumps across the world, rows swapped and shuffled (the hints then name other
 // discs), rows removed and added, discs stacked on one point (ties on distance and on the hints'
-// own distances), k changed, and calls for a subset of rows in between (no hints).
+// own distances), k changed, calls for a subset of rows in between (no hints), rows permuted
+// with the grid told, and the grid told of a permutation that did not happen.
 TEST(NeighbourGrid, ListsOfTheCallBeforeChangeNothing) {
   Rng rng(17);
   NeighbourNaive naive;
@@ -115,7 +116,7 @@ TEST(NeighbourGrid, ListsOfTheCallBeforeChangeNothing) {
         t.x[i] += rng.uniform(-0.13, 0.13);
         t.y[i] += rng.uniform(-0.13, 0.13);
       }
-      switch (rng.below(8)) {
+      switch (rng.below(10)) {
         case 0:  // a few jump anywhere
           for (int j = 0; j < 10; ++j) {
             const std::size_t i = rng.below(n);
@@ -153,6 +154,26 @@ TEST(NeighbourGrid, ListsOfTheCallBeforeChangeNothing) {
             t.y[i] = 20;
           }
           break;
+        case 7: {  // rows permuted, as the tick's curve order does, and the grid told
+          std::vector<uint32_t> order(t.size());
+          for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<uint32_t>(i);
+          for (std::size_t i = order.size(); i > 1; --i)
+            std::swap(order[i - 1], order[rng.below(i)]);
+          DiscTable p;
+          for (uint32_t r : order)
+            p.push_back(t.id[r], t.x[r], t.y[r], t.vx[r], t.vy[r], t.radius[r]);
+          t = p;
+          grid.rows_permuted(order);
+          break;
+        }
+        case 8: {  // told of a permutation that did not happen: hints name anything, the
+                   // querying row itself included
+          std::vector<uint32_t> order(t.size());
+          for (std::size_t i = 0; i < order.size(); ++i)
+            order[i] = static_cast<uint32_t>((i + 1) % order.size());
+          grid.rows_permuted(order);
+          break;
+        }
         case 5:  // another k: the slots no longer hold lists of this k
           k = static_cast<uint32_t>(1 + rng.below(16));
           break;
@@ -167,6 +188,40 @@ TEST(NeighbourGrid, ListsOfTheCallBeforeChangeNothing) {
       }
     }
   }
+}
+
+// Told of a permutation of the rows, the grid carries each row's hints to its new place: the
+// permuted table's search then does exactly the work of the unpermuted one (the same cells and
+// bounds); without the hints carried along it would not.
+TEST(NeighbourGrid, CarriesTheHintsThroughAPermutation) {
+  const DiscTable t = build::uniform(3000, {0, 0, 80, 80}, 1.3, 0.25, 0.25, 41);
+  Executor ex(1);
+  auto tests_of = [&](NeighbourGrid& g, const DiscTable& d) {
+    QueryStats st;
+    NeighbourLists out;
+    g.run(d.view(), {}, 5, 10, out, ex, st);
+    return st.pair_tests;
+  };
+  NeighbourGrid grid;
+  tests_of(grid, t);
+  const uint64_t hinted = tests_of(grid, t);  // every hint exact
+  Rng rng(3);
+  std::vector<uint32_t> order(t.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<uint32_t>(i);
+  for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.below(i)]);
+  DiscTable p;
+  for (uint32_t r : order) p.push_back(t.id[r], t.x[r], t.y[r], t.vx[r], t.vy[r], t.radius[r]);
+  NeighbourGrid untold;
+  tests_of(untold, t);
+  EXPECT_NE(tests_of(untold, p), hinted);  // the test can tell
+  grid.rows_permuted(order);
+  EXPECT_EQ(tests_of(grid, p), hinted);
+  NeighbourNaive naive;
+  NeighbourLists a, b;
+  QueryStats st;
+  grid.run(p.view(), {}, 5, 10, a, ex, st);
+  naive.run(p.view(), {}, 5, 10, b, ex, st);
+  expect_same(a, b);
 }
 
 TEST(NeighbourQuery, PublicFunctionChecksItsArguments) {
