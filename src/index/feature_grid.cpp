@@ -78,6 +78,33 @@ void FeatureGrid::build(const StaticScene& scene, double cell) {
     start_[c + 1] = start_[c] + static_cast<uint32_t>(cells[c].size());
   items_.reserve(start_.back());
   for (const auto& c : cells) items_.insert(items_.end(), c.begin(), c.end());
+  // Chebyshev distance transform (two passes, each cell from its four earlier neighbours).
+  constexpr uint16_t kFar = UINT16_MAX;  // > 1025, the most cells an axis has
+  clear_.assign(cells.size(), kFar);
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    if (!cells[c].empty()) clear_[c] = 0;
+  const auto at = [&](int64_t cx, int64_t cy) -> uint16_t& {
+    return clear_[static_cast<std::size_t>(cy * W_ + cx)];
+  };
+  auto relax = [&](int64_t cx, int64_t cy, int64_t nx, int64_t ny) {
+    if (nx < 0 || ny < 0 || nx >= W_ || ny >= H_) return;
+    const uint16_t d = at(nx, ny);
+    if (d != kFar && d + 1 < at(cx, cy)) at(cx, cy) = static_cast<uint16_t>(d + 1);
+  };
+  for (int64_t cy = 0; cy < H_; ++cy)
+    for (int64_t cx = 0; cx < W_; ++cx) {
+      relax(cx, cy, cx - 1, cy);
+      relax(cx, cy, cx - 1, cy - 1);
+      relax(cx, cy, cx, cy - 1);
+      relax(cx, cy, cx + 1, cy - 1);
+    }
+  for (int64_t cy = H_ - 1; cy >= 0; --cy)
+    for (int64_t cx = W_ - 1; cx >= 0; --cx) {
+      relax(cx, cy, cx + 1, cy);
+      relax(cx, cy, cx + 1, cy + 1);
+      relax(cx, cy, cx, cy + 1);
+      relax(cx, cy, cx - 1, cy + 1);
+    }
 }
 
 void FeatureGrid::run(const DiscView& p, std::span<const double> reach, const StaticScene& scene,
@@ -111,6 +138,14 @@ void FeatureGrid::run(const DiscView& p, std::span<const double> reach, const St
         };
         auto clamp_col = [&](double x) { return clamp_cell(x - x0_, W_); };
         auto clamp_row = [&](double y) { return clamp_cell(y - y0_, H_); };
+        // Far from every feature: nothing to look at (see the header). A point outside the
+        // grid is binned to the border cell, which is nearer to every feature than it is.
+        const uint16_t m = clear_[static_cast<std::size_t>(clamp_row(py) * W_ + clamp_col(px))];
+        const double slack = 1e-9 * (cell_ + std::abs(px) + std::abs(py) + r);
+        if (m >= 3 && static_cast<double>(m - 3) * cell_ > r + slack) {
+          lists.counts[c].push_back(0);
+          continue;
+        }
         // One cell of slack on each side against rounding of the box.
         const int64_t cx0 = std::max<int64_t>(0, clamp_col(px - r) - 1);
         const int64_t cx1 = std::min<int64_t>(W_ - 1, clamp_col(px + r) + 1);

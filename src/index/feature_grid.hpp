@@ -8,7 +8,13 @@
 // of p's reach box. Candidates are de-duplicated, then decided by feature_dist2, the primitive
 // the naive scan uses: the lists are identical. The grid covers the features' bounding box only
 // (query boxes are clamped to it); its cell is the mean reach of the first query, but at most
-// 1024 cells per axis. Build O(F + registrations), query O(cells + candidates log candidates).
+// 1024 cells per axis. Build O(F + registrations + cells), query O(cells + candidates log
+// candidates).
+//
+// Far from every feature (most of a crowd, most of the time) a query ends after one look-up:
+// each cell keeps its Chebyshev distance, in cells, to the nearest cell holding a feature, so a
+// query point in a cell at distance m is more than (m - 3) cells from every feature (a cell of
+// slack each against rounding where the point and where a feature's box were binned).
 #pragma once
 
 #include <cstdint>
@@ -31,6 +37,7 @@ class FeatureGrid final : public FeaturePath {
   int64_t W_ = 0, H_ = 0;
   std::vector<uint32_t> start_;  // W * H + 1
   std::vector<uint32_t> items_;  // feature numbers, ascending within a cell
+  std::vector<uint16_t> clear_;  // per cell: Chebyshev distance to the nearest non-empty cell
 };
 
 }  // namespace crowddb::index

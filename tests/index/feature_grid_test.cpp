@@ -77,6 +77,49 @@ TEST(FeatureGrid, EqualsNaiveOnRandomScenes) {
   }
 }
 
+// Far from every feature a query ends at its cell's distance to the nearest feature cell. Points
+// on rings around a circle and along a long diagonal wall at the reach (and a hair inside and
+// outside it), with reaches from a tenth of a cell to many cells, and points outside the grid.
+TEST(FeatureGrid, SkipsOnlyWhatIsOutOfReach) {
+  const std::vector<CircleObstacle> circles = {{50, 50, 0.5, 1}};
+  const std::vector<PolygonObstacle> polys = {
+      {{{10, 80}, {80, 10}, {80.2, 10.2}, {10.2, 80.2}}, 1}};
+  const StaticScene scene(circles, polys, 1, ObstacleCharges::none, nullptr);
+  FeatureNaive naive;
+  for (double first : {0.05, 0.3, 1.0}) {
+    FeatureGrid grid;
+    DiscTable pts;
+    std::vector<double> reach;
+    uint64_t id = 1;
+    auto add = [&](double x, double y, double r) {
+      pts.push_back(id++, x, y, 0, 0, 0.2);
+      reach.push_back(r);
+    };
+    add(50, 50, first);  // the first query sets the cell: about `first`
+    for (double r : {0.01, 0.1, 0.7, 2.0, 9.0})
+      for (double hair : {-1e-9, 0.0, 1e-9, 0.01, 1.0})
+        for (int k = 0; k < 16; ++k) {
+          const double a = k * 0.3927, d = 0.5 + r + hair;  // from the circle's edge
+          add(50 + d * std::cos(a), 50 + d * std::sin(a), r);
+          const double t = k / 16.0, off = r + hair;  // from the wall's near side
+          add(10 + 70 * t - off * 0.7071, 80 - 70 * t - off * 0.7071, r);
+        }
+    for (double r : {1.0, 30.0, 200.0}) {  // outside the grid, beyond every side
+      add(-40, 50, r);
+      add(50, 130, r);
+      add(130, -40, r);
+    }
+    SCOPED_TRACE("first reach " + std::to_string(first));
+    const FeatureLists want = run(naive, pts.view(), reach, scene);
+    expect_same(run(grid, pts.view(), reach, scene), want);
+    std::size_t found = 0;
+    for (std::size_t q = 0; q + 1 < want.offset.size(); ++q)
+      found += want.offset[q + 1] > want.offset[q];
+    EXPECT_GT(found, pts.size() / 3);  // the rings straddle the reach: many hit, many miss
+    EXPECT_LT(found, pts.size());
+  }
+}
+
 TEST(FeatureGrid, RebuildsForANewSceneAndHandlesAnEmptyOne) {
   Rng rng(8);
   FeatureNaive naive;
