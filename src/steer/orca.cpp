@@ -337,7 +337,7 @@ class OrcaModel final : public Model {
     const AgentTable& t = in.agents;
     const double back = in.cfg.steering.orca.max_retreat * t.pref_speed[i];
     if (back >= t.max_speed[i]) return;  // cannot bind
-    const double w = std::sqrt(in.pref_vx[i] * in.pref_vx[i] + in.pref_vy[i] * in.pref_vy[i]);
+    const double w = std::hypot(in.pref_vx[i], in.pref_vy[i]);
     if (w == 0) return;  // no direction to keep to (idle, or on its target)
     const double ux = in.pref_vx[i] / w, uy = in.pref_vy[i] / w;
     out.push_back({-ux * back, -uy * back, ux, uy});
@@ -396,8 +396,7 @@ class OrcaModel final : public Model {
     if (g.is_polygon()) {
       d = inside_goal(g, t.x[i], t.y[i]) ? 0 : std::sqrt(dist2_to_boundary(g.area, t.x[i], t.y[i]));
     } else {
-      const double gx = g.x - t.x[i], gy = g.y - t.y[i];
-      d = std::max(0.0, std::sqrt(gx * gx + gy * gy) - g.arrival_radius);
+      d = std::max(0.0, std::hypot(g.x - t.x[i], g.y - t.y[i]) - g.arrival_radius);
     }
     return d / t.pref_speed[i];
   }

@@ -94,10 +94,7 @@ inline bool discs_overlap(double dx, double dy, double rsum) {
 // goal: inside or on the boundary (within a micrometre, so that an agent that steps exactly onto
 // the nearest boundary point arrives whatever the rounding).
 inline bool inside_goal(const Goal& g, double px, double py) {
-  if (!g.is_polygon()) {
-    const double dx = g.x - px, dy = g.y - py;
-    return std::sqrt(dx * dx + dy * dy) <= g.arrival_radius;  // (hypot is several times slower)
-  }
+  if (!g.is_polygon()) return std::hypot(g.x - px, g.y - py) <= g.arrival_radius;
   return point_in_polygon(g.area, px, py) || dist2_to_boundary(g.area, px, py) <= 1e-12;
 }
 
