@@ -6,6 +6,42 @@
 #include "world/geometry.hpp"
 
 namespace crowddb::index {
+namespace {
+
+constexpr std::size_t kChunk = 8192;  // rows per chunk of a parallel build
+
+// radix_sort's passes in chunks on the executor's threads: each chunk counts its digits, the
+// chunks' places follow in (digit, chunk) order, and each chunk scatters its words in order, so
+// the result is the stable sort's, the same as one thread's.
+void radix_sort_parallel(std::vector<uint64_t>& a, std::vector<uint64_t>& tmp, int lo_bit,
+                         int hi_bit, Executor& ex) {
+  constexpr int kDigit = 11;
+  constexpr std::size_t kBuckets = std::size_t{1} << kDigit;
+  const std::size_t n = a.size(), chunks = (n + kChunk - 1) / kChunk;
+  tmp.resize(n);
+  std::vector<uint32_t> place(chunks * kBuckets);
+  for (int shift = lo_bit; shift < hi_bit; shift += kDigit) {
+    ex.for_each_chunk(n, kChunk, [&](std::size_t b, std::size_t e) {
+      uint32_t* count = place.data() + b / kChunk * kBuckets;
+      std::fill(count, count + kBuckets, 0u);
+      for (std::size_t k = b; k < e; ++k) ++count[(a[k] >> shift) & (kBuckets - 1)];
+    });
+    uint32_t sum = 0;
+    for (std::size_t digit = 0; digit < kBuckets; ++digit)
+      for (std::size_t c = 0; c < chunks; ++c) {
+        const uint32_t k = place[c * kBuckets + digit];
+        place[c * kBuckets + digit] = sum;
+        sum += k;
+      }
+    ex.for_each_chunk(n, kChunk, [&](std::size_t b, std::size_t e) {
+      uint32_t* at = place.data() + b / kChunk * kBuckets;
+      for (std::size_t k = b; k < e; ++k) tmp[at[(a[k] >> shift) & (kBuckets - 1)]++] = a[k];
+    });
+    a.swap(tmp);
+  }
+}
+
+}  // namespace
 
 int64_t CellIndex::cell_of(double u) const {
   const double c = std::floor(u / cell_);
@@ -22,7 +58,7 @@ int64_t CellIndex::row_of(double v) const {
 }
 
 void CellIndex::build(const DiscView& d, std::span<const uint32_t> rows, const Frame& frame,
-                      double R) {
+                      double R, Executor* ex) {
   frame_ = frame;
   R_ = R;
   const std::size_t n = rows.empty() ? d.n : rows.size();
@@ -40,23 +76,38 @@ void CellIndex::build(const DiscView& d, std::span<const uint32_t> rows, const F
 
   key_.resize(n);
   row_.resize(n);
+  // Chunked passes pay from a few chunks per thread on.
+  Executor* const par = ex && ex->threads() > 1 && n >= 2 * kChunk ? ex : nullptr;
+  auto each = [&](auto&& body) {
+    if (par)
+      par->for_each_chunk(n, kChunk, body);
+    else
+      body(std::size_t{0}, n);
+  };
   const auto space = static_cast<uint64_t>(W_) * static_cast<uint64_t>(H_);
   const int key_bits = bits_for(space);
   if (key_bits <= 32) {
     // key in the high word, the position in `rows` in the low word: one radix sort over the key.
     auto& packed = scratch_;
     packed.resize(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      const uint32_t i = row_at(k);
-      const auto key =
-          static_cast<uint64_t>(row_of(d.y[i] - frame.y0) * W_ + cell_of(d.x[i] - frame.x0));
-      packed[k] = key << 32 | k;
-    }
-    radix_sort(packed, scratch2_, 32, 32 + key_bits);
-    for (std::size_t k = 0; k < n; ++k) {
-      key_[k] = packed[k] >> 32;
-      row_[k] = row_at(packed[k] & 0xffffffffu);
-    }
+    each([&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const uint32_t i = row_at(k);
+        const auto key =
+            static_cast<uint64_t>(row_of(d.y[i] - frame.y0) * W_ + cell_of(d.x[i] - frame.x0));
+        packed[k] = key << 32 | k;
+      }
+    });
+    if (par)
+      radix_sort_parallel(packed, scratch2_, 32, 32 + key_bits, *par);
+    else
+      radix_sort(packed, scratch2_, 32, 32 + key_bits);
+    each([&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        key_[k] = packed[k] >> 32;
+        row_[k] = row_at(packed[k] & 0xffffffffu);
+      }
+    });
   } else {
     std::vector<std::pair<uint64_t, uint32_t>> kv(n);
     for (std::size_t k = 0; k < n; ++k) {
@@ -73,12 +124,14 @@ void CellIndex::build(const DiscView& d, std::span<const uint32_t> rows, const F
   x_.resize(n);
   y_.resize(n);
   r_.resize(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    const uint32_t i = row_[k];
-    x_[k] = d.x[i];
-    y_[k] = d.y[i];
-    r_[k] = d.radius[i];
-  }
+  each([&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      const uint32_t i = row_[k];
+      x_[k] = d.x[i];
+      y_[k] = d.y[i];
+      r_[k] = d.radius[i];
+    }
+  });
 }
 
 void CellIndex::pairs(PairList& out, uint64_t& tests) const {

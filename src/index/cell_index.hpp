@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "index/collision_common.hpp"
+#include "util/executor.hpp"
 
 namespace crowddb::index {
 
@@ -27,8 +28,12 @@ class CellIndex {
  public:
   // Buckets `rows` of d (all rows when empty) with cell side >= 2 * reach(R); R must be >= every
   // radius among them. The frame is that of all discs the caller will ever query against.
-  void build(const DiscView& d, std::span<const uint32_t> rows, const Frame& frame, double R);
-  void build_all(const DiscView& d, const Frame& frame, double R) { build(d, {}, frame, R); }
+  // With an executor, large builds run their passes in chunks on its threads (the same index).
+  void build(const DiscView& d, std::span<const uint32_t> rows, const Frame& frame, double R,
+             Executor* ex = nullptr);
+  void build_all(const DiscView& d, const Frame& frame, double R, Executor* ex = nullptr) {
+    build(d, {}, frame, R, ex);
+  }
 
   std::size_t size() const { return key_.size(); }
   double max_radius() const { return R_; }

@@ -27,7 +27,7 @@ void CollisionNn::run(const DiscView& d, const StaticScene& scene, CollisionPair
     return;
   }
   Stopwatch sw;
-  cells_.build_all(d, frame, R);
+  cells_.build_all(d, frame, R, &ex);
   stats.build_seconds += sw.seconds();
   sw.restart();
   // Each candidate pair once (half neighbourhood), updating both discs' nearest neighbour:
