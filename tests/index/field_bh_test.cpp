@@ -30,7 +30,7 @@ struct Abs {
   std::vector<double> pot, grad;  // S_abs and G_abs per probe
 };
 
-Abs abs_sums(const DiscView& d, const StaticScene& scene, const PotentialSpec& spec) {
+Abs bh_abs_sums(const DiscView& d, const StaticScene& scene, const PotentialSpec& spec) {
   const PairKernel kernel(spec);
   Abs a;
   for (std::size_t p = 0; p < d.n; ++p) {
@@ -57,7 +57,7 @@ double check(const DiscTable& t, const StaticScene& scene, const PotentialSpec& 
   const FieldColumns naive = potential_field(t.view(), scene, s, "naive");
   QueryStats st;
   const FieldColumns bh = potential_field(t.view(), scene, s, "bh", 1, &st);
-  const Abs a = abs_sums(t.view(), scene, s);
+  const Abs a = bh_abs_sums(t.view(), scene, s);
   const double gb = bh_gradient_bound(s.metric);
   std::vector<double> rel;
   int bad = 0;
