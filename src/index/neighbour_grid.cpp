@@ -16,7 +16,9 @@ constexpr uint32_t kBatch = 32;  // candidates filtered at once before any is of
 // Measured on the RVO2-style airport (2 * 10^4 agents, k = 10, 100 ticks; the neighbour stage's
 // ms per tick, min of 5 interleaved runs): 2 -> 9.5, 4 -> 9.0, 6 -> 8.8, 8 -> 8.6 (2 without
 // the hints: 11.3). With the hints most queries scan chords, and fewer, longer runs of cells
-// beat fewer candidates: the filter is branch-free, each run is not.
+// beat fewer candidates: the filter is branch-free, each run is not. 6 rather than 8: the two
+// are within the host's noise, and the larger cells also serve the queries that never have
+// hints (a subset of rows: the stalemate stage's, idle groups'; the first tick), unmeasured.
 constexpr double kBlockFill = 6;
 constexpr double kChordReach = 1.5;  // hinted bounds up to this many cells scan chords
 constexpr uint32_t kNoRow = ~0u;     // pads the hints (no table has 2^32 rows)
@@ -72,6 +74,9 @@ void NeighbourGrid::build(const DiscView& d, double range, uint32_t k, Executor&
   cell_ = cell;
   W_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(w / cell)) + 1);
   H_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(h / cell)) + 1);
+  // Rounding of the cell coordinates (x0 + c * cell) is relative to the grid's origin and
+  // extent, whatever the query's own coordinates: part of every cell test's slack.
+  slack_ = 1e-9 * (cell_ + std::abs(x0_) + std::abs(y0_) + static_cast<double>(W_ + H_) * cell_);
   const auto cells = static_cast<std::size_t>(W_ * H_);
   start_.assign(cells + 1, 0);
   cell_of_.resize(d.n);
@@ -103,8 +108,16 @@ void NeighbourGrid::rows_permuted(std::span<const uint32_t> order) {
   // Rows removed or added since the last call (arrivals, sources) do not stop this: the hints of
   // the rows they touched name the wrong discs, which costs time, never exactness.
   const std::size_t n = order.size(), last_n = slot_count_.size();
-  std::vector<uint32_t> new_of(n);
-  for (std::size_t r = 0; r < n; ++r) new_of[order[r]] = static_cast<uint32_t>(r);
+  // Hints must be distinct rows (each is offered once): only a permutation keeps them so.
+  constexpr uint32_t kUnset = ~0u;
+  std::vector<uint32_t> new_of(n, kUnset);
+  for (std::size_t r = 0; r < n; ++r) {
+    if (order[r] >= n || new_of[order[r]] != kUnset) {
+      hint_k_ = 0;
+      return;
+    }
+    new_of[order[r]] = static_cast<uint32_t>(r);
+  }
   std::vector<uint32_t> count(n, 0), rows(n * k);
   for (std::size_t r = 0; r < n; ++r) {
     const std::size_t old = order[r];
@@ -144,14 +157,15 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
   // gathered per chunk.
   const bool spatial = queries.empty() && k > 0;
   // Last call's lists seed this call's (see the header): only when they were made the same way.
-  const bool hints = spatial && k == hint_k_ && k <= NearestK::kInline;
+  const bool hintable = spatial && k <= NearestK::kInline;
+  const bool hints = hintable && k == hint_k_;
   if (spatial) {
     if (!hints) slot_count_.assign(d.n, 0);
     slot_count_.resize(d.n, 0);  // rows new since the last call have no hints
     slot_row_.resize(d.n * k);
     slot_d2_.resize(d.n * k);
   }
-  hint_k_ = spatial ? k : 0;
+  hint_k_ = hintable ? k : 0;
   ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
     const std::size_t c = b / kGrain;
     NearestK best;
@@ -174,7 +188,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
           if (j >= d.n || j == i) continue;
           const double dx = d.x[j] - px, dy = d.y[j] - py;
           const double d2 = dx * dx + dy * dy;
-          if (d2 >= r2) continue;
+          if (!(d2 < r2)) continue;  // the scans' range test
           hint[nh++] = j;
           best.offer(j, d.id[j], d2);
         }
@@ -241,7 +255,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
       // scanned row by row, each row's chord of it as one run, and nothing else: no ring needs
       // visiting. col() and row() are monotone, so an entry within the chord (widened by
       // `slack` against rounding) lies in a cell of the run.
-      const double slack = 1e-9 * (cell_ + std::abs(px) + std::abs(py));
+      const double slack = slack_ + 1e-9 * (std::abs(px) + std::abs(py));
       if (k > 0 && best.full() && best.bound() < kChordReach * kChordReach * cell_ * cell_) {
         const double reach = std::sqrt(best.bound()) + slack;
         const int64_t cy0 = row(py - reach), cy1 = row(py + reach);

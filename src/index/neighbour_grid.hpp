@@ -6,8 +6,9 @@
 // list hardly changes, so the hints arrive nearly sorted (cheap insertions) and fill the list
 // with a tight bound on the k-th distance at once. Any rows would do as hints: the answer is the
 // best k of all candidates in whatever order they come, so stale hints (rows reordered, removed,
-// or another table) cost time, never exactness; the scans skip the hinted rows, so no candidate
-// is offered twice (test: NeighbourGrid.ListsOfTheCallBeforeChangeNothing).
+// or another table) cost time, never exactness, as long as they are distinct rows (a list is;
+// rows_permuted refuses anything but a permutation); the scans skip the hinted rows, so no
+// candidate is offered twice (test: NeighbourGrid.ListsOfTheCallBeforeChangeNothing).
 //
 // Search: with a full list whose k-th distance is within 1.5 cells (the usual case with hints),
 // the cells meeting the disc of that radius are scanned row by row, each row's chord of the
@@ -50,6 +51,7 @@ class NeighbourGrid final : public NeighbourPath {
   int64_t row(double y) const;
 
   double x0_ = 0, y0_ = 0, cell_ = 1;
+  double slack_ = 0;  // rounding of cell coordinates (see build)
   int64_t W_ = 1, H_ = 1;
   std::vector<uint32_t> start_;  // W * H + 1 offsets into the cell-ordered arrays
   std::vector<uint32_t> rows_;   // table rows in cell order

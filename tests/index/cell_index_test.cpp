@@ -42,6 +42,7 @@ TEST(CellIndex, ThreadsBuildTheSameIndex) {
           ASSERT_EQ(many.row(k), one.row(k)) << k;
           ASSERT_EQ(many.x(k), one.x(k)) << k;
           ASSERT_EQ(many.y(k), one.y(k)) << k;
+          ASSERT_EQ(many.r(k), one.r(k)) << k;
         }
       }
     }

@@ -77,17 +77,24 @@ TEST(FeatureGrid, EqualsNaiveOnRandomScenes) {
   }
 }
 
-// Far from every feature a query ends at its cell's distance to the nearest feature cell. Points
-// on rings around a circle and along a long diagonal wall at the reach (and a hair inside and
-// outside it), with reaches from a tenth of a cell to many cells, and points outside the grid.
+// Far from every feature a query ends at its cell's distance to the nearest feature cell. The
+// grid's cell is set by a first query of one point (its reach); then points at every distance
+// from a circle and from a diagonal wall, in steps finer than a cell, ask for a reach a hair
+// above or below that distance, so the feature is just in or just out of reach and their cells
+// lie at every Chebyshev distance from the features' cells; and points beyond the grid's box.
+// Skipping a cell early (the bound m instead of m - 1) fails it.
 TEST(FeatureGrid, SkipsOnlyWhatIsOutOfReach) {
   const std::vector<CircleObstacle> circles = {{50, 50, 0.5, 1}};
   const std::vector<PolygonObstacle> polys = {
       {{{10, 80}, {80, 10}, {80.2, 10.2}, {10.2, 80.2}}, 1}};
   const StaticScene scene(circles, polys, 1, ObstacleCharges::none, nullptr);
   FeatureNaive naive;
-  for (double first : {0.05, 0.3, 1.0}) {
+  for (double cell : {0.3, 1.0, 2.5}) {
     FeatureGrid grid;
+    DiscTable first;
+    first.push_back(1, 50, 50, 0, 0, 0.2);
+    const std::vector<double> first_reach = {cell};
+    run(grid, first.view(), first_reach, scene);  // the grid's cell: the first query's reach
     DiscTable pts;
     std::vector<double> reach;
     uint64_t id = 1;
@@ -95,27 +102,26 @@ TEST(FeatureGrid, SkipsOnlyWhatIsOutOfReach) {
       pts.push_back(id++, x, y, 0, 0, 0.2);
       reach.push_back(r);
     };
-    add(50, 50, first);  // the first query sets the cell: about `first`
-    for (double r : {0.01, 0.1, 0.7, 2.0, 9.0})
-      for (double hair : {-1e-9, 0.0, 1e-9, 0.01, 1.0})
-        for (int k = 0; k < 16; ++k) {
-          const double a = k * 0.3927, d = 0.5 + r + hair;  // from the circle's edge
-          add(50 + d * std::cos(a), 50 + d * std::sin(a), r);
-          const double t = k / 16.0, off = r + hair;  // from the wall's near side
-          add(10 + 70 * t - off * 0.7071, 80 - 70 * t - off * 0.7071, r);
-        }
-    for (double r : {1.0, 30.0, 200.0}) {  // outside the grid, beyond every side
+    for (double dist = 0.05; dist < 12; dist += 0.0371)
+      for (double hair : {-1e-9, 1e-9, 0.02}) {
+        const double a = dist * 7.3;  // directions spread over the circle
+        add(50 + (0.5 + dist) * std::cos(a), 50 + (0.5 + dist) * std::sin(a), dist + hair);
+        // From the wall's south-west side (its normal is (-1, -1) / sqrt 2), along its length.
+        const double t = std::fmod(dist * 0.137, 1.0);
+        add(10 + 70 * t - dist * 0.70710678, 80 - 70 * t - dist * 0.70710678, dist + hair);
+      }
+    for (double r : {1.0, 30.0, 200.0}) {  // beyond the grid's box on every side
       add(-40, 50, r);
       add(50, 130, r);
       add(130, -40, r);
     }
-    SCOPED_TRACE("first reach " + std::to_string(first));
+    SCOPED_TRACE("cell " + std::to_string(cell));
     const FeatureLists want = run(naive, pts.view(), reach, scene);
     expect_same(run(grid, pts.view(), reach, scene), want);
     std::size_t found = 0;
     for (std::size_t q = 0; q + 1 < want.offset.size(); ++q)
       found += want.offset[q + 1] > want.offset[q];
-    EXPECT_GT(found, pts.size() / 3);  // the rings straddle the reach: many hit, many miss
+    EXPECT_GT(found, pts.size() / 3);  // the reaches straddle the distances: many hit, many miss
     EXPECT_LT(found, pts.size());
   }
 }
