@@ -8,38 +8,7 @@
 namespace crowddb::index {
 namespace {
 
-constexpr std::size_t kChunk = 8192;  // rows per chunk of a parallel build
-
-// radix_sort's passes in chunks on the executor's threads: each chunk counts its digits, the
-// chunks' places follow in (digit, chunk) order, and each chunk scatters its words in order, so
-// the result is the stable sort's, the same as one thread's.
-void radix_sort_parallel(std::vector<uint64_t>& a, std::vector<uint64_t>& tmp, int lo_bit,
-                         int hi_bit, Executor& ex) {
-  constexpr int kDigit = 11;
-  constexpr std::size_t kBuckets = std::size_t{1} << kDigit;
-  const std::size_t n = a.size(), chunks = (n + kChunk - 1) / kChunk;
-  tmp.resize(n);
-  std::vector<uint32_t> place(chunks * kBuckets);
-  for (int shift = lo_bit; shift < hi_bit; shift += kDigit) {
-    ex.for_each_chunk(n, kChunk, [&](std::size_t b, std::size_t e) {
-      uint32_t* count = place.data() + b / kChunk * kBuckets;
-      std::fill(count, count + kBuckets, 0u);
-      for (std::size_t k = b; k < e; ++k) ++count[(a[k] >> shift) & (kBuckets - 1)];
-    });
-    uint32_t sum = 0;
-    for (std::size_t digit = 0; digit < kBuckets; ++digit)
-      for (std::size_t c = 0; c < chunks; ++c) {
-        const uint32_t k = place[c * kBuckets + digit];
-        place[c * kBuckets + digit] = sum;
-        sum += k;
-      }
-    ex.for_each_chunk(n, kChunk, [&](std::size_t b, std::size_t e) {
-      uint32_t* at = place.data() + b / kChunk * kBuckets;
-      for (std::size_t k = b; k < e; ++k) tmp[at[(a[k] >> shift) & (kBuckets - 1)]++] = a[k];
-    });
-    a.swap(tmp);
-  }
-}
+constexpr std::size_t kChunk = kRadixChunk;  // rows per chunk of a parallel build
 
 }  // namespace
 
@@ -98,10 +67,7 @@ void CellIndex::build(const DiscView& d, std::span<const uint32_t> rows, const F
         packed[k] = key << 32 | k;
       }
     });
-    if (par)
-      radix_sort_parallel(packed, scratch2_, 32, 32 + key_bits, *par);
-    else
-      radix_sort(packed, scratch2_, 32, 32 + key_bits);
+    radix_sort(packed, scratch2_, 32, 32 + key_bits, par);
     each([&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
         key_[k] = packed[k] >> 32;

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "crowddb/query.hpp"
+#include "util/executor.hpp"
 
 namespace crowddb::index {
 
@@ -67,22 +68,42 @@ struct Frame {
 
 // Sorts 64-bit words by their bits [lo_bit, hi_bit) (stable, least significant digit first).
 // `tmp` is scratch of any size. Used with the key in the high word and a row in the low word.
-inline void radix_sort(std::vector<uint64_t>& a, std::vector<uint64_t>& tmp, int lo_bit,
-                       int hi_bit) {
+// With an executor the passes run in chunks of kRadixChunk on its threads: each chunk counts its
+// digits, the chunks' places follow in (digit, chunk) order and each chunk scatters its words in
+// order, so the result is the one-thread sort's.
+inline constexpr std::size_t kRadixChunk = 8192;
+inline void radix_sort(std::vector<uint64_t>& a, std::vector<uint64_t>& tmp, int lo_bit, int hi_bit,
+                       Executor* ex = nullptr) {
   constexpr int kDigit = 11;
   constexpr std::size_t kBuckets = std::size_t{1} << kDigit;
-  tmp.resize(a.size());
-  std::vector<uint32_t> count(kBuckets);
+  const std::size_t n = a.size();
+  const std::size_t chunk = ex ? kRadixChunk : std::max<std::size_t>(n, 1);
+  const std::size_t chunks = (n + chunk - 1) / chunk;
+  auto each = [&](auto&& body) {
+    if (ex)
+      ex->for_each_chunk(n, chunk, body);
+    else
+      body(std::size_t{0}, n);
+  };
+  tmp.resize(n);
+  std::vector<uint32_t> place(std::max<std::size_t>(chunks, 1) * kBuckets);
   for (int shift = lo_bit; shift < hi_bit; shift += kDigit) {
-    std::fill(count.begin(), count.end(), 0u);
-    for (uint64_t w : a) ++count[(w >> shift) & (kBuckets - 1)];
+    each([&](std::size_t b, std::size_t e) {
+      uint32_t* count = place.data() + b / chunk * kBuckets;
+      std::fill(count, count + kBuckets, 0u);
+      for (std::size_t k = b; k < e; ++k) ++count[(a[k] >> shift) & (kBuckets - 1)];
+    });
     uint32_t sum = 0;
-    for (auto& c : count) {
-      const uint32_t k = c;
-      c = sum;
-      sum += k;
-    }
-    for (uint64_t w : a) tmp[count[(w >> shift) & (kBuckets - 1)]++] = w;
+    for (std::size_t digit = 0; digit < kBuckets; ++digit)
+      for (std::size_t c = 0; c < chunks; ++c) {
+        const uint32_t k = place[c * kBuckets + digit];
+        place[c * kBuckets + digit] = sum;
+        sum += k;
+      }
+    each([&](std::size_t b, std::size_t e) {
+      uint32_t* at = place.data() + b / chunk * kBuckets;
+      for (std::size_t k = b; k < e; ++k) tmp[at[(a[k] >> shift) & (kBuckets - 1)]++] = a[k];
+    });
     a.swap(tmp);
   }
 }

@@ -18,6 +18,34 @@ NeighbourLists run(NeighbourPath& p, const DiscView& d, double range, uint32_t k
   return out;
 }
 
+// Removes up to `count` random rows the way the world does (the last row moves into the hole),
+// keeping at least 20.
+void remove_rows(DiscTable& t, Rng& rng, int count) {
+  for (int j = 0; j < count && t.size() > 20; ++j) {
+    const std::size_t i = rng.below(t.size());
+    for (auto* col : {&t.x, &t.y, &t.vx, &t.vy, &t.radius, &t.charge}) {
+      (*col)[i] = col->back();
+      col->pop_back();
+    }
+    t.id[i] = t.id.back();
+    t.id.pop_back();
+  }
+}
+
+// A random order of n rows (order[new row] = old row).
+std::vector<uint32_t> shuffled_rows(std::size_t n, Rng& rng) {
+  std::vector<uint32_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(i);
+  for (std::size_t i = n; i > 1; --i) std::swap(order[i - 1], order[rng.below(i)]);
+  return order;
+}
+
+DiscTable permuted(const DiscTable& t, std::span<const uint32_t> order) {
+  DiscTable p;
+  for (uint32_t r : order) p.push_back(t.id[r], t.x[r], t.y[r], t.vx[r], t.vy[r], t.radius[r]);
+  return p;
+}
+
 void expect_same(const NeighbourLists& a, const NeighbourLists& b) {
   ASSERT_EQ(a.offset, b.offset);
   EXPECT_EQ(a.row, b.row);
@@ -136,15 +164,7 @@ TEST(NeighbourGrid, ListsOfTheCallBeforeChangeNothing) {
           }
           break;
         case 2:  // rows removed from the end and the middle
-          for (int j = 0; j < 30 && t.size() > 20; ++j) {
-            const std::size_t i = rng.below(t.size());
-            for (auto* col : {&t.x, &t.y, &t.vx, &t.vy, &t.radius, &t.charge}) {
-              (*col)[i] = col->back();
-              col->pop_back();
-            }
-            t.id[i] = t.id.back();
-            t.id.pop_back();
-          }
+          remove_rows(t, rng, 30);
           break;
         case 3:  // rows added
           for (int j = 0; j < 30; ++j)
@@ -158,35 +178,15 @@ TEST(NeighbourGrid, ListsOfTheCallBeforeChangeNothing) {
           }
           break;
         case 7: {  // rows permuted, as the tick's curve order does, and the grid told
-          std::vector<uint32_t> order(t.size());
-          for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<uint32_t>(i);
-          for (std::size_t i = order.size(); i > 1; --i)
-            std::swap(order[i - 1], order[rng.below(i)]);
-          DiscTable p;
-          for (uint32_t r : order)
-            p.push_back(t.id[r], t.x[r], t.y[r], t.vx[r], t.vy[r], t.radius[r]);
-          t = p;
+          const std::vector<uint32_t> order = shuffled_rows(t.size(), rng);
+          t = permuted(t, order);
           grid.rows_permuted(order);
           break;
         }
         case 9: {  // the tick's order: rows removed (arrivals), then the reorder, then the query
-          for (int j = 0; j < 15 && t.size() > 20; ++j) {
-            const std::size_t i = rng.below(t.size());
-            for (auto* col : {&t.x, &t.y, &t.vx, &t.vy, &t.radius, &t.charge}) {
-              (*col)[i] = col->back();
-              col->pop_back();
-            }
-            t.id[i] = t.id.back();
-            t.id.pop_back();
-          }
-          std::vector<uint32_t> order(t.size());
-          for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<uint32_t>(i);
-          for (std::size_t i = order.size(); i > 1; --i)
-            std::swap(order[i - 1], order[rng.below(i)]);
-          DiscTable p;
-          for (uint32_t r : order)
-            p.push_back(t.id[r], t.x[r], t.y[r], t.vx[r], t.vy[r], t.radius[r]);
-          t = p;
+          remove_rows(t, rng, 15);
+          const std::vector<uint32_t> order = shuffled_rows(t.size(), rng);
+          t = permuted(t, order);
           grid.rows_permuted(order);
           break;
         }
@@ -235,11 +235,8 @@ TEST(NeighbourGrid, CarriesTheHintsThroughAPermutation) {
   tests_of(grid, t);
   const uint64_t hinted = tests_of(grid, t);  // every hint exact
   Rng rng(3);
-  std::vector<uint32_t> order(t.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<uint32_t>(i);
-  for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.below(i)]);
-  DiscTable p;
-  for (uint32_t r : order) p.push_back(t.id[r], t.x[r], t.y[r], t.vx[r], t.vy[r], t.radius[r]);
+  const std::vector<uint32_t> order = shuffled_rows(t.size(), rng);
+  const DiscTable p = permuted(t, order);
   NeighbourGrid untold;
   tests_of(untold, t);
   EXPECT_NE(tests_of(untold, p), hinted);  // the test can tell
