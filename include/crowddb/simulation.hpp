@@ -52,6 +52,10 @@ struct OrcaParams {
   // [s] headway: the preferred speed is capped at spacing / time_gap to the agent ahead going the
   // same way or standing (>= 0; 0: off, the default). steer/orca.cpp says when it helps.
   double time_gap = 0;
+  // [s] stream gap: where streams meet (neighbours bound for another goal coming towards or
+  // across) and in the queues behind such a meeting, the preferred speed is capped at the speed
+  // of the agent ahead plus spacing / stream_gap (>= 0; 0: off). steer/orca.cpp says why.
+  double stream_gap = 1;
   // No sweeping back: a hard plane keeps the velocity's component against the preferred direction
   // at most max_retreat * pref_speed (>= 0; a value >= max_speed / pref_speed never binds, so a
   // large one such as 10 switches it off). steer/orca.cpp says why.

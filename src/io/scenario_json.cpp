@@ -870,6 +870,7 @@ void read_steering(Node& root, SimConfig& cfg) {
     op.first_share = o.positive("first_share", op.first_share);
     if (!(op.first_share < 1)) o.fail("first_share", "must be < 1");
     op.time_gap = o.non_negative("time_gap", op.time_gap);
+    op.stream_gap = o.non_negative("stream_gap", op.stream_gap);
     op.max_retreat = o.non_negative("max_retreat", op.max_retreat);
     o.finish();
   }

@@ -72,6 +72,8 @@ void SimConfig::validate() const {
   require(std::isfinite(o.first_share) && o.first_share > 0 && o.first_share < 1,
           "steering/orca/first_share", "must be in (0, 1)");
   require(std::isfinite(o.time_gap) && o.time_gap >= 0, "steering/orca/time_gap", "must be >= 0");
+  require(std::isfinite(o.stream_gap) && o.stream_gap >= 0, "steering/orca/stream_gap",
+          "must be >= 0");
   require(std::isfinite(o.max_retreat) && o.max_retreat >= 0, "steering/orca/max_retreat",
           "must be >= 0");
   const CfsmParams& c = steering.cfsm;

@@ -166,6 +166,7 @@ TEST(ScenarioJson, InvalidFieldsNameTheirPointer) {
       {head + R"("steering": {"orca": {"first_share": 1}}})", "/steering/orca/first_share"},
       {head + R"("steering": {"orca": {"time_gap": -0.5}}})", "/steering/orca/time_gap"},
       {head + R"("steering": {"orca": {"max_retreat": -0.1}}})", "/steering/orca/max_retreat"},
+      {head + R"("steering": {"orca": {"stream_gap": -1}}})", "/steering/orca/stream_gap"},
       {R"({"bounds": [-1e308, -1e308, 1e308, 1e308]})",
        "/bounds: coordinates must lie within +-1e9 m (got -1e+308)"},
       {head + R"("steering": {"cfsm": {"time_gap": -1}}})", "/steering/cfsm/time_gap"},

@@ -104,6 +104,40 @@ TEST(Orca, HeadwayCapsTheWishBehindAnAgentGoingTheSameWay) {
   EXPECT_EQ(first_tick_speed_of_follower("W", 2), first_tick_speed_of_follower("W", 0));
 }
 
+// The stream gap: a queue of seven walking east whose head meets someone coming west. The last
+// in the queue is 5.6 m from the oncoming one, beyond its neighbour range (5 m), and learns of
+// the meeting through the six ahead of it: its wish is capped at v_ahead + spacing / stream_gap
+// (everyone starts at rest, spacing 0.3 m: at most 0.3 m/s with a gap of 1 s). When the one
+// ahead of the queue walks east too, or the stream gap is off, it starts at walking speed.
+double first_tick_speed_of_last_in_queue(const std::string& ahead_goal, double stream_gap) {
+  std::string agents;
+  for (int k = 0; k < 7; ++k)
+    agents += R"({"x": )" + std::to_string(10 + 0.8 * k) +
+              R"(, "y": 2, "radius": 0.25, "pref_speed": 1.3, "goal": "E"}, )";
+  const std::string text = R"({"bounds": [0, 0, 40, 4], "duration": 1, "walls": false,
+    "stall": {"resolve": false},
+    "steering": {"model": "orca", "orca": {"stream_gap": )" +
+                           std::to_string(stream_gap) + R"(}},
+    "goals": [{"name": "E", "x": 39, "y": 2}, {"name": "W", "x": 1, "y": 2}],
+    "agents": [)" + agents +
+                           R"({"x": 15.6, "y": 2, "radius": 0.25, "pref_speed": 1.3, "goal": ")" +
+                           ahead_goal + R"("}]})";
+  Scenario sc = parse_scenario(text, "t.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  sim.step();
+  const AgentTable& t = sim.world().agents();
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (t.x[i] < 10.5) return std::sqrt(t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i]);
+  ADD_FAILURE() << "the last in the queue is missing";
+  return 0;
+}
+
+TEST(Orca, StreamGapSlowsAQueueBehindAMeeting) {
+  EXPECT_LE(first_tick_speed_of_last_in_queue("W", 1), 0.3 + 1e-9);
+  EXPECT_GT(first_tick_speed_of_last_in_queue("W", 0), 1.0);
+  EXPECT_GT(first_tick_speed_of_last_in_queue("E", 1), 1.0);
+}
+
 // A lone walker meets a group in a 2 m corridor. The group goes first (less path left); without
 // the retreat plane ORCA's nearest permitted velocity carries the walker backwards with it (11 m
 // when measured); with it the walker gives way sideways or stands, never moving against its
