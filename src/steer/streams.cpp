@@ -7,7 +7,7 @@
 namespace crowddb::steer {
 namespace {
 
-constexpr std::size_t kGrain = 1024;
+constexpr std::size_t kStreamGrain = 1024;  // rows per chunk of the marking
 
 }  // namespace
 
@@ -51,7 +51,7 @@ void mark_meetings(const StreamView& v, StreamMarks& out, Executor& ex) {
   out.follows.assign(nb.row.size(), 0);
   // Per row, in parallel (each chunk writes its own rows and list entries): the meetings, and
   // whom the others follow.
-  ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
+  ex.for_each_chunk(n, kStreamGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       marked[i] = at_meeting(v, i);
       double ux, uy;
