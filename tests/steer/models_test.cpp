@@ -75,6 +75,18 @@ TEST(Orca, HeadwayChangesNothingAcrossAccessPathsAndThreads) {
             reference);
 }
 
+// The speed after one tick of the agent that starts at x = 10 (the only one west of 10.5 m).
+double first_tick_speed_of_the_agent_at_10(const std::string& text) {
+  Scenario sc = parse_scenario(text, "t.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  sim.step();
+  const AgentTable& t = sim.world().agents();
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (t.x[i] < 10.5) return std::sqrt(t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i]);
+  ADD_FAILURE() << "the agent at x = 10 is missing";
+  return 0;
+}
+
 // The headway caps the wish at spacing / time_gap behind a neighbour going the same way, and
 // leaves it alone for one coming towards. Two agents 0.5 m apart (spacing), both start at rest.
 double first_tick_speed_of_follower(const std::string& leader_goal, double time_gap) {
@@ -85,14 +97,7 @@ double first_tick_speed_of_follower(const std::string& leader_goal, double time_
     "agents": [{"x": 10, "y": 2, "radius": 0.25, "pref_speed": 1.3, "goal": "E"},
                {"x": 11, "y": 2, "radius": 0.25, "pref_speed": 1.3, "goal": ")" +
                            leader_goal + R"("}]})";
-  Scenario sc = parse_scenario(text, "t.json");
-  Simulation sim(std::move(sc.world), sc.config);
-  sim.step();
-  const AgentTable& t = sim.world().agents();
-  for (std::size_t i = 0; i < t.size(); ++i)
-    if (t.x[i] < 10.5) return std::sqrt(t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i]);
-  ADD_FAILURE() << "the follower is missing";
-  return 0;
+  return first_tick_speed_of_the_agent_at_10(text);
 }
 
 TEST(Orca, HeadwayCapsTheWishBehindAnAgentGoingTheSameWay) {
@@ -122,14 +127,7 @@ double first_tick_speed_of_last_in_queue(const std::string& ahead_goal, double s
     "agents": [)" + agents +
                            R"({"x": 15.6, "y": 2, "radius": 0.25, "pref_speed": 1.3, "goal": ")" +
                            ahead_goal + R"("}]})";
-  Scenario sc = parse_scenario(text, "t.json");
-  Simulation sim(std::move(sc.world), sc.config);
-  sim.step();
-  const AgentTable& t = sim.world().agents();
-  for (std::size_t i = 0; i < t.size(); ++i)
-    if (t.x[i] < 10.5) return std::sqrt(t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i]);
-  ADD_FAILURE() << "the last in the queue is missing";
-  return 0;
+  return first_tick_speed_of_the_agent_at_10(text);
 }
 
 TEST(Orca, StreamGapSlowsAQueueBehindAMeeting) {
