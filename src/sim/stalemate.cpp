@@ -158,8 +158,10 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     if (blocker[q] < 0) continue;
     const auto j = static_cast<std::size_t>(blocker[q]);
     const Vec2 dj = heading(t, goals, j);
-    same_way[q] = standing(t.state[j]) || t.goal[j] == t.goal[i] ||
-                  dj.x * dir[q].x + dj.y * dir[q].y >= kSameWay;
+    // Someone idle heads a queue only at i's own goal: idle on another goal (arrivals of
+    // the other stream) or anywhere else, it is an obstacle that does not move away by itself.
+    same_way[q] = t.goal[j] == t.goal[i] ||
+                  (!standing(t.state[j]) && dj.x * dir[q].x + dj.y * dir[q].y >= kSameWay);
     bpos[q] = pos(j);
   }
   // A queue ends in someone who moves: an agent waits in one when its same-way blocker is

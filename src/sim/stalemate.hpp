@@ -9,11 +9,15 @@
 // the agent is looked at: its blocker is the nearest agent in front of it (towards its target)
 // within 0.6 m of its disc.
 //   - queueing: the blocker walks the same way (the same goal, or directions within 60 degrees)
-//     or stands idle at the goal, and is itself progressing or queueing: a queue ends in someone
-//     who moves. Waiting in one is no stalemate (the back of a queue of 500 at a 1 m exit gains a
-//     few centimetres a second): no action, not counted as stalled. A cycle of mutual blockers
-//     (people arching in a door, all heading for it) has no moving head: they are stalled.
-//   - stalled: no blocker (walls, a local minimum) or a blocker heading elsewhere.
+//     or stands idle at the agent's own goal, and is itself progressing or queueing: a queue ends
+//     in someone who moves. Waiting in one is no stalemate (the back of a queue of 500 at a 1 m
+//     exit gains a few centimetres a second): no action, not counted as stalled. A cycle of mutual
+//     blockers (people arching in a door, all heading for it) has no moving head: they are
+//     stalled.
+//   - stalled: no blocker (walls, a local minimum), a blocker heading elsewhere, or one standing
+//     idle anywhere but at the agent's goal (the other stream's arrivals: in Menge's stress
+//     example one agent stood behind them for the last 250 s of 300, counted as queueing, so
+//     nothing acted).
 // Resolution (deterministic: it depends on the committed state, the seed and the ids only). Of
 // two stalled agents the one with less of its path left goes first (at a clogged door: the one
 // nearest to getting through, as in orca's right of way); ties go by a seeded rank (a hash of

@@ -12,7 +12,8 @@ namespace {
 
 // One agent 10 m east of its goal, heading west with velocity (vx, 0); its best distance so far
 // was 5 m (a counter-stream carried it 5 m back), and it has not beaten that for 6 s. With
-// `blocker`, a second agent, heading east, stands 0.55 m west of it.
+// `blocker`, a second agent, bound for `blocker_goal` (east by default), stands 0.55 m west of
+// it, idle there when `blocker_arrived`.
 struct PushedBack {
   World w{Bounds{0, 0, 40, 10}};
   SimConfig cfg;
@@ -20,7 +21,7 @@ struct PushedBack {
   std::unique_ptr<NeighbourPath> path = neighbour_method("naive", 2).make();
   QueryStats stats;
 
-  PushedBack(double vx, bool blocker) {
+  PushedBack(double vx, bool blocker, bool blocker_arrived = false, uint32_t blocker_goal = 1) {
     w.add_goal({"W", 0, 5, 0.5, 1, {}});
     w.add_goal({"E", 39, 5, 0.5, 1, {}});
     AgentSpec a;
@@ -36,11 +37,12 @@ struct PushedBack {
       AgentSpec b = a;
       b.x = 9.45;
       b.vx = 0;
-      b.goal = 1;
+      b.goal = blocker_goal;
       w.insert(b);
     }
     w.apply_pending();
     AgentTable& t = w.agents_for_tick();
+    if (blocker && blocker_arrived) t.state[1] = AgentState::arrived;
     t.progress_best[0] = 5;
     t.stall_ticks[0] = static_cast<uint32_t>(cfg.ticks_for(6.0));
   }
@@ -77,6 +79,24 @@ TEST(Stalemates, AnAgentWalkingTowardsABlockerStillSidesteps) {
   EXPECT_EQ(c.stalled, 1u);
   EXPECT_EQ(c.sidestepping, 1u);
   EXPECT_EQ(s.action(), StallAction::sidestep);
+}
+
+TEST(Stalemates, StandingBehindIdleArrivalsOfAnotherGoalIsAStalemate) {
+  // The other stream's arrivals idle in its way (Menge's stress example): nobody ahead moves,
+  // so it is no queue; the summary counts it and an action gets it round them.
+  PushedBack s(0.0, true, true, 1);
+  const StallCounts c = s.run();
+  EXPECT_EQ(c.stalled, 1u);
+  EXPECT_EQ(c.queueing, 0u);
+  EXPECT_NE(s.action(), StallAction::none);
+}
+
+TEST(Stalemates, StandingBehindIdleArrivalsAtItsOwnGoalIsQueueing) {
+  PushedBack s(0.0, true, true, 0);
+  const StallCounts c = s.run();
+  EXPECT_EQ(c.stalled, 0u);
+  EXPECT_EQ(c.queueing, 1u);
+  EXPECT_EQ(s.action(), StallAction::none);
 }
 
 // Two stalled agents touching (0.05 m apart): a at (ax, ay) heading for goal ga, b at (bx, by)
