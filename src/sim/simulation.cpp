@@ -315,8 +315,9 @@ uint64_t Simulation::state_hash() const {
 namespace {
 
 constexpr std::string_view kCheckpointMagic = "crowddb-checkpoint";
-// 2: narrow meshes in the path service's state; 3: goal waits (the wait_until column).
-constexpr uint32_t kCheckpointVersion = 3;
+// 2: narrow meshes in the path service's state; 3: goal waits (the wait_until column); 4: the
+// goal each agent left last (the left_goal column).
+constexpr uint32_t kCheckpointVersion = 4;
 
 // What a checkpoint must agree on with the simulation it is restored into: the static tables
 // and the settings that change what a tick computes (not the thread count).
@@ -538,6 +539,7 @@ const TickMetrics& Simulation::step() {
           Rng rng = Rng::stream(cfg.seed ^ (m.tick * 0x9e3779b97f4a7c15ull), t.id[i]);
           const auto others = static_cast<uint32_t>(world_.goals().size() - 1);
           const auto pick = static_cast<uint32_t>(rng.below(others));
+          t.left_goal[i] = t.goal[i];
           t.goal[i] = pick >= t.goal[i] ? pick + 1 : pick;
           t.route[i].clear();
           t.path_goal[i] = AgentTable::kNoPath;  // a new goal: re-plan

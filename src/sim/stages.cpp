@@ -53,6 +53,21 @@ double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i
   return len + std::sqrt(dx * dx + dy * dy);
 }
 
+namespace {
+// Does walking row a leave the goal walking row b heads for, from nearer to it than b is?
+bool lets_out(const AgentTable& t, std::span<const Goal> goals, std::size_t a, std::size_t b) {
+  if (t.left_goal[a] != t.goal[b] || standing(t.state[a]) || standing(t.state[b])) return false;
+  const Goal& g = goals[t.goal[b]];
+  const double ax = t.x[a] - g.x, ay = t.y[a] - g.y, bx = t.x[b] - g.x, by = t.y[b] - g.y;
+  return ax * ax + ay * ay < bx * bx + by * by;
+}
+}  // namespace
+
+int out_before_in(const AgentTable& t, std::span<const Goal> goals, std::size_t i, std::size_t j) {
+  const bool i_out = lets_out(t, goals, i, j), j_out = lets_out(t, goals, j, i);
+  return i_out == j_out ? 0 : (i_out ? 1 : -1);
+}
+
 void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,
                 uint64_t tick, std::span<const uint32_t> demand, Preferred& pref, Executor& ex,
                 const path::Navigation* nav) {

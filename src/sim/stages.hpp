@@ -38,6 +38,14 @@ Vec2 current_target(const AgentTable& t, std::span<const Goal> goals, std::size_
 // with one number across waypoint changes.
 double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i);
 
+// Out before in: of two walking agents, one that has just left the goal the other heads for
+// (AgentTable::left_goal) and is nearer to it goes first, as people let those who come out of a
+// door, off a train or away from a ticket machine out before they go in. Pressing in first, the
+// crowd around a point everyone must touch locks those who touched it inside (SteerSuite's
+// free-tickets). +1: i goes first, -1: j goes first, 0: the rule does not decide (neither, or
+// both, each leaving the other's goal). Antisymmetric: out_before_in(i, j) == -out_before_in(j, i).
+int out_before_in(const AgentTable& t, std::span<const Goal> goals, std::size_t i, std::size_t j);
+
 // The goal stage: per row, the preferred velocity pref_speed towards its current target (slower
 // when it would overshoot within one tick). On top of it, in this order:
 // - a stalemate action in progress (yield or sidestep: StallAction) replaces the direction;

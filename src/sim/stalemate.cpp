@@ -212,9 +212,13 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
                                  !(bpos[q] >= 0 && queueing[static_cast<std::size_t>(bpos[q])]);
     // The one with less of its path left goes first (at a clogged door: the one nearest to
     // getting through), as in orca's right of way; ties by the seeded rank.
+    // Out before in (sim::out_before_in) comes before that.
     const double li = path_left(t, goals, i), lj = blocker_stalled ? path_left(t, goals, j) : 0;
+    const int out = blocker_stalled ? out_before_in(t, goals, i, j) : 0;
     bool j_first =
-        lj < li || (lj == li && priority(cfg.seed, t.id[j]) > priority(cfg.seed, t.id[i]));
+        out != 0
+            ? out < 0
+            : lj < li || (lj == li && priority(cfg.seed, t.id[j]) > priority(cfg.seed, t.id[i]));
     // Taking turns: a pair both stalled for reverse_after swaps the order in every other period
     // (the same for both of them: it depends on the pair and the tick only).
     if (blocker_stalled && reverse_after > 0 && t.stall_ticks[i] >= reverse_after &&

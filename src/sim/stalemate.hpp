@@ -19,8 +19,9 @@
 //     example one agent stood behind them for the last 250 s of 300, counted as queueing, so
 //     nothing acted).
 // Resolution (deterministic: it depends on the committed state, the seed and the ids only). Of
-// two stalled agents the one with less of its path left goes first (at a clogged door: the one
-// nearest to getting through, as in orca's right of way); ties go by a seeded rank (a hash of
+// two stalled agents one coming out of the goal the other heads for goes first (out before in,
+// sim::out_before_in), else the one with less of its path left (at a clogged door: the one
+// nearest to getting through), as in orca's right of way; ties go by a seeded rank (a hash of
 // seed and id):
 //   - the blocker is stalled too and goes first: yield, i.e. step back from it and to the side
 //     away from it at half speed; when the chain of stalled blockers in front ends in people

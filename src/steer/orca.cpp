@@ -29,7 +29,9 @@
 // Right of way (ours): the paper splits every avoidance half and half and builds each plane from
 // the neighbours' current velocities. In a crowd that deadlocks discs that cannot overlap: in a
 // door they arch (each waits for the other), and when everyone stands still no plane asks anyone
-// to make room, so nobody ever moves again. So for each pair one agent goes first: the one with
+// to make room, so nobody ever moves again. So for each pair one agent goes first: one coming
+// out of the goal the other heads for (out before in, sim::out_before_in: else a crowd pressing
+// in towards a point everyone must touch locks in those who touched it), else the one with
 // less of its path left (ties: a seeded rank; idle agents go last, they make room). It takes
 // first_share of the avoidance and may close 1 - first_share of a gap; the other takes the rest
 // (the shares add up to one, so the contact guarantee holds) and avoids the first one where it
@@ -263,7 +265,7 @@ class OrcaModel final : public Model {
             if (gap >= reach || d == 0) continue;
             const double nx = (t.x[j] - t.x[i]) / d, ny = (t.y[j] - t.y[i]) / d;
             // v . n <= g  <=>  v . (-n) >= -g: the plane through -n g with normal -n.
-            const double share = first(i, j) ? 1 - hi_share : hi_share;
+            const double share = first(in, i, j) ? 1 - hi_share : hi_share;
             const double g = std::max(0.0, gap) * share / in.cfg.dt;
             planes.push_back({nx * g, ny * g, -nx, -ny});
           }
@@ -273,7 +275,7 @@ class OrcaModel final : public Model {
             const uint32_t j = nb_.row[a];
             // Right of way: a neighbour that goes first is avoided where it wants to go, as far as
             // it is held up (walking as it wishes, its velocity says it already).
-            const bool i_first = first(i, j);
+            const bool i_first = first(in, i, j);
             const double vjx = i_first ? t.vx[j] : avoid_x_[j];
             const double vjy = i_first ? t.vy[j] : avoid_y_[j];
             // The pair's horizon: no longer than until one of them arrives (see the top).
@@ -441,10 +443,11 @@ class OrcaModel final : public Model {
     return d / t.pref_speed[i];
   }
 
-  // Does i go before j? An agent yielding to a stalemate (see the top), then less path left, then
-  // the seeded rank.
-  bool first(std::size_t i, std::size_t j) const {
+  // Does i go before j? An agent yielding to a stalemate (see the top), then out before in
+  // (sim::out_before_in), then less path left, then the seeded rank.
+  bool first(const TickInput& in, std::size_t i, std::size_t j) const {
     if (yielding_[i] != yielding_[j]) return yielding_[i];
+    if (const int o = sim::out_before_in(in.agents, in.goals, i, j); o != 0) return o > 0;
     return remaining_[i] < remaining_[j] || (remaining_[i] == remaining_[j] && rank_[i] > rank_[j]);
   }
   NeighbourLists nb_;

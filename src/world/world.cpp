@@ -291,6 +291,7 @@ void World::push_row(AgentId id, const AgentSpec& s) {
   t.id.push_back(id.value());
   t.route.emplace_back();
   t.then.push_back(s.then);
+  t.left_goal.push_back(AgentTable::kNoGoal);
   t.stall_action.push_back(StallAction::none);
   t.stall_until.push_back(0);
   t.stall_dir_x.push_back(0);
@@ -328,6 +329,7 @@ void each_column(AgentTable& t, F&& f) {
   f(t.id);
   f(t.route);
   f(t.then);
+  f(t.left_goal);
   f(t.stall_action);
   f(t.stall_until);
   f(t.stall_dir_x);
@@ -337,7 +339,7 @@ void each_column(AgentTable& t, F&& f) {
   f(t.replan_ticks);
   f(t.wait_until);
 }
-static_assert(sizeof(AgentTable) == 27 * sizeof(std::vector<double>));
+static_assert(sizeof(AgentTable) == 28 * sizeof(std::vector<double>));
 
 }  // namespace
 
@@ -406,6 +408,7 @@ void World::refresh_target(std::size_t row) {
 bool World::advance_goal(std::size_t row) {
   AgentTable& t = agents_;
   if (t.then[row].empty()) return false;
+  t.left_goal[row] = t.goal[row];
   t.goal[row] = t.then[row].front();
   t.then[row].erase(t.then[row].begin());
   t.route[row].clear();
@@ -442,6 +445,7 @@ std::size_t World::apply_pending() {
       case Change::Kind::retarget: {
         const auto row = row_of(c.id);
         if (!row) break;  // erased earlier in this batch
+        if (standing(agents_.state[*row])) agents_.left_goal[*row] = agents_.goal[*row];
         agents_.goal[*row] = c.goal;
         agents_.then[*row].clear();
         agents_.route[*row].clear();
@@ -482,6 +486,7 @@ void World::validate() const {
   same(t.id.size(), "id");
   same(t.route.size(), "route");
   same(t.then.size(), "then");
+  same(t.left_goal.size(), "left_goal");
   same(t.stall_action.size(), "stall_action");
   same(t.stall_until.size(), "stall_until");
   same(t.stall_dir_x.size(), "stall_dir_x");
@@ -567,6 +572,7 @@ void columns(Io& io, Table& t) {
   io.vec(t.path_ticket);
   io.vec(t.replan_ticks);
   io.vec(t.wait_until);
+  io.vec(t.left_goal);
 }
 
 }  // namespace
@@ -640,6 +646,8 @@ void World::restore_agents(ByteReader& in) {
         bad(row + ": a route point lies beyond +-1e9");
     if (a.path_goal[r] != AgentTable::kNoPath && a.path_goal[r] >= goals_.size())
       bad(row + ": bad planned goal");
+    if (a.left_goal[r] != AgentTable::kNoGoal && a.left_goal[r] >= goals_.size())
+      bad(row + ": bad goal left");
   }
   std::vector<uint8_t> seen(trial.slots_.size(), 0);
   for (uint32_t f : free_slots) {

@@ -46,8 +46,8 @@ Reference run_reference(const std::string& name, uint64_t ticks, const std::vect
 }
 
 // Scenarios with sources, navigation (searches in flight across the checkpoint), idling
-// arrivals and stalemates. The bottleneck's people of radius 0.3 (the 0.5 class, whose mesh
-// has no 1.2 m door) find the door on the narrow mesh: those searches are in flight too.
+// arrivals, goal sequences and stalemates. The bottleneck's people of radius 0.3 (the 0.5 class,
+// whose mesh has no 1.2 m door) find the door on the narrow mesh: those searches are in flight too.
 TEST(Checkpoint, ARestoredRunContinuesBitIdenticallyOnAnyThreadCount) {
   struct Case {
     std::string name;
@@ -61,6 +61,11 @@ TEST(Checkpoint, ARestoredRunContinuesBitIdenticallyOnAnyThreadCount) {
       {"bottleneck", 200, {3, 120}, {}},
       {"bottleneck", 200, {2, 3, 151}, {"groups.0.radius=0.3", "groups.0.count=60"}},
       {"crossing", 260, {2, 200}, {"goals.0.wait=[1, 4]", "goals.1.wait=2"}},  // people waiting
+      // goal sequences: the goal each left (out before in) crosses the checkpoint
+      {"crossing",
+       420,
+       {2, 330},
+       {R"(groups.0.goal=["east", "north"])", R"(groups.1.goal=["north", "east"])"}},
   };
   for (const Case& c : cases) {
     const Reference ref = run_reference(c.name, c.ticks, c.at, c.overrides);

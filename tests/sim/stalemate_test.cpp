@@ -184,6 +184,44 @@ TEST(Stalemates, APairStalledLongTakesTurnsToYield) {
   }
 }
 
+// Out before in: the pair above, but b has just been to W, where a is going, and is nearer to
+// it: b goes first, and a, with less path left, yields.
+TEST(Stalemates, OneComingOutOfTheOthersGoalGoesFirst) {
+  Pair s(10, 5, 0, 9.45, 5, 1);
+  s.w.agents_for_tick().left_goal[1] = 0;
+  EXPECT_EQ(out_before_in(s.w.agents(), s.w.goals(), 0, 1), -1);
+  EXPECT_EQ(out_before_in(s.w.agents(), s.w.goals(), 1, 0), 1);
+  EXPECT_EQ(s.run().yielding, 1u);
+  EXPECT_EQ(s.w.agents().stall_action[0], StallAction::yield);
+  EXPECT_EQ(s.w.agents().stall_action[1], StallAction::none);
+}
+
+TEST(Stalemates, OutBeforeInOnlyForTheOneNearerTheGoalAndBothWalking) {
+  auto decides = [](Pair& s) { return out_before_in(s.w.agents(), s.w.goals(), 0, 1); };
+  {  // b left W but stands farther from it than a
+    Pair s(9.45, 5, 0, 10, 5, 1);
+    s.w.agents_for_tick().left_goal[1] = 0;
+    EXPECT_EQ(decides(s), 0);
+  }
+  {  // b left a goal a is not heading for
+    Pair s(10, 5, 0, 9.45, 5, 1);
+    s.w.agents_for_tick().left_goal[1] = 2;
+    EXPECT_EQ(decides(s), 0);
+  }
+  {  // each left the other's goal and is nearer to it: the rule does not decide
+    Pair s(10, 5, 0, 9.45, 5, 1);
+    s.w.agents_for_tick().left_goal[0] = 1;
+    s.w.agents_for_tick().left_goal[1] = 0;
+    EXPECT_EQ(decides(s), 0);
+  }
+  {  // b stands idle: idle people come last whatever they left
+    Pair s(10, 5, 0, 9.45, 5, 1);
+    s.w.agents_for_tick().left_goal[1] = 0;
+    s.w.agents_for_tick().state[1] = AgentState::arrived;
+    EXPECT_EQ(decides(s), 0);
+  }
+}
+
 TEST(Stalemates, TurnsStartWhenBothHaveBeenStalledReverseAfter) {
   for (auto [a, b] : {std::pair{13.0, 11.0}, std::pair{11.0, 13.0}, std::pair{6.0, 6.0}}) {
     Pair s(10, 5, 0, 9.45, 5, 1);
