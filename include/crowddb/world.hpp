@@ -159,8 +159,9 @@ struct AgentTable {
   std::vector<uint64_t> id;                 // AgentId::value()
   std::vector<std::vector<Vec2>> route;     // intermediate waypoints still ahead of the goal
   std::vector<std::vector<uint32_t>> then;  // goals still to visit after `goal`, in order
-  // The goal reached last on the way (a goal sequence, a retarget), kNoGoal before any: whoever
-  // heads there lets it out first (steering's right of way, the stalemate stage).
+  // The goal reached last on the way (a goal sequence's stop, or the goal an idle agent stood at
+  // when World::retarget sent it on), kNoGoal before any: whoever heads there lets it out first
+  // (sim::out_before_in: steering's right of way, the stalemate stage).
   static constexpr uint32_t kNoGoal = std::numeric_limits<uint32_t>::max();
   std::vector<uint32_t> left_goal;
   // stalemate resolution (only touched for stalled agents)

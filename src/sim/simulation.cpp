@@ -539,7 +539,7 @@ const TickMetrics& Simulation::step() {
           Rng rng = Rng::stream(cfg.seed ^ (m.tick * 0x9e3779b97f4a7c15ull), t.id[i]);
           const auto others = static_cast<uint32_t>(world_.goals().size() - 1);
           const auto pick = static_cast<uint32_t>(rng.below(others));
-          t.left_goal[i] = t.goal[i];
+          // (left_goal stays: out before in is for goal sequences, see sim::out_before_in)
           t.goal[i] = pick >= t.goal[i] ? pick + 1 : pick;
           t.route[i].clear();
           t.path_goal[i] = AgentTable::kNoPath;  // a new goal: re-plan
