@@ -126,8 +126,23 @@ TEST(Simulation, ArrivalPoliciesIdleAndRetarget) {
       EXPECT_EQ(sim.world().agents().vx[row], 0.0);
     } else {
       EXPECT_EQ(sim.world().agents().goal[row], 1u);  // the only other goal
+      // A wandering crowd records no goal left (out before in is for goal sequences).
+      EXPECT_EQ(sim.world().agents().left_goal[row], AgentTable::kNoGoal);
     }
   }
+}
+
+TEST(Simulation, AGoalSequenceRecordsTheGoalLeft) {
+  World w = corridor_world();
+  AgentSpec s = walker(85, 0);
+  s.then = {1};
+  const AgentId a = w.insert(s);
+  Simulation sim(std::move(w), test::thesis_config());
+  EXPECT_EQ(sim.world().agents().left_goal[0], AgentTable::kNoGoal);
+  for (int t = 0; t < 10; ++t) sim.step();
+  const std::size_t row = *sim.world().row_of(a);
+  EXPECT_EQ(sim.world().agents().goal[row], 1u);
+  EXPECT_EQ(sim.world().agents().left_goal[row], 0u);  // east, reached on the way
 }
 
 TEST(Simulation, ChangesMadeBetweenTicksApplyAtTheNextTickAsOneBatch) {
