@@ -114,8 +114,13 @@ struct NavigationParams {
   // [s] A request dispatched at tick t is applied at the start of the tick latency later (at
   // least one tick), whatever the worker's timing: the tick waits for a due result not ready yet.
   double latency = 0.2;
-  uint32_t budget = 64;       // path searches dispatched per tick (>= 1); the rest wait, FIFO
-  double replan_after = 4;    // [s] re-plan after this long without progress; 0: never
+  uint32_t budget = 64;     // path searches dispatched per tick (>= 1); the rest wait, FIFO
+  double replan_after = 4;  // [s] re-plan after this long without progress; 0: never
+  // [m] Congestion-aware planning: a path search dispatched while agents are stalled where
+  // streams meet head-on (two streams locked in a passage) counts this much extra for each of
+  // them (not heading the searcher's way) in a mesh polygon it enters, so that a way round the
+  // jam wins when it is shorter than that; 0: off. src/path/navigation.hpp has the detail.
+  double congestion_cost = 5;
   double radius_step = 0.25;  // [m] radius classes: an agent's radius rounded up to a multiple
   double cell_size = 0;       // [m] navmesh cell; 0: auto (a quarter of the class radius, at
                               // most 4096 x 4096 cells over the world's area)

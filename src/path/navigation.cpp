@@ -165,7 +165,8 @@ std::size_t Navigation::apply_results(World& world, uint64_t tick) {
   return applied;
 }
 
-std::size_t Navigation::request_paths(World& world, uint64_t tick) {
+std::size_t Navigation::request_paths(World& world, uint64_t tick,
+                                      const std::vector<uint32_t>& head_on) {
   AgentTable& t = world.agents_for_tick();
   std::size_t made = 0;
   // Requests are numbered and queued in agent id order, not row order: who is served first
@@ -201,6 +202,11 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
   }
   // Dispatch the queue head within the budget, from the agents' current positions.
   std::vector<PathJob> jobs;
+  std::vector<std::size_t> stalled;  // rows, in row order (only counted, so the order is moot)
+  std::map<const NavMesh*, std::vector<StalledAt>> located;  // this tick's, per mesh
+  if (params_.congestion_cost > 0 && !queue_.empty())
+    for (uint32_t i : head_on)
+      if (i < t.size() && !standing(t.state[i])) stalled.push_back(i);
   while (!queue_.empty() && jobs.size() < params_.budget) {
     const Queued q = queue_.front();
     queue_.pop_front();
@@ -213,7 +219,15 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
     const Vec2 goal = goal_target(world.goals()[t.goal[i]], t.x[i], t.y[i], t.radius[i]);
     const int k = q.narrow ? narrow_key(t.radius[i]) : class_of(t.radius[i]);
     stats_.narrow += q.narrow;
-    jobs.push_back({q.ticket, q.agent, &mesh_of_class(k), {t.x[i], t.y[i]}, goal});
+    const NavMesh* mesh = &mesh_of_class(k);
+    std::shared_ptr<const PolygonCosts> c;
+    if (!stalled.empty()) {
+      auto [it, fresh] = located.try_emplace(mesh);
+      if (fresh) it->second = locate(world, *mesh, stalled);
+      c = congestion(it->second, heading(t, i));
+    }
+    stats_.costed += c != nullptr;
+    jobs.push_back({q.ticket, q.agent, mesh, {t.x[i], t.y[i]}, goal, std::move(c)});
   }
   if (!jobs.empty()) {
     stats_.dispatched += jobs.size();
@@ -222,11 +236,45 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick) {
   return made;
 }
 
+std::vector<Navigation::StalledAt> Navigation::locate(const World& world, const NavMesh& m,
+                                                      const std::vector<std::size_t>& stalled) {
+  const AgentTable& t = world.agents();
+  // An agent pressed against a wall stands up to about the mesh's clearance off it.
+  const double reach = m.clearance() + 2 * m.params().cell_size;
+  std::vector<StalledAt> out;
+  for (std::size_t i : stalled)
+    if (const uint32_t ref = m.polygon_at({t.x[i], t.y[i]}, reach))
+      out.push_back({ref, heading(t, i)});
+  return out;
+}
+
+Vec2 Navigation::heading(const AgentTable& t, std::size_t i) {
+  const double dx = t.target_x[i] - t.x[i], dy = t.target_y[i] - t.y[i];
+  const double d = std::hypot(dx, dy);
+  return d > 0 ? Vec2{dx / d, dy / d} : Vec2{0, 0};
+}
+
+std::shared_ptr<const PolygonCosts> Navigation::congestion(const std::vector<StalledAt>& stalled,
+                                                           Vec2 dir) const {
+  // Stalled people walking one's own way (within 60 degrees: an arch at the door one heads for
+  // too) are followed, not walked round: they go where one goes.
+  constexpr double kSameWay = 0.5;
+  std::map<uint32_t, uint64_t> count;
+  for (const StalledAt& s : stalled)
+    if (s.dir.x * dir.x + s.dir.y * dir.y < kSameWay) ++count[s.ref];
+  if (count.empty()) return nullptr;
+  auto c = std::make_shared<PolygonCosts>();
+  c->entries.reserve(count.size());
+  for (const auto& [ref, n] : count)
+    c->entries.emplace_back(ref, static_cast<double>(n) * params_.congestion_cost);
+  return c;
+}
+
 void Navigation::save(ByteWriter& out) const {
   out.u64(next_ticket_);
-  for (uint64_t v :
-       {stats_.requests, stats_.replans, stats_.dispatched, stats_.superseded, stats_.applied,
-        stats_.failed, stats_.partial, stats_.sight_checks, stats_.narrow, stats_.narrow_routes})
+  for (uint64_t v : {stats_.requests, stats_.replans, stats_.dispatched, stats_.superseded,
+                     stats_.applied, stats_.failed, stats_.partial, stats_.sight_checks,
+                     stats_.narrow, stats_.narrow_routes, stats_.costed})
     out.u64(v);
   out.u64(queue_.size());
   for (const Queued& q : queue_) {
@@ -249,6 +297,12 @@ void Navigation::save(ByteWriter& out) const {
       out.u64(j.agent);
       out.u32(static_cast<uint32_t>(k));  // -class for a narrow mesh (two's complement)
       for (double v : {j.start.x, j.start.y, j.goal.x, j.goal.y}) out.f64(v);
+      out.u64(j.costs ? j.costs->entries.size() : 0);
+      if (j.costs)
+        for (const auto& [ref, cost] : j.costs->entries) {
+          out.u32(ref);
+          out.f64(cost);
+        }
     }
   }
 }
@@ -257,7 +311,7 @@ void Navigation::restore(ByteReader& in, uint64_t tick) {
   next_ticket_ = in.u64();
   for (uint64_t* v : {&stats_.requests, &stats_.replans, &stats_.dispatched, &stats_.superseded,
                       &stats_.applied, &stats_.failed, &stats_.partial, &stats_.sight_checks,
-                      &stats_.narrow, &stats_.narrow_routes})
+                      &stats_.narrow, &stats_.narrow_routes, &stats_.costed})
     *v = in.u64();
   queue_.resize(in.count(17));
   for (Queued& q : queue_) {
@@ -281,7 +335,7 @@ void Navigation::restore(ByteReader& in, uint64_t tick) {
       in.fail("path searches due at tick " + std::to_string(due) + " after tick " +
               std::to_string(tick));
     last_due = due;
-    std::vector<PathJob> jobs(in.count(52));
+    std::vector<PathJob> jobs(in.count(60));
     for (PathJob& j : jobs) {
       j.ticket = in.u64();
       j.agent = in.u64();
@@ -298,6 +352,21 @@ void Navigation::restore(ByteReader& in, uint64_t tick) {
       if (!std::isfinite(j.start.x) || !std::isfinite(j.start.y) || !std::isfinite(j.goal.x) ||
           !std::isfinite(j.goal.y))
         in.fail("a path search with a point that is not finite");
+      const uint64_t entries = in.count(12);
+      if (entries > 0) {
+        auto pc = std::make_shared<PolygonCosts>();
+        pc->entries.resize(entries);
+        for (std::size_t e = 0; e < pc->entries.size(); ++e) {
+          auto& [ref, cost] = pc->entries[e];
+          ref = in.u32();
+          cost = in.f64();
+          if (!j.mesh->valid_polygon(ref) || (e > 0 && ref <= pc->entries[e - 1].first))
+            in.fail("a path search's congestion with a bad or unsorted polygon ref");
+          if (!std::isfinite(cost) || cost < 0)
+            in.fail("a path search's congestion with a cost that is not finite and >= 0");
+        }
+        j.costs = std::move(pc);
+      }
     }
     service_->submit(due, std::move(jobs));
   }

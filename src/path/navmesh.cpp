@@ -11,7 +11,9 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstring>
+#include <queue>
 #include <string>
+#include <unordered_map>
 
 #include "util/executor.hpp"
 #include "util/plain_number.hpp"
@@ -32,6 +34,7 @@ constexpr int kErodeMargin = 1;
 constexpr unsigned short kWalkFlag = 1;
 constexpr int kMaxPathPolys = 4096;
 constexpr int kMaxStraight = 512;
+static_assert(sizeof(dtPolyRef) == sizeof(uint32_t), "polygon refs are stored as 32 bits");
 
 // Recast reports failures through its context's log; keep the first error for the message.
 class Context : public rcContext {
@@ -410,9 +413,58 @@ std::vector<std::vector<Vec2>> NavMesh::polygons() const {
   return out;
 }
 
-PathFinder::PathFinder(const NavMesh& mesh, int max_nodes) : mesh_(mesh), polys_(kMaxPathPolys) {
+uint32_t NavMesh::polygon_at(Vec2 p, double reach) const {
+  const float c[3] = {lx(p.x), 0, ly(p.y)};
+  const float ext[3] = {static_cast<float>(reach), 2 * kFloorAbove, static_cast<float>(reach)};
+  dtPolyRef ref = 0;
+  float s[3];
+  if (dtStatusFailed(shared_query_->findNearestPoly(c, ext, filter_.get(), &ref, s))) return 0;
+  return ref;
+}
+
+bool NavMesh::valid_polygon(uint32_t ref) const {
+  return ref != 0 && mesh_->isValidPolyRef(ref);
+}
+
+std::vector<MeshPortal> NavMesh::portals() const {
+  std::vector<MeshPortal> out;
+  const dtNavMesh& m = *mesh_;
+  for (int i = 0; i < m.getMaxTiles(); ++i) {
+    const dtMeshTile* t = m.getTile(i);
+    if (!t || !t->header) continue;
+    const dtPolyRef base = m.getPolyRefBase(t);
+    for (int k = 0; k < t->header->polyCount; ++k) {
+      const dtPoly& p = t->polys[k];
+      if (p.getType() != DT_POLYTYPE_GROUND) continue;
+      for (unsigned int l = p.firstLink; l != DT_NULL_LINK; l = t->links[l].next) {
+        const dtLink& link = t->links[l];
+        if (!link.ref) continue;
+        const float* v0 = &t->verts[p.verts[link.edge] * 3];
+        const float* v1 = &t->verts[p.verts[(link.edge + 1) % p.vertCount] * 3];
+        float a[3], b[3];
+        dtVcopy(a, v0);
+        dtVcopy(b, v1);
+        if (link.side != 0xff && (link.bmin != 0 || link.bmax != 255)) {
+          dtVlerp(a, v0, v1, link.bmin / 255.0f);
+          dtVlerp(b, v0, v1, link.bmax / 255.0f);
+        }
+        out.push_back({base | static_cast<dtPolyRef>(k), link.ref, world(a), world(b)});
+      }
+    }
+  }
+  return out;
+}
+
+double PolygonCosts::of(uint32_t ref) const {
+  const auto it = std::lower_bound(entries.begin(), entries.end(), ref,
+                                   [](const auto& e, uint32_t r) { return e.first < r; });
+  return it != entries.end() && it->first == ref ? it->second : 0;
+}
+
+PathFinder::PathFinder(const NavMesh& mesh, int max_nodes)
+    : mesh_(mesh), max_nodes_(std::clamp(max_nodes, 64, 65535)), polys_(kMaxPathPolys) {
   query_ = dtAllocNavMeshQuery();
-  if (!query_ || dtStatusFailed(query_->init(mesh.mesh_, std::clamp(max_nodes, 64, 65535))))
+  if (!query_ || dtStatusFailed(query_->init(mesh.mesh_, max_nodes_)))
     throw Error(Error::Kind::input, "navigation mesh: out of memory for the path search");
 }
 
@@ -420,7 +472,7 @@ PathFinder::~PathFinder() {
   dtFreeNavMeshQuery(query_);
 }
 
-PathResult PathFinder::find(Vec2 start, Vec2 goal) {
+PathResult PathFinder::find(Vec2 start, Vec2 goal, const PolygonCosts* costs) {
   PathResult r;
   const dtQueryFilter* filter = mesh_.filter_.get();
   const float sp[3] = {mesh_.lx(start.x), 0, mesh_.ly(start.y)};
@@ -440,8 +492,10 @@ PathResult PathFinder::find(Vec2 start, Vec2 goal) {
   r.snap = std::max(std::hypot(ws.x - start.x, ws.y - start.y),
                     std::hypot(wg.x - goal.x, wg.y - goal.y));
   int npolys = 0;
-  const dtStatus st =
-      query_->findPath(sref, gref, s, g, filter, polys_.data(), &npolys, kMaxPathPolys);
+  dtStatus st = DT_SUCCESS;
+  if (costs && !costs->entries.empty()) npolys = costed_corridor(sref, gref, s, g, *costs, r.cost);
+  if (npolys == 0)
+    st = query_->findPath(sref, gref, s, g, filter, polys_.data(), &npolys, kMaxPathPolys);
   if (dtStatusFailed(st) || npolys == 0) {
     r.status = PathStatus::no_goal;
     return r;
@@ -464,6 +518,7 @@ PathResult PathFinder::find(Vec2 start, Vec2 goal) {
     return r;
   }
   if (!(flags[ns - 1] & DT_STRAIGHTPATH_END)) r.status = PathStatus::partial;  // truncated
+  r.corridor.assign(polys_.begin(), polys_.begin() + npolys);
   r.start = mesh_.world(&straight[0]);
   r.end = mesh_.world(&straight[(ns - 1) * 3]);
   if (mesh_.params_.corner_push > 0)
@@ -477,6 +532,92 @@ PathResult PathFinder::find(Vec2 start, Vec2 goal) {
   }
   r.length += std::hypot(r.end.x - prev.x, r.end.y - prev.y);
   return r;
+}
+
+// Nodes are the portals' midpoints (a portal entered from one side is a node of its own), the
+// start and the goal points. A* with the straight-line distance to the goal as the heuristic:
+// consistent, since every step costs at least its length, so the first time the goal comes off
+// the queue its cost is the least. Ties on the queue go by node number, which follows the
+// deterministic expansion order.
+int PathFinder::costed_corridor(unsigned int sref, unsigned int gref, const float* s,
+                                const float* g, const PolygonCosts& costs, double& cost) {
+  struct Node {
+    double g;        // cost so far
+    double x, z;     // position (local mesh coordinates)
+    uint32_t poly;   // the polygon this node is in (entered)
+    int32_t parent;  // node index, -1 for the start
+    bool closed;
+  };
+  const auto dist = [](double ax, double az, double bx, double bz) {
+    return std::hypot(bx - ax, bz - az);
+  };
+  const double gx = g[0], gz = g[2];
+  std::vector<Node> nodes;
+  std::unordered_map<uint64_t, int32_t> index;  // (from << 32 | to) of a portal -> node
+  using Entry = std::pair<double, int32_t>;     // (cost + heuristic, node)
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
+  nodes.push_back({0, s[0], s[2], sref, -1, false});
+  open.push({dist(s[0], s[2], gx, gz), 0});
+  int32_t goal_node = -1;
+  double goal_cost = INFINITY;
+  int expanded = 0;
+  const dtNavMesh& m = *mesh_.mesh_;
+  const dtQueryFilter& filter = *mesh_.filter_;
+  while (!open.empty()) {
+    const auto [f, n] = open.top();
+    open.pop();
+    if (f >= goal_cost) break;  // the goal, reached at goal_cost, is the least now
+    Node& node = nodes[static_cast<std::size_t>(n)];
+    if (node.closed) continue;
+    node.closed = true;
+    if (++expanded > max_nodes_) return 0;
+    const Node here = node;  // nodes may grow below
+    if (here.poly == gref) {
+      const double c = here.g + dist(here.x, here.z, gx, gz);
+      if (c < goal_cost) {
+        goal_cost = c;
+        goal_node = n;
+      }
+    }
+    const dtMeshTile* tile = nullptr;
+    const dtPoly* poly = nullptr;
+    m.getTileAndPolyByRefUnsafe(here.poly, &tile, &poly);
+    for (unsigned int k = poly->firstLink; k != DT_NULL_LINK; k = tile->links[k].next) {
+      const dtPolyRef next = tile->links[k].ref;
+      if (!next) continue;
+      const dtMeshTile* ntile = nullptr;
+      const dtPoly* npoly = nullptr;
+      m.getTileAndPolyByRefUnsafe(next, &ntile, &npoly);
+      // Detour's passFilter, which its library does not export (inline in its source).
+      if (!(npoly->flags & filter.getIncludeFlags()) || (npoly->flags & filter.getExcludeFlags()))
+        continue;
+      float left[3], right[3];
+      if (!portal(here.poly, next, left, right)) continue;
+      const double mx = 0.5 * (static_cast<double>(left[0]) + right[0]);
+      const double mz = 0.5 * (static_cast<double>(left[2]) + right[2]);
+      const double c = here.g + dist(here.x, here.z, mx, mz) + costs.of(next);
+      const uint64_t key = static_cast<uint64_t>(here.poly) << 32 | next;
+      const auto [it, fresh] = index.try_emplace(key, static_cast<int32_t>(nodes.size()));
+      if (fresh) {
+        nodes.push_back({c, mx, mz, next, n, false});
+      } else {
+        Node& o = nodes[static_cast<std::size_t>(it->second)];
+        if (o.closed || c >= o.g) continue;
+        o.g = c;
+        o.parent = n;
+      }
+      open.push({c + dist(mx, mz, gx, gz), it->second});
+    }
+  }
+  if (goal_node < 0) return 0;
+  int count = 0;
+  for (int32_t n = goal_node; n >= 0; n = nodes[static_cast<std::size_t>(n)].parent) ++count;
+  if (count > kMaxPathPolys) return 0;
+  int k = count;
+  for (int32_t n = goal_node; n >= 0; n = nodes[static_cast<std::size_t>(n)].parent)
+    polys_[static_cast<std::size_t>(--k)] = nodes[static_cast<std::size_t>(n)].poly;
+  cost = goal_cost;
+  return count;
 }
 
 // The edge shared by adjacent polygons `from` and `to` (a part of it at a tile border), as

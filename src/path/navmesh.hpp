@@ -89,6 +89,24 @@ struct PathResult {
   // clearance for a point a disc of its radius can stand on; farther for one in a pocket or a
   // passage too narrow for the mesh, whose nearest polygon may lie across a wall.
   double snap = 0;
+  std::vector<uint32_t> corridor;  // the polygons walked through, start to end (mesh refs)
+  // With polygon costs: the search's cost (length through the portals' midpoints plus the costs
+  // of the polygons entered); 0 when Detour's own search ran (no costs given, or none applied).
+  double cost = 0;
+};
+
+// Extra costs [m] of entering mesh polygons, for a search that should avoid some (congestion-
+// aware re-planning, src/path/navigation.hpp): sorted by polygon ref, each ref once, costs
+// finite and >= 0.
+struct PolygonCosts {
+  std::vector<std::pair<uint32_t, double>> entries;
+  double of(uint32_t ref) const;
+};
+
+// The shared edge between two adjacent mesh polygons, as the search sees it.
+struct MeshPortal {
+  uint32_t from = 0, to = 0;
+  Vec2 left{}, right{};  // as seen walking from `from` to `to`
 };
 
 class NavMesh {
@@ -114,6 +132,12 @@ class NavMesh {
 
   // Every mesh polygon as world-coordinate vertices (for tests and debugging).
   std::vector<std::vector<Vec2>> polygons() const;
+  // The polygon (ref) under or nearest to p within `reach`; 0 when none.
+  uint32_t polygon_at(Vec2 p, double reach) const;
+  bool valid_polygon(uint32_t ref) const;
+  // Every link between adjacent polygons, each direction once, in mesh order (for tests: the
+  // naive twin of the search with polygon costs).
+  std::vector<MeshPortal> portals() const;
 
  private:
   friend class PathFinder;
@@ -143,12 +167,21 @@ class PathFinder {
 
   // The shortest corridor of polygons from start to goal, and its corner points (Detour's
   // findPath + findStraightPath). Deterministic: the same mesh and inputs give the same result.
-  PathResult find(Vec2 start, Vec2 goal);
+  // With `costs` (not empty): the corridor of least cost instead, where a step from one portal
+  // to the next (or from the start, or to the goal) costs its length, plus the cost of the
+  // polygon it enters; the corners then come from Detour's funnel over that corridor as usual.
+  // When that search cannot reach the goal within the node budget, Detour's search runs.
+  PathResult find(Vec2 start, Vec2 goal, const PolygonCosts* costs = nullptr);
 
  private:
   bool portal(unsigned int from, unsigned int to, float* left, float* right) const;
   void funnel(PathResult& r, const float* start, const float* end, int npolys, double push) const;
+  // A* over the portals' midpoints with polygon costs; fills polys_ and returns their number,
+  // or 0 when the goal is not reached within max_nodes_ expansions.
+  int costed_corridor(unsigned int sref, unsigned int gref, const float* s, const float* g,
+                      const PolygonCosts& costs, double& cost);
   const NavMesh& mesh_;
+  int max_nodes_ = 16384;
   dtNavMeshQuery* query_ = nullptr;
   std::vector<unsigned int> polys_;
 };

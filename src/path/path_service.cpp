@@ -97,7 +97,7 @@ void PathService::run() {
         if (options_.before_job) options_.before_job(j);
         auto& f = finders[j.mesh];
         if (!f) f = std::make_unique<PathFinder>(*j.mesh, options_.max_nodes);
-        b->replies.push_back({j.ticket, j.agent, f->find(j.start, j.goal), j.mesh});
+        b->replies.push_back({j.ticket, j.agent, f->find(j.start, j.goal, j.costs.get()), j.mesh});
       }
     } catch (...) {
       error = std::current_exception();

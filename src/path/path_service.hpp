@@ -29,6 +29,8 @@ struct PathJob {
   uint64_t agent = 0;   // AgentId::value()
   const NavMesh* mesh = nullptr;
   Vec2 start{}, goal{};
+  // Polygon costs of the search (congestion; shared by the jobs of one dispatch), or none.
+  std::shared_ptr<const PolygonCosts> costs;
 };
 
 struct PathReply {

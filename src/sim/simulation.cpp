@@ -113,6 +113,8 @@ void SimConfig::validate() const {
   require(n.budget >= 1, "navigation/budget", "must be >= 1");
   require(std::isfinite(n.replan_after) && n.replan_after >= 0, "navigation/replan_after",
           "must be >= 0");
+  require(std::isfinite(n.congestion_cost) && n.congestion_cost >= 0, "navigation/congestion_cost",
+          "must be >= 0");
   require(std::isfinite(n.radius_step) && n.radius_step > 0, "navigation/radius_step",
           "must be > 0");
   require(std::isfinite(n.cell_size) && n.cell_size >= 0, "navigation/cell_size", "must be >= 0");
@@ -316,8 +318,9 @@ namespace {
 
 constexpr std::string_view kCheckpointMagic = "crowddb-checkpoint";
 // 2: narrow meshes in the path service's state; 3: goal waits (the wait_until column); 4: the
-// goal each agent left last (the left_goal column).
-constexpr uint32_t kCheckpointVersion = 4;
+// goal each agent left last (the left_goal column); 5: congestion costs of the path searches in
+// flight.
+constexpr uint32_t kCheckpointVersion = 5;
 
 // What a checkpoint must agree on with the simulation it is restored into: the static tables
 // and the settings that change what a tick computes (not the thread count).
@@ -617,6 +620,7 @@ const TickMetrics& Simulation::step() {
   });
 
   // 6. stalemates: progress watch, then an action for each agent stalled without one
+  std::vector<uint32_t> head_on;  // stalled where streams meet head-on (path requests avoid them)
   log.timed("stalemates", world_.agents().size(), [&] {
     if (!e.stall_path)
       e.stall_path = neighbour_method(cfg.access.neighbours, world_.agents().size()).make();
@@ -628,12 +632,13 @@ const TickMetrics& Simulation::step() {
     m.queueing = sc.queueing;
     m.yielding = sc.yielding;
     m.sidestepping = sc.sidestepping;
+    head_on = std::move(sc.head_on);
   });
 
   // 7. path requests: new requests, re-plans, dispatch to the worker within the budget
   if (e.nav) {
     std::size_t made = 0;
-    log.timed("path requests", 0, [&] { made = e.nav->request_paths(world_, m.tick); });
+    log.timed("path requests", 0, [&] { made = e.nav->request_paths(world_, m.tick, head_on); });
     log.at("path requests").rows += made;
   }
   m.agents = world_.agents().size();
@@ -724,7 +729,11 @@ std::string Simulation::explain() const {
     os << "  " << step++ << " path requests      new goal or no progress for "
        << num(nv.replan_after) << " s -> FIFO queue; <= " << nv.budget
        << " dispatched per tick, due " << latency << " tick" << (latency == 1 ? "" : "s")
-       << " later\n";
+       << " later; congestion "
+       << (nv.congestion_cost > 0
+               ? "+" + num(nv.congestion_cost) + " m per agent stalled head-on in a polygon"
+               : std::string("off"))
+       << "\n";
   return os.str();
 }
 
@@ -780,13 +789,14 @@ std::string Simulation::explain_analyze() const {
         "  path service: %llu requests (%llu re-plans), %llu dispatched, %llu superseded, %llu "
         "queued; "
         "%llu routes applied (%llu partial, %llu without a path); %llu searches on a narrow mesh, "
-        "%llu of them reaching the goal\n",
+        "%llu of them reaching the goal; %llu searched round congestion\n",
         static_cast<unsigned long long>(ns.requests), static_cast<unsigned long long>(ns.replans),
         static_cast<unsigned long long>(ns.dispatched),
         static_cast<unsigned long long>(ns.superseded), static_cast<unsigned long long>(ns.queued),
         static_cast<unsigned long long>(ns.applied), static_cast<unsigned long long>(ns.partial),
         static_cast<unsigned long long>(ns.failed), static_cast<unsigned long long>(ns.narrow),
-        static_cast<unsigned long long>(ns.narrow_routes));
+        static_cast<unsigned long long>(ns.narrow_routes),
+        static_cast<unsigned long long>(ns.costed));
     os << line;
     std::snprintf(line, sizeof line,
                   "  worker: %llu searches in %.3f ms; the tick waited for it %llu times, %.3f ms; "

@@ -197,6 +197,8 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   if (!cfg.stall.resolve) return c;
   const std::vector<uint8_t> jammed =
       jammed_ahead(t, goals, looked_at, blocker, bpos, queueing, dir);
+  for (std::size_t q = 0; q < looked_at.size(); ++q)
+    if (!queueing[q] && !jammed[q]) c.head_on.push_back(looked_at[q]);
   // 3. actions for the stalled ones that have none running
   for (std::size_t q = 0; q < looked_at.size(); ++q) {
     const uint32_t i = looked_at[q];

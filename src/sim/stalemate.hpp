@@ -41,10 +41,13 @@
 //   - otherwise: sidestep, i.e. walk at a seeded angle of 45-90 degrees off the target direction
 //     for sidestep_time.
 // After the action the agent heads for its target again; with navigation, one that stays stalled
-// also re-plans its path (NavigationParams::replan_after).
+// also re-plans its path (NavigationParams::replan_after), and the rows stalled head-on
+// (StallCounts::head_on) make the tick's path searches plan round them
+// (NavigationParams::congestion_cost).
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "crowddb/simulation.hpp"
 #include "plan/access_path.hpp"
@@ -54,6 +57,11 @@ namespace crowddb::sim {
 
 struct StallCounts {
   std::size_t stalled = 0, started = 0, longest = 0, queueing = 0, yielding = 0, sidestepping = 0;
+  // Rows (in row order) stalled where streams meet head-on: the chain of stalled blockers in
+  // front ends in someone heading at them, or is a cycle with two such (not an arch at a door,
+  // where all walk one way). Path searches plan round them (NavigationParams::congestion_cost).
+  // Filled only with cfg.stall.resolve.
+  std::vector<uint32_t> head_on;
 };
 
 // The progress watch, the queueing test and (with cfg.stall.resolve) the actions, for the tick

@@ -1,12 +1,15 @@
 // The navigation mesh against an independent oracle: shortest paths of a disc over a visibility
 // graph (tests/path/visibility_graph.hpp) on fixed and random worlds, the clearance of every
-// returned path, line of sight, tiling and determinism.
+// returned path, line of sight, tiling and determinism. The search with polygon costs against its
+// naive twin: Dijkstra over every portal of the mesh.
 #include "path/navmesh.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <set>
+#include <utility>
 
 #include "path/visibility_graph.hpp"
 #include "util/executor.hpp"
@@ -53,6 +56,42 @@ double polyline_length(const PathResult& r) {
     prev = c;
   }
   return len + std::hypot(r.end.x - prev.x, r.end.y - prev.y);
+}
+
+Vec2 midpoint(const MeshPortal& p) {
+  return {0.5 * (p.left.x + p.right.x), 0.5 * (p.left.y + p.right.y)};
+}
+
+double dist(Vec2 a, Vec2 b) {
+  return std::hypot(b.x - a.x, b.y - a.y);
+}
+
+// The naive twin of PathFinder's search with polygon costs: Dijkstra, scanning every node for
+// the next one, over the start, the goal and every portal's midpoint (one node per direction),
+// with the same steps: to a portal out of the polygon one stands in, its length plus the cost
+// of the polygon entered; to the goal from anywhere in the goal's polygon, its length.
+double naive_costed(const NavMesh& mesh, uint32_t sref, Vec2 s, uint32_t gref, Vec2 g,
+                    const PolygonCosts& costs) {
+  const std::vector<MeshPortal> portals = mesh.portals();
+  const std::size_t start = portals.size(), goal = start + 1;
+  std::vector<double> best(goal + 1, INFINITY);
+  std::vector<bool> done(goal + 1, false);
+  best[start] = 0;
+  for (;;) {
+    std::size_t u = goal + 1;
+    for (std::size_t k = 0; k <= goal; ++k)
+      if (!done[k] && std::isfinite(best[k]) && (u > goal || best[k] < best[u])) u = k;
+    if (u > goal || u == goal) break;
+    done[u] = true;
+    const Vec2 at = u == start ? s : midpoint(portals[u]);
+    const uint32_t poly = u == start ? sref : portals[u].to;
+    if (poly == gref) best[goal] = std::min(best[goal], best[u] + dist(at, g));
+    for (std::size_t k = 0; k < portals.size(); ++k)
+      if (portals[k].from == poly)
+        best[k] =
+            std::min(best[k], best[u] + dist(at, midpoint(portals[k])) + costs.of(portals[k].to));
+  }
+  return best[goal];
 }
 
 TEST(NavMesh, OpenFloorGivesTheStraightLine) {
@@ -253,6 +292,106 @@ TEST(NavMesh, RandomWorldsAgreeWithTheVisibilityGraphOracle) {
       "[ navmesh  ] %d random paths compared; smallest clearance %.3f x radius; longest %.3f x the "
       "wider disc's\n",
       compared, worst_clearance, worst_excess);
+}
+
+// Random worlds over small tiles (links across tile borders), random costs on a third of the
+// polygons: the search finds the least cost the naive twin finds, along a corridor of adjacent
+// polygons from the start's to the goal's, whose cost it reports.
+TEST(PathFinder, CostedSearchAgreesWithDijkstraOverEveryPortal) {
+  Rng rng(20261129);
+  int compared = 0, detours = 0;
+  for (int world = 0; world < 5; ++world) {
+    NavGeometry g{{0, 0, 40, 30}, {}, {}};
+    for (int k = 0; k < 6; ++k) {
+      const double x = rng.uniform(4, 34), y = rng.uniform(4, 24);
+      if (rng.below(3) == 0)
+        g.circles.push_back({x, y, rng.uniform(0.5, 2.5), 1});
+      else
+        g.polygons.push_back(rect(x, y, x + rng.uniform(1, 6), y + rng.uniform(1, 6)));
+    }
+    auto mesh = NavMesh::build(g, {0.5, 0.25, 32});
+    const std::vector<MeshPortal> portals = mesh->portals();
+    std::set<std::pair<uint32_t, uint32_t>> adjacent;
+    std::set<uint32_t> refs;
+    for (const MeshPortal& p : portals) {
+      adjacent.insert({p.from, p.to});
+      refs.insert(p.from);
+    }
+    ASSERT_GT(refs.size(), 20u);
+    PolygonCosts costs;
+    for (uint32_t ref : refs)
+      if (rng.below(3) == 0) costs.entries.emplace_back(ref, rng.uniform(0, 25));
+    PathFinder f(*mesh);
+    for (int q = 0; q < 6; ++q) {
+      const Vec2 a{rng.uniform(1, 39), rng.uniform(1, 29)},
+          b{rng.uniform(1, 39), rng.uniform(1, 29)};
+      const PathResult plain = f.find(a, b);
+      if (plain.status != PathStatus::ok) continue;  // in an obstacle, or cut off
+      const PathResult r = f.find(a, b, &costs);
+      ASSERT_EQ(r.status, PathStatus::ok);
+      ASSERT_FALSE(r.corridor.empty());
+      EXPECT_EQ(r.corridor.front(), plain.corridor.front());
+      EXPECT_EQ(r.corridor.back(), plain.corridor.back());
+      for (std::size_t k = 0; k + 1 < r.corridor.size(); ++k)
+        EXPECT_TRUE(adjacent.count({r.corridor[k], r.corridor[k + 1]})) << "world " << world;
+      const double naive =
+          naive_costed(*mesh, r.corridor.front(), r.start, r.corridor.back(), r.end, costs);
+      EXPECT_NEAR(r.cost, naive, 1e-6 * naive) << "world " << world << " query " << q;
+      // The corridor's own cost through its portals' midpoints is the reported one.
+      double along = 0;
+      Vec2 at = r.start;
+      for (std::size_t k = 0; k + 1 < r.corridor.size(); ++k)
+        for (const MeshPortal& p : portals)
+          if (p.from == r.corridor[k] && p.to == r.corridor[k + 1]) {
+            along += dist(at, midpoint(p)) + costs.of(p.to);
+            at = midpoint(p);
+            break;
+          }
+      along += dist(at, r.end);
+      EXPECT_NEAR(along, r.cost, 1e-6 * r.cost);
+      detours += r.corridor != plain.corridor;
+      ++compared;
+    }
+  }
+  EXPECT_GE(compared, 15);
+  EXPECT_GE(detours, 3);  // the costs do change routes
+}
+
+// Two stands 12 m long with a 1.2 m passage between them and 3 m aisles round them: the route
+// goes through the passage unless entering it costs more than the way round.
+TEST(PathFinder, APassageThatCostsMoreThanTheWayRoundIsWalkedRound) {
+  NavGeometry g{{0, 0, 40, 30}, {}, {rect(14, 3, 26, 14.4), rect(14, 15.6, 26, 27)}};
+  auto mesh = NavMesh::build(g, {0.25, 0.0625});
+  PathFinder f(*mesh);
+  const Vec2 a{5, 15}, b{35, 15};
+  const PathResult plain = f.find(a, b);
+  ASSERT_EQ(plain.status, PathStatus::ok);
+  EXPECT_LT(plain.length, 30.5);
+  EXPECT_EQ(plain.cost, 0);  // Detour's search
+  const uint32_t passage = mesh->polygon_at({20, 15}, 0.1);
+  ASSERT_NE(passage, 0u);
+  ASSERT_TRUE(mesh->valid_polygon(passage));
+  EXPECT_FALSE(mesh->valid_polygon(0));
+  // The way round is 42.7 m against 30 (the search's midpoint measure puts them closer).
+  PolygonCosts cheap{{{passage, 1}}}, dear{{{passage, 40}}};
+  const PathResult through = f.find(a, b, &cheap), round = f.find(a, b, &dear);
+  ASSERT_EQ(through.status, PathStatus::ok);
+  ASSERT_EQ(round.status, PathStatus::ok);
+  EXPECT_NEAR(through.length, plain.length, 0.05);
+  EXPECT_GT(round.length, 42);
+  EXPECT_LT(round.length, 44);
+  for (const Vec2& c : round.corners) EXPECT_TRUE(c.y < 3 || c.y > 27) << c.x << " " << c.y;
+  // With no way round (both aisles closed), the passage is the route whatever it costs.
+  NavGeometry closed = g;
+  closed.polygons.push_back(rect(14, 0, 26, 3));
+  closed.polygons.push_back(rect(14, 27, 26, 30));
+  auto cm = NavMesh::build(closed, {0.25, 0.0625});
+  PathFinder fc(*cm);
+  const PolygonCosts blocked{{{cm->polygon_at({20, 15}, 0.1), 1000}}};
+  const PathResult only = fc.find(a, b, &blocked);
+  ASSERT_EQ(only.status, PathStatus::ok);
+  EXPECT_NEAR(only.length, fc.find(a, b).length, 0.05);
+  EXPECT_GT(only.cost, 1000);
 }
 
 TEST(NavMesh, TilesJoinSeamlessly) {

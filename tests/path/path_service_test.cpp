@@ -29,7 +29,8 @@ std::vector<PathJob> random_jobs(const NavMesh& mesh, uint64_t first_ticket, int
                     static_cast<uint64_t>(100 + i),
                     &mesh,
                     {rng.uniform(2, 58), rng.uniform(2, 38)},
-                    {rng.uniform(2, 58), rng.uniform(2, 38)}});
+                    {rng.uniform(2, 58), rng.uniform(2, 38)},
+                    nullptr});
   return jobs;
 }
 

@@ -16,8 +16,10 @@ namespace crowddb {
 namespace {
 
 Simulation build(const std::string& name, int threads, std::vector<std::string> overrides = {}) {
-  Scenario sc = load_scenario(test::source_path("scenarios/" + name + ".json"),
-                              LoadOptions{{}, std::move(overrides)});
+  // A name with a slash is a path in the source tree (tests/data/...), else a shipped scenario.
+  const std::string file =
+      name.find('/') != std::string::npos ? name + ".json" : "scenarios/" + name + ".json";
+  Scenario sc = load_scenario(test::source_path(file), LoadOptions{{}, std::move(overrides)});
   sc.config.threads = threads;
   return Simulation(std::move(sc.world), sc.config);
 }
@@ -66,6 +68,9 @@ TEST(Checkpoint, ARestoredRunContinuesBitIdenticallyOnAnyThreadCount) {
        420,
        {2, 330},
        {R"(groups.0.goal=["east", "north"])", R"(groups.1.goal=["north", "east"])"}},
+      // people stalled in a passage: searches round them (with congestion costs) dispatched in
+      // ticks 301 and 310, due two ticks later: in flight at 301, 302 and 310
+      {"tests/data/passage", 340, {301, 302, 310}, {}},
   };
   for (const Case& c : cases) {
     const Reference ref = run_reference(c.name, c.ticks, c.at, c.overrides);
