@@ -492,14 +492,21 @@ PathResult PathFinder::find(Vec2 start, Vec2 goal, const PolygonCosts* costs) {
   r.snap = std::max(std::hypot(ws.x - start.x, ws.y - start.y),
                     std::hypot(wg.x - goal.x, wg.y - goal.y));
   int npolys = 0;
-  dtStatus st = DT_SUCCESS;
-  if (costs && !costs->entries.empty()) npolys = costed_corridor(sref, gref, s, g, *costs, r.cost);
-  if (npolys == 0)
-    st = query_->findPath(sref, gref, s, g, filter, polys_.data(), &npolys, kMaxPathPolys);
+  const dtStatus st =
+      query_->findPath(sref, gref, s, g, filter, polys_.data(), &npolys, kMaxPathPolys);
   if (dtStatusFailed(st) || npolys == 0) {
     r.status = PathStatus::no_goal;
     return r;
   }
+  // With costs, search again only when Detour's corridor to the goal enters a polygon that has
+  // one: costs only make other corridors dearer, so one that avoids them stays the least (and a
+  // search over a 200 m forest of obstacles, SteerSuite's scenarioSpace, is not repeated for
+  // every agent while a jam stands somewhere else).
+  if (costs && !costs->entries.empty() && !dtStatusDetail(st, DT_PARTIAL_RESULT) &&
+      polys_[static_cast<std::size_t>(npolys - 1)] == gref &&
+      std::any_of(polys_.begin() + 1, polys_.begin() + npolys,
+                  [&](dtPolyRef p) { return costs->of(p) > 0; }))
+    if (const int n = costed_corridor(sref, gref, s, g, *costs, r.cost); n > 0) npolys = n;
   r.status = PathStatus::ok;
   float end[3] = {g[0], g[1], g[2]};
   if (polys_[static_cast<std::size_t>(npolys - 1)] != gref ||
@@ -541,37 +548,36 @@ PathResult PathFinder::find(Vec2 start, Vec2 goal, const PolygonCosts* costs) {
 // deterministic expansion order.
 int PathFinder::costed_corridor(unsigned int sref, unsigned int gref, const float* s,
                                 const float* g, const PolygonCosts& costs, double& cost) {
-  struct Node {
-    double g;        // cost so far
-    double x, z;     // position (local mesh coordinates)
-    uint32_t poly;   // the polygon this node is in (entered)
-    int32_t parent;  // node index, -1 for the start
-    bool closed;
-  };
   const auto dist = [](double ax, double az, double bx, double bz) {
     return std::hypot(bx - ax, bz - az);
   };
   const double gx = g[0], gz = g[2];
-  std::vector<Node> nodes;
-  std::unordered_map<uint64_t, int32_t> index;  // (from << 32 | to) of a portal -> node
-  using Entry = std::pair<double, int32_t>;     // (cost + heuristic, node)
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
+  std::vector<CostNode>& nodes = cost_nodes_;
+  auto& index = cost_index_;  // (from << 32 | to) of a portal -> node
+  auto& open = cost_open_;    // (cost + heuristic, node), least first
+  nodes.clear();
+  index.clear();
+  open.clear();
+  const auto push = [&](double f, int32_t n) {
+    open.emplace_back(f, n);
+    std::push_heap(open.begin(), open.end(), std::greater<>());
+  };
   nodes.push_back({0, s[0], s[2], sref, -1, false});
-  open.push({dist(s[0], s[2], gx, gz), 0});
+  push(dist(s[0], s[2], gx, gz), 0);
   int32_t goal_node = -1;
   double goal_cost = INFINITY;
   int expanded = 0;
   const dtNavMesh& m = *mesh_.mesh_;
   const dtQueryFilter& filter = *mesh_.filter_;
   while (!open.empty()) {
-    const auto [f, n] = open.top();
-    open.pop();
+    std::pop_heap(open.begin(), open.end(), std::greater<>());
+    const auto [f, n] = open.back();
+    open.pop_back();
     if (f >= goal_cost) break;  // the goal, reached at goal_cost, is the least now
-    Node& node = nodes[static_cast<std::size_t>(n)];
-    if (node.closed) continue;
-    node.closed = true;
+    if (nodes[static_cast<std::size_t>(n)].closed) continue;
+    nodes[static_cast<std::size_t>(n)].closed = true;
     if (++expanded > max_nodes_) return 0;
-    const Node here = node;  // nodes may grow below
+    const CostNode here = nodes[static_cast<std::size_t>(n)];  // nodes may grow below
     if (here.poly == gref) {
       const double c = here.g + dist(here.x, here.z, gx, gz);
       if (c < goal_cost) {
@@ -583,7 +589,8 @@ int PathFinder::costed_corridor(unsigned int sref, unsigned int gref, const floa
     const dtPoly* poly = nullptr;
     m.getTileAndPolyByRefUnsafe(here.poly, &tile, &poly);
     for (unsigned int k = poly->firstLink; k != DT_NULL_LINK; k = tile->links[k].next) {
-      const dtPolyRef next = tile->links[k].ref;
+      const dtLink& link = tile->links[k];
+      const dtPolyRef next = link.ref;
       if (!next) continue;
       const dtMeshTile* ntile = nullptr;
       const dtPoly* npoly = nullptr;
@@ -591,22 +598,30 @@ int PathFinder::costed_corridor(unsigned int sref, unsigned int gref, const floa
       // Detour's passFilter, which its library does not export (inline in its source).
       if (!(npoly->flags & filter.getIncludeFlags()) || (npoly->flags & filter.getExcludeFlags()))
         continue;
-      float left[3], right[3];
-      if (!portal(here.poly, next, left, right)) continue;
-      const double mx = 0.5 * (static_cast<double>(left[0]) + right[0]);
-      const double mz = 0.5 * (static_cast<double>(left[2]) + right[2]);
+      // The portal's midpoint, from this link (as portal() finds it).
+      const float* v0 = &tile->verts[poly->verts[link.edge] * 3];
+      const float* v1 = &tile->verts[poly->verts[(link.edge + 1) % poly->vertCount] * 3];
+      double mx = 0.5 * (static_cast<double>(v0[0]) + v1[0]);
+      double mz = 0.5 * (static_cast<double>(v0[2]) + v1[2]);
+      if (link.side != 0xff && (link.bmin != 0 || link.bmax != 255)) {
+        float l[3], r[3];
+        dtVlerp(l, v0, v1, link.bmin / 255.0f);
+        dtVlerp(r, v0, v1, link.bmax / 255.0f);
+        mx = 0.5 * (static_cast<double>(l[0]) + r[0]);
+        mz = 0.5 * (static_cast<double>(l[2]) + r[2]);
+      }
       const double c = here.g + dist(here.x, here.z, mx, mz) + costs.of(next);
       const uint64_t key = static_cast<uint64_t>(here.poly) << 32 | next;
       const auto [it, fresh] = index.try_emplace(key, static_cast<int32_t>(nodes.size()));
       if (fresh) {
         nodes.push_back({c, mx, mz, next, n, false});
       } else {
-        Node& o = nodes[static_cast<std::size_t>(it->second)];
+        CostNode& o = nodes[static_cast<std::size_t>(it->second)];
         if (o.closed || c >= o.g) continue;
         o.g = c;
         o.parent = n;
       }
-      open.push({c + dist(mx, mz, gx, gz), it->second});
+      push(c + dist(mx, mz, gx, gz), it->second);
     }
   }
   if (goal_node < 0) return 0;

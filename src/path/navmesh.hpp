@@ -23,6 +23,8 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "crowddb/world.hpp"
@@ -91,7 +93,7 @@ struct PathResult {
   double snap = 0;
   std::vector<uint32_t> corridor;  // the polygons walked through, start to end (mesh refs)
   // With polygon costs: the search's cost (length through the portals' midpoints plus the costs
-  // of the polygons entered); 0 when Detour's own search ran (no costs given, or none applied).
+  // of the polygons entered); 0 when Detour's corridor stands (no costs given, or none on it).
   double cost = 0;
 };
 
@@ -167,10 +169,11 @@ class PathFinder {
 
   // The shortest corridor of polygons from start to goal, and its corner points (Detour's
   // findPath + findStraightPath). Deterministic: the same mesh and inputs give the same result.
-  // With `costs` (not empty): the corridor of least cost instead, where a step from one portal
-  // to the next (or from the start, or to the goal) costs its length, plus the cost of the
-  // polygon it enters; the corners then come from Detour's funnel over that corridor as usual.
-  // When that search cannot reach the goal within the node budget, Detour's search runs.
+  // With `costs` (not empty), when Detour's corridor enters a polygon with a cost: the corridor
+  // of least cost instead, where a step from one portal to the next (or from the start, or to
+  // the goal) costs its length, plus the cost of the polygon it enters; the corners then come
+  // from Detour's funnel over that corridor as usual. When that search cannot reach the goal
+  // within the node budget, Detour's corridor stays.
   PathResult find(Vec2 start, Vec2 goal, const PolygonCosts* costs = nullptr);
 
  private:
@@ -184,6 +187,17 @@ class PathFinder {
   int max_nodes_ = 16384;
   dtNavMeshQuery* query_ = nullptr;
   std::vector<unsigned int> polys_;
+  // costed_corridor's scratch, kept from search to search.
+  struct CostNode {
+    double g;        // cost so far
+    double x, z;     // position (local mesh coordinates)
+    uint32_t poly;   // the polygon this node is in (entered)
+    int32_t parent;  // node index, -1 for the start
+    bool closed;
+  };
+  std::vector<CostNode> cost_nodes_;
+  std::unordered_map<uint64_t, int32_t> cost_index_;
+  std::vector<std::pair<double, int32_t>> cost_open_;
 };
 
 }  // namespace crowddb::path
