@@ -17,6 +17,11 @@ constexpr double kNarrowStep = 0.01;  // [m] narrow meshes are per radius to the
 // where without a bound the path worker took 4.5 times as long); the rest plan as before.
 constexpr std::size_t kCostedPerTick = 8;
 
+// Where row i walks now: the unit vector to its waypoint (World::refresh_target's).
+Vec2 heading(const AgentTable& t, std::size_t i) {
+  return unit_towards(t.x[i], t.y[i], {t.target_x[i], t.target_y[i]});
+}
+
 }  // namespace
 
 Navigation::Navigation(const World& world, const SimConfig& cfg, Executor& ex)
@@ -252,12 +257,6 @@ std::vector<Navigation::StalledAt> Navigation::locate(const World& world, const 
     if (const uint32_t ref = m.polygon_at({t.x[i], t.y[i]}, reach))
       out.push_back({ref, heading(t, i)});
   return out;
-}
-
-Vec2 Navigation::heading(const AgentTable& t, std::size_t i) {
-  const double dx = t.target_x[i] - t.x[i], dy = t.target_y[i] - t.y[i];
-  const double d = std::hypot(dx, dy);
-  return d > 0 ? Vec2{dx / d, dy / d} : Vec2{0, 0};
 }
 
 std::shared_ptr<const PolygonCosts> Navigation::congestion(const std::vector<StalledAt>& stalled,

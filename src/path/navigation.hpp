@@ -119,7 +119,6 @@ class Navigation {
   };
   static std::vector<StalledAt> locate(const World& world, const NavMesh& m,
                                        const std::vector<std::size_t>& stalled);
-  static Vec2 heading(const AgentTable& t, std::size_t i);
   // Congestion for a search by an agent heading `dir`: congestion_cost for each stalled agent
   // not heading its way in the polygon it stands in; null when there is none.
   std::shared_ptr<const PolygonCosts> congestion(const std::vector<StalledAt>& stalled,

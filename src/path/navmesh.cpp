@@ -240,6 +240,20 @@ int bits_for(int n) {
   throw Error(Error::Kind::input, "navigation mesh: " + what);
 }
 
+// The edge a link of `poly` crosses into its neighbour (a part of it at a tile border), as
+// Detour's private getPortalPoints finds it: left and right as seen walking out of `poly`.
+void link_portal(const dtMeshTile& tile, const dtPoly& poly, const dtLink& link, float* left,
+                 float* right) {
+  const float* v0 = &tile.verts[poly.verts[link.edge] * 3];
+  const float* v1 = &tile.verts[poly.verts[(link.edge + 1) % poly.vertCount] * 3];
+  dtVcopy(left, v0);
+  dtVcopy(right, v1);
+  if (link.side != 0xff && (link.bmin != 0 || link.bmax != 255)) {
+    dtVlerp(left, v0, v1, link.bmin / 255.0f);
+    dtVlerp(right, v0, v1, link.bmax / 255.0f);
+  }
+}
+
 }  // namespace
 
 const char* to_string(PathStatus s) {
@@ -439,15 +453,8 @@ std::vector<MeshPortal> NavMesh::portals() const {
       for (unsigned int l = p.firstLink; l != DT_NULL_LINK; l = t->links[l].next) {
         const dtLink& link = t->links[l];
         if (!link.ref) continue;
-        const float* v0 = &t->verts[p.verts[link.edge] * 3];
-        const float* v1 = &t->verts[p.verts[(link.edge + 1) % p.vertCount] * 3];
         float a[3], b[3];
-        dtVcopy(a, v0);
-        dtVcopy(b, v1);
-        if (link.side != 0xff && (link.bmin != 0 || link.bmax != 255)) {
-          dtVlerp(a, v0, v1, link.bmin / 255.0f);
-          dtVlerp(b, v0, v1, link.bmax / 255.0f);
-        }
+        link_portal(*t, p, link, a, b);
         out.push_back({base | static_cast<dtPolyRef>(k), link.ref, world(a), world(b)});
       }
     }
@@ -599,17 +606,10 @@ int PathFinder::costed_corridor(unsigned int sref, unsigned int gref, const floa
       if (!(npoly->flags & filter.getIncludeFlags()) || (npoly->flags & filter.getExcludeFlags()))
         continue;
       // The portal's midpoint, from this link (as portal() finds it).
-      const float* v0 = &tile->verts[poly->verts[link.edge] * 3];
-      const float* v1 = &tile->verts[poly->verts[(link.edge + 1) % poly->vertCount] * 3];
-      double mx = 0.5 * (static_cast<double>(v0[0]) + v1[0]);
-      double mz = 0.5 * (static_cast<double>(v0[2]) + v1[2]);
-      if (link.side != 0xff && (link.bmin != 0 || link.bmax != 255)) {
-        float l[3], r[3];
-        dtVlerp(l, v0, v1, link.bmin / 255.0f);
-        dtVlerp(r, v0, v1, link.bmax / 255.0f);
-        mx = 0.5 * (static_cast<double>(l[0]) + r[0]);
-        mz = 0.5 * (static_cast<double>(l[2]) + r[2]);
-      }
+      float l[3], r[3];
+      link_portal(*tile, *poly, link, l, r);
+      const double mx = 0.5 * (static_cast<double>(l[0]) + r[0]);
+      const double mz = 0.5 * (static_cast<double>(l[2]) + r[2]);
       const double c = here.g + dist(here.x, here.z, mx, mz) + costs.of(next);
       const uint64_t key = static_cast<uint64_t>(here.poly) << 32 | next;
       const auto [it, fresh] = index.try_emplace(key, static_cast<int32_t>(nodes.size()));
@@ -635,8 +635,8 @@ int PathFinder::costed_corridor(unsigned int sref, unsigned int gref, const floa
   return count;
 }
 
-// The edge shared by adjacent polygons `from` and `to` (a part of it at a tile border), as
-// Detour's private getPortalPoints finds it: left and right as seen walking from `from`.
+// The edge shared by adjacent polygons `from` and `to`: left and right as seen walking from
+// `from`; false when they are not adjacent.
 bool PathFinder::portal(unsigned int from, unsigned int to, float* left, float* right) const {
   const dtMeshTile* tile = nullptr;
   const dtPoly* poly = nullptr;
@@ -644,14 +644,7 @@ bool PathFinder::portal(unsigned int from, unsigned int to, float* left, float* 
   for (unsigned int k = poly->firstLink; k != DT_NULL_LINK; k = tile->links[k].next) {
     const dtLink& link = tile->links[k];
     if (link.ref != to) continue;
-    const float* v0 = &tile->verts[poly->verts[link.edge] * 3];
-    const float* v1 = &tile->verts[poly->verts[(link.edge + 1) % poly->vertCount] * 3];
-    dtVcopy(left, v0);
-    dtVcopy(right, v1);
-    if (link.side != 0xff && (link.bmin != 0 || link.bmax != 255)) {
-      dtVlerp(left, v0, v1, link.bmin / 255.0f);
-      dtVlerp(right, v0, v1, link.bmax / 255.0f);
-    }
+    link_portal(*tile, *poly, link, left, right);
     return true;
   }
   return false;

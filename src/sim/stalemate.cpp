@@ -6,6 +6,7 @@
 
 #include "sim/stages.hpp"
 #include "util/rng.hpp"
+#include "world/geometry.hpp"
 
 namespace crowddb::sim {
 namespace {
@@ -23,9 +24,7 @@ uint64_t priority(uint64_t seed, uint64_t id) {
 
 // Unit direction from row i to its current target (0, 0 when on it).
 Vec2 heading(const AgentTable& t, std::span<const Goal> goals, std::size_t i) {
-  const Vec2 c = current_target(t, goals, i);
-  const double dx = c.x - t.x[i], dy = c.y - t.y[i], l = std::sqrt(dx * dx + dy * dy);
-  return l > 0 ? Vec2{dx / l, dy / l} : Vec2{0, 0};
+  return unit_towards(t.x[i], t.y[i], current_target(t, goals, i));
 }
 
 // Following each stalled agent's blocker while the blocker is stalled too gives chains that end

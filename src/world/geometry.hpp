@@ -90,6 +90,12 @@ inline bool discs_overlap(double dx, double dy, double rsum) {
   return dx * dx + dy * dy < rsum * rsum;
 }
 
+// The unit vector from (px, py) towards p; (0, 0) when on it.
+inline Vec2 unit_towards(double px, double py, Vec2 p) {
+  const double dx = p.x - px, dy = p.y - py, l = std::sqrt(dx * dx + dy * dy);
+  return l > 0 ? Vec2{dx / l, dy / l} : Vec2{0, 0};
+}
+
 // Has a point reached a goal area? A disc goal: within arrival_radius of its centre. A polygon
 // goal: inside or on the boundary (within a micrometre, so that an agent that steps exactly onto
 // the nearest boundary point arrives whatever the rounding).
