@@ -60,6 +60,10 @@ struct OrcaParams {
   // at most max_retreat * pref_speed (>= 0; a value >= max_speed / pref_speed never binds, so a
   // large one such as 10 switches it off). steer/orca.cpp says why.
   double max_retreat = 0.25;
+  // Keeping to one side: someone coming towards an agent in its lane ahead turns its wish a little
+  // to this side, so that people meeting head-on pass each other on the same side and counter-
+  // flows sort into lanes (none: off). steer/orca.cpp says why.
+  enum class PassSide { none, right, left } pass_side = PassSide::right;
 };
 
 // The collision-free speed model (Tordeux, Chraibi, Seyfried 2016), model "cfsm"; defaults are

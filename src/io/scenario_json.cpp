@@ -872,6 +872,10 @@ void read_steering(Node& root, SimConfig& cfg) {
     op.time_gap = o.non_negative("time_gap", op.time_gap);
     op.stream_gap = o.non_negative("stream_gap", op.stream_gap);
     op.max_retreat = o.non_negative("max_retreat", op.max_retreat);
+    const std::string side = o.choice("pass_side", {"right", "left", "none"}, "right");
+    op.pass_side = side == "right"  ? OrcaParams::PassSide::right
+                   : side == "left" ? OrcaParams::PassSide::left
+                                    : OrcaParams::PassSide::none;
     o.finish();
   }
   if (s.has("cfsm")) {
