@@ -374,6 +374,23 @@ double lane_order(const std::string& side) {
   return sum[0] / static_cast<double>(count[0]) - sum[1] / static_cast<double>(count[1]);
 }
 
+// Keeping to a side turns wishes from the neighbour lists of the committed state: the same run
+// on any thread count and neighbour access path (mixed() has no one passing).
+TEST(Orca, KeepingToASideChangesNothingAcrossAccessPathsAndThreads) {
+  const auto run = [](const std::vector<std::string>& sets) {
+    Scenario sc =
+        load_scenario(test::source_path("tests/data/corridor-two-way.json"), LoadOptions{{}, sets});
+    Simulation sim(std::move(sc.world), sc.config);
+    std::vector<uint64_t> h;
+    while (sim.ticks() < 600) h.push_back(sim.step().state_hash);
+    return h;
+  };
+  const auto reference = run({});
+  EXPECT_EQ(run({"threads=2"}), reference);
+  EXPECT_EQ(run({"threads=3", "access.neighbours=naive"}), reference);
+  EXPECT_NE(run({"steering.orca.pass_side=none"}), reference);  // the rule does act here
+}
+
 TEST(Orca, TwoWayTrafficKeepsToTheSideSet) {
   EXPECT_LT(lane_order("right"), -0.3);
   EXPECT_GT(lane_order("left"), 0.3);
