@@ -10,15 +10,19 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "crowddb/error.hpp"
 
 namespace crowddb {
+
+class ObstacleLookup;
 
 class ByteWriter;  // src/util/byte_codec.hpp
 class ByteReader;
@@ -285,9 +289,12 @@ class World {
   Bounds bounds_{};
   bool has_bounds_ = false;
   bool walls_ = true;
-  std::vector<Bounds> polygon_boxes_;  // of polygons_, to skip most polygons in check_walkable
+  // The obstacles near a point, for check_walkable (src/world/obstacle_lookup.hpp): built at the
+  // first check after an obstacle was added; shared by copies (it is never changed).
+  mutable std::shared_ptr<const ObstacleLookup> lookup_;
   AgentTable agents_;
   std::vector<Goal> goals_;
+  std::unordered_map<std::string, uint32_t> goal_rows_;  // goals_ by name: O(1) per new goal
   bool any_goal_wait_ = false;
   std::vector<Source> sources_;
   std::vector<CircleObstacle> circles_;

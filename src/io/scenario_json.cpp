@@ -21,6 +21,7 @@
 #include "steer/model.hpp"
 #include "util/rng.hpp"
 #include "world/geometry.hpp"
+#include "world/obstacle_lookup.hpp"
 
 namespace crowddb {
 namespace {
@@ -259,7 +260,9 @@ struct Loader {
   const io::WalkableArea* walkable = nullptr;  // the "walkable" WKT, if given
   std::size_t walkable_pieces = 0;             // polygons [0, walkable_pieces) are its blocked area
   std::vector<std::size_t> circle_src,
-      polygon_src;  // /obstacles index of each circle / polygon row
+      polygon_src;                                 // /obstacles index of each circle / polygon row
+  mutable std::unique_ptr<ObstacleLookup> lookup;  // built at the first obstacle question
+  mutable std::vector<uint32_t> near;              // its last answer
 
   // Why a point is not walkable (a goal or an agent's centre), or empty when it is: outside the
   // walkable WKT area or the walled bounds, or strictly inside an obstacle.
@@ -268,27 +271,43 @@ struct Loader {
     const Bounds& b = sc.world.bounds();
     if (sc.config.walls && (x < b.xmin || x > b.xmax || y < b.ymin || y > b.ymax))
       return "lies outside the bounds (the walls)";
-    for (std::size_t k = 0; k < sc.world.circles().size(); ++k) {
-      const CircleObstacle& c = sc.world.circles()[k];
-      if (std::hypot(c.x - x, c.y - y) < c.radius)
-        return "lies inside obstacle /obstacles/" + std::to_string(circle_src[k]) +
-               ", outside the walkable area";
-    }
-    for (std::size_t k = walkable_pieces; k < sc.world.polygons().size(); ++k) {
-      const auto& ring = sc.world.polygons()[k].vertices;
-      if (point_in_polygon(ring, x, y) && dist2_to_boundary(ring, x, y) > 0)
-        return "lies inside obstacle /obstacles/" +
-               std::to_string(polygon_src[k - walkable_pieces]) + ", outside the walkable area";
+    const std::size_t circles = sc.world.circles().size();
+    for (uint32_t k : obstacles_near(x, y, 0)) {
+      if (k < circles) {
+        const CircleObstacle& c = sc.world.circles()[k];
+        if (std::hypot(c.x - x, c.y - y) < c.radius)
+          return "lies inside obstacle /obstacles/" + std::to_string(circle_src[k]) +
+                 ", outside the walkable area";
+      } else if (const std::size_t p = k - circles; p >= walkable_pieces) {
+        const auto& ring = sc.world.polygons()[p].vertices;
+        if (point_in_polygon(ring, x, y) && dist2_to_boundary(ring, x, y) > 0)
+          return "lies inside obstacle /obstacles/" +
+                 std::to_string(polygon_src[p - walkable_pieces]) + ", outside the walkable area";
+      }
     }
     return {};
   }
 
   bool blocked_by_obstacle(double x, double y, double r, double gap) const {
-    for (const CircleObstacle& c : sc.world.circles())
-      if (discs_overlap(c.x - x, c.y - y, c.radius + r + gap)) return true;
-    for (const PolygonObstacle& p : sc.world.polygons())
-      if (disc_overlaps_polygon(p.vertices, x, y, r + gap)) return true;
+    const std::size_t circles = sc.world.circles().size();
+    for (uint32_t k : obstacles_near(x, y, r + gap)) {
+      if (k < circles) {
+        const CircleObstacle& c = sc.world.circles()[k];
+        if (discs_overlap(c.x - x, c.y - y, c.radius + r + gap)) return true;
+      } else if (disc_overlaps_polygon(sc.world.polygons()[k - circles].vertices, x, y, r + gap)) {
+        return true;
+      }
+    }
     return false;
+  }
+
+  // The obstacles (circles, then polygons, by row) that a disc of radius `reach` at (x, y) may
+  // touch, in row order (world/obstacle_lookup.hpp). The lookup is built at the first question: the
+  // obstacles are all read by then (read_walkable, read_obstacles), and none come after.
+  const std::vector<uint32_t>& obstacles_near(double x, double y, double reach) const {
+    if (!lookup) lookup = std::make_unique<ObstacleLookup>(sc.world.circles(), sc.world.polygons());
+    lookup->candidates(x, y, reach, near);
+    return near;
   }
 
   uint32_t goal_named(Node& n, const std::string& key, const std::string& name) {
@@ -1047,7 +1066,7 @@ Scenario parse_document(std::string_view text, const std::string& source, const 
     o.finish();
   }
 
-  Loader loader{sc, {}, {}, {}, nullptr, nullptr, 0, {}, {}};
+  Loader loader{sc, {}, {}, {}, nullptr, nullptr, 0, {}, {}, nullptr, {}};
   if (walkable) loader.read_walkable(root, *walkable, walkable_charge);
   loader.read_goals(root);
   loader.read_obstacles(root);

@@ -8,6 +8,7 @@
 
 #include "util/byte_codec.hpp"
 #include "world/geometry.hpp"
+#include "world/obstacle_lookup.hpp"
 
 namespace crowddb {
 namespace {
@@ -89,9 +90,9 @@ void World::validate_spec(const AgentSpec& s, std::size_t goal_count) {
 }
 
 std::optional<uint32_t> World::goal_named(std::string_view name) const {
-  for (std::size_t i = 0; i < goals_.size(); ++i)
-    if (goals_[i].name == name) return static_cast<uint32_t>(i);
-  return std::nullopt;
+  const auto it = goal_rows_.find(std::string(name));
+  if (it == goal_rows_.end()) return std::nullopt;
+  return it->second;
 }
 
 uint32_t World::add_goal(Goal g) {
@@ -115,8 +116,10 @@ uint32_t World::add_goal(Goal g) {
           "x", "the goal's point (" + fmt(g.x) + ", " + fmt(g.y) + ") lies outside its area");
   }
   any_goal_wait_ = any_goal_wait_ || g.has_wait();
+  const auto row = static_cast<uint32_t>(goals_.size());
+  goal_rows_.emplace(g.name, row);
   goals_.push_back(std::move(g));
-  return static_cast<uint32_t>(goals_.size() - 1);
+  return row;
 }
 
 uint32_t World::add_source(Source src) {
@@ -149,21 +152,15 @@ uint32_t World::add_obstacle(const CircleObstacle& c) {
   require_positive("radius", c.radius);
   require_finite("charge", c.charge);
   circles_.push_back(c);
+  lookup_.reset();
   return static_cast<uint32_t>(circles_.size() - 1);
 }
 
 uint32_t World::add_obstacle(PolygonObstacle p) {
   require_finite("charge", p.charge);
   normalize_ring(p.vertices, "vertices");
-  Bounds box{INFINITY, INFINITY, -INFINITY, -INFINITY};
-  for (const Vec2& v : p.vertices) {
-    box.xmin = std::min(box.xmin, v.x);
-    box.ymin = std::min(box.ymin, v.y);
-    box.xmax = std::max(box.xmax, v.x);
-    box.ymax = std::max(box.ymax, v.y);
-  }
-  polygon_boxes_.push_back(box);
   polygons_.push_back(std::move(p));
+  lookup_.reset();
   return static_cast<uint32_t>(polygons_.size() - 1);
 }
 
@@ -203,15 +200,20 @@ void World::check_walkable(double x, double y) const {
   if (walls_ && has_bounds_ && !(x >= b.xmin && x <= b.xmax && y >= b.ymin && y <= b.ymax))
     throw InvalidRow("x", at() + "outside the bounds [" + fmt(b.xmin) + ", " + fmt(b.xmax) +
                               "] x [" + fmt(b.ymin) + ", " + fmt(b.ymax) + "] (the walls)");
-  for (std::size_t k = 0; k < circles_.size(); ++k)
-    if (std::hypot(circles_[k].x - x, circles_[k].y - y) < circles_[k].radius)
-      throw InvalidRow("x", at() + "inside circle obstacle " + std::to_string(k));
-  for (std::size_t k = 0; k < polygons_.size(); ++k) {
-    const Bounds& box = polygon_boxes_[k];
-    if (x <= box.xmin || x >= box.xmax || y <= box.ymin || y >= box.ymax) continue;
-    const auto& ring = polygons_[k].vertices;
+  if (circles_.empty() && polygons_.empty()) return;
+  if (!lookup_) lookup_ = std::make_shared<const ObstacleLookup>(circles_, polygons_);
+  thread_local std::vector<uint32_t> near;
+  lookup_->candidates(x, y, 0, near);
+  for (const uint32_t k : near) {  // circles, then polygons, by row: the first hit as a scan's
+    if (k < circles_.size()) {
+      if (std::hypot(circles_[k].x - x, circles_[k].y - y) < circles_[k].radius)
+        throw InvalidRow("x", at() + "inside circle obstacle " + std::to_string(k));
+      continue;
+    }
+    const std::size_t p = k - circles_.size();
+    const auto& ring = polygons_[p].vertices;
     if (point_in_polygon(ring, x, y) && dist2_to_boundary(ring, x, y) > 0)
-      throw InvalidRow("x", at() + "inside polygon obstacle " + std::to_string(k));
+      throw InvalidRow("x", at() + "inside polygon obstacle " + std::to_string(p));
   }
 }
 
@@ -609,6 +611,7 @@ void World::restore_agents(ByteReader& in) {
   const auto bad = [&](const std::string& why) { in.fail("agents table: " + why); };
   World trial;  // column lengths, slot map and goal rows, by the world's own invariants
   trial.goals_ = goals_;
+  trial.goal_rows_ = goal_rows_;
   trial.agents_ = std::move(t);
   trial.slots_ = std::move(slots);
   try {
