@@ -20,9 +20,7 @@ Box feature_box(const StaticScene& scene, std::size_t f) {
     const CircleObstacle& c = scene.circles()[f];
     return {c.x - c.radius, c.y - c.radius, c.x + c.radius, c.y + c.radius};
   }
-  const auto [p, e] = scene.edge_of(f);
-  const auto& v = scene.polygons()[p].vertices;
-  const Vec2 a = v[e], b = v[(e + 1) % v.size()];
+  const auto [a, b] = scene.edge(f);
   return {std::min(a.x, b.x), std::min(a.y, b.y), std::max(a.x, b.x), std::max(a.y, b.y)};
 }
 

@@ -68,8 +68,14 @@ StaticScene::StaticScene(std::vector<CircleObstacle> circles, std::vector<Polygo
     for (int i = 0; i < 4 && charged; ++i)
       sample_segment(c[i], c[(i + 1) % 4], spacing, 1.0, px_, py_, pc_);
   }
-  for (const PolygonObstacle& p : polygons_)
-    edge_start_.push_back(edge_start_.back() + static_cast<uint32_t>(p.vertices.size()));
+  for (std::size_t k = 0; k < polygons_.size(); ++k) {
+    const auto& v = polygons_[k].vertices;
+    edge_start_.push_back(edge_start_.back() + static_cast<uint32_t>(v.size()));
+    for (std::size_t e = 0; e < v.size(); ++e) {
+      edge_polygon_.push_back(static_cast<uint32_t>(k));
+      edges_.push_back({v[e], v[(e + 1) % v.size()]});
+    }
+  }
   for (const PolygonObstacle& p : polygons_) {
     Box b{INFINITY, INFINITY, -INFINITY, -INFINITY};
     for (const Vec2& a : p.vertices)
@@ -79,24 +85,14 @@ StaticScene::StaticScene(std::vector<CircleObstacle> circles, std::vector<Polygo
   }
 }
 
-std::pair<std::size_t, std::size_t> StaticScene::edge_of(std::size_t f) const {
-  // Binary search in the prefix sums of edge counts.
-  const std::size_t e = f - circles_.size();
-  const auto it =
-      std::upper_bound(edge_start_.begin(), edge_start_.end(), static_cast<uint32_t>(e));
-  const auto p = static_cast<std::size_t>(it - edge_start_.begin()) - 1;
-  return {p, e - edge_start_[p]};
-}
-
 double feature_dist2(const StaticScene& scene, std::size_t f, double px, double py) {
   if (f < scene.circles().size()) {
     const CircleObstacle& c = scene.circles()[f];
     const double d = std::hypot(px - c.x, py - c.y) - c.radius;
     return d > 0 ? d * d : 0.0;
   }
-  const auto [p, e] = scene.edge_of(f);
-  const auto& v = scene.polygons()[p].vertices;
-  return dist2_to_segment(v[e], v[(e + 1) % v.size()], px, py);
+  const StaticScene::Edge& e = scene.edge(f);
+  return dist2_to_segment(e.a, e.b, px, py);
 }
 
 Vec2 feature_closest(const StaticScene& scene, std::size_t f, double px, double py) {
@@ -106,9 +102,8 @@ Vec2 feature_closest(const StaticScene& scene, std::size_t f, double px, double 
     if (d == 0) return {px, py};
     return {c.x + dx * c.radius / d, c.y + dy * c.radius / d};
   }
-  const auto [p, e] = scene.edge_of(f);
-  const auto& v = scene.polygons()[p].vertices;
-  return closest_on_segment(v[e], v[(e + 1) % v.size()], px, py);
+  const StaticScene::Edge& e = scene.edge(f);
+  return closest_on_segment(e.a, e.b, px, py);
 }
 
 }  // namespace crowddb

@@ -120,9 +120,8 @@ class CfsmModel final : public Model {
         if (dx * dx + dy * dy < c.radius * c.radius) return true;
         continue;
       }
-      const auto [poly, e] = scene.edge_of(f);
-      const auto& v = scene.polygons()[poly].vertices;
-      if (segments_cross(t.x[i], t.y[i], t.x[j], t.y[j], v[e], v[(e + 1) % v.size()])) return true;
+      const StaticScene::Edge& e = scene.edge(f);
+      if (segments_cross(t.x[i], t.y[i], t.x[j], t.y[j], e.a, e.b)) return true;
     }
     return false;
   }

@@ -463,13 +463,11 @@ class OrcaModel final : public Model {
         ny = dy / l;
         d = l - c.radius;
       } else {
-        const auto [poly, e] = scene.edge_of(f);
-        const auto& v = scene.polygons()[poly].vertices;
-        const Vec2 a0 = v[e], a1 = v[(e + 1) % v.size()];
+        const auto [a0, a1] = scene.edge(f);
         // Polygons are counter-clockwise: the inside is left of each edge. Back face: skip.
         const double side = (a1.x - a0.x) * (y - a0.y) - (a1.y - a0.y) * (x - a0.x);
         if (side > 0) continue;
-        const Vec2 c = feature_closest(scene, f, x, y);
+        const Vec2 c = closest_on_segment(a0, a1, x, y);
         const double dx = x - c.x, dy = y - c.y, l = std::sqrt(dx * dx + dy * dy);
         if (l > 0) {
           nx = dx / l;
