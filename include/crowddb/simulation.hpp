@@ -230,6 +230,9 @@ class Simulation {
   std::size_t entered_total() const { return entered_total_; }
   // Agents that sources have still to let in (waiting for a free spot or for their time).
   std::size_t waiting_to_enter() const;
+  // Agents still walking whose last planned route does not reach their goal (with navigation;
+  // 0 without): a goal walled in, or out of the mesh's reach.
+  std::size_t without_path() const;
   // Hash of the current committed state; equal hashes mean bit-identical states.
   uint64_t state_hash() const;
 

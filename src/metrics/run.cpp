@@ -197,6 +197,7 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
   const auto& states = sim.world().agents().state;
   s.waiting_at_goals =
       static_cast<std::size_t>(std::count(states.begin(), states.end(), AgentState::waiting));
+  s.without_path = sim.without_path();
   s.all_arrived = last.active == 0 && s.waiting_to_enter == 0;
   s.last_arrival_s = last_arrival ? static_cast<double>(last_arrival) * dt : -1;
   s.overlapping_pairs_at_end = last.overlapping_pairs;
@@ -234,6 +235,7 @@ std::string RunSummary::json() const {
   j["arrived"] = arrived;
   j["still_walking"] = still_walking;
   j["waiting_at_goals"] = waiting_at_goals;
+  j["without_path"] = without_path;
   j["all_arrived"] = all_arrived;
   if (last_arrival_s >= 0)
     j["last_arrival_s"] = ns(last_arrival_s);
@@ -295,6 +297,10 @@ std::string RunSummary::text(const SimConfig& cfg) const {
   os << (all_arrived ? "; everyone arrived"
                      : "; " + std::to_string(still_walking) + " still walking");
   if (waiting_at_goals > 0) os << " (" << waiting_at_goals << " of them waiting at a goal)";
+  if (without_path > 0)
+    os << "; " << without_path
+       << " of them with no path to their goal on the navigation mesh (their route ends short "
+          "of it: a goal walled in, or out of the mesh's reach)";
   os << "\n  overlaps after a tick: at most " << max_overlapping_pairs << " agent pairs and "
      << max_obstacle_overlaps << " agent-obstacle; at the end " << overlapping_pairs_at_end
      << " pairs\n  backoff: " << (cfg.backoff ? "on" : "off") << ", " << frozen_agent_ticks

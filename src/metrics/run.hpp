@@ -31,6 +31,7 @@ struct RunSummary {
   std::size_t arrived = 0;
   std::size_t still_walking = 0;     // not arrived at the end
   std::size_t waiting_at_goals = 0;  // of those, waiting at a goal (Goal::wait_min/max)
+  std::size_t without_path = 0;      // of those, with a route that does not reach their goal
   bool all_arrived = false;          // nobody still walking and nobody waiting to enter
   double last_arrival_s = -1;        // -1: nobody arrived
   std::size_t max_overlapping_pairs = 0, max_obstacle_overlaps = 0, overlapping_pairs_at_end = 0;

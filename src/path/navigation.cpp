@@ -113,6 +113,14 @@ bool Navigation::visible(double radius, uint64_t agent, Vec2 from, Vec2 to) cons
   return it != meshes_.end() && it->second->visible(from, to);
 }
 
+std::size_t Navigation::without_path(const World& world) const {
+  const AgentTable& t = world.agents();
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    n += !standing(t.state[i]) && short_routes_.count(t.id[i]) > 0;
+  return n;
+}
+
 void Navigation::trim_passed(World& world, std::size_t row) {
   AgentTable& t = world.agents_for_tick();
   auto& route = t.route[row];
@@ -146,6 +154,7 @@ std::size_t Navigation::apply_results(World& world, uint64_t tick) {
       if (off_mesh(r.result, *r.mesh)) continue;
       ++stats_.narrow_routes;
       narrow_routes_.insert(r.agent);
+      short_routes_.erase(r.agent);
       t.route[i] = std::move(r.result.corners);
       if (params_.skip_visible) trim_passed(world, i);
     } else {
@@ -155,6 +164,10 @@ std::size_t Navigation::apply_results(World& world, uint64_t tick) {
         t.path_ticket[i] = ++next_ticket_;
         queue_.push_back({t.path_ticket[i], r.agent, true});
       }
+      if (r.result.status == PathStatus::ok)
+        short_routes_.erase(r.agent);
+      else
+        short_routes_.insert(r.agent);
       if (r.result.status == PathStatus::no_start || r.result.status == PathStatus::no_goal) {
         ++stats_.failed;
         t.route[i].clear();  // no path: steer straight at the goal
@@ -287,8 +300,10 @@ void Navigation::save(ByteWriter& out) const {
     out.u64(q.agent);
     out.u8(q.narrow ? 1 : 0);
   }
-  out.u64(narrow_routes_.size());
-  for (uint64_t a : narrow_routes_) out.u64(a);
+  for (const std::set<uint64_t>* s : {&narrow_routes_, &short_routes_}) {
+    out.u64(s->size());
+    for (uint64_t a : *s) out.u64(a);
+  }
   const auto batches = service_->pending_jobs();
   out.u64(batches.size());
   for (const auto& [due, jobs] : batches) {
@@ -326,9 +341,11 @@ void Navigation::restore(ByteReader& in, uint64_t tick) {
     if (narrow > 1) in.fail("a queued path request with a bad mesh flag");
     q.narrow = narrow == 1;
   }
-  narrow_routes_.clear();
-  const uint64_t routes = in.count(8);
-  for (uint64_t k = 0; k < routes; ++k) narrow_routes_.insert(in.u64());
+  for (std::set<uint64_t>* s : {&narrow_routes_, &short_routes_}) {
+    s->clear();
+    const uint64_t routes = in.count(8);
+    for (uint64_t k = 0; k < routes; ++k) s->insert(in.u64());
+  }
   // The searches the constructor dispatched are not this run's: start a fresh service.
   service_ = std::make_unique<PathService>();
   const uint64_t batches = in.count(16);

@@ -88,6 +88,11 @@ class Navigation {
   // Line of sight for agent `agent` (AgentId value) of `radius`: on its class mesh, or on the
   // narrow one when its route came from there. False when that mesh is not built yet.
   bool visible(double radius, uint64_t agent, Vec2 from, Vec2 to) const;
+  // Agents still walking whose last route does not reach their goal: the search ended short
+  // of it (no way there on the mesh: a goal walled in) or found no path at all (the agent
+  // steers straight at the goal). A passage on the narrow mesh but narrower than the agent's
+  // disc is not caught (its route reaches the goal).
+  std::size_t without_path(const World& world) const;
 
   double class_radius(double radius) const;
   const NavigationParams& params() const { return params_; }
@@ -138,7 +143,8 @@ class Navigation {
   Executor& ex_;
   std::map<int, std::unique_ptr<NavMesh>> meshes_;  // by class (radius = class * radius_step);
                                                     // negative: narrow meshes (narrow_key)
-  std::set<uint64_t> narrow_routes_;                // agents whose route came from a narrow mesh
+  std::set<uint64_t> short_routes_;   // agents whose last route does not reach their goal
+  std::set<uint64_t> narrow_routes_;  // agents whose route came from a narrow mesh
   std::deque<Queued> queue_;
   uint64_t next_ticket_ = 0;
   NavigationStats stats_;

@@ -320,7 +320,7 @@ constexpr std::string_view kCheckpointMagic = "crowddb-checkpoint";
 // 2: narrow meshes in the path service's state; 3: goal waits (the wait_until column); 4: the
 // goal each agent left last (the left_goal column); 5: congestion costs of the path searches in
 // flight.
-constexpr uint32_t kCheckpointVersion = 5;
+constexpr uint32_t kCheckpointVersion = 6;  // 6: the navigation's routes that fall short
 
 // What a checkpoint must agree on with the simulation it is restored into: the static tables
 // and the settings that change what a tick computes (not the thread count).
@@ -429,6 +429,10 @@ void Simulation::restore_state(std::string_view bytes, const std::string& what) 
 
 std::size_t Simulation::waiting_to_enter() const {
   return engine_->sources.waiting(world_);
+}
+
+std::size_t Simulation::without_path() const {
+  return engine_->nav ? engine_->nav->without_path(world_) : 0;
 }
 
 const TickMetrics& Simulation::step() {

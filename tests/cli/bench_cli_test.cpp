@@ -38,7 +38,7 @@ TEST(SummaryJson, KeysAgreeWithTheRun) {
   for (const char* k : {"agents_total", "arrived", "all_arrived", "last_arrival_s", "sim_seconds",
                         "ticks", "max_overlapping_pairs", "max_obstacle_overlaps", "stalled_at_end",
                         "max_stalled_s", "frozen_agent_ticks", "wall_seconds", "ms_per_tick_median",
-                        "state_hash", "steerbench", "model"})
+                        "state_hash", "steerbench", "model", "without_path"})
     EXPECT_TRUE(j.contains(k)) << k;
   EXPECT_EQ(j["agents_total"], 1);
   EXPECT_EQ(j["arrived"], 1);
@@ -58,6 +58,35 @@ TEST(SummaryJson, KeysAgreeWithTheRun) {
   const CliResult s = run_cli("run " + sc.string() + " --summary-json - --no-output --quiet", dir);
   ASSERT_EQ(s.status, 0) << s.err;
   EXPECT_EQ(nlohmann::json::parse(s.out)["state_hash"], j["state_hash"]);
+}
+
+// A goal walled in on every side: its agent's route ends short of it, and the summary says so
+// (the one whose goal is open arrives and is not counted).
+TEST(SummaryJson, AgentsWithNoPathToTheirGoalAreCounted) {
+  TempDir dir;
+  const auto sc = dir.write("walled.json", R"({"name": "walled", "bounds": [0, 0, 20, 10],
+    "duration": 20, "navigation": {},
+    "goals": [{"name": "open", "x": 4, "y": 8, "arrival_radius": 0.3},
+              {"name": "closed", "x": 15, "y": 5, "arrival_radius": 0.3}],
+    "obstacles": [{"type": "polygon", "vertices": [[13, 3], [17, 3], [17, 3.3], [13, 3.3]]},
+                  {"type": "polygon", "vertices": [[13, 6.7], [17, 6.7], [17, 7], [13, 7]]},
+                  {"type": "polygon", "vertices": [[13, 3.3], [13.3, 3.3], [13.3, 6.7], [13, 6.7]]},
+                  {"type": "polygon", "vertices": [[16.7, 3.3], [17, 3.3], [17, 6.7], [16.7, 6.7]]}],
+    "agents": [{"x": 2, "y": 5, "goal": "closed"}, {"x": 2, "y": 2, "goal": "open"}]})");
+  const CliResult r = run_cli("run " + sc.string() + " --no-output --quiet", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("1 of them with no path to their goal"), std::string::npos) << r.out;
+  const CliResult j = run_cli("run " + sc.string() + " --summary-json - --no-output --quiet", dir);
+  ASSERT_EQ(j.status, 0) << j.err;
+  const auto s = nlohmann::json::parse(j.out);
+  EXPECT_EQ(s["arrived"], 1);
+  EXPECT_EQ(s["still_walking"], 1);
+  EXPECT_EQ(s["without_path"], 1);
+  // Without navigation nothing is planned, so nothing is counted.
+  const CliResult n =
+      run_cli("run " + sc.string() + " --no-navigation --summary-json - --no-output --quiet", dir);
+  ASSERT_EQ(n.status, 0) << n.err;
+  EXPECT_EQ(nlohmann::json::parse(n.out)["without_path"], 0);
 }
 
 TEST(Convert, ImportedFileConvertsToAScenarioThatRunsTheSame) {

@@ -212,20 +212,21 @@ int bench(const BenchOptions& o) {
     std::ostringstream c;
     c << "file,format,name,model,status,agents_total,arrived,all_arrived,last_arrival_s,"
          "sim_seconds,ticks,max_overlapping_pairs,max_obstacle_overlaps,stalled_at_end,"
-         "max_stalled_s,frozen_agent_ticks,collisions,composite01,composite02,wall_seconds,"
+         "without_path,max_stalled_s,frozen_agent_ticks,collisions,composite01,composite02,wall_"
+         "seconds,"
          "ms_per_tick_median,state_hash,error\n";
     for (const Row& r : rows) {
       const auto& s = r.s;
       c << csv_field(r.file) << ",";
       if (!r.error.empty()) {
-        c << ",,,error,,,,,,,,,,,,,,,,,," << csv_field(r.error) << "\n";
+        c << ",,,error,,,,,,,,,,,,,,,,,,," << csv_field(r.error) << "\n";
         continue;
       }
       c << s.format << "," << csv_field(s.name) << "," << s.model << ",ok," << s.agents_total << ","
         << s.arrived << "," << (s.all_arrived ? 1 : 0) << ","
         << (s.last_arrival_s >= 0 ? format_number(s.last_arrival_s) : "") << ","
         << format_number(s.sim_seconds) << "," << s.ticks << "," << s.max_overlapping_pairs << ","
-        << s.max_obstacle_overlaps << "," << s.stalled_at_end << ","
+        << s.max_obstacle_overlaps << "," << s.stalled_at_end << "," << s.without_path << ","
         << format_number(s.max_stalled_s) << "," << s.frozen_agent_ticks << ","
         << s.steerbench.collisions << "," << format_number(s.steerbench.composite01) << ","
         << format_number(s.steerbench.composite02) << "," << format_number(s.wall_seconds) << ","
