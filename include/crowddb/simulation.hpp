@@ -144,7 +144,7 @@ struct NavigationParams {
 // navigation, one that stays stalled re-plans (NavigationParams::replan_after).
 // src/sim/stalemate.hpp has the detail.
 struct StallParams {
-  double after = 4;       // [s] (> 0)
+  double after = 2;       // [s] (> 0)
   double progress = 0.1;  // [m] getting this much closer than ever counts as progress (> 0)
   bool resolve = true;
   double yield_time = 1.5;          // [s] a yield in a jam (an arch at a door) (> 0)

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "path/navigation.hpp"
 #include "util/hash.hpp"
 #include "util/rng.hpp"
 #include "world/geometry.hpp"
+#include "world/obstacle_lookup.hpp"
 
 namespace crowddb::sim {
 namespace {
@@ -18,6 +20,49 @@ constexpr std::size_t kGrain = 256;
 bool idle(const AgentTable& t, std::size_t i) {
   return standing(t.state[i]);
 }
+
+// Does idle row i stand on (or touch) disc goal g?
+bool on_disc(const AgentTable& t, const Goal& g, std::size_t i) {
+  return std::hypot(g.x - t.x[i], g.y - t.y[i]) < g.arrival_radius + t.radius[i];
+}
+
+// The preferred velocity of idle row i stepping off disc goal g: away from its centre at half
+// its preferred speed (on the centre itself, in a seeded direction of its own).
+Vec2 step_off(const AgentTable& t, const Goal& g, const SimConfig& cfg, std::size_t i) {
+  double dx = t.x[i] - g.x, dy = t.y[i] - g.y;
+  double len = std::sqrt(dx * dx + dy * dy);
+  if (len == 0) {
+    Rng rng = Rng::stream(cfg.seed ^ 0x1d1e, t.id[i]);
+    const double a = rng.uniform(0, 2 * std::numbers::pi);
+    dx = std::cos(a);
+    dy = std::sin(a);
+    len = 1;
+  }
+  return {0.5 * t.pref_speed[i] * dx / len, 0.5 * t.pref_speed[i] * dy / len};
+}
+
+// The disc goals others still head for (demand > 0), for idle agents that stand in the way of
+// one that is not their own: closer to its disc than the widest of those heading for it needs
+// (Menge's formations put goals 0.3 m apart: the first to arrive stood where its neighbour had
+// to stand, and the neighbour circled it for good). Rebuilt every tick: O(agents + goals).
+struct NeededDiscs {
+  std::vector<uint32_t> goal;        // goal row of each disc
+  std::vector<CircleObstacle> area;  // each disc grown by the widest radius heading for it
+  std::optional<ObstacleLookup> lookup;
+
+  NeededDiscs(const AgentTable& t, std::span<const Goal> goals, std::span<const uint32_t> demand) {
+    if (demand.empty()) return;
+    std::vector<double> widest(goals.size(), 0);
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (!standing(t.state[i])) widest[t.goal[i]] = std::max(widest[t.goal[i]], t.radius[i]);
+    for (std::size_t g = 0; g < goals.size(); ++g)
+      if (demand[g] > 0 && !goals[g].is_polygon()) {
+        goal.push_back(static_cast<uint32_t>(g));
+        area.push_back({goals[g].x, goals[g].y, goals[g].arrival_radius + widest[g], 0});
+      }
+    if (!area.empty()) lookup.emplace(area, std::span<const PolygonObstacle>{});
+  }
+};
 
 }  // namespace
 
@@ -76,7 +121,9 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
   const uint64_t sight_ticks = cfg.ticks_for(cfg.navigation.sight_interval);
   const uint64_t nudge_ticks = cfg.nudge_after > 0 ? cfg.ticks_for(cfg.nudge_after) : 0;
   const double noise = cfg.steering.perturbation;
+  const NeededDiscs needed(t, goals, demand);
   ex.for_each_chunk(t.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<uint32_t> near;  // candidates of NeededDiscs::lookup
     for (std::size_t i = b; i < e; ++i) {
       double px = 0, py = 0;  // preferred velocity
       if (idle(t, i)) {
@@ -94,21 +141,24 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
             px = s * dx / len;
             py = s * dy / len;
           }
-        } else if (!demand.empty() && demand[t.goal[i]] > 0) {
-          // Standing on (or touching) a goal disc others still need: step off it.
-          const bool on = std::hypot(g.x - t.x[i], g.y - t.y[i]) < g.arrival_radius + t.radius[i];
-          if (on) {
-            double dx = t.x[i] - g.x, dy = t.y[i] - g.y;
-            double len = std::sqrt(dx * dx + dy * dy);
-            if (len == 0) {  // on the goal's point: a direction of its own
-              Rng rng = Rng::stream(cfg.seed ^ 0x1d1e, t.id[i]);
-              const double a = rng.uniform(0, 2 * std::numbers::pi);
-              dx = std::cos(a);
-              dy = std::sin(a);
-              len = 1;
-            }
-            px = 0.5 * t.pref_speed[i] * dx / len;
-            py = 0.5 * t.pref_speed[i] * dy / len;
+        } else if (!demand.empty() && demand[t.goal[i]] > 0 && on_disc(t, g, i)) {
+          // Standing on (or touching) its goal's disc, which others still need: step off it.
+          const Vec2 v = step_off(t, g, cfg, i);
+          px = v.x;
+          py = v.y;
+        }
+        if (px == 0 && py == 0 && needed.lookup) {
+          // In the way of another goal's disc that others still need: step off the first one.
+          needed.lookup->candidates(t.x[i], t.y[i], t.radius[i], near);
+          for (uint32_t k : near) {
+            const CircleObstacle& c = needed.area[k];
+            if (needed.goal[k] == t.goal[i] ||
+                !(std::hypot(c.x - t.x[i], c.y - t.y[i]) < c.radius + t.radius[i]))
+              continue;
+            const Vec2 v = step_off(t, goals[needed.goal[k]], cfg, i);
+            px = v.x;
+            py = v.y;
+            break;
           }
         }
         pref.vx[i] = px;

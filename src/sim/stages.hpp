@@ -58,6 +58,8 @@ int out_before_in(const AgentTable& t, std::span<const Goal> goals, std::size_t 
 // empty when arrivals do not idle) says others still head for their goal: at a polygon goal they
 // walk on into the area towards its inner point (its edge stays free for those coming), at a
 // disc goal they step off the disc, away from its centre; both at half their preferred speed.
+// An idle agent in the way of another disc goal others still head for (closer to the disc than
+// the widest of them needs to reach it) steps off that one the same way (the first in goal order).
 // Waypoint following: with `nav` (and skip_visible, every sight interval per agent), an agent whose
 // waypoint after the current one is in sight steers at that one and records the skip.
 void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,

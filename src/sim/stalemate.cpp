@@ -120,7 +120,13 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
         ++t.stall_ticks[i];
         ++t.replan_ticks[i];
       }
-      if (t.stall_action[i] != StallAction::none && tick >= t.stall_until[i])
+      // A sidestep is followed by `after` of walking on before the next action: the agent
+      // heads for its target again and gets the same time as anyone to make progress. Acting
+      // again at once chained sidesteps into a random walk for as long as its best distance
+      // stayed out of reach (Menge's formationNavigation: one pushed off its spot at the
+      // start wandered 280 s with stall.after 2 s).
+      if (t.stall_action[i] != StallAction::none &&
+          tick >= t.stall_until[i] + (t.stall_action[i] == StallAction::sidestep ? after : 0))
         t.stall_action[i] = StallAction::none;
       look[i] = t.stall_ticks[i] >= after;
     }

@@ -39,7 +39,9 @@
 //     nothing (it is walking back to where a counter-stream carried it from; it stays counted as
 //     stalled until it gets there, but a sidestep would only slow it down);
 //   - otherwise: sidestep, i.e. walk at a seeded angle of 45-90 degrees off the target direction
-//     for sidestep_time.
+//     for sidestep_time, then head for the target again for `after` before the next action (a
+//     sidestep moves the agent off its best distance; acting again at once chained sidesteps
+//     into a random walk).
 // After the action the agent heads for its target again; with navigation, one that stays stalled
 // also re-plans its path (NavigationParams::replan_after), and the rows stalled head-on
 // (StallCounts::head_on) make the tick's path searches plan round them

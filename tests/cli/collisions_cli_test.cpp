@@ -95,7 +95,7 @@ TEST(RunCli, ExplainShowsTheCollisionPlanAndTheSummaryReportsGridlock) {
   const CliResult run = run_cli("run " + circle + " --ticks 60 --no-output --quiet", dir);
   EXPECT_EQ(run.status, 0) << run.err;
   EXPECT_NE(run.out.find("gridlock (frozen 5 s in a row)"), std::string::npos) << run.out;
-  EXPECT_NE(run.out.find("stalled (no progress for 4 s)"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("stalled (no progress for 2 s)"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("nudge: sidestep after 0.2 s frozen"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("freeze rounds per tick"), std::string::npos) << run.out;
   const CliResult off =

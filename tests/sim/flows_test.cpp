@@ -66,6 +66,36 @@ TEST(Goals, IdleArrivalsMakeRoomAndLaterOnesJoinThem) {
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a.state[i], AgentState::arrived);
 }
 
+TEST(Goals, AnIdleArrivalStepsOutOfTheWayOfAnotherGoalThatSomeoneStillNeeds) {
+  // A formation (Menge's formationNavigation): goals 0.3 m apart, each person's own spot. "near"
+  // starts on its spot and idles there; "far"'s spot is 0.3 m away, so far (0.25 m) could not
+  // stand on it beside near (0.25 m). Far is 8 m off, beyond ORCA's 5 m range, so nothing but the
+  // goal stage moves near: it steps away from far's spot at once, not when far is upon it.
+  Loaded r(R"({"bounds": [0, 0, 20, 10], "duration": 60, "arrival": "idle",
+    "goals": [{"name": "near", "x": 10, "y": 5, "arrival_radius": 0.05},
+              {"name": "far", "x": 10.3, "y": 5, "arrival_radius": 0.05}],
+    "agents": [{"x": 10, "y": 5, "radius": 0.25, "goal": "near"},
+               {"x": 2, "y": 5.5, "radius": 0.25, "goal": "far"}]})");
+  for (int k = 0; k < 3; ++k) r.sim->step();
+  {
+    const AgentTable& a = r.sim->world().agents();
+    ASSERT_EQ(a.state[0], AgentState::arrived);
+    EXPECT_LT(a.vx[0], -0.1);  // away from far's spot, which lies east of it
+    EXPECT_NEAR(a.vy[0], 0, 1e-3);
+  }
+  for (uint64_t t = 3; t < r.sc.ticks && r.sim->arrived_total() < 2; ++t)
+    EXPECT_EQ(r.sim->step().overlapping_pairs, 0u);
+  EXPECT_EQ(r.sim->arrived_total(), 2u);
+  // With nobody left to come, near stands still, out of far's way and close to its own spot.
+  for (int k = 0; k < 20; ++k) r.sim->step();
+  const AgentTable& a = r.sim->world().agents();
+  ASSERT_EQ(a.size(), 2u);
+  const std::size_t n = a.goal[0] == 0 ? 0 : 1;  // rows are re-ordered every 2 s
+  EXPECT_EQ(a.vx[n], 0.0);
+  EXPECT_EQ(a.vy[n], 0.0);
+  EXPECT_LT(std::hypot(a.x[n] - 10, a.y[n] - 5), 1.0);
+}
+
 TEST(Goals, IdleArrivalsWalkIntoAnAreaAndKeepItsEdgeFree) {
   // A box goal 1 m beyond a 1 m gap in a wall. Arrivals that stepped off the box stood in the
   // strip between the gap and the box and locked the later ones out (14 of 30 arrived when
