@@ -170,7 +170,7 @@ struct AgentTable {
   std::vector<uint32_t> left_goal;
   // stalemate resolution (only touched for stalled agents)
   std::vector<StallAction> stall_action;
-  std::vector<uint64_t> stall_until;             // tick at which the action ends
+  std::vector<uint64_t> stall_until;  // tick the action ends (a sidestep: its pause starts)
   std::vector<double> stall_dir_x, stall_dir_y;  // unit direction of the action
   // path service (DESIGN.md §6); only read when navigation is on
   static constexpr uint32_t kNoPath = std::numeric_limits<uint32_t>::max();

@@ -29,7 +29,8 @@
 //     yield_time and goes first in orca, so that the people behind it make room (yield_ahead);
 //     head-on it lasts head_on_yield_time (the same by default; shorter helps dense counter-flow
 //     and hurts doors with mixed destinations, measured in docs/verify.md);
-//   - the blocker is stalled too and goes second: keep going (the blocker yields);
+//   - the blocker is stalled too and goes second: keep going (the blocker yields; not while
+//     the blocker is in the pause after a sidestep, below: then nobody acts for up to `after`);
 //   - taking turns: when both have been stalled for reverse_after, the order is swapped in every
 //     other reverse_period. An order that has not ended a stalemate in that long will not: in
 //     dense counter-flow the block that went first pressed the other against the wall at its own

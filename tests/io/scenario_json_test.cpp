@@ -43,7 +43,7 @@ TEST(ScenarioJson, MinimalFileHasDefaults) {
 
 TEST(ScenarioJson, UnitsAreMetresAndSeconds) {
   const std::string text = R"({"bounds": [0, 0, 100, 100], "dt": 0.05, "duration": 12.5,
-    "gridlock_time": 3, "nudge_after": 0.5, "stall": {"after": 2, "progress": 0.2},
+    "gridlock_time": 3, "nudge_after": 0.5, "stall": {"after": 3, "progress": 0.2},
     "navigation": {"latency": 0.25, "replan_after": 6},
     "steering": {"orca": {"time_horizon": 3, "time_horizon_obst": 1, "neighbor_dist": 4}},
     "goals": [{"name": "g", "x": 90, "y": 50}],
@@ -53,7 +53,7 @@ TEST(ScenarioJson, UnitsAreMetresAndSeconds) {
   EXPECT_EQ(sc.ticks, 250u);  // 12.5 s at 0.05 s per tick
   EXPECT_EQ(sc.config.ticks_for(sc.config.gridlock_time), 60u);
   EXPECT_EQ(sc.config.ticks_for(sc.config.nudge_after), 10u);
-  EXPECT_EQ(sc.config.ticks_for(sc.config.stall.after), 40u);
+  EXPECT_EQ(sc.config.ticks_for(sc.config.stall.after), 60u);  // not the default (2 s)
   EXPECT_EQ(sc.config.ticks_for(sc.config.navigation.latency), 5u);
   EXPECT_EQ(sc.config.steering.orca.time_horizon, 3.0);
   const AgentTable& t = sc.world.agents();
