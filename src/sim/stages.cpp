@@ -44,7 +44,8 @@ Vec2 step_off(const AgentTable& t, const Goal& g, const SimConfig& cfg, std::siz
 // The disc goals others still head for (demand > 0), for idle agents that stand in the way of
 // one that is not their own: closer to its disc than the widest of those heading for it needs
 // (Menge's formations put goals 0.3 m apart: the first to arrive stood where its neighbour had
-// to stand, and the neighbour circled it for good). Rebuilt every tick: O(agents + goals).
+// to stand, and the neighbour circled it for good). Rebuilt every tick while someone idles:
+// O(agents + goals).
 struct NeededDiscs {
   std::vector<uint32_t> goal;        // goal row of each disc
   std::vector<CircleObstacle> area;  // each disc grown by the widest radius heading for it
@@ -53,8 +54,14 @@ struct NeededDiscs {
   NeededDiscs(const AgentTable& t, std::span<const Goal> goals, std::span<const uint32_t> demand) {
     if (demand.empty()) return;
     std::vector<double> widest(goals.size(), 0);
-    for (std::size_t i = 0; i < t.size(); ++i)
-      if (!standing(t.state[i])) widest[t.goal[i]] = std::max(widest[t.goal[i]], t.radius[i]);
+    bool anyone_idle = false;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (standing(t.state[i]))
+        anyone_idle = true;
+      else
+        widest[t.goal[i]] = std::max(widest[t.goal[i]], t.radius[i]);
+    }
+    if (!anyone_idle) return;  // nobody to step off anything: no grid to build
     for (std::size_t g = 0; g < goals.size(); ++g)
       if (demand[g] > 0 && !goals[g].is_polygon()) {
         goal.push_back(static_cast<uint32_t>(g));
