@@ -89,6 +89,10 @@ struct Goal {
   // when wait_mean > 0 (then wait_min = wait_max = 0), from an exponential distribution with
   // that mean, cut at kMaxWait (a queue's service time).
   double wait_min = 0, wait_max = 0, wait_mean = 0;
+  // Derived, set by World::add_goal whatever the caller put there: for a convex area, the unit
+  // inward normal of each edge (edge i runs from area[i] to area[i + 1]); empty otherwise. The
+  // steering target (goal_target) reads them rather than taking square roots on every call.
+  std::vector<Vec2> inward_normals{};
   static constexpr double kMaxWait = 1e7;  // [s] about 116 days
   bool is_polygon() const { return !area.empty(); }
   bool has_wait() const { return wait_max > 0 || wait_mean > 0; }

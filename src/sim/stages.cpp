@@ -77,6 +77,7 @@ void Preferred::reset(std::size_t n) {
   vx.assign(n, 0.0);
   vy.assign(n, 0.0);
   skip.assign(n, 0);
+  left.assign(n, INFINITY);
 }
 
 void NextState::resize(std::size_t n) {
@@ -173,6 +174,13 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
         continue;
       }
       Vec2 target = current_target(t, goals, i);
+      // path_left, without a second goal_target when the waypoint is the goal's own point.
+      if (t.route[i].empty()) {
+        const double dx = target.x - t.x[i], dy = target.y - t.y[i];
+        pref.left[i] = std::sqrt(dx * dx + dy * dy);
+      } else {
+        pref.left[i] = path_left(t, goals, i);
+      }
       if (sight && !t.route[i].empty() && (tick + t.id[i]) % sight_ticks == 0) {
         // The waypoint after the current one: the next route point, or the goal.
         const auto& route = t.route[i];

@@ -21,6 +21,7 @@ namespace crowddb::sim {
 struct Preferred {
   std::vector<double> vx, vy;  // [m/s]
   std::vector<uint8_t> skip;   // route waypoints passed by line of sight (popped at commit)
+  std::vector<double> left;    // [m] path_left of each row; infinite for those standing
   void reset(std::size_t n);
 };
 

@@ -42,6 +42,8 @@ struct TickInput {
   const SimConfig& cfg;
   std::span<const double> pref_vx, pref_vy;  // [m/s] from the goal stage (idle agents: 0, or
                                              // stepping off a goal area others need)
+  std::span<const double> path_left;         // [m] sim::path_left per row (goal stage); infinite
+                                             // for those standing
   uint64_t tick;                             // the tick being computed
 };
 

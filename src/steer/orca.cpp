@@ -252,7 +252,7 @@ class OrcaModel final : public Model {
       avoid_y_.resize(n);
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
-          remaining_[i] = standing(t.state[i]) ? INFINITY : sim::path_left(t, in.goals, i);
+          remaining_[i] = in.path_left[i];
           yielding_[i] =
               t.stall_action[i] == StallAction::yield_ahead && in.tick < t.stall_until[i];
           arrive_[i] = arrival_time(in, i);

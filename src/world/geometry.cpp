@@ -1,6 +1,7 @@
 #include "world/geometry.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "world/halfplane_lp.hpp"
@@ -113,40 +114,49 @@ std::optional<SelfIntersection> first_self_intersection(std::span<const Vec2> ri
   return found ? *found : SelfIntersection{0, 0, false};
 }
 
-namespace {
-
-bool convex_ccw(std::span<const Vec2> ring) {
-  for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+std::vector<Vec2> convex_inward_normals(std::span<const Vec2> ring) {
+  const std::size_t n = ring.size();
+  if (n < 3) return {};
+  for (std::size_t i = 0; i < n; ++i) {
     const Vec2& a = ring[i];
     const Vec2& b = ring[(i + 1) % n];
     const Vec2& c = ring[(i + 2) % n];
-    if (cross(b.x - a.x, b.y - a.y, c.x - b.x, c.y - b.y) < 0) return false;
+    if (cross(b.x - a.x, b.y - a.y, c.x - b.x, c.y - b.y) < 0) return {};
   }
-  return true;
+  std::vector<Vec2> normals(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2& a = ring[i];
+    const Vec2& b = ring[(i + 1) % n];
+    const double ex = b.x - a.x, ey = b.y - a.y, l = std::sqrt(ex * ex + ey * ey);
+    normals[i] = {-ey / l, ex / l};
+  }
+  return normals;
 }
-
-}  // namespace
 
 Vec2 goal_target(const Goal& g, double px, double py, double r) {
   if (!g.is_polygon()) return {g.x, g.y};
   if (point_in_polygon(g.area, px, py)) return {px, py};
-  Vec2 c{};
-  dist2_to_boundary(g.area, px, py, &c);
-  if (!(r > 0) || !convex_ccw(g.area)) return c;
+  const std::size_t n = g.area.size();
+  std::vector<Vec2> computed;  // a goal not from World::add_goal
+  std::span<const Vec2> normals = g.inward_normals;
+  if (r > 0 && normals.size() != n) normals = computed = convex_inward_normals(g.area);
+  if (!(r > 0) || normals.size() != n) {  // a point, or an area that is not convex
+    Vec2 c{};
+    dist2_to_boundary(g.area, px, py, &c);
+    return c;
+  }
   // The area's edges moved inwards by r, as half-planes (the area is counter-clockwise: inside
-  // is left of each edge); the closest point to p within them.
-  std::vector<HalfPlane> planes;
+  // is left of each edge); the closest point to p within them. The planes live in a buffer of
+  // the thread's, neither allocated nor cleared per call: this runs for every agent and tick.
+  thread_local std::vector<HalfPlane> buffer;
+  if (buffer.size() < n) buffer.resize(n);
+  const std::span<HalfPlane> planes(buffer.data(), n);
   double extent = std::abs(px) + std::abs(py);
   for (const Vec2& a : g.area) extent = std::max(extent, std::abs(a.x) + std::abs(a.y));
   auto eroded = [&](double by) {
-    planes.clear();
-    for (std::size_t i = 0, n = g.area.size(); i < n; ++i) {
-      const Vec2& a = g.area[i];
-      const Vec2& b = g.area[(i + 1) % n];
-      const double ex = b.x - a.x, ey = b.y - a.y, l = std::sqrt(ex * ex + ey * ey);
-      const double nx = -ey / l, ny = ex / l;
-      planes.push_back({a.x + nx * by, a.y + ny * by, nx, ny});
-    }
+    for (std::size_t i = 0; i < n; ++i)
+      planes[i] = {g.area[i].x + normals[i].x * by, g.area[i].y + normals[i].y * by, normals[i].x,
+                   normals[i].y};
     return solve_velocity_lp(planes, 0, 4 * extent + 1, px, py);
   };
   LpResult q = eroded(r);

@@ -2,6 +2,7 @@
 // the same primitive for the same pair, so that "exact" comparisons between them are meaningful.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <optional>
@@ -101,8 +102,23 @@ inline Vec2 unit_towards(double px, double py, Vec2 p) {
 // the nearest boundary point arrives whatever the rounding).
 inline bool inside_goal(const Goal& g, double px, double py) {
   if (!g.is_polygon()) return std::hypot(g.x - px, g.y - py) <= g.arrival_radius;
+  // A point a millimetre outside the area's box is outside (and far beyond the micrometre): this
+  // runs for every walking agent and tick, and the boundary distance divides once per edge.
+  constexpr double kFar = 1e-3;
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  for (const Vec2& a : g.area) {
+    x0 = std::min(x0, a.x);
+    y0 = std::min(y0, a.y);
+    x1 = std::max(x1, a.x);
+    y1 = std::max(y1, a.y);
+  }
+  if (px < x0 - kFar || px > x1 + kFar || py < y0 - kFar || py > y1 + kFar) return false;
   return point_in_polygon(g.area, px, py) || dist2_to_boundary(g.area, px, py) <= 1e-12;
 }
+
+// The unit inward normals of a counter-clockwise ring's edges (edge i runs from ring[i] to
+// ring[i + 1]) when the ring is convex (collinear edges allowed); empty otherwise.
+std::vector<Vec2> convex_inward_normals(std::span<const Vec2> ring);
 
 // Where an agent at p steers for its goal when no waypoint is left: a disc goal's centre, or a
 // polygon goal's nearest point where a disc of radius r fits (the nearest point of the area

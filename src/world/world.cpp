@@ -115,6 +115,7 @@ uint32_t World::add_goal(Goal g) {
       throw InvalidRow(
           "x", "the goal's point (" + fmt(g.x) + ", " + fmt(g.y) + ") lies outside its area");
   }
+  g.inward_normals = convex_inward_normals(g.area);
   any_goal_wait_ = any_goal_wait_ || g.has_wait();
   const auto row = static_cast<uint32_t>(goals_.size());
   goal_rows_.emplace(g.name, row);

@@ -2,11 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "crowddb/simulation.hpp"
 #include "support/configs.hpp"
+#include "util/rng.hpp"
+#include "world/geometry.hpp"
 
 namespace crowddb {
 namespace {
@@ -242,6 +246,57 @@ TEST(World, PolygonsAreStoredCounterClockwiseAndClosingVertexDropped) {
   for (std::size_t i = 0; i < v.size(); ++i)
     area2 += v[i].x * v[(i + 1) % v.size()].y - v[(i + 1) % v.size()].x * v[i].y;
   EXPECT_GT(area2, 0);
+}
+
+// add_goal stores a convex area's inward edge normals so that goal_target need not take square
+// roots per call; a goal built by hand (none stored) must get the very same targets, and a
+// polygon that is not convex stores none (its target is the nearest boundary point).
+TEST(World, GoalTargetsFromStoredNormalsEqualThoseComputedPerCall) {
+  World w(Bounds{-50, -50, 50, 50});
+  Rng rng(7);
+  for (int k = 0; k < 40; ++k) {
+    // A convex polygon: corners at increasing angles round a centre (counter-clockwise).
+    const std::size_t n = 3 + rng.below(10);
+    std::vector<double> angles(n);
+    for (double& a : angles) a = rng.uniform(0, 2 * std::numbers::pi);
+    std::sort(angles.begin(), angles.end());
+    Goal g{"c" + std::to_string(k), rng.uniform(-5, 5), rng.uniform(-5, 5), 1, 1, {}};
+    const double rx = rng.uniform(0.3, 6), ry = rng.uniform(0.3, 6);
+    for (double a : angles) g.area.push_back({g.x + rx * std::cos(a), g.y + ry * std::sin(a)});
+    if (!point_in_polygon(g.area, g.x, g.y)) continue;  // a sliver not round its centre
+    const uint32_t row = w.add_goal(g);  // (before goals(): adding may move the table)
+    const Goal& stored = w.goals()[row];
+    ASSERT_EQ(stored.inward_normals.size(), stored.area.size());
+    Goal by_hand = stored;
+    by_hand.inward_normals.clear();
+    for (int q = 0; q < 200; ++q) {
+      const double px = rng.uniform(-20, 20), py = rng.uniform(-20, 20);
+      const double r = q % 4 == 0 ? 0 : rng.uniform(0.05, 1.5);
+      const Vec2 a = goal_target(stored, px, py, r), b = goal_target(by_hand, px, py, r);
+      ASSERT_EQ(a.x, b.x) << k << " " << px << " " << py << " " << r;
+      ASSERT_EQ(a.y, b.y);
+      // Arrival: inside or within a micrometre of the boundary (the box test is only a shortcut).
+      const Vec2& corner = stored.area[q % stored.area.size()];
+      const double cx = corner.x + rng.uniform(-3e-3, 3e-3),
+                   cy = corner.y + rng.uniform(-3e-3, 3e-3);
+      for (const auto& [x, y] : {std::pair{px, py}, std::pair{cx, cy}, std::pair{a.x, a.y}}) {
+        ASSERT_EQ(inside_goal(stored, x, y), point_in_polygon(stored.area, x, y) ||
+                                                 dist2_to_boundary(stored.area, x, y) <= 1e-12);
+      }
+      // Outside the area, the target keeps the disc inside wherever the area is wide enough.
+      if (r > 0 && !point_in_polygon(stored.area, px, py) &&
+          !(dist2_to_boundary(stored.area, a.x, a.y) < 0.99 * r * r)) {
+        EXPECT_TRUE(point_in_polygon(stored.area, a.x, a.y));
+      }
+    }
+  }
+  const uint32_t row =
+      w.add_goal({"L", 1, 1, 1, 1, {{0, 0}, {4, 0}, {4, 2}, {2, 2}, {2, 4}, {0, 4}}});
+  const Goal& l = w.goals()[row];
+  EXPECT_TRUE(l.inward_normals.empty());
+  const Vec2 c = goal_target(l, 3, 2.5, 0.5);  // the nearest boundary point, not eroded
+  EXPECT_EQ(c.x, 3);
+  EXPECT_EQ(c.y, 2);
 }
 
 }  // namespace
