@@ -151,6 +151,7 @@ struct Simulation::Engine {
   double scene_spacing = INFINITY;
   std::unique_ptr<steer::Model> model;
   sim::Preferred pref;
+  sim::AimMemo aim;  // aim points, from the stalemate watch to the next goal stage
   sim::NextState next;
   std::vector<uint32_t> demand;  // active agents per goal row (arrival = idle only)
   sim::SourceEmitter sources;
@@ -484,7 +485,8 @@ const TickMetrics& Simulation::step() {
     for (std::size_t i = 0; i < n; ++i)
       m.nudged += !standing(t.state[i]) && t.frozen_ticks[i] >= nudge_ticks;
   log.timed("goal stage", n, [&] {
-    sim::goal_stage(t, world_.goals(), cfg, m.tick, e.demand, e.pref, e.ex, e.nav.get());
+    e.aim.resize(n);
+    sim::goal_stage(t, world_.goals(), cfg, m.tick, e.demand, e.pref, e.ex, e.nav.get(), &e.aim);
   });
 
   // 2. the steering model: one velocity per row
@@ -628,8 +630,9 @@ const TickMetrics& Simulation::step() {
   log.timed("stalemates", world_.agents().size(), [&] {
     if (!e.stall_path)
       e.stall_path = neighbour_method(cfg.access.neighbours, world_.agents().size()).make();
-    const sim::StallCounts sc =
-        sim::stalemates(world_, cfg, m.tick, *e.stall_path, e.ex, log.at("stalemates").query);
+    e.aim.resize(world_.agents().size());
+    const sim::StallCounts sc = sim::stalemates(world_, cfg, m.tick, *e.stall_path, e.ex,
+                                                log.at("stalemates").query, &e.aim);
     m.stalled = sc.stalled;
     m.stall_started = sc.started;
     m.longest_stall = sc.longest;

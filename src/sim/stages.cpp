@@ -1,6 +1,7 @@
 #include "sim/stages.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -88,12 +89,23 @@ void NextState::resize(std::size_t n) {
   frozen.assign(n, 0);
 }
 
-Vec2 current_target(const AgentTable& t, std::span<const Goal> goals, std::size_t i) {
-  if (!t.route[i].empty()) return t.route[i].front();
-  return goal_target(goals[t.goal[i]], t.x[i], t.y[i], t.radius[i]);
+Vec2 AimMemo::target(std::span<const Goal> goals, uint32_t goal, double px, double py, double r,
+                     std::size_t row) {
+  Entry& e = entries_[row];
+  const auto bx = std::bit_cast<uint64_t>(px), by = std::bit_cast<uint64_t>(py),
+             br = std::bit_cast<uint64_t>(r);
+  if (e.goal != goal || e.x != bx || e.y != by || e.r != br)
+    e = {goal, bx, by, br, goal_target(goals[goal], px, py, r)};
+  return e.target;
 }
 
-double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i) {
+Vec2 current_target(const AgentTable& t, std::span<const Goal> goals, std::size_t i, AimMemo* aim) {
+  if (!t.route[i].empty()) return t.route[i].front();
+  return aim ? aim->target(goals, t.goal[i], t.x[i], t.y[i], t.radius[i], i)
+             : goal_target(goals[t.goal[i]], t.x[i], t.y[i], t.radius[i]);
+}
+
+double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i, AimMemo* aim) {
   double x = t.x[i], y = t.y[i], len = 0;
   for (const Vec2& w : t.route[i]) {
     const double dx = w.x - x, dy = w.y - y;
@@ -101,7 +113,8 @@ double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i
     x = w.x;
     y = w.y;
   }
-  const Vec2 e = goal_target(goals[t.goal[i]], x, y, t.radius[i]);
+  const Vec2 e = aim ? aim->target(goals, t.goal[i], x, y, t.radius[i], i)
+                     : goal_target(goals[t.goal[i]], x, y, t.radius[i]);
   const double dx = e.x - x, dy = e.y - y;
   return len + std::sqrt(dx * dx + dy * dy);
 }
@@ -123,7 +136,7 @@ int out_before_in(const AgentTable& t, std::span<const Goal> goals, std::size_t 
 
 void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,
                 uint64_t tick, std::span<const uint32_t> demand, Preferred& pref, Executor& ex,
-                const path::Navigation* nav) {
+                const path::Navigation* nav, AimMemo* aims) {
   const double dt = cfg.dt;
   const bool sight = nav && cfg.navigation.skip_visible;
   const uint64_t sight_ticks = cfg.ticks_for(cfg.navigation.sight_interval);
@@ -173,13 +186,13 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
         pref.vy[i] = py;
         continue;
       }
-      Vec2 target = current_target(t, goals, i);
+      Vec2 target = current_target(t, goals, i, aims);
       // path_left, without a second goal_target when the waypoint is the goal's own point.
       if (t.route[i].empty()) {
         const double dx = target.x - t.x[i], dy = target.y - t.y[i];
         pref.left[i] = std::sqrt(dx * dx + dy * dy);
       } else {
-        pref.left[i] = path_left(t, goals, i);
+        pref.left[i] = path_left(t, goals, i, aims);
       }
       if (sight && !t.route[i].empty() && (tick + t.id[i]) % sight_ticks == 0) {
         // The waypoint after the current one: the next route point, or the goal.

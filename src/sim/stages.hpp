@@ -32,12 +32,37 @@ struct NextState {
   void resize(std::size_t n);
 };
 
-// Where row i is heading now: its next route waypoint, else the nearest point of its goal area.
-Vec2 current_target(const AgentTable& t, std::span<const Goal> goals, std::size_t i);
+// The aim point each row asked for last (goal_target: a small linear program per call, for every
+// walking agent and tick). The stalemate watch of one tick and the goal stage of the next ask
+// for the same row at the same position, so the second reads the first's answer. An entry
+// answers only the goal, point (bit for bit) and radius it was computed for, and any other
+// question recomputes it: the memo never changes a result, whatever rows were reordered,
+// removed or added in between. A row's entry is only touched by the thread that has the row.
+class AimMemo {
+ public:
+  void resize(std::size_t rows) { entries_.resize(rows); }
+  // goal_target(goals[goal], px, py, r), the answer kept for row `row`.
+  Vec2 target(std::span<const Goal> goals, uint32_t goal, double px, double py, double r,
+              std::size_t row);
+
+ private:
+  struct Entry {
+    uint32_t goal = UINT32_MAX;
+    uint64_t x = 0, y = 0, r = 0;  // the question's bits
+    Vec2 target;
+  };
+  std::vector<Entry> entries_;
+};
+
+// Where row i is heading now: its next route waypoint, else the nearest point of its goal area
+// (through `aim` when given).
+Vec2 current_target(const AgentTable& t, std::span<const Goal> goals, std::size_t i,
+                    AimMemo* aim = nullptr);
 // Length of the path still ahead of row i: to its waypoint, along its route, to its goal's
 // target point. Continuous when a waypoint is passed, so progress along a route can be watched
 // with one number across waypoint changes.
-double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i);
+double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i,
+                 AimMemo* aim = nullptr);
 
 // Out before in: of two walking agents, one that has just left the goal the other heads for
 // (AgentTable::left_goal) and is nearer to it goes first, as people let those who come out of a
@@ -65,7 +90,7 @@ int out_before_in(const AgentTable& t, std::span<const Goal> goals, std::size_t 
 // waypoint after the current one is in sight steers at that one and records the skip.
 void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,
                 uint64_t tick, std::span<const uint32_t> demand, Preferred& pref, Executor& ex,
-                const path::Navigation* nav = nullptr);
+                const path::Navigation* nav = nullptr, AimMemo* aims = nullptr);
 
 // Tentative positions from the model's velocities: p' = p + v' dt.
 void integrate(const AgentTable& t, NextState& next, double dt, Executor& ex);

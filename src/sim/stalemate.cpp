@@ -88,7 +88,7 @@ std::vector<uint8_t> jammed_ahead(const AgentTable& t, std::span<const Goal> goa
 }  // namespace
 
 StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, NeighbourPath& path,
-                       Executor& ex, QueryStats& stats) {
+                       Executor& ex, QueryStats& stats, AimMemo* aim) {
   AgentTable& t = world.agents_for_tick();
   const auto goals = world.goals();
   const uint64_t after = cfg.ticks_for(cfg.stall.after);
@@ -108,7 +108,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
         t.stall_action[i] = StallAction::none;
         continue;
       }
-      const double d = path_left(t, goals, i);
+      const double d = path_left(t, goals, i, aim);
       if (!std::isfinite(t.progress_best[i])) {
         t.progress_best[i] = d;  // a new goal: this tick is the reference
       } else if (d < t.progress_best[i] - cfg.stall.progress) {

@@ -58,6 +58,8 @@
 
 namespace crowddb::sim {
 
+class AimMemo;  // stages.hpp
+
 struct StallCounts {
   std::size_t stalled = 0, started = 0, longest = 0, queueing = 0, yielding = 0, sidestepping = 0;
   // Rows (in row order) stalled where streams meet head-on: the chain of stalled blockers in
@@ -69,7 +71,8 @@ struct StallCounts {
 
 // The progress watch, the queueing test and (with cfg.stall.resolve) the actions, for the tick
 // `tick` just committed.
+// `aim`: the rows' aim points, shared with the goal stage (stages.hpp).
 StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, NeighbourPath& path,
-                       Executor& ex, QueryStats& stats);
+                       Executor& ex, QueryStats& stats, AimMemo* aim = nullptr);
 
 }  // namespace crowddb::sim
