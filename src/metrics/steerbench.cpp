@@ -35,7 +35,12 @@ uint32_t SteerBench::open_track(uint64_t id, Track tr) {
 
 void SteerBench::close_track(uint32_t slot) {
   Track& tr = tracks_[slot];
-  scores_[tr.score].arrived = true;
+  AgentScore& s = scores_[tr.score];
+  s.time = tr.time;
+  s.path_length = tr.path_length;
+  s.energy = tr.energy;
+  s.acceleration = tr.acceleration;
+  s.arrived = true;
   active_.erase(tr.id);
   tr.live = false;
   free_slots_.push_back(slot);
@@ -56,10 +61,12 @@ void SteerBench::tick(const World& world, const TickMetrics& m) {
   ++tick_;
   const AgentTable& t = world.agents();
   row_slot_.resize(t.size(), kNoSlot);
+  std::size_t moved = 0;  // rows whose track had to be looked up
   for (std::size_t i = 0; i < t.size(); ++i) {
     const uint64_t id = t.id[i];
     uint32_t slot = row_slot_[i];
     if (slot == kNoSlot || !tracks_[slot].live || tracks_[slot].id != id) {
+      ++moved;
       const auto it = active_.find(id);
       slot = it == active_.end() ? kNoSlot : it->second;
       row_slot_[i] = slot;
@@ -73,7 +80,6 @@ void SteerBench::tick(const World& world, const TickMetrics& m) {
       continue;
     }
     Track& tr = tracks_[slot];
-    AgentScore& s = scores_[tr.score];
     if (t.state[i] == AgentState::arrived) {  // arrived in this tick: the tick is not counted
       close_track(slot);
       row_slot_[i] = kNoSlot;
@@ -82,12 +88,12 @@ void SteerBench::tick(const World& world, const TickMetrics& m) {
     tr.seen = tick_;
     const double dx = t.x[i] - tr.x, dy = t.y[i] - tr.y;
     const double vx = dx / dt_, vy = dy / dt_;
-    s.time += dt_;
-    s.path_length += std::sqrt(dx * dx + dy * dy);
-    s.energy += 0.5 * (vx * vx + vy * vy);
+    tr.time += dt_;
+    tr.path_length += std::sqrt(dx * dx + dy * dy);
+    tr.energy += 0.5 * (vx * vx + vy * vy);
     if (tr.has_v) {
       const double ax = vx - tr.vx, ay = vy - tr.vy;
-      s.acceleration += std::sqrt(ax * ax + ay * ay) / dt_;
+      tr.acceleration += std::sqrt(ax * ax + ay * ay) / dt_;
     }
     tr.x = t.x[i];
     tr.y = t.y[i];
@@ -98,9 +104,40 @@ void SteerBench::tick(const World& world, const TickMetrics& m) {
   // Agents no longer in the table left it on arrival (or were deleted).
   for (uint32_t slot = 0; slot < tracks_.size(); ++slot)
     if (tracks_[slot].live && tracks_[slot].seen != tick_) close_track(slot);
+  if (moved > t.size() / 8) lay_out_in_row_order(t);
   if (m.overlapping_pairs > 0 || m.obstacle_overlaps > 0 || !open_pairs_.empty() ||
       !open_obstacles_.empty())
     collisions(world);
+}
+
+void SteerBench::flush() const {
+  for (const Track& tr : tracks_) {
+    if (!tr.live) continue;
+    AgentScore& s = scores_[tr.score];
+    s.time = tr.time;
+    s.path_length = tr.path_length;
+    s.energy = tr.energy;
+    s.acceleration = tr.acceleration;
+  }
+}
+
+void SteerBench::lay_out_in_row_order(const AgentTable& t) {
+  std::vector<Track> laid;
+  laid.reserve(active_.size());
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    uint32_t& slot = row_slot_[i];
+    if (slot == kNoSlot) continue;
+    const Track& tr = tracks_[slot];
+    if (!tr.live || tr.id != t.id[i]) {  // closed this tick (arrived)
+      slot = kNoSlot;
+      continue;
+    }
+    slot = static_cast<uint32_t>(laid.size());
+    active_[tr.id] = slot;
+    laid.push_back(tr);
+  }
+  tracks_ = std::move(laid);
+  free_slots_.clear();
 }
 
 void SteerBench::collisions(const World& world) {
@@ -170,6 +207,7 @@ void SteerBench::collisions(const World& world) {
 }
 
 SteerBenchTotals SteerBench::totals() const {
+  flush();
   SteerBenchTotals s;
   s.agents = scores_.size();
   if (scores_.empty()) return s;
@@ -194,6 +232,7 @@ SteerBenchTotals SteerBench::totals() const {
 }
 
 void SteerBench::save(ByteWriter& out) const {
+  flush();
   out.u64(tick_);
   out.u64(scores_.size());
   for (const AgentScore& a : scores_) {
@@ -251,6 +290,11 @@ void SteerBench::restore(ByteReader& in) {
     for (double* v : {&tr.x, &tr.y, &tr.vx, &tr.vy}) *v = in.f64();
     tr.has_v = in.u8() != 0;
     tr.seen = in.u64();
+    const AgentScore& s = scores_[tr.score];
+    tr.time = s.time;
+    tr.path_length = s.path_length;
+    tr.energy = s.energy;
+    tr.acceleration = s.acceleration;
     if (active_.count(id)) in.fail("steerbench: a track twice");
     open_track(id, tr);
   }

@@ -58,7 +58,10 @@ class SteerBench {
   // can have started and the per-pair search is skipped).
   void tick(const World& world, const TickMetrics& m);
   // In order of first appearance.
-  const std::vector<AgentScore>& scores() const { return scores_; }
+  const std::vector<AgentScore>& scores() const {
+    flush();
+    return scores_;
+  }
   SteerBenchTotals totals() const;
   // Checkpoints (a resumed run's scores equal the uninterrupted run's).
   void save(ByteWriter& out) const;
@@ -72,21 +75,29 @@ class SteerBench {
     uint64_t seen = 0;  // tick it was last in the table
     uint64_t id = 0;
     bool live = true;  // false: the slot is free
+    // The running sums, copied into scores_[score] when read (flush) and on close: scores_ is
+    // in order of appearance, the rows are not, and a write there per row and tick was a cache
+    // miss each.
+    double time = 0, path_length = 0, energy = 0, acceleration = 0;
   };
   static constexpr uint32_t kNoSlot = UINT32_MAX;
   uint32_t open_track(uint64_t id, Track tr);
   void close_track(uint32_t slot);
   void collisions(const World& world);
+  void flush() const;  // the live tracks' sums into scores_
+  // Puts the live tracks in the order of the rows that hold them (slot = place in that order).
+  void lay_out_in_row_order(const AgentTable& t);
 
   double dt_;
   bool walls_;
   uint64_t tick_ = 0;
-  std::vector<AgentScore> scores_;
+  mutable std::vector<AgentScore> scores_;  // a live agent's sums are in its track (flush)
   // The agents measured now: their tracks in slots (reused once closed), found by id. Each tick
   // visits every row, so a row remembers the id it held and its slot: rows change only when the
   // table reorders them or agents leave or enter (then the slot's track is closed or another
   // agent's), and the hash lookup (a cache miss per agent at 10^5 agents and more) is left for
-  // those.
+  // those. After a tick in which many rows changed (the table put its rows in curve order), the
+  // tracks are laid out again in row order, so that the next ticks walk them in memory order.
   std::vector<Track> tracks_;
   std::vector<uint32_t> free_slots_;
   std::unordered_map<uint64_t, uint32_t> active_;  // agent id -> slot in tracks_

@@ -3,9 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <numeric>
 
 #include "crowddb/simulation.hpp"
+#include "util/rng.hpp"
 
 namespace crowddb::metrics {
 namespace {
@@ -72,6 +76,81 @@ TEST(SteerBench, CollisionEpisodesCountOncePerAgentAndEpisode) {
   EXPECT_EQ(sb.scores()[1].collisions, 2u);
   EXPECT_EQ(sb.scores()[2].collisions, 1u);  // the wall
   EXPECT_EQ(sb.totals().collisions, 5u);
+}
+
+// The tracks follow agents, not rows: the same walks give the same scores, bit for bit, whether
+// the table keeps its rows in place or shuffles them every few ticks (as the curve order does,
+// after which the tracks are laid out again in row order), with agents leaving on the way and
+// the scores read in the middle of the run.
+TEST(SteerBench, ScoresDoNotDependOnTheRowOrder) {
+  auto make = [] {
+    World w(Bounds{0, 0, 100, 100});
+    w.add_goal({"g", 90, 50, 0.5, 1, {}});
+    Rng rng(5);
+    for (int k = 0; k < 300; ++k) {
+      AgentSpec a;
+      a.x = rng.uniform(5, 95);
+      a.y = rng.uniform(5, 95);
+      a.radius = 0.1;
+      a.goal = 0;
+      w.insert(a);
+    }
+    w.apply_pending();
+    return w;
+  };
+  World still = make(), shuffled = make();
+  SteerBench a(0.1, false), b(0.1, false);
+  a.start(still);
+  b.start(shuffled);
+  Rng order_rng(9);
+  TickMetrics m;
+  for (int tick = 1; tick <= 60; ++tick) {
+    for (World* w : {&still, &shuffled}) {
+      AgentTable& t = w->agents_for_tick();
+      for (std::size_t i = 0; i < t.size(); ++i) {  // each agent's own walk, from its id
+        Rng walk = Rng::stream(static_cast<uint64_t>(tick), t.id[i]);
+        t.x[i] += walk.uniform(-0.1, 0.1);
+        t.y[i] += walk.uniform(-0.1, 0.1);
+      }
+    }
+    if (tick % 7 == 0) {  // some leave: the same agents in both
+      for (World* w : {&still, &shuffled}) {
+        std::vector<std::size_t> rows;
+        const AgentTable& t = w->agents();
+        for (std::size_t i = 0; i < t.size(); ++i)
+          if ((t.id[i] ^ static_cast<uint64_t>(tick)) % 11 == 0) rows.push_back(i);
+        w->remove_rows(rows);
+      }
+    }
+    if (tick % 5 == 0) {
+      std::vector<uint32_t> order(shuffled.agents().size());
+      std::iota(order.begin(), order.end(), 0u);
+      for (std::size_t i = order.size(); i > 1; --i)
+        std::swap(order[i - 1], order[order_rng.below(i)]);
+      shuffled.permute_rows(order);
+    }
+    a.tick(still, m);
+    b.tick(shuffled, m);
+    if (tick % 13 == 0) {
+      ASSERT_EQ(a.scores().size(), b.scores().size());
+    }
+  }
+  ASSERT_EQ(a.scores().size(), b.scores().size());
+  auto bits = [](double v) { return std::bit_cast<uint64_t>(v); };
+  std::size_t closed = 0;
+  for (std::size_t k = 0; k < a.scores().size(); ++k) {
+    const AgentScore &x = a.scores()[k], &y = b.scores()[k];
+    EXPECT_EQ(x.id, y.id);
+    EXPECT_EQ(bits(x.time), bits(y.time)) << k;
+    EXPECT_EQ(bits(x.path_length), bits(y.path_length)) << k;
+    EXPECT_EQ(bits(x.energy), bits(y.energy)) << k;
+    EXPECT_EQ(bits(x.acceleration), bits(y.acceleration)) << k;
+    EXPECT_EQ(x.arrived, y.arrived);
+    closed += x.arrived;
+  }
+  EXPECT_GT(closed, 20u);  // agents did leave
+  EXPECT_LT(closed, a.scores().size());
+  EXPECT_GT(a.totals().avg_path, 1.0);  // the walks were measured
 }
 
 }  // namespace
