@@ -8,10 +8,13 @@
 // walls as obstacles. Steps are interleaved (crowddb, RVO2, crowddb, ...) so that load changes
 // hit both alike; the medians and minima over `steps` steps are printed with the load average.
 // crowddb's tick is the whole Simulation::step (goal stage, queries, LP, integrate, backoff,
-// commit, stalemates); RVO2's step is setting the preferred velocities plus doStep.
+// commit, stalemates); RVO2's step is setting the preferred velocities plus doStep. Both get
+// `threads` threads: RVO2's OpenMP is set to that many here, whatever OMP_NUM_THREADS says
+// (left unset, OpenMP took every core for RVO2 while crowddb had one).
 //
 //   rvo2_side_by_side [--agents 20000] [--threads 1] [--steps 60] [--density 0.5] [--csv FILE]
 #include <RVO.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -76,6 +79,7 @@ int main(int argc, char** argv) {
   Scenario sc = parse_scenario(doc, "side-by-side");
   const AgentTable& t = sc.world.agents();
 
+  omp_set_num_threads(threads);
   RVO::RVOSimulator rvo;
   rvo.setTimeStep(0.1f);
   rvo.setAgentDefaults(5.0f, 10, 2.0f, 0.5f, 0.25f, 1.3f);
@@ -116,12 +120,12 @@ int main(int argc, char** argv) {
   const double lo = *std::min_element(ours.begin(), ours.end()) * 1e3;
   const double lt = *std::min_element(theirs.begin(), theirs.end()) * 1e3;
   std::printf(
-      "agents %d, threads %d (RVO2: OMP_NUM_THREADS=%s), %d steps, load %.2f -> %.2f\n"
+      "agents %d, threads %d (RVO2: %d OpenMP threads), %d steps, load %.2f -> %.2f\n"
       "  crowddb orca tick  median %8.2f ms  min %8.2f ms\n"
       "  RVO2 doStep        median %8.2f ms  min %8.2f ms\n"
       "  ratio crowddb / RVO2: median %.2f, min %.2f\n",
-      agents, threads, std::getenv("OMP_NUM_THREADS") ? std::getenv("OMP_NUM_THREADS") : "unset",
-      steps, load_before, load_after, mo, lo, mt, lt, mo / mt, lo / lt);
+      agents, threads, omp_get_max_threads(), steps, load_before, load_after, mo, lo, mt, lt,
+      mo / mt, lo / lt);
   if (!csv.empty()) {
     std::ofstream f(csv, std::ios::app);
     f << agents << "," << threads << "," << steps << "," << load_before << "," << mo << "," << lo
