@@ -33,14 +33,18 @@ uint32_t SteerBench::open_track(uint64_t id, Track tr) {
   return slot;
 }
 
-void SteerBench::close_track(uint32_t slot) {
-  Track& tr = tracks_[slot];
+void SteerBench::store_sums(const Track& tr) const {
   AgentScore& s = scores_[tr.score];
   s.time = tr.time;
   s.path_length = tr.path_length;
   s.energy = tr.energy;
   s.acceleration = tr.acceleration;
-  s.arrived = true;
+}
+
+void SteerBench::close_track(uint32_t slot) {
+  Track& tr = tracks_[slot];
+  store_sums(tr);
+  scores_[tr.score].arrived = true;
   active_.erase(tr.id);
   tr.live = false;
   free_slots_.push_back(slot);
@@ -111,14 +115,8 @@ void SteerBench::tick(const World& world, const TickMetrics& m) {
 }
 
 void SteerBench::flush() const {
-  for (const Track& tr : tracks_) {
-    if (!tr.live) continue;
-    AgentScore& s = scores_[tr.score];
-    s.time = tr.time;
-    s.path_length = tr.path_length;
-    s.energy = tr.energy;
-    s.acceleration = tr.acceleration;
-  }
+  for (const Track& tr : tracks_)
+    if (tr.live) store_sums(tr);
 }
 
 void SteerBench::lay_out_in_row_order(const AgentTable& t) {

@@ -84,7 +84,8 @@ class SteerBench {
   uint32_t open_track(uint64_t id, Track tr);
   void close_track(uint32_t slot);
   void collisions(const World& world);
-  void flush() const;  // the live tracks' sums into scores_
+  void store_sums(const Track& tr) const;  // its sums into scores_[tr.score]
+  void flush() const;                      // the live tracks' sums into scores_
   // Puts the live tracks in the order of the rows that hold them (slot = place in that order).
   void lay_out_in_row_order(const AgentTable& t);
 

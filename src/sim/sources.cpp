@@ -66,13 +66,7 @@ std::size_t SourceEmitter::emit(World& world, const SimConfig& cfg, const Static
     const double k = std::floor((now - src.start) * src.rate * (1 + 1e-12)) + 1;
     const uint64_t due = std::min<uint64_t>(total, k >= 1.8e19 ? total : static_cast<uint64_t>(k));
     if (st.entered >= due) continue;
-    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-    for (const Vec2& v : src.area) {
-      x0 = std::min(x0, v.x);
-      y0 = std::min(y0, v.y);
-      x1 = std::max(x1, v.x);
-      y1 = std::max(y1, v.y);
-    }
+    const auto [x0, y0, x1, y1] = ring_box(src.area);
     const double rmax = std::max(src.agent.radius, src.radius_max);
     // Rows that may touch the area: the free-spot test only looks at them.
     double table_rmax = 0;

@@ -81,6 +81,21 @@ inline double dist2_to_boundary(std::span<const Vec2> ring, double px, double py
   return best;
 }
 
+// The axis-aligned box of a ring's vertices.
+struct RingBox {
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+};
+inline RingBox ring_box(std::span<const Vec2> ring) {
+  RingBox b;
+  for (const Vec2& v : ring) {
+    b.x0 = std::min(b.x0, v.x);
+    b.y0 = std::min(b.y0, v.y);
+    b.x1 = std::max(b.x1, v.x);
+    b.y1 = std::max(b.y1, v.y);
+  }
+  return b;
+}
+
 // Does a disc of radius r centred at p overlap the polygon (interior or boundary closer than r)?
 inline bool disc_overlaps_polygon(std::span<const Vec2> ring, double px, double py, double r) {
   return point_in_polygon(ring, px, py) || dist2_to_boundary(ring, px, py) < r * r;
@@ -105,14 +120,8 @@ inline bool inside_goal(const Goal& g, double px, double py) {
   // A point a millimetre outside the area's box is outside (and far beyond the micrometre): this
   // runs for every walking agent and tick, and the boundary distance divides once per edge.
   constexpr double kFar = 1e-3;
-  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-  for (const Vec2& a : g.area) {
-    x0 = std::min(x0, a.x);
-    y0 = std::min(y0, a.y);
-    x1 = std::max(x1, a.x);
-    y1 = std::max(y1, a.y);
-  }
-  if (px < x0 - kFar || px > x1 + kFar || py < y0 - kFar || py > y1 + kFar) return false;
+  const RingBox b = ring_box(g.area);
+  if (px < b.x0 - kFar || px > b.x1 + kFar || py < b.y0 - kFar || py > b.y1 + kFar) return false;
   return point_in_polygon(g.area, px, py) || dist2_to_boundary(g.area, px, py) <= 1e-12;
 }
 
