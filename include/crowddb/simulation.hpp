@@ -64,6 +64,9 @@ struct OrcaParams {
   // to this side, so that people meeting head-on pass each other on the same side and counter-
   // flows sort into lanes (none: off). steer/orca.cpp says why.
   enum class PassSide { none, right, left } pass_side = PassSide::right;
+  // [m] ... looking this far ahead for people coming towards the agent, not only among its
+  // neighbours (>= 0; 0: the neighbours only). steer/passing.hpp says why.
+  double pass_look = 10;
 };
 
 // The collision-free speed model (Tordeux, Chraibi, Seyfried 2016), model "cfsm"; defaults are

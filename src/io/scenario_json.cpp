@@ -895,6 +895,7 @@ void read_steering(Node& root, SimConfig& cfg) {
     op.pass_side = side == "right"  ? OrcaParams::PassSide::right
                    : side == "left" ? OrcaParams::PassSide::left
                                     : OrcaParams::PassSide::none;
+    op.pass_look = o.non_negative("pass_look", op.pass_look);
     o.finish();
   }
   if (s.has("cfsm")) {

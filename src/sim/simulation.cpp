@@ -76,6 +76,8 @@ void SimConfig::validate() const {
           "must be >= 0");
   require(std::isfinite(o.max_retreat) && o.max_retreat >= 0, "steering/orca/max_retreat",
           "must be >= 0");
+  require(std::isfinite(o.pass_look) && o.pass_look >= 0, "steering/orca/pass_look",
+          "must be >= 0");
   const CfsmParams& c = steering.cfsm;
   require(std::isfinite(c.time_gap) && c.time_gap > 0, "steering/cfsm/time_gap", "must be > 0");
   require(std::isfinite(c.strength_neighbor) && c.strength_neighbor >= 0,

@@ -169,6 +169,8 @@ TEST(ScenarioJson, InvalidFieldsNameTheirPointer) {
       {head + R"("steering": {"orca": {"stream_gap": -1}}})", "/steering/orca/stream_gap"},
       {head + R"("steering": {"orca": {"pass_side": "middle"}}})",
        "/steering/orca/pass_side: 'middle' is not one of: right, left, none"},
+      {head + R"("steering": {"orca": {"pass_look": -2}}})", "/steering/orca/pass_look"},
+      {head + R"("steering": {"orca": {"pass_look": "far"}}})", "/steering/orca/pass_look"},
       {R"({"bounds": [-1e308, -1e308, 1e308, 1e308]})",
        "/bounds: coordinates must lie within +-1e9 m (got -1e+308)"},
       {head + R"("steering": {"cfsm": {"time_gap": -1}}})", "/steering/cfsm/time_gap"},

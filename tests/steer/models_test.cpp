@@ -391,16 +391,49 @@ TEST(Orca, KeepingToASideChangesNothingAcrossAccessPathsAndThreads) {
   EXPECT_NE(run({"steering.orca.pass_side=none"}), reference);  // the rule does act here
 }
 
+// Counter-flow in a corridor 1 m wide (Vadere's TestPsychology 07 in kind): 20 + 20 people
+// filling both of its lanes walk towards each other from 18 m apart. Looking 10 m ahead for
+// people passing (steering.orca.pass_look), each stream moves to its right lane before they
+// meet; seeing them only among the ten nearest, too late, the streams knot. Arrivals in 120 s
+// over seeds 1-6, measured: 240 of 240 with the default, 19 with pass_look 0.
+std::size_t corridor_counterflow_arrivals(double pass_look) {
+  std::size_t arrived = 0;
+  for (int seed = 1; seed <= 6; ++seed) {
+    const std::string text = R"({"bounds": [0, 0, 40, 1], "duration": 120, "seed": )" +
+                             std::to_string(seed) + R"(,
+      "steering": {"orca": {"pass_look": )" +
+                             std::to_string(pass_look) + R"(}},
+      "goals": [{"name": "E", "area": [[39.5, 0], [40, 0], [40, 1], [39.5, 1]]},
+                {"name": "W", "area": [[0, 0], [0.5, 0], [0.5, 1], [0, 1]]}],
+      "groups": [{"count": 20, "goal": "E", "radius": 0.2, "pref_speed": [1.2, 1.4],
+                  "placement": {"type": "uniform", "region": [0.5, 0, 10.5, 1], "gap": 0.05}},
+                 {"count": 20, "goal": "W", "radius": 0.2, "pref_speed": [1.2, 1.4],
+                  "placement": {"type": "uniform", "region": [29.5, 0, 39.5, 1], "gap": 0.05}}]})";
+    std::size_t frozen = 0, got = 0;
+    hashes(text, &frozen, &got);
+    arrived += got;
+  }
+  return arrived;
+}
+
+TEST(Orca, CounterFlowInANarrowCorridorSortsIntoLanesBeforeTheStreamsMeet) {
+  EXPECT_EQ(corridor_counterflow_arrivals(10), 240u);
+  EXPECT_LT(corridor_counterflow_arrivals(0), 120u);
+}
+
 TEST(Orca, TwoWayTrafficKeepsToTheSideSet) {
   EXPECT_LT(lane_order("right"), -0.3);
   EXPECT_GT(lane_order("left"), 0.3);
 }
 
 // ORCA's contact planes keep the crowd overlap-free by themselves: the backoff finds nothing.
+// (mixed() has no navigation: walkers head straight for E, and some press against the wall's
+// west face until the stalemate stage's sidesteps take them round it; the last of them arrives
+// at 72.6 s, measured.)
 TEST(Orca, TheBackoffHasNothingToDoAndEveryoneArrives) {
   std::size_t frozen = 0, arrived = 0;
   std::string text = mixed("orca");
-  text.replace(text.find(R"("duration": 12)"), 14, R"("duration": 60)");
+  text.replace(text.find(R"("duration": 12)"), 14, R"("duration": 90)");
   hashes(text, &frozen, &arrived);
   EXPECT_EQ(frozen, 0u);
   EXPECT_EQ(arrived, 100u);

@@ -1,0 +1,216 @@
+#include "steer/passing.hpp"
+
+#include <algorithm>
+#include <numbers>
+
+#include "util/executor.hpp"
+
+namespace crowddb::steer {
+namespace {
+
+constexpr std::size_t kBuildGrain = 8192;  // rows per chunk of the grid's build
+constexpr double kMinCell = 1;             // [m] about the lane's width: a few people per cell
+constexpr uint32_t kBatch = 32;            // rows filtered at once before any is asked in full
+
+// An edge of the lane's rectangle as x over y: the part within ylo <= y <= yhi adds its x to a
+// band's range. Horizontal edges (dy = 0) add both ends when their y lies in the band.
+struct Edge {
+  double y0, y1;  // y0 <= y1
+  double xa, ya;  // one end
+  double slope;   // dx / dy (0 when horizontal)
+  double xb;      // the other end's x
+  void add(double ylo, double yhi, double& xmin, double& xmax) const {
+    const double lo = std::max(ylo, y0), hi = std::min(yhi, y1);
+    if (lo > hi) return;
+    double x0 = xa, x1 = xb;
+    if (y0 < y1) {
+      x0 = xa + (lo - ya) * slope;
+      x1 = xa + (hi - ya) * slope;
+    }
+    xmin = std::min({xmin, x0, x1});
+    xmax = std::max({xmax, x0, x1});
+  }
+};
+
+Edge make_edge(double x1, double y1, double x2, double y2) {
+  const double dy = y2 - y1;
+  return {std::min(y1, y2), std::max(y1, y2), x1, y1, dy != 0 ? (x2 - x1) / dy : 0, x2};
+}
+
+// A pseudo-angle of direction (x, y), not both zero: in [0, 4), increasing with the angle from
+// the x axis counter-clockwise (the "diamond angle": cheaper than atan2, and only its order is
+// used). Its sixteenth (0..15) is a row's heading class.
+double diamond_angle(double x, double y) {
+  const double s = std::abs(x) + std::abs(y);
+  if (y >= 0) return x >= 0 ? y / s : 1 - x / s;
+  return x < 0 ? 2 - y / s : 3 + x / s;
+}
+
+int heading_class(double x, double y) {
+  return std::min(15, static_cast<int>(diamond_angle(x, y) * 4));
+}
+
+// The heading classes a wish more than 120 degrees from the unit direction (ux, uy) can fall in:
+// those of the arc within 60 degrees of (-ux, -uy), widened by 2 degrees on each side against
+// rounding (counter-clockwise from the arc's start to its end; it is less than half a turn).
+uint16_t opposite_classes(double ux, double uy) {
+  constexpr double kArc = (60.0 + 2.0) * std::numbers::pi / 180;
+  const double c = std::cos(kArc), s = std::sin(kArc);
+  const double bx = -ux, by = -uy;
+  const int from = heading_class(bx * c + by * s, -bx * s + by * c);  // turned clockwise
+  const int to = heading_class(bx * c - by * s, bx * s + by * c);     // counter-clockwise
+  uint16_t mask = 0;
+  for (int k = from;; k = (k + 1) % 16) {
+    mask |= static_cast<uint16_t>(1u << k);
+    if (k == to) break;
+  }
+  return mask;
+}
+
+}  // namespace
+
+bool passing_ahead_naive(const PassingView& v, std::size_t i, double ux, double uy, double look) {
+  for (std::size_t j = 0; j < v.x.size(); ++j)
+    if (j != i && passing(v, i, j, ux, uy, look)) return true;
+  return false;
+}
+
+inline int64_t PassingLookahead::col(double x) const {
+  // Truncation is the floor for c >= 0, and anything below 0 clamps to 0.
+  const double c = (x - x0_) * inv_cell_;
+  return c < 0 ? 0 : (c >= static_cast<double>(W_) ? W_ - 1 : static_cast<int64_t>(c));
+}
+
+inline int64_t PassingLookahead::row(double y) const {
+  // Truncation is the floor for c >= 0, and anything below 0 clamps to 0.
+  const double c = (y - y0_) * inv_cell_;
+  return c < 0 ? 0 : (c >= static_cast<double>(H_) ? H_ - 1 : static_cast<int64_t>(c));
+}
+
+// A counting sort into cells: each row's cell in chunks on every thread, the count and the
+// placement in one pass in row order (the layout is that of one thread).
+void PassingLookahead::build(const PassingView& v, Executor& ex) {
+  const std::size_t n = v.x.size();
+  rows_.resize(n);
+  if (n == 0) {
+    start_.assign(2, 0);
+    classes_.assign(1, 0);
+    W_ = H_ = 1;
+    return;
+  }
+  double xmin = INFINITY, ymin = INFINITY, xmax = -INFINITY, ymax = -INFINITY;
+  rmax_ = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    xmin = std::min(xmin, v.x[i]);
+    xmax = std::max(xmax, v.x[i]);
+    ymin = std::min(ymin, v.y[i]);
+    ymax = std::max(ymax, v.y[i]);
+    rmax_ = std::max(rmax_, v.radius[i]);
+  }
+  const double w = std::max(xmax - xmin, 1e-9), h = std::max(ymax - ymin, 1e-9);
+  // At most about two cells per row, however sparse or large the world.
+  double cell = std::max(kMinCell, std::sqrt(w * h / (2.0 * static_cast<double>(n))));
+  if (!std::isfinite(cell)) cell = std::max(w, h);
+  x0_ = xmin;
+  y0_ = ymin;
+  cell_ = cell;
+  inv_cell_ = 1 / cell;
+  W_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(w / cell)) + 1);
+  H_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(h / cell)) + 1);
+  const auto cells = static_cast<std::size_t>(W_ * H_);
+  start_.assign(cells + 1, 0);
+  cell_of_.resize(n);
+  ex.for_each_chunk(n, kBuildGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) cell_of_[i] = row(v.y[i]) * W_ + col(v.x[i]);
+  });
+  for (std::size_t i = 0; i < n; ++i) ++start_[static_cast<std::size_t>(cell_of_[i]) + 1];
+  for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
+  fill_.assign(start_.begin(), start_.end() - 1);
+  for (std::size_t i = 0; i < n; ++i)
+    rows_[fill_[static_cast<std::size_t>(cell_of_[i])]++] = static_cast<uint32_t>(i);
+  copy_.resize(n);
+  ex.for_each_chunk(n, kBuildGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t a = b; a < e; ++a) {
+      const uint32_t i = rows_[a];
+      copy_[a] = {v.x[i], v.y[i], v.radius[i], v.wish_x[i], v.wish_y[i]};
+    }
+  });
+  classes_.assign(cells, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (v.wish_x[i] != 0 || v.wish_y[i] != 0)  // standing rows pass nobody
+      classes_[static_cast<std::size_t>(cell_of_[i])] |=
+          static_cast<uint16_t>(1u << heading_class(v.wish_x[i], v.wish_y[i]));
+}
+
+bool PassingLookahead::ahead(const PassingView& v, std::size_t i, double ux, double uy, double look,
+                             uint64_t& tests) const {
+  if (rows_.size() < 2 || !(look > 0)) return false;
+  const double px = v.x[i], py = v.y[i];
+  // Nobody lies farther than the grid's farthest corner: no need to draw the lane longer.
+  const double gx =
+      std::max(std::abs(px - x0_), std::abs(x0_ + static_cast<double>(W_) * cell_ - px));
+  const double gy =
+      std::max(std::abs(py - y0_), std::abs(y0_ + static_cast<double>(H_) * cell_ - py));
+  const double len = std::min(look, gx + gy);
+  const double ri = v.radius[i];
+  const double half = ri + rmax_ + kSideReach;
+  const Copy* const C = copy_.data();
+  const uint16_t against = opposite_classes(ux, uy);
+  // The lane ahead, widened by eps on every side against rounding: it decides only which rows
+  // are looked at; passing() decides the answer.
+  const double eps = 1e-7 * (1 + std::abs(px) + std::abs(py) + len + half);
+  const double nx = -uy * (half + eps), ny = ux * (half + eps);
+  const double bx = px - eps * ux, by = py - eps * uy;                          // back middle
+  const double fx = bx + (len + 2 * eps) * ux, fy = by + (len + 2 * eps) * uy;  // front middle
+  const double qx[4] = {bx + nx, bx - nx, fx - nx, fx + nx};
+  const double qy[4] = {by + ny, by - ny, fy - ny, fy + ny};
+  Edge edges[4];
+  for (int e = 0; e < 4; ++e) edges[e] = make_edge(qx[e], qy[e], qx[(e + 1) % 4], qy[(e + 1) % 4]);
+  const int64_t cy0 = row(std::min({qy[0], qy[1], qy[2], qy[3]}) - eps);
+  const int64_t cy1 = row(std::max({qy[0], qy[1], qy[2], qy[3]}) + eps);
+  for (int64_t cy = cy0; cy <= cy1; ++cy) {
+    // The band of cells; the grid's edge bands reach to infinity (row() clamps into them).
+    const double ylo = cy == 0 ? -INFINITY : y0_ + static_cast<double>(cy) * cell_ - eps;
+    const double yhi = cy == H_ - 1 ? INFINITY : y0_ + static_cast<double>(cy + 1) * cell_ + eps;
+    double xmin = INFINITY, xmax = -INFINITY;
+    for (const Edge& e : edges) e.add(ylo, yhi, xmin, xmax);
+    if (xmin > xmax) continue;
+    // The band's cells from xmin to xmax hold one run of rows in memory; it is read only when
+    // one of them holds a heading coming towards the query. passing()'s first three tests on
+    // the copies, without a branch (whether a row passes them is a coin toss to the
+    // predictor): the same expressions on the same values, so a row they reject passing()
+    // would reject too. The few left are asked in full.
+    const auto base = static_cast<std::size_t>(cy * W_);
+    const std::size_t c0 = base + static_cast<std::size_t>(col(xmin - eps));
+    const std::size_t c1 = base + static_cast<std::size_t>(col(xmax + eps));
+    uint16_t held = 0;
+    for (std::size_t c = c0; c <= c1; ++c) held |= classes_[c];
+    if (!(held & against)) continue;
+    {
+      const uint32_t lo = start_[c0], hi = start_[c1 + 1];
+      tests += hi - lo;
+      for (uint32_t a0 = lo; a0 < hi; a0 += kBatch) {
+        const uint32_t a1 = std::min(hi, a0 + kBatch);
+        uint32_t pick[kBatch];
+        uint32_t m = 0;
+        for (uint32_t a = a0; a < a1; ++a) {
+          const Copy& r = C[a];
+          const double rx = r.x - px, ry = r.y - py;
+          const double along = rx * ux + ry * uy;
+          const double w2 = r.wx * r.wx + r.wy * r.wy, dot = r.wx * ux + r.wy * uy;
+          pick[m] = a;
+          m += static_cast<uint32_t>((along > 0) & (along <= look) &
+                                     (std::abs(rx * uy - ry * ux) <= ri + r.r + kSideReach) &
+                                     (dot < 0) & (dot * dot >= kSameWay * kSameWay * w2));
+        }
+        for (uint32_t u = 0; u < m; ++u) {
+          const uint32_t j = rows_[pick[u]];
+          if (j != i && passing(v, i, j, ux, uy, look)) return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
+}  // namespace crowddb::steer

@@ -1,0 +1,172 @@
+// Who is passing whom (src/steer/passing.*): the grid's look-ahead against its naive twin (every
+// row asked) on random and adversarial crowds, on 1 and 2 threads' builds.
+#include "steer/passing.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "util/executor.hpp"
+
+namespace crowddb::steer {
+namespace {
+
+struct Crowd {
+  std::vector<double> x, y, radius, wish_x, wish_y, target_x, target_y;
+
+  std::size_t size() const { return x.size(); }
+  // A row walking with wish (wx, wy) towards a target `ahead` metres along it.
+  void add(double px, double py, double wx, double wy, double r = 0.25, double ahead = 30) {
+    x.push_back(px);
+    y.push_back(py);
+    radius.push_back(r);
+    wish_x.push_back(wx);
+    wish_y.push_back(wy);
+    const double w = std::hypot(wx, wy);
+    target_x.push_back(w > 0 ? px + wx / w * ahead : px);
+    target_y.push_back(w > 0 ? py + wy / w * ahead : py);
+  }
+  PassingView view() const { return {x, y, radius, wish_x, wish_y, target_x, target_y}; }
+};
+
+struct Tally {
+  std::size_t yes = 0, no = 0;
+};
+
+// Every row with a wish asks both, for each look-ahead; the answers must be equal.
+Tally compare(const Crowd& c, const std::vector<double>& looks) {
+  Tally tally;
+  for (int threads : {1, 2}) {
+    Executor ex(threads);
+    PassingLookahead grid;
+    grid.build(c.view(), ex);
+    for (double look : looks)
+      for (std::size_t i = 0; i < c.size(); ++i) {
+        const double w = std::hypot(c.wish_x[i], c.wish_y[i]);
+        if (w == 0) continue;
+        const double ux = c.wish_x[i] / w, uy = c.wish_y[i] / w;
+        uint64_t tests = 0;
+        const bool want = passing_ahead_naive(c.view(), i, ux, uy, look);
+        const bool got = grid.ahead(c.view(), i, ux, uy, look, tests);
+        EXPECT_EQ(got, want) << "row " << i << " of " << c.size() << ", look " << look << " at ("
+                             << c.x[i] << ", " << c.y[i] << ") wish (" << ux << ", " << uy << ")";
+        if (got != want) return tally;
+        ++(want ? tally.yes : tally.no);
+      }
+  }
+  return tally;
+}
+
+const std::vector<double> kLooks = {0, 0.4, 2, 5, 10, 37.5, 1e9, INFINITY};
+
+// Two streams crossing a square at every angle, wishes of any length (some standing), radii
+// 0.1-0.6 m: many rows see someone passing, many do not.
+TEST(PassingLookahead, AnswersAsTheNaiveTwinOnRandomCrowds) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int round = 0; round < 12; ++round) {
+    Crowd c;
+    const double side = 5 + 60 * u(rng);
+    const int n = 20 + static_cast<int>(400 * u(rng));
+    const double heading = 2 * M_PI * u(rng);
+    for (int k = 0; k < n; ++k) {
+      // Half one way, half the other, each turned up to +-40 degrees; one in ten stands.
+      const double a = heading + (k % 2 ? M_PI : 0) + (u(rng) - 0.5) * 1.4;
+      const double s = k % 10 == 0 ? 0 : 0.3 + 1.2 * u(rng);
+      c.add(side * u(rng), side * u(rng), s * std::cos(a), s * std::sin(a), 0.1 + 0.5 * u(rng),
+            1 + 40 * u(rng));
+    }
+    const Tally t = compare(c, kLooks);
+    EXPECT_GT(t.yes, 50u) << "round " << round;  // both answers are tested
+    EXPECT_GT(t.no, 50u) << "round " << round;
+  }
+}
+
+// The grid's cells are about 1 m: rows exactly on cell corners and edges, wishes along the axes
+// and diagonals, the one passing row exactly at the end of the look-ahead or at the edge of the
+// lane (the widest radius sets the cells scanned), far from the origin, piled on one point.
+TEST(PassingLookahead, AnswersAsTheNaiveTwinOnAdversarialCrowds) {
+  {  // a lattice of integer positions, wishes of 8 headings
+    Crowd c;
+    for (int gx = 0; gx < 14; ++gx)
+      for (int gy = 0; gy < 14; ++gy) {
+        const double a = M_PI / 4 * ((gx * 3 + gy * 5) % 8);
+        c.add(gx, gy, std::cos(a), std::sin(a), 0.25);
+      }
+    const Tally t = compare(c, kLooks);
+    EXPECT_GT(t.yes, 100u);
+    EXPECT_GT(t.no, 100u);
+  }
+  for (double far : {0.0, 1e6, -3.7e5}) {  // one row coming head-on at the edge of reach
+    for (double along : {0.5, 3.0, 9.999, 10.0, 10.001}) {
+      for (double lateral : {0.0, 0.9, 1.1, 1.0999999, 1.1000001}) {
+        for (double a : {0.0, M_PI / 4, M_PI / 2, 2.1, M_PI}) {
+          Crowd c;
+          const double ux = std::cos(a), uy = std::sin(a);
+          c.add(far + 0.5, far + 0.5, ux, uy, 0.25);
+          c.add(far + 0.5 + along * ux - lateral * uy, far + 0.5 + along * uy + lateral * ux, -ux,
+                -uy, 0.25);
+          c.add(far - 4, far + 7, 0, 0, 0.25);  // stands: widens the grid
+          compare(c, {10.0, 5.0, INFINITY});
+        }
+      }
+    }
+  }
+  for (int q = 0; q < 16; ++q) {  // the cells' compass eighths: wishes on their edges, and
+    // coming towards the query at exactly 120 degrees from its wish (the passing test's edge)
+    const double a = M_PI / 8 * q;
+    for (double off : {0.0, 15.0, 45.0, 59.99, 60.0, 60.01, 90.0, -45.0, -60.0, -60.01}) {
+      Crowd c;
+      const double ux = std::cos(a), uy = std::sin(a), b = a + M_PI + off * M_PI / 180;
+      c.add(0, 0, ux, uy, 0.25);
+      c.add(3 * ux, 3 * uy, std::cos(b), std::sin(b), 0.25, 30);
+      c.add(-5, 9, 0, 1, 0.25);  // widens the grid
+      compare(c, {10.0});
+    }
+  }
+  {  // a wide row among narrow ones: every lane is r_i + 3 + 0.6 wide
+    Crowd c;
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(0, 20);
+    for (int k = 0; k < 200; ++k) c.add(u(rng), u(rng), k % 2 ? 1 : -1, 0, 0.2);
+    c.add(10, 10, 0, 1, 3.0);
+    c.add(10, 14, 0, -1, 0.2);
+    const Tally t = compare(c, kLooks);
+    EXPECT_GT(t.yes, 10u);
+  }
+  {  // everyone on one point, or nearly
+    Crowd c;
+    for (int k = 0; k < 30; ++k) c.add(2 + 1e-12 * (k % 3), 2, k % 2 ? 1 : -1, 0.01 * k);
+    compare(c, kLooks);
+  }
+  {  // one row, and two
+    Crowd c;
+    c.add(1, 1, 1, 0);
+    compare(c, kLooks);
+    c.add(3, 1, -1, 0);
+    EXPECT_GT(compare(c, kLooks).yes, 0u);
+  }
+}
+
+// Converging on one point from its two sides is not passing (each one's target lies in front of
+// the other), and nobody behind or standing is.
+TEST(PassingLookahead, ConvergingBehindOrStandingIsNotPassing) {
+  Crowd c;
+  c.add(0, 0, 1, 0, 0.25, 5);    // target (5, 0)
+  c.add(10, 0, -1, 0, 0.25, 5);  // target (5, 0): converging
+  c.add(-3, 0, -1, 0, 0.25);     // behind row 0, walking away
+  c.add(6, 0.2, 0, 0, 0.25);     // stands ahead
+  const PassingView v = c.view();
+  EXPECT_FALSE(passing_ahead_naive(v, 0, 1, 0, 10));
+  Crowd d = c;
+  d.target_x[0] = 30;  // each now bound past the other: passing
+  d.target_x[1] = -20;
+  EXPECT_TRUE(passing_ahead_naive(d.view(), 0, 1, 0, 10));
+  EXPECT_FALSE(passing_ahead_naive(d.view(), 0, 1, 0, 9.99));  // beyond the look-ahead
+  compare(c, kLooks);
+  compare(d, kLooks);
+}
+
+}  // namespace
+}  // namespace crowddb::steer
