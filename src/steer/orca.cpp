@@ -94,7 +94,7 @@
 // to their sides before they meet (2,000 of 2,000 and 480 of 480; docs/steering.md). Not within
 // kTurnNearWaypoint (2 m) of its waypoint: there the path bends (a corridor's mouth, a door), and
 // a turned wish pressed people coming out of a room against the wall beside the mouth while the
-// other stream took the whole corridor (a corridor between two rooms lost a quarter of its
+// other stream took the whole corridor (a corridor between two rooms lost a sixth of its
 // arrivals).
 //
 // No sweeping back (ours): avoiding a stream that goes first, ORCA's closest permitted velocity
@@ -152,6 +152,7 @@ namespace {
 // no longer turns (the path bends there: a corner, a door).
 constexpr double kSideTurn = 30 * std::numbers::pi / 180;
 constexpr double kTurnNearWaypoint = 2;  // [m]
+constexpr double kStanding = 1e-100;     // [m/s] a wish below this does not look for anyone
 
 // The half-plane agent i gets from neighbour j (relative position p = p_j - p_i, relative
 // velocity v = v_i - v_j, combined radius r), with agent i's velocity (vix, viy).
@@ -364,9 +365,11 @@ class OrcaModel final : public Model {
     if (p.pass_side != OrcaParams::PassSide::none) {
       os << "  " << step++
          << " ORCA keeping to a side per row: is someone coming towards it in its lane, the two "
-            "passing each other? Among its neighbours, ";
+            "passing each other? ";
+      if (!(p.pass_look >= p.neighbor_dist)) os << "Among its neighbours, ";
       if (p.pass_look > 0)
-        os << "else within " << explain_number(p.pass_look)
+        os << (p.pass_look >= p.neighbor_dist ? "Within " : "else within ")
+           << explain_number(p.pass_look)
            << " m ahead\n       access path: grid (uniform grid over positions and their "
               "headings, built per tick; the cells meeting the lane ahead, band by band)\n";
       else
@@ -466,7 +469,7 @@ class OrcaModel final : public Model {
         turn_[i] = 0;
         const double wx = in.pref_vx[i], wy = in.pref_vy[i];
         const double w = std::sqrt(wx * wx + wy * wy);
-        if (w == 0) continue;
+        if (!(w > kStanding)) continue;  // (a wish this small has no reliable direction)
         const double dx = t.target_x[i] - t.x[i], dy = t.target_y[i] - t.y[i];
         if (dx * dx + dy * dy < kTurnNearWaypoint * kTurnNearWaypoint) continue;
         const double ux = wx / w, uy = wy / w;

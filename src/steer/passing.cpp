@@ -108,8 +108,10 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
     rmax_ = std::max(rmax_, v.radius[i]);
   }
   const double w = std::max(xmax - xmin, 1e-9), h = std::max(ymax - ymin, 1e-9);
-  // At most about two cells per row, however sparse or large the world.
-  double cell = std::max(kMinCell, std::sqrt(w * h / (2.0 * static_cast<double>(n))));
+  // Bounded by the rows, however sparse, large or thin the world: with c the cell, w h / c^2 <= 2n
+  // and w / c, h / c <= 2n, so W H <= (w / c + 2)(h / c + 2) <= 2n + 2 (2n + 2n) + 4 = 10n + 4.
+  const auto rows = static_cast<double>(n);
+  double cell = std::max({kMinCell, std::sqrt(w * h / (2 * rows)), std::max(w, h) / (2 * rows)});
   if (!std::isfinite(cell)) cell = std::max(w, h);
   x0_ = xmin;
   y0_ = ymin;
@@ -136,10 +138,16 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
     }
   });
   classes_.assign(cells, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    if (v.wish_x[i] != 0 || v.wish_y[i] != 0)  // standing rows pass nobody
-      classes_[static_cast<std::size_t>(cell_of_[i])] |=
-          static_cast<uint16_t>(1u << heading_class(v.wish_x[i], v.wish_y[i]));
+  for (std::size_t i = 0; i < n; ++i) {
+    const double wx = v.wish_x[i], wy = v.wish_y[i];
+    if (wx == 0 && wy == 0) continue;  // standing rows pass nobody
+    // A wish so small or so large that its square leaves the doubles' range makes passing()'s
+    // angle test meaningless (0 >= 0): such a row may be passing in any direction.
+    const double w2 = wx * wx + wy * wy;
+    classes_[static_cast<std::size_t>(cell_of_[i])] |=
+        w2 > 1e-280 && w2 < 1e280 ? static_cast<uint16_t>(1u << heading_class(wx, wy))
+                                  : uint16_t{0xFFFF};
+  }
 }
 
 bool PassingLookahead::ahead(const PassingView& v, std::size_t i, double ux, double uy, double look,
@@ -158,7 +166,9 @@ bool PassingLookahead::ahead(const PassingView& v, std::size_t i, double ux, dou
   const uint16_t against = opposite_classes(ux, uy);
   // The lane ahead, widened by eps on every side against rounding: it decides only which rows
   // are looked at; passing() decides the answer.
-  const double eps = 1e-7 * (1 + std::abs(px) + std::abs(py) + len + half);
+  // The band edges y0 + cy cell round relative to the grid's origin and extent as well.
+  const double eps = 1e-7 * (1 + std::abs(px) + std::abs(py) + len + half + std::abs(x0_) +
+                             std::abs(y0_) + static_cast<double>(W_ + H_) * cell_);
   const double nx = -uy * (half + eps), ny = ux * (half + eps);
   const double bx = px - eps * ux, by = py - eps * uy;                          // back middle
   const double fx = bx + (len + 2 * eps) * ux, fy = by + (len + 2 * eps) * uy;  // front middle

@@ -66,8 +66,8 @@ class PassingLookahead {
  public:
   // Buckets every row of `v` (the positions must be finite).
   void build(const PassingView& v, Executor& ex);
-  // Is any row passing row i within `look` ahead? (ux, uy): i's unit wish; `tests` counts the
-  // rows looked at.
+  // Is any row passing row i within `look` ahead? (ux, uy): i's unit wish (its length must be
+  // 1 up to rounding: it sets the lane's width); `tests` counts the rows looked at.
   bool ahead(const PassingView& v, std::size_t i, double ux, double uy, double look,
              uint64_t& tests) const;
 

@@ -374,8 +374,9 @@ double lane_order(const std::string& side) {
   return sum[0] / static_cast<double>(count[0]) - sum[1] / static_cast<double>(count[1]);
 }
 
-// Keeping to a side turns wishes from the neighbour lists of the committed state: the same run
-// on any thread count and neighbour access path (mixed() has no one passing).
+// Keeping to a side looks at the committed state (within pass_look ahead through its grid, and
+// among the neighbours when pass_look is shorter than their range): the same run on any thread
+// count and neighbour access path.
 TEST(Orca, KeepingToASideChangesNothingAcrossAccessPathsAndThreads) {
   const auto run = [](const std::vector<std::string>& sets) {
     Scenario sc =
@@ -388,6 +389,9 @@ TEST(Orca, KeepingToASideChangesNothingAcrossAccessPathsAndThreads) {
   const auto reference = run({});
   EXPECT_EQ(run({"threads=2"}), reference);
   EXPECT_EQ(run({"threads=3", "access.neighbours=naive"}), reference);
+  const auto short_look = run({"steering.orca.pass_look=3"});  // the neighbours are asked too
+  EXPECT_EQ(run({"threads=2", "access.neighbours=naive", "steering.orca.pass_look=3"}), short_look);
+  EXPECT_NE(short_look, reference);
   EXPECT_NE(run({"steering.orca.pass_side=none"}), reference);  // the rule does act here
 }
 

@@ -149,6 +149,57 @@ TEST(PassingLookahead, AnswersAsTheNaiveTwinOnAdversarialCrowds) {
   }
 }
 
+// Wishes whose squares leave the doubles' range (the angle test then accepts any direction),
+// rows spread along one line or across a billion metres (the grid stays small: at most about
+// 10n + 4 cells), and a table large enough to build on two threads.
+TEST(PassingLookahead, AnswersAsTheNaiveTwinOnExtremeInputs) {
+  {
+    Crowd c;
+    c.add(0, 0, 1, 0, 0.25);
+    c.add(3, 0, -1e-200, 9e-200, 0.25);  // tiny wish, pointing up and back: heading class 4
+    c.target_x[1] = -20;
+    c.target_x[0] = 30;
+    c.add(3, 0.5, 1e200, -1e200, 0.25);  // huge wish
+    c.add(-4, 6, 0, 1, 0.25);
+    EXPECT_TRUE(passing_ahead_naive(c.view(), 0, 1, 0, 10));  // the tiny wish counts as towards
+    compare(c, kLooks);
+  }
+  for (double spread : {1e3, 1e6, 1e8, 1e9}) {
+    Crowd c;
+    for (int k = 0; k < 40; ++k) {
+      const double x = (k % 2 ? spread : 0) + 0.6 * (k / 2);
+      c.add(x - 1e9 * (spread == 1e9), 5, k % 4 < 2 ? 1 : -1, 0, 0.25);
+    }
+    compare(c, kLooks);
+  }
+  {
+    Crowd c;
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int k = 0; k < 9000; ++k) {
+      const double a = (k % 2 ? M_PI : 0) + (u(rng) - 0.5);
+      c.add(100 * u(rng), 100 * u(rng), 1.3 * std::cos(a), 1.3 * std::sin(a), 0.25,
+            5 + 30 * u(rng));
+    }
+    Executor one(1), two(2);
+    PassingLookahead g1, g2;
+    g1.build(c.view(), one);
+    g2.build(c.view(), two);
+    std::size_t yes = 0;
+    for (std::size_t i = 0; i < c.size(); i += 37) {
+      const double w = std::hypot(c.wish_x[i], c.wish_y[i]);
+      const double ux = c.wish_x[i] / w, uy = c.wish_y[i] / w;
+      uint64_t t1 = 0, t2 = 0;
+      const bool want = passing_ahead_naive(c.view(), i, ux, uy, 10);
+      EXPECT_EQ(g1.ahead(c.view(), i, ux, uy, 10, t1), want) << "row " << i;
+      EXPECT_EQ(g2.ahead(c.view(), i, ux, uy, 10, t2), want) << "row " << i;
+      EXPECT_EQ(t1, t2);
+      yes += want;
+    }
+    EXPECT_GT(yes, 20u);
+  }
+}
+
 // Converging on one point from its two sides is not passing (each one's target lies in front of
 // the other), and nobody behind or standing is.
 TEST(PassingLookahead, ConvergingBehindOrStandingIsNotPassing) {
