@@ -297,9 +297,10 @@ class OrcaModel final : public Model {
           planes.clear();
           obstacle_planes(in, i, planes);
           const double vix = t.vx[i], viy = t.vy[i];
+          const uint32_t a0 = nb_.offset[i];
           // Contact planes of the neighbours within one tick's reach (hard).
           const double reach = 2 * in.cfg.dt * t.max_speed[i];
-          for (uint32_t a = nb_.offset[i]; a < nb_.offset[i + 1]; ++a) {
+          for (uint32_t a = a0; a < nb_.offset[i + 1]; ++a) {
             const uint32_t j = nb_.row[a];
             const double d = std::sqrt(nb_.dist2[a]);
             const double gap = d - t.radius[i] - t.radius[j] - kSkin;
@@ -312,7 +313,7 @@ class OrcaModel final : public Model {
           }
           retreat_plane(in, i, planes);
           const std::size_t hard = planes.size();
-          for (uint32_t a = nb_.offset[i]; a < nb_.offset[i + 1]; ++a) {
+          for (uint32_t a = a0; a < nb_.offset[i + 1]; ++a) {
             const uint32_t j = nb_.row[a];
             // Right of way: a neighbour that goes first is avoided where it wants to go, as far as
             // it is held up (walking as it wishes, its velocity says it already).
@@ -396,6 +397,16 @@ class OrcaModel final : public Model {
 
   void rows_permuted(std::span<const uint32_t> order) override {
     for (auto& [name, path] : neighbour_paths_) path->rows_permuted(order);
+    // The witnesses move with their rows and are renamed (anything else costs time, not answers).
+    const std::size_t n = order.size();
+    std::vector<uint32_t> new_of(witness_.size(), PassingLookahead::kNobody);
+    for (std::size_t r = 0; r < n; ++r)
+      if (order[r] < new_of.size()) new_of[order[r]] = static_cast<uint32_t>(r);
+    std::vector<uint32_t> moved(n, PassingLookahead::kNobody);
+    for (std::size_t r = 0; r < n; ++r)
+      if (order[r] < witness_.size() && witness_[order[r]] < new_of.size())
+        moved[r] = new_of[witness_[order[r]]];
+    witness_.swap(moved);
   }
 
  private:
@@ -461,6 +472,7 @@ class OrcaModel final : public Model {
     stats.build_seconds += sw.seconds();
     sw.restart();
     turn_.resize(n);
+    witness_.resize(n, PassingLookahead::kNobody);  // rows new since the last tick: no hint
     const std::size_t chunks = (n + kGrain - 1) / kGrain;
     std::vector<uint64_t> tests(chunks, 0), near(chunks, 0), far(chunks, 0);
     ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
@@ -480,9 +492,12 @@ class OrcaModel final : public Model {
           tests[c] += nb_.offset[i + 1] - nb_.offset[i];
           near[c] += seen;
         }
-        if (!seen && look > 0 && lookahead_.ahead(view, i, ux, uy, look, tests[c])) {
-          seen = true;
-          ++far[c];
+        if (!seen && look > 0) {
+          witness_[i] = lookahead_.find(view, i, ux, uy, look, tests[c], witness_[i]);
+          if (witness_[i] != PassingLookahead::kNobody) {
+            seen = true;
+            ++far[c];
+          }
         }
         turn_[i] = seen;
       }
@@ -580,7 +595,8 @@ class OrcaModel final : public Model {
   }
   NeighbourLists nb_;
   PassingLookahead lookahead_;
-  std::vector<uint8_t> turn_;  // per row: turns aside for someone passing (find_passing)
+  std::vector<uint8_t> turn_;      // per row: turns aside for someone passing (find_passing)
+  std::vector<uint32_t> witness_;  // per row: who passed it last tick (a hint; kNobody: none)
   uint64_t passing_near_ = 0, passing_far_ = 0;
   FeatureLists features_;
   std::vector<double> reach_;

@@ -150,9 +150,13 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
   }
 }
 
-bool PassingLookahead::ahead(const PassingView& v, std::size_t i, double ux, double uy, double look,
-                             uint64_t& tests) const {
-  if (rows_.size() < 2 || !(look > 0)) return false;
+uint32_t PassingLookahead::find(const PassingView& v, std::size_t i, double ux, double uy,
+                                double look, uint64_t& tests, uint32_t hint) const {
+  if (rows_.size() < 2 || !(look > 0)) return kNobody;
+  if (hint < rows_.size() && hint != i) {
+    ++tests;
+    if (passing(v, i, hint, ux, uy, look)) return hint;
+  }
   const double px = v.x[i], py = v.y[i];
   // Nobody lies farther than the grid's farthest corner: no need to draw the lane longer.
   const double gx =
@@ -215,12 +219,12 @@ bool PassingLookahead::ahead(const PassingView& v, std::size_t i, double ux, dou
         }
         for (uint32_t u = 0; u < m; ++u) {
           const uint32_t j = rows_[pick[u]];
-          if (j != i && passing(v, i, j, ux, uy, look)) return true;
+          if (j != i && passing(v, i, j, ux, uy, look)) return j;
         }
       }
     }
   }
-  return false;
+  return kNobody;
 }
 
 }  // namespace crowddb::steer

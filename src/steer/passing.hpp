@@ -66,10 +66,19 @@ class PassingLookahead {
  public:
   // Buckets every row of `v` (the positions must be finite).
   void build(const PassingView& v, Executor& ex);
-  // Is any row passing row i within `look` ahead? (ux, uy): i's unit wish (its length must be
-  // 1 up to rounding: it sets the lane's width); `tests` counts the rows looked at.
+  static constexpr uint32_t kNobody = ~0u;
+  // A row passing row i within `look` ahead, or kNobody. (ux, uy): i's unit wish (its length must
+  // be 1 up to rounding: it sets the lane's width); `tests` counts the rows looked at. `hint`, any
+  // row number (kNobody: none), is asked first: last tick's answer usually still is one (people
+  // pass each other over seconds), and then the grid is not read. Which row is returned may
+  // depend on the hint; whether one is does not.
+  uint32_t find(const PassingView& v, std::size_t i, double ux, double uy, double look,
+                uint64_t& tests, uint32_t hint = kNobody) const;
+  // Is any row passing row i within `look` ahead?
   bool ahead(const PassingView& v, std::size_t i, double ux, double uy, double look,
-             uint64_t& tests) const;
+             uint64_t& tests) const {
+    return find(v, i, ux, uy, look, tests) != kNobody;
+  }
 
  private:
   int64_t col(double x) const;

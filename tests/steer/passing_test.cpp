@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -52,6 +53,18 @@ Tally compare(const Crowd& c, const std::vector<double>& looks) {
         EXPECT_EQ(got, want) << "row " << i << " of " << c.size() << ", look " << look << " at ("
                              << c.x[i] << ", " << c.y[i] << ") wish (" << ux << ", " << uy << ")";
         if (got != want) return tally;
+        // With any hint (none, the row itself, rows out of range, a random row, the answer
+        // itself): the same answer, and a row returned is one passing.
+        const uint32_t n = static_cast<uint32_t>(c.size());
+        const uint32_t own = grid.find(c.view(), i, ux, uy, look, tests);
+        for (uint32_t hint : {PassingLookahead::kNobody, static_cast<uint32_t>(i), n, n + 1000,
+                              static_cast<uint32_t>((i * 7919 + 13) % std::max(n, 1u)), own}) {
+          const uint32_t j = grid.find(c.view(), i, ux, uy, look, tests, hint);
+          EXPECT_EQ(j != PassingLookahead::kNobody, want) << "row " << i << ", hint " << hint;
+          if (j != PassingLookahead::kNobody) {
+            EXPECT_TRUE(j != i && passing(c.view(), i, j, ux, uy, look)) << "row " << i;
+          }
+        }
         ++(want ? tally.yes : tally.no);
       }
   }
