@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 
+#include "index/row_buckets.hpp"
 #include "query/naive_paths.hpp"
 #include "util/stopwatch.hpp"
 
@@ -39,29 +40,10 @@ inline int64_t NeighbourGrid::row(double y) const {
   return c < 0 ? 0 : (c >= static_cast<double>(H_) ? H_ - 1 : static_cast<int64_t>(c));
 }
 
-// The counting sort's passes over the rows run in chunks on every thread (the bounding box, each
-// row's cell, the copies in cell order); the count, its prefix sum and the placement, a few
-// instructions per row, stay in one pass in row order, so the layout is that of one thread.
+// A counting sort (index/row_buckets.hpp): the bounding box, each row's cell and the copies in
+// cell order in chunks on every thread, the placement in one pass (the layout of one thread).
 void NeighbourGrid::build(const DiscView& d, double range, uint32_t k, Executor& ex) {
-  const std::size_t chunks = (d.n + kBuildGrain - 1) / kBuildGrain;
-  std::vector<std::array<double, 4>> box(chunks);  // min x, min y, -max x, -max y
-  ex.for_each_chunk(d.n, kBuildGrain, [&](std::size_t b, std::size_t e) {
-    std::array<double, 4> m = {INFINITY, INFINITY, INFINITY, INFINITY};
-    for (std::size_t i = b; i < e; ++i) {
-      m[0] = std::min(m[0], d.x[i]);
-      m[1] = std::min(m[1], d.y[i]);
-      m[2] = std::min(m[2], -d.x[i]);
-      m[3] = std::min(m[3], -d.y[i]);
-    }
-    box[b / kBuildGrain] = m;
-  });
-  double xmin = INFINITY, ymin = INFINITY, xmax = -INFINITY, ymax = -INFINITY;
-  for (const auto& m : box) {  // min and max are exact: the order of the chunks is immaterial
-    xmin = std::min(xmin, m[0]);
-    ymin = std::min(ymin, m[1]);
-    xmax = std::max(xmax, -m[2]);
-    ymax = std::max(ymax, -m[3]);
-  }
+  const auto [xmin, ymin, xmax, ymax] = bounding_box({d.x, d.n}, {d.y, d.n}, ex);
   const double w = std::max(xmax - xmin, 1e-9), h = std::max(ymax - ymin, 1e-9);
   const auto n = static_cast<double>(std::max<std::size_t>(d.n, 1));
   const double density = n / (w * h);
@@ -78,20 +60,14 @@ void NeighbourGrid::build(const DiscView& d, double range, uint32_t k, Executor&
   // extent, whatever the query's own coordinates: part of every cell test's slack.
   slack_ = 1e-9 * (cell_ + std::abs(x0_) + std::abs(y0_) + static_cast<double>(W_ + H_) * cell_);
   const auto cells = static_cast<std::size_t>(W_ * H_);
-  start_.assign(cells + 1, 0);
   cell_of_.resize(d.n);
   ex.for_each_chunk(d.n, kBuildGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) cell_of_[i] = row(d.y[i]) * W_ + col(d.x[i]);
   });
-  for (std::size_t i = 0; i < d.n; ++i) ++start_[static_cast<std::size_t>(cell_of_[i]) + 1];
-  for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
-  rows_.resize(d.n);
+  bucket_rows(cell_of_, cells, start_, rows_, fill_);
   x_.resize(d.n);
   y_.resize(d.n);
   id_.resize(d.n);
-  fill_.assign(start_.begin(), start_.end() - 1);
-  for (std::size_t i = 0; i < d.n; ++i)
-    rows_[fill_[static_cast<std::size_t>(cell_of_[i])]++] = static_cast<uint32_t>(i);
   ex.for_each_chunk(d.n, kBuildGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {
       const uint32_t i = rows_[a];

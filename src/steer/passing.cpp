@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <numbers>
 
+#include "index/row_buckets.hpp"
 #include "util/executor.hpp"
 
 namespace crowddb::steer {
@@ -87,8 +88,8 @@ inline int64_t PassingLookahead::row(double y) const {
   return c < 0 ? 0 : (c >= static_cast<double>(H_) ? H_ - 1 : static_cast<int64_t>(c));
 }
 
-// A counting sort into cells: each row's cell in chunks on every thread, the count and the
-// placement in one pass in row order (the layout is that of one thread).
+// A counting sort into cells (index/row_buckets.hpp): each row's cell in chunks on every
+// thread, the placement in one pass in row order (the layout is that of one thread).
 void PassingLookahead::build(const PassingView& v, Executor& ex) {
   const std::size_t n = v.x.size();
   rows_.resize(n);
@@ -98,15 +99,8 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
     W_ = H_ = 1;
     return;
   }
-  double xmin = INFINITY, ymin = INFINITY, xmax = -INFINITY, ymax = -INFINITY;
-  rmax_ = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    xmin = std::min(xmin, v.x[i]);
-    xmax = std::max(xmax, v.x[i]);
-    ymin = std::min(ymin, v.y[i]);
-    ymax = std::max(ymax, v.y[i]);
-    rmax_ = std::max(rmax_, v.radius[i]);
-  }
+  const auto [xmin, ymin, xmax, ymax] = index::bounding_box(v.x, v.y, ex);
+  rmax_ = std::max(0.0, *std::max_element(v.radius.begin(), v.radius.end()));
   const double w = std::max(xmax - xmin, 1e-9), h = std::max(ymax - ymin, 1e-9);
   // Bounded by the rows, however sparse, large or thin the world: with c the cell, w h / c^2 <= 2n
   // and w / c, h / c <= 2n, so W H <= (w / c + 2)(h / c + 2) <= 2n + 2 (2n + 2n) + 4 = 10n + 4.
@@ -120,16 +114,11 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
   W_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(w / cell)) + 1);
   H_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(h / cell)) + 1);
   const auto cells = static_cast<std::size_t>(W_ * H_);
-  start_.assign(cells + 1, 0);
   cell_of_.resize(n);
   ex.for_each_chunk(n, kBuildGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) cell_of_[i] = row(v.y[i]) * W_ + col(v.x[i]);
   });
-  for (std::size_t i = 0; i < n; ++i) ++start_[static_cast<std::size_t>(cell_of_[i]) + 1];
-  for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
-  fill_.assign(start_.begin(), start_.end() - 1);
-  for (std::size_t i = 0; i < n; ++i)
-    rows_[fill_[static_cast<std::size_t>(cell_of_[i])]++] = static_cast<uint32_t>(i);
+  index::bucket_rows(cell_of_, cells, start_, rows_, fill_);
   copy_.resize(n);
   ex.for_each_chunk(n, kBuildGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {

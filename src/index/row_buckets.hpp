@@ -1,0 +1,30 @@
+// Rows bucketed into the cells of a uniform grid, for the grids rebuilt every tick
+// (index/neighbour_grid, steer/passing): the rows' bounding box, then a counting sort.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace crowddb {
+class Executor;
+}
+
+namespace crowddb::index {
+
+struct Box {
+  double xmin, ymin, xmax, ymax;  // INFINITY, INFINITY, -INFINITY, -INFINITY when empty
+};
+
+// The smallest box holding every (x[i], y[i]), in chunks on every thread (min and max are exact,
+// so the answer does not depend on the thread count).
+Box bounding_box(std::span<const double> x, std::span<const double> y, Executor& ex);
+
+// A counting sort of rows into `cells` cells, cell_of[i] being row i's (in [0, cells)): rows
+// lists the rows cell by cell, row order within a cell, and cell c's rows are
+// rows[start[c] .. start[c + 1]). One pass in row order (a few instructions per row), so the
+// layout is that of one thread. `scratch` is reused between calls.
+void bucket_rows(std::span<const int64_t> cell_of, std::size_t cells, std::vector<uint32_t>& start,
+                 std::vector<uint32_t>& rows, std::vector<uint32_t>& scratch);
+
+}  // namespace crowddb::index
