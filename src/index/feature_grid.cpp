@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "index/row_buckets.hpp"
 #include "query/naive_paths.hpp"
 #include "util/stopwatch.hpp"
 
@@ -11,11 +12,11 @@ namespace {
 
 constexpr std::size_t kFeatureGrain = 64;
 
-struct Box {
+struct FeatureBox {
   double x0, y0, x1, y1;
 };
 
-Box feature_box(const StaticScene& scene, std::size_t f) {
+FeatureBox feature_box(const StaticScene& scene, std::size_t f) {
   if (f < scene.circles().size()) {
     const CircleObstacle& c = scene.circles()[f];
     return {c.x - c.radius, c.y - c.radius, c.x + c.radius, c.y + c.radius};
@@ -32,7 +33,7 @@ void FeatureGrid::build(const StaticScene& scene, double cell) {
   x0_ = y0_ = INFINITY;
   x1_ = y1_ = -INFINITY;
   for (std::size_t f = 0; f < F; ++f) {
-    const Box b = feature_box(scene, f);
+    const FeatureBox b = feature_box(scene, f);
     x0_ = std::min(x0_, b.x0);
     y0_ = std::min(y0_, b.y0);
     x1_ = std::max(x1_, b.x1);
@@ -47,10 +48,16 @@ void FeatureGrid::build(const StaticScene& scene, double cell) {
   if (!(cell_ > 0) || !std::isfinite(cell_)) cell_ = side;
   W_ = static_cast<int64_t>(std::floor((x1_ - x0_) / cell_)) + 1;
   H_ = static_cast<int64_t>(std::floor((y1_ - y0_) / cell_)) + 1;
-  std::vector<std::vector<uint32_t>> cells(static_cast<std::size_t>(W_ * H_));
+  // (cell, feature) registrations in feature order, then a counting sort by cell: each cell's
+  // features stay ascending. One vector per cell instead took 40 ms on a walled 200 m square (the
+  // walls reach 200 m beyond it: 667 x 667 cells); now 14-20 ms, most of it the first touch of
+  // the per-cell arrays' memory.
+  const std::size_t cells = static_cast<std::size_t>(W_ * H_);
+  std::vector<int64_t> reg_cell;
+  std::vector<uint32_t> reg_feature;
   const double half_diag = cell_ * std::sqrt(0.5) * (1 + 1e-9);
   for (std::size_t f = 0; f < F; ++f) {
-    const Box b = feature_box(scene, f);
+    const FeatureBox b = feature_box(scene, f);
     const int64_t cx0 =
         std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.x0 - x0_) / cell_)), 0, W_ - 1);
     const int64_t cx1 =
@@ -68,19 +75,19 @@ void FeatureGrid::build(const StaticScene& scene, double cell) {
           const double my = y0_ + (static_cast<double>(cy) + 0.5) * cell_;
           if (feature_dist2(scene, f, mx, my) > half_diag * half_diag) continue;
         }
-        cells[static_cast<std::size_t>(cy * W_ + cx)].push_back(static_cast<uint32_t>(f));
+        reg_cell.push_back(cy * W_ + cx);
+        reg_feature.push_back(static_cast<uint32_t>(f));
       }
   }
-  start_.assign(cells.size() + 1, 0);
-  for (std::size_t c = 0; c < cells.size(); ++c)
-    start_[c + 1] = start_[c] + static_cast<uint32_t>(cells[c].size());
-  items_.reserve(start_.back());
-  for (const auto& c : cells) items_.insert(items_.end(), c.begin(), c.end());
+  std::vector<uint32_t> order, scratch;
+  bucket_rows(reg_cell, cells, start_, order, scratch);
+  items_.resize(order.size());
+  for (std::size_t a = 0; a < order.size(); ++a) items_[a] = reg_feature[order[a]];
   // Chebyshev distance transform (two passes, each cell from its four earlier neighbours).
   constexpr uint16_t kFar = UINT16_MAX;  // > 1025, the most cells an axis has
-  clear_.assign(cells.size(), kFar);
-  for (std::size_t c = 0; c < cells.size(); ++c)
-    if (!cells[c].empty()) clear_[c] = 0;
+  clear_.assign(cells, kFar);
+  for (std::size_t c = 0; c < cells; ++c)
+    if (start_[c + 1] > start_[c]) clear_[c] = 0;
   const auto at = [&](int64_t cx, int64_t cy) -> uint16_t& {
     return clear_[static_cast<std::size_t>(cy * W_ + cx)];
   };
