@@ -115,8 +115,19 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
   H_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(h / cell)) + 1);
   const auto cells = static_cast<std::size_t>(W_ * H_);
   cell_of_.resize(n);
+  class_of_.resize(n);
   ex.for_each_chunk(n, kBuildGrain, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) cell_of_[i] = row(v.y[i]) * W_ + col(v.x[i]);
+    for (std::size_t i = b; i < e; ++i) {
+      cell_of_[i] = row(v.y[i]) * W_ + col(v.x[i]);
+      // The row's heading class as a bit; standing rows pass nobody. A wish so small or so
+      // large that its square leaves the doubles' range makes passing()'s angle test
+      // meaningless (0 >= 0): such a row may be passing in any direction.
+      const double wx = v.wish_x[i], wy = v.wish_y[i], w2 = wx * wx + wy * wy;
+      class_of_[i] = wx == 0 && wy == 0 ? uint16_t{0}
+                     : w2 > 1e-280 && w2 < 1e280
+                         ? static_cast<uint16_t>(1u << heading_class(wx, wy))
+                         : uint16_t{0xFFFF};
+    }
   });
   index::bucket_rows(cell_of_, cells, start_, rows_, fill_);
   copy_.resize(n);
@@ -127,16 +138,8 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
     }
   });
   classes_.assign(cells, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double wx = v.wish_x[i], wy = v.wish_y[i];
-    if (wx == 0 && wy == 0) continue;  // standing rows pass nobody
-    // A wish so small or so large that its square leaves the doubles' range makes passing()'s
-    // angle test meaningless (0 >= 0): such a row may be passing in any direction.
-    const double w2 = wx * wx + wy * wy;
-    classes_[static_cast<std::size_t>(cell_of_[i])] |=
-        w2 > 1e-280 && w2 < 1e280 ? static_cast<uint16_t>(1u << heading_class(wx, wy))
-                                  : uint16_t{0xFFFF};
-  }
+  for (std::size_t i = 0; i < n; ++i)
+    classes_[static_cast<std::size_t>(cell_of_[i])] |= class_of_[i];
 }
 
 uint32_t PassingLookahead::find(const PassingView& v, std::size_t i, double ux, double uy,

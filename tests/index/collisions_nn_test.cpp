@@ -83,6 +83,14 @@ TEST(CollisionNn, ThreadsSplittingTheCellsChangeNothing) {
       CollisionPairs got;
       nn.run(d, StaticScene(), got, ex, st);
       EXPECT_EQ(got.agents, expect) << "shape " << shape << ", threads " << threads;
+      // With obstacles: the disc-obstacle half runs in chunks of rows on every thread.
+      for (const auto& [scene_name, scene] : test::collision_scenes(test::box_of(t))) {
+        const CollisionPairs want = test::naive_pairs(d, scene);
+        nn.run(d, scene, got, ex, st);
+        EXPECT_TRUE(got.obstacles == want.obstacles)
+            << "shape " << shape << ", " << scene_name << ", threads " << threads;
+        EXPECT_EQ(got.agents, expect);
+      }
     }
   }
 }
