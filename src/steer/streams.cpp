@@ -60,16 +60,21 @@ void mark_meetings(const StreamView& v, StreamMarks& out, Executor& ex) {
         out.follows[a] = follows(v, i, nb.row[a], ux, uy);
     }
   });
-  // The followers of each row (the "follows" edges reversed), by counting.
+  // The followers of each row (the "follows" edges reversed), by counting. Only rows not at a
+  // meeting have edges (where nearly everyone is, as in an airport, the lists are not read).
   std::vector<uint32_t>& offset = out.follower_offset;
   offset.assign(n + 1, 0);
-  for (std::size_t a = 0; a < nb.row.size(); ++a) offset[nb.row[a] + 1] += out.follows[a];
+  for (std::size_t i = 0; i < n; ++i)
+    if (!marked[i])
+      for (uint32_t a = nb.offset[i]; a < nb.offset[i + 1]; ++a)
+        offset[nb.row[a] + 1] += out.follows[a];
   for (std::size_t j = 0; j < n; ++j) offset[j + 1] += offset[j];
   out.follower.resize(offset[n]);
   out.cursor.assign(offset.begin(), offset.end() - 1);
   for (std::size_t i = 0; i < n; ++i)
-    for (uint32_t a = nb.offset[i]; a < nb.offset[i + 1]; ++a)
-      if (out.follows[a]) out.follower[out.cursor[nb.row[a]]++] = static_cast<uint32_t>(i);
+    if (!marked[i])
+      for (uint32_t a = nb.offset[i]; a < nb.offset[i + 1]; ++a)
+        if (out.follows[a]) out.follower[out.cursor[nb.row[a]]++] = static_cast<uint32_t>(i);
   // Breadth first from the meetings: the set reached does not depend on the order.
   out.queue.clear();
   for (std::size_t i = 0; i < n; ++i)
