@@ -129,7 +129,7 @@ io::Imported import(const std::string& text, const std::string& name = "t.scenar
   return io::import_vadere(name, text, {});
 }
 
-std::string error_of(const std::string& text, const std::string& name = "t.scenario") {
+std::string vadere_error_of(const std::string& text, const std::string& name = "t.scenario") {
   try {
     TempDir dir;
     load_scenario(dir.write(name, text));
@@ -247,7 +247,7 @@ TEST(VadereImport, ClassNameSourceOf116) {
   // Classes the 2.0 migration rejects are errors.
   s.topography = join({list("targets", {kExit}),
                        list("sources", {flat("org.vadere.state.scenario.Other", "[30.0]")})});
-  EXPECT_NE(error_of(v24(s)).find("is not supported"), std::string::npos);
+  EXPECT_NE(vadere_error_of(v24(s)).find("is not supported"), std::string::npos);
 }
 
 // 0.1: the root is "vadere"; seeds were useRandomSeed / randomSeed; a source's interval was
@@ -560,7 +560,7 @@ TEST(VadereImport, ZeroIntervalIsAnError) {
                        list("sources", {source(1, rect(1, 1, 1, 1), "[1]", 0, 10, 1, 0)})});
   const std::string text = v24(s);
   EXPECT_EQ(
-      error_of(text),
+      vadere_error_of(text),
       "t.scenario:" + std::to_string(vadere_line_of(text, "\"id\": 1, \"shape\": {\"x\": 1,")) +
           ": /scenario/topography/sources/0/spawner/distribution: "
           "updateFrequency 0: must be > 0 when constraintsTimeEnd != "
@@ -585,7 +585,7 @@ TEST(VadereImport, SourceWithoutTargetsIsAnError) {
   Spec s;
   s.topography = join({list("targets", {kExit}), list("sources", {src})});
   const std::string text = v24(s);
-  EXPECT_EQ(error_of(text).substr(0, error_of(text).find(": a source")),
+  EXPECT_EQ(vadere_error_of(text).substr(0, vadere_error_of(text).find(": a source")),
             "t.scenario:" + std::to_string(vadere_line_of(text, src)) +
                 ": /scenario/topography/sources/0");
 }
@@ -812,7 +812,7 @@ TEST(VadereImport, BadInputNamesFileAndLine) {
         std::isdigit(static_cast<unsigned char>(c.message[0]))  // line:column of a syntax error
             ? "t.scenario:" + c.message
             : "t.scenario:" + std::to_string(vadere_line_of(c.text, c.marker)) + ": " + c.message;
-    EXPECT_EQ(error_of(c.text), expected);
+    EXPECT_EQ(vadere_error_of(c.text), expected);
   }
 }
 
@@ -827,14 +827,14 @@ TEST(VadereImport, DeeplyNestedValuesCostLinearMemory) {
                            std::string(depth, ']') + "}";
   const std::string expected = "t.scenario:1: /description: expected a string, got array";
 #if defined(CROWDDB_TEST_ASAN)
-  EXPECT_EQ(error_of(text), expected);
+  EXPECT_EQ(vadere_error_of(text), expected);
 #else
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   const auto read_limited = [&] {
     rlimit limit;
     limit.rlim_cur = limit.rlim_max = rlim_t{2} << 30;
     setrlimit(RLIMIT_AS, &limit);
-    std::exit(error_of(text) == expected ? 0 : 1);
+    std::exit(vadere_error_of(text) == expected ? 0 : 1);
   };
   EXPECT_EXIT(read_limited(), ::testing::ExitedWithCode(0), "");
 #endif
