@@ -1,7 +1,6 @@
 #include "index/neighbour_grid.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 #include "index/row_buckets.hpp"

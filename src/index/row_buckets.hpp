@@ -1,5 +1,6 @@
-// Rows bucketed into the cells of a uniform grid, for the grids rebuilt every tick
-// (index/neighbour_grid, steer/passing): the rows' bounding box, then a counting sort.
+// Rows bucketed into the cells of a uniform grid: the rows' bounding box, then a counting sort.
+// For the grids rebuilt every tick (index/neighbour_grid, steer/passing) and the obstacle
+// features' grid, built once per scene (index/feature_grid: its rows are registrations).
 #pragma once
 
 #include <cstdint>

@@ -595,8 +595,10 @@ class OrcaModel final : public Model {
   }
   NeighbourLists nb_;
   PassingLookahead lookahead_;
-  std::vector<uint8_t> turn_;      // per row: turns aside for someone passing (find_passing)
-  std::vector<uint32_t> witness_;  // per row: who passed it last tick (a hint; kNobody: none)
+  std::vector<uint8_t> turn_;  // per row: turns aside for someone passing (find_passing)
+  // Per row: the last row the grid found passing it (a hint for find, maybe many ticks old or
+  // naming another row since; kNobody: none).
+  std::vector<uint32_t> witness_;
   uint64_t passing_near_ = 0, passing_far_ = 0;
   FeatureLists features_;
   std::vector<double> reach_;

@@ -88,8 +88,9 @@ inline int64_t PassingLookahead::row(double y) const {
   return c < 0 ? 0 : (c >= static_cast<double>(H_) ? H_ - 1 : static_cast<int64_t>(c));
 }
 
-// A counting sort into cells (index/row_buckets.hpp): each row's cell in chunks on every
-// thread, the placement in one pass in row order (the layout is that of one thread).
+// A counting sort into cells (index/row_buckets.hpp): the bounding box, each row's cell and
+// heading class, and the copies in chunks on every thread; the placement and the cells' masks in
+// one pass in row order (the layout is that of one thread).
 void PassingLookahead::build(const PassingView& v, Executor& ex) {
   const std::size_t n = v.x.size();
   rows_.resize(n);
@@ -100,7 +101,8 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
     return;
   }
   const auto [xmin, ymin, xmax, ymax] = index::bounding_box(v.x, v.y, ex);
-  rmax_ = std::max(0.0, *std::max_element(v.radius.begin(), v.radius.end()));
+  rmax_ = 0;
+  for (const double r : v.radius) rmax_ = std::max(rmax_, r);
   const double w = std::max(xmax - xmin, 1e-9), h = std::max(ymax - ymin, 1e-9);
   // Bounded by the rows, however sparse, large or thin the world: with c the cell, w h / c^2 <= 2n
   // and w / c, h / c <= 2n, so W H <= (w / c + 2)(h / c + 2) <= 2n + 2 (2n + 2n) + 4 = 10n + 4.

@@ -86,6 +86,9 @@ TEST(CollisionNn, ThreadsSplittingTheCellsChangeNothing) {
       // With obstacles: the disc-obstacle half runs in chunks of rows on every thread.
       for (const auto& [scene_name, scene] : test::collision_scenes(test::box_of(t))) {
         const CollisionPairs want = test::naive_pairs(d, scene);
+        if (!scene.empty()) {
+          ASSERT_FALSE(want.obstacles.empty()) << scene_name;
+        }
         nn.run(d, scene, got, ex, st);
         EXPECT_TRUE(got.obstacles == want.obstacles)
             << "shape " << shape << ", " << scene_name << ", threads " << threads;
