@@ -12,11 +12,8 @@ namespace {
 
 constexpr std::size_t kFeatureGrain = 64;
 
-struct FeatureBox {
-  double x0, y0, x1, y1;
-};
-
-FeatureBox feature_box(const StaticScene& scene, std::size_t f) {
+// A feature's bounding box (Box of index/row_buckets.hpp).
+Box feature_box(const StaticScene& scene, std::size_t f) {
   if (f < scene.circles().size()) {
     const CircleObstacle& c = scene.circles()[f];
     return {c.x - c.radius, c.y - c.radius, c.x + c.radius, c.y + c.radius};
@@ -33,11 +30,11 @@ void FeatureGrid::build(const StaticScene& scene, double cell) {
   x0_ = y0_ = INFINITY;
   x1_ = y1_ = -INFINITY;
   for (std::size_t f = 0; f < F; ++f) {
-    const FeatureBox b = feature_box(scene, f);
-    x0_ = std::min(x0_, b.x0);
-    y0_ = std::min(y0_, b.y0);
-    x1_ = std::max(x1_, b.x1);
-    y1_ = std::max(y1_, b.y1);
+    const Box b = feature_box(scene, f);
+    x0_ = std::min(x0_, b.xmin);
+    y0_ = std::min(y0_, b.ymin);
+    x1_ = std::max(x1_, b.xmax);
+    y1_ = std::max(y1_, b.ymax);
   }
   W_ = H_ = 0;
   start_.assign(1, 0);
@@ -57,15 +54,15 @@ void FeatureGrid::build(const StaticScene& scene, double cell) {
   std::vector<uint32_t> reg_feature;
   const double half_diag = cell_ * std::sqrt(0.5) * (1 + 1e-9);
   for (std::size_t f = 0; f < F; ++f) {
-    const FeatureBox b = feature_box(scene, f);
+    const Box b = feature_box(scene, f);
     const int64_t cx0 =
-        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.x0 - x0_) / cell_)), 0, W_ - 1);
+        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.xmin - x0_) / cell_)), 0, W_ - 1);
     const int64_t cx1 =
-        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.x1 - x0_) / cell_)), 0, W_ - 1);
+        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.xmax - x0_) / cell_)), 0, W_ - 1);
     const int64_t cy0 =
-        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.y0 - y0_) / cell_)), 0, H_ - 1);
+        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.ymin - y0_) / cell_)), 0, H_ - 1);
     const int64_t cy1 =
-        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.y1 - y0_) / cell_)), 0, H_ - 1);
+        std::clamp<int64_t>(static_cast<int64_t>(std::floor((b.ymax - y0_) / cell_)), 0, H_ - 1);
     const bool edge = f >= scene.circles().size();
     for (int64_t cy = cy0; cy <= cy1; ++cy)
       for (int64_t cx = cx0; cx <= cx1; ++cx) {

@@ -297,10 +297,9 @@ class OrcaModel final : public Model {
           planes.clear();
           obstacle_planes(in, i, planes);
           const double vix = t.vx[i], viy = t.vy[i];
-          const uint32_t a0 = nb_.offset[i];
           // Contact planes of the neighbours within one tick's reach (hard).
           const double reach = 2 * in.cfg.dt * t.max_speed[i];
-          for (uint32_t a = a0; a < nb_.offset[i + 1]; ++a) {
+          for (uint32_t a = nb_.offset[i]; a < nb_.offset[i + 1]; ++a) {
             const uint32_t j = nb_.row[a];
             const double d = std::sqrt(nb_.dist2[a]);
             const double gap = d - t.radius[i] - t.radius[j] - kSkin;
@@ -313,7 +312,7 @@ class OrcaModel final : public Model {
           }
           retreat_plane(in, i, planes);
           const std::size_t hard = planes.size();
-          for (uint32_t a = a0; a < nb_.offset[i + 1]; ++a) {
+          for (uint32_t a = nb_.offset[i]; a < nb_.offset[i + 1]; ++a) {
             const uint32_t j = nb_.row[a];
             // Right of way: a neighbour that goes first is avoided where it wants to go, as far as
             // it is held up (walking as it wishes, its velocity says it already).
