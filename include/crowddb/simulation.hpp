@@ -132,8 +132,14 @@ struct NavigationParams {
   double cell_size = 0;       // [m] navmesh cell; 0: auto (a quarter of the class radius, at
                               // most 4096 x 4096 cells over the world's area)
   double clearance = 0;       // [m] extra distance kept from obstacles beyond the class radius
-  uint32_t tile_size = 256;   // navmesh tile side [cells] (16..4096)
-  bool skip_visible = true;   // skip a waypoint when the one after it is in sight (Detour raycast)
+  // [m] A path's corners keep this far inside the mesh's edges where there is room, moving by
+  // at most an eighth of a passage's width from either side (so beyond the class radius from a
+  // door's posts or a corner's wall). 0: Detour's straight path, its corners on the mesh's
+  // edge. Opt-in: it eases arches of people 1 m wide at a door, and slows doors for people of
+  // 0.2-0.25 m by a tenth (docs/steering.md, "Corners off the door posts").
+  double corner_push = 0;
+  uint32_t tile_size = 256;  // navmesh tile side [cells] (16..4096)
+  bool skip_visible = true;  // skip a waypoint when the one after it is in sight (Detour raycast)
   // [s] Time between an agent's line-of-sight checks (at least every tick), staggered by agent
   // id: each check is a mesh query, about a microsecond, and at 10^4 agents they add up.
   double sight_interval = 0;

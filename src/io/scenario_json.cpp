@@ -1040,6 +1040,7 @@ Scenario parse_document(std::string_view text, const std::string& source, const 
     nav.radius_step = n.positive("radius_step", nav.radius_step);
     nav.cell_size = n.non_negative("cell_size", nav.cell_size);
     nav.clearance = n.non_negative("clearance", nav.clearance);
+    nav.corner_push = n.non_negative("corner_push", nav.corner_push);
     nav.tile_size = static_cast<uint32_t>(n.integer("tile_size", nav.tile_size, 4096));
     if (nav.tile_size < 16) n.fail("tile_size", "must be in 16..4096");
     nav.skip_visible = n.boolean("skip_visible", nav.skip_visible);

@@ -652,13 +652,14 @@ bool PathFinder::portal(unsigned int from, unsigned int to, float* left, float* 
 
 // The funnel algorithm (Mononen's "simple stupid funnel", as Detour's findStraightPath runs it)
 // over the corridor's portals, each shrunk by `push` from both ends (to its midpoint when it is
-// narrower than twice that): the corners keep `push` from the corridor's edges where there is
-// room, and pass through the middle of a narrower gap.
+// narrower than twice that; by at most push_share of its length): the corners keep `push` from
+// the corridor's edges where there is room, and pass through the middle of a narrower gap.
 void PathFinder::funnel(PathResult& r, const float* start, const float* end, int npolys,
                         double push) const {
   struct Portal {
     float l[3], rt[3];
   };
+  const double share = std::clamp(mesh_.params_.push_share, 0.0, 0.5);
   std::vector<Portal> portals;
   portals.reserve(static_cast<std::size_t>(npolys) + 1);
   Portal first;
@@ -672,7 +673,7 @@ void PathFinder::funnel(PathResult& r, const float* start, const float* end, int
       break;
     const float dx = p.rt[0] - p.l[0], dz = p.rt[2] - p.l[2];
     const double len = std::sqrt(static_cast<double>(dx) * dx + static_cast<double>(dz) * dz);
-    const double t = len > 2 * push ? push / len : 0.5;
+    const double t = std::min(len > 2 * push ? push / len : 0.5, share);
     const float l0 = p.l[0], l2 = p.l[2];
     p.l[0] = static_cast<float>(l0 + dx * t);
     p.l[2] = static_cast<float>(l2 + dz * t);

@@ -59,9 +59,14 @@ struct NavMeshParams {
   double touch = 0.7071067811865476;  // sqrt(0.5)
   // [length] PathFinder keeps a path's corners this far inside the mesh's edges where there is
   // room (the funnel over portals shrunk by it; through the middle of a narrower gap); 0:
-  // corners on the mesh's edges (Detour's straight path). For a mesh eroded by less than the
-  // agent's radius.
+  // corners on the mesh's edges (Detour's straight path). On a mesh eroded by less than the
+  // agent's radius, to keep its disc off the walls; on one eroded by the radius, to keep the
+  // corners off a door's posts (NavigationParams::corner_push).
   double corner_push = 0;
+  // The most `corner_push` moves either end of a portal, as a share of its length: 0.5 lets a
+  // gap narrower than twice the push be crossed at its middle; less keeps a strip of it in use
+  // (one point for everyone slows a crowd through a narrow exit).
+  double push_share = 0.5;
 };
 
 struct NavMeshStats {

@@ -121,6 +121,8 @@ void SimConfig::validate() const {
           "must be > 0");
   require(std::isfinite(n.cell_size) && n.cell_size >= 0, "navigation/cell_size", "must be >= 0");
   require(std::isfinite(n.clearance) && n.clearance >= 0, "navigation/clearance", "must be >= 0");
+  require(std::isfinite(n.corner_push) && n.corner_push >= 0, "navigation/corner_push",
+          "must be >= 0");
   require(n.tile_size >= 16 && n.tile_size <= 4096, "navigation/tile_size", "must be in 16..4096");
   require(std::isfinite(n.sight_interval) && n.sight_interval >= 0, "navigation/sight_interval",
           "must be >= 0");
@@ -687,7 +689,10 @@ std::string Simulation::explain() const {
        << (latency == 1 ? "" : "s") << " earlier; waits only for a late worker)\n"
        << "       path service: Recast/Detour navigation mesh per radius class (radius rounded up "
           "to a multiple of "
-       << num(nv.radius_step) << " m), findPath + findStraightPath on a worker thread\n"
+       << num(nv.radius_step) << " m), findPath + "
+       << (nv.corner_push > 0 ? "corners kept " + num(nv.corner_push) + " m in from the edges"
+                              : std::string("findStraightPath"))
+       << " on a worker thread\n"
        << e.nav->describe_meshes();
   }
   os << "  1 goal stage         per row: v_pref = pref_speed towards the waypoint (goal areas: "

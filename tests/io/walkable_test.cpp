@@ -175,6 +175,8 @@ TEST(ScenarioGeometry, ErrorsNameTheFileAndField) {
       {scenario(box + ", 'navigation': {'latency': -1}"),
        "t.json: /navigation/latency: must be >= 0"},
       {scenario(box + ", 'navigation': {'budget': 0}"), "t.json: /navigation/budget: must be >= 1"},
+      {scenario(box + ", 'navigation': {'corner_push': -0.1}"),
+       "t.json: /navigation/corner_push: must be >= 0"},
       {scenario(box + ", 'navigation': {'cell': 1}"), "t.json: /navigation/cell: unknown key"},
       {scenario(box + ", 'navigation': {'tile_size': 8}"),
        "t.json: /navigation/tile_size: must be in 16..4096"},
@@ -195,7 +197,7 @@ TEST(ScenarioGeometry, NavigationBlockSwitchesTheServiceOn) {
       scenario(
           "'bounds': [0, 0, 40, 40], 'navigation': {'latency': 4, 'budget': 9, 'replan_after': 0, "
           "'radius_step': 0.5, 'cell_size': 0.2, 'clearance': 0.1, 'tile_size': 64, "
-          "'skip_visible': false, 'sight_interval': 3}"),
+          "'skip_visible': false, 'sight_interval': 3, 'corner_push': 0.5}"),
       "t.json");
   const NavigationParams& n = on.config.navigation;
   EXPECT_TRUE(n.enabled);
@@ -205,6 +207,7 @@ TEST(ScenarioGeometry, NavigationBlockSwitchesTheServiceOn) {
   EXPECT_EQ(n.radius_step, 0.5);
   EXPECT_EQ(n.cell_size, 0.2);
   EXPECT_EQ(n.clearance, 0.1);
+  EXPECT_EQ(n.corner_push, 0.5);
   EXPECT_EQ(n.tile_size, 64u);
   EXPECT_FALSE(n.skip_visible);
   EXPECT_EQ(n.sight_interval, 3u);

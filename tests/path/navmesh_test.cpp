@@ -207,6 +207,70 @@ TEST(NavMesh, CornersArePushedIntoTheMiddleOfANarrowDoor) {
   }
 }
 
+// On a class mesh (eroded by the radius), corners pushed in keep the path that much farther
+// from a 2 m door's posts, a little longer than the straight path; without, the corners lie on
+// the mesh's edge, the disc's edge next to a post.
+TEST(NavMesh, PushedCornersKeepOffTheDoorPostsOnAClassMesh) {
+  NavGeometry g{{0, 0, 30, 20}, {}, {rect(14.5, 0, 15.5, 9), rect(14.5, 11, 15.5, 20)}};
+  double clear0[2] = {}, len0[2] = {};
+  for (double push : {0.0, 0.25}) {
+    NavMeshParams p{0.5, 0.125};
+    p.corner_push = push;
+    auto mesh = NavMesh::build(g, p);
+    PathFinder f(*mesh);
+    const std::pair<Vec2, Vec2> ends[2] = {{{5, 3}, {25, 17}}, {{5, 17}, {25, 3}}};
+    for (int k = 0; k < 2; ++k) {
+      const PathResult r = f.find(ends[k].first, ends[k].second);
+      ASSERT_EQ(r.status, PathStatus::ok);
+      ASSERT_GE(r.corners.size(), 1u);
+      const double clear = min_clearance(disc_world(g), r);
+      EXPECT_NEAR(r.length, polyline_length(r), 1e-9);
+      if (push == 0) {
+        clear0[k] = clear;
+        len0[k] = r.length;
+        EXPECT_LT(clear, mesh->clearance() + 2 * p.cell_size + 0.05);  // on the edge
+      } else {
+        EXPECT_GE(clear, clear0[k] + 0.7 * push) << "path " << k;
+        EXPECT_GT(r.length, len0[k] - 1e-9);
+        EXPECT_LT(r.length, len0[k] * 1.01);
+      }
+    }
+  }
+}
+
+// A push larger than a quarter of a narrow exit: with push_share 0.5 every path crosses the
+// exit at its middle; at 0.25 the corners keep to the strip a quarter in from either end, so
+// paths from either side cross on their own side of the middle.
+TEST(NavMesh, PushShareKeepsAStripOfANarrowExitInUse) {
+  NavGeometry g{{0, 0, 30, 20}, {}, {rect(14.5, 0, 15.5, 9.5), rect(14.5, 10.5, 15.5, 20)}};
+  for (double share : {0.5, 0.25}) {
+    NavMeshParams p{0.25, 0.0625};
+    p.corner_push = 0.25;
+    p.push_share = share;
+    auto mesh = NavMesh::build(g, p);
+    PathFinder f(*mesh);
+    const std::pair<Vec2, Vec2> ends[2] = {{{5, 3}, {25, 17}}, {{5, 17}, {25, 3}}};
+    double ys[2] = {0, 0};  // the corner nearest the exit's middle, per path
+    for (int k = 0; k < 2; ++k) {
+      const PathResult r = f.find(ends[k].first, ends[k].second);
+      ASSERT_EQ(r.status, PathStatus::ok);
+      ASSERT_GE(r.corners.size(), 1u);
+      double best = INFINITY;
+      for (const Vec2& c : r.corners)
+        if (std::abs(c.y - 10) < std::abs(best - 10)) best = c.y;
+      ys[k] = best;
+      EXPECT_GE(min_clearance(disc_world(g), r), 0.8 * p.radius);
+    }
+    if (share == 0.5) {
+      EXPECT_NEAR(ys[0], 10, 0.02);
+      EXPECT_NEAR(ys[1], 10, 0.02);
+    } else {
+      EXPECT_LT(ys[0], 9.97);  // from below: the lower post's side of the middle
+      EXPECT_GT(ys[1], 10.03);
+    }
+  }
+}
+
 TEST(NavMesh, NonConvexPolygonsAndCirclesAreRespected) {
   // A U opening west with the goal behind its closed side, and a pillar.
   PolygonObstacle u{
