@@ -10,12 +10,12 @@
 // Obstacles differ from RVO2 on purpose: each feature (an edge as an exact segment, or a circle)
 // gives the half-plane that keeps the agent on its side of a line separating it from the feature
 // for time_horizon_obst: v . n >= -(d - r) / tau_obst, n the line's unit normal towards the
-// agent, d the centre's distance from it. A circle's line is the tangent at the nearest point.
-// An edge's is the one, of the tangent at the nearest point and lines through the edge's ends
-// (steer/separating_line.hpp), that leaves the agent's wish the most room: the tangent alone
+// agent, d the centre's distance from it: of the tangent at the nearest point and other lines
+// (an edge's own line and lines through its ends; a circle's other tangents), the one that
+// leaves the agent's wish the most room (steer/separating_line.hpp). The nearest tangent alone
 // forbade gliding past a door post's end faster than the gap closes, and walking diagonally
 // towards a wall into the door beside it, and so slowed everyone entering a door (flows through
-// 0.8-2.5 m doors 0.85-1.35 /(m s) with it, 1.34-1.51 with the ends' lines: docs/validation.md).
+// 0.8-2.5 m doors 0.85-1.35 /(m s) with it, 1.34-1.50 with the ends' lines: docs/validation.md).
 // Any such line is collision-free for that long, needs no vertex convexity flags, and v = 0
 // satisfies it when the agent overlaps nothing, so the hard obstacle planes never leave the
 // program empty. Edges whose inner side holds the agent's centre are skipped (back faces: the
@@ -545,11 +545,13 @@ class OrcaModel final : public Model {
       double nx, ny, d;
       if (f < scene.circles().size()) {
         const CircleObstacle& c = scene.circles()[f];
-        const double dx = x - c.x, dy = y - c.y, l = std::sqrt(dx * dx + dy * dy);
-        if (l == 0) continue;  // centre on the circle's centre: the backoff keeps it out
-        nx = dx / l;
-        ny = dy / l;
-        d = l - c.radius;
+        const double dx = x - c.x, dy = y - c.y;
+        if (std::sqrt(dx * dx + dy * dy) == 0) continue;  // on its centre: the backoff keeps it out
+        const SeparatingLine sl =
+            separating_line(c.x, c.y, c.radius, x, y, r, tau, in.pref_vx[i], in.pref_vy[i], kSkin);
+        nx = sl.nx;
+        ny = sl.ny;
+        d = sl.d;
       } else {
         const auto [a0, a1] = scene.edge(f);
         // Polygons are counter-clockwise: the inside is left of each edge. Back face: skip.

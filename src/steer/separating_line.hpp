@@ -14,7 +14,8 @@
 //   - the edge's own line,
 //   - per end e, the line through e square to g = w + (p - e) / tau (the best of all lines
 //     through e: room is g . n - r / tau), and the two through e that touch the disc.
-// The candidates depend on the wish only through which one is picked: every one is valid.
+// The candidates depend on the wish only through which one is picked: every one is valid. A
+// circle's lines are its tangents, chosen the same way (the second overload).
 #pragma once
 
 #include <cmath>
@@ -77,6 +78,39 @@ inline SeparatingLine separating_line(const Vec2& a0, const Vec2& a1, double px,
     offer(e, other, c * hx - s * hy, c * hy + s * hx);
     offer(e, other, c * hx + s * hy, c * hy - s * hx);
   }
+  return best;
+}
+
+// The line agent (px, py) of radius r with wish (wx, wy) keeps from the circle (cx, cy) of radius
+// R for tau: a tangent of the circle, so the whole circle is behind it. Of the one at the nearest
+// point and the others the agent's disc is clear of, the one that leaves the wish the most room
+// (room is g . m - (R + r) / tau, g = w + (p - c) / tau, m the normal): m along g when that clears
+// the disc, else one of the two tangents whose lines touch the disc. Centre on the circle's
+// centre: the normal (1, 0), deterministic.
+inline SeparatingLine separating_line(double cx, double cy, double R, double px, double py,
+                                      double r, double tau, double wx, double wy, double skin) {
+  const double qx = px - cx, qy = py - cy, ql = std::sqrt(qx * qx + qy * qy);
+  if (!(ql > 0)) return {1, 0, -R};
+  SeparatingLine best{qx / ql, qy / ql, ql - R};
+  const double clear = R + r + skin;
+  if (!(ql >= clear)) return best;
+  auto room = [&](double nx, double ny) { return wx * nx + wy * ny + (qx * nx + qy * ny) / tau; };
+  double best_room = room(best.nx, best.ny);
+  auto offer = [&](double nx, double ny) {
+    const double d = qx * nx + qy * ny;
+    if (!(d >= clear)) return;
+    const double w = room(nx, ny);
+    if (w > best_room) {
+      best_room = w;
+      best = {nx, ny, d - R};
+    }
+  };
+  const double gx = wx + qx / tau, gy = wy + qy / tau, gl = std::sqrt(gx * gx + gy * gy);
+  if (gl > 0) offer(gx / gl, gy / gl);
+  const double c = clear / ql, s = std::sqrt(std::max(0.0, 1 - c * c));
+  const double hx = qx / ql, hy = qy / ql;
+  offer(c * hx - s * hy, c * hy + s * hx);
+  offer(c * hx + s * hy, c * hy - s * hx);
   return best;
 }
 

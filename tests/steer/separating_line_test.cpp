@@ -121,5 +121,64 @@ TEST(SeparatingLine, LetsAnAgentPassADoorPostsCorner) {
   EXPECT_GE(swept_gap({px, py}, {px + wx * tau, py + wy * tau}, a0, a1), r - 1e-9);
 }
 
+// Circles: every permitted velocity keeps the disc clear of the circle for tau (the path's
+// segment stays R + r from the centre), the whole circle is behind the line, and the wish never
+// gets less room than under the tangent at the nearest point.
+TEST(SeparatingLine, EveryPermittedVelocityKeepsTheDiscClearOfTheCircle) {
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(-3, 3), rad(0.05, 0.6), big(0.01, 2), speed(0, 2),
+      ang(0, 2 * std::acos(-1.0)), mag(0, 3);
+  const double taus[] = {0.1, 0.5, 2};
+  int cases = 0;
+  while (cases < 4000) {
+    const Vec2 c{u(rng), u(rng)}, p{u(rng), u(rng)};
+    const double R = big(rng), r = rad(rng), tau = taus[cases % 3];
+    const double qx = p.x - c.x, qy = p.y - c.y, ql = std::hypot(qx, qy);
+    // Some barely clear, some a wish straight at the centre.
+    if (!(ql >= R + r + kLineSkin)) continue;
+    const double ws = speed(rng), wa = ang(rng);
+    double wx = ws * std::cos(wa), wy = ws * std::sin(wa);
+    if (cases % 7 == 0) {
+      wx = -ws * qx / ql;
+      wy = -ws * qy / ql;
+    }
+    SCOPED_TRACE(testing::Message()
+                 << "circle (" << c.x << ", " << c.y << ") R " << R << ", agent (" << p.x << ", "
+                 << p.y << ") r " << r << ", tau " << tau << ", wish (" << wx << ", " << wy << ")");
+    const SeparatingLine l = separating_line(c.x, c.y, R, p.x, p.y, r, tau, wx, wy, kLineSkin);
+    ASSERT_NEAR(std::hypot(l.nx, l.ny), 1.0, 1e-12);
+    EXPECT_GE(l.d, r + kLineSkin - 1e-12);
+    EXPECT_NEAR(qx * l.nx + qy * l.ny - R, l.d, 1e-12);  // a tangent: the circle behind it
+    const SeparatingLine tangent{qx / ql, qy / ql, ql - R};
+    EXPECT_GE(line_room(l, wx, wy, r, tau), line_room(tangent, wx, wy, r, tau) - 1e-12);
+    const double bound = -(l.d - r) / tau;
+    for (int k = 0; k < 64; ++k) {
+      double vx = wx, vy = wy;
+      if (k > 0) {
+        const double a = ang(rng), m = mag(rng);
+        vx = m * std::cos(a);
+        vy = m * std::sin(a);
+      }
+      if (vx * l.nx + vy * l.ny < bound) continue;
+      const Vec2 q{p.x + vx * tau, p.y + vy * tau};
+      EXPECT_GE(std::sqrt(dist2_to_segment(p, q, c.x, c.y)), R + r - 1e-9)
+          << "velocity (" << vx << ", " << vy << ")";
+    }
+    ++cases;
+  }
+}
+
+// Passing a pillar: the wish goes by it 0.05 m clear, which the tangent at the nearest point
+// forbids (it only lets the gap close at (d - r) / tau) and a tangent further round permits.
+TEST(SeparatingLine, LetsAnAgentGlidePastAPillar) {
+  const double R = 0.5, r = 0.25, tau = 0.5;
+  const double px = -0.9, py = 0.8, wx = 1.34, wy = 0;  // passes 0.8 from the centre: 0.05 clear
+  const SeparatingLine tangent{px / std::hypot(px, py), py / std::hypot(px, py),
+                               std::hypot(px, py) - R};
+  EXPECT_LT(line_room(tangent, wx, wy, r, tau), 0);
+  const SeparatingLine l = separating_line(0, 0, R, px, py, r, tau, wx, wy, kLineSkin);
+  EXPECT_GE(line_room(l, wx, wy, r, tau), 0);
+}
+
 }  // namespace
 }  // namespace crowddb::steer
