@@ -316,9 +316,9 @@ void Navigation::save(ByteWriter& out) const {
     out.u64(due);
     out.u64(jobs.size());
     for (const PathJob& j : jobs) {
-      int k = 0;
+      int k = j.key;
       for (const auto& [c, m] : meshes_)
-        if (m.get() == j.mesh) k = c;
+        if (j.mesh && m.get() == j.mesh) k = c;
       out.u64(j.ticket);
       out.u64(j.agent);
       out.u32(static_cast<uint32_t>(k));  // -class for a narrow mesh (two's complement)
@@ -333,7 +333,8 @@ void Navigation::save(ByteWriter& out) const {
   }
 }
 
-void Navigation::restore(ByteReader& in, uint64_t tick) {
+void Navigation::restore(ByteReader& in, uint64_t tick, const World& world) {
+  const AgentTable& t = world.agents();
   next_ticket_ = in.u64();
   for (uint64_t* v : {&stats_.requests, &stats_.replans, &stats_.dispatched, &stats_.superseded,
                       &stats_.applied, &stats_.failed, &stats_.partial, &stats_.sight_checks,
@@ -374,7 +375,17 @@ void Navigation::restore(ByteReader& in, uint64_t tick) {
       const int32_t c = k < 0 ? (k == INT32_MIN ? 0 : -k) : k;
       if (c < 1 || c * (k < 0 ? kNarrowStep : params_.radius_step) > side)
         in.fail("bad radius class " + std::to_string(k));
-      j.mesh = &mesh_of_class(k);
+      j.key = k;
+      // Its agent takes the reply only if it is still here and has not asked again since.
+      const auto row = world.row_of(AgentId::from_value(j.agent));
+      if (row && t.path_ticket[*row] == j.ticket) {
+        const double r = t.radius[*row];
+        if (k != (k < 0 ? narrow_key(r) : class_of(r)))
+          in.fail("a path search on mesh class " + std::to_string(k) + ", not its agent's");
+        j.mesh = &mesh_of_class(k);
+      } else if (const auto it = meshes_.find(k); it != meshes_.end() && it->second) {
+        j.mesh = it->second.get();
+      }
       j.start = {in.f64(), in.f64()};
       j.goal = {in.f64(), in.f64()};
       if (!std::isfinite(j.start.x) || !std::isfinite(j.start.y) || !std::isfinite(j.goal.x) ||
@@ -388,7 +399,7 @@ void Navigation::restore(ByteReader& in, uint64_t tick) {
           auto& [ref, cost] = pc->entries[e];
           ref = in.u32();
           cost = in.f64();
-          if (!j.mesh->valid_polygon(ref) || (e > 0 && ref <= pc->entries[e - 1].first))
+          if ((j.mesh && !j.mesh->valid_polygon(ref)) || (e > 0 && ref <= pc->entries[e - 1].first))
             in.fail("a path search's congestion with a bad or unsorted polygon ref");
           if (!std::isfinite(cost) || cost < 0)
             in.fail("a path search's congestion with a cost that is not finite and >= 0");

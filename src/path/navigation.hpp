@@ -105,9 +105,12 @@ class Navigation {
 
   // Checkpoints: tickets, counters, the request queue and the searches in flight (submitted
   // again on restore; their results depend on the job and the mesh only, so they come out the
-  // same). restore() replaces what the constructor requested; `tick` is the restored tick.
+  // same). restore() replaces what the constructor requested; `tick` is the restored tick,
+  // `world` the restored agents: a search that its agent will take must be on that agent's mesh,
+  // and one it will not (the agent has gone or asked again since) builds no mesh, so that a
+  // damaged checkpoint cannot make restore build meshes nobody uses (seconds each).
   void save(ByteWriter& out) const;
-  void restore(ByteReader& in, uint64_t tick);
+  void restore(ByteReader& in, uint64_t tick, const World& world);
 
  private:
   int class_of(double radius) const;

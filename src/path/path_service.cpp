@@ -95,6 +95,10 @@ void PathService::run() {
       b->replies.reserve(b->jobs.size());
       for (const PathJob& j : b->jobs) {
         if (options_.before_job) options_.before_job(j);
+        if (!j.mesh) {  // restored, and nobody will take it
+          b->replies.push_back({j.ticket, j.agent, PathResult{}, nullptr});
+          continue;
+        }
         auto& f = finders[j.mesh];
         if (!f) f = std::make_unique<PathFinder>(*j.mesh, options_.max_nodes);
         b->replies.push_back({j.ticket, j.agent, f->find(j.start, j.goal, j.costs.get()), j.mesh});

@@ -427,7 +427,7 @@ void Simulation::restore_state(std::string_view bytes, const std::string& what) 
   e.sources.restore(in, world_);
   const bool nav = in.u8() != 0;
   if (nav != (e.nav != nullptr)) in.fail("navigation is on in one and off in the other");
-  if (e.nav) e.nav->restore(in, last_.tick);
+  if (e.nav) e.nav->restore(in, last_.tick, world_);
   if (in.text() != kCheckpointMagic || !in.at_end()) in.fail("trailing or damaged data");
   if (last_.state_hash != state_hash()) in.fail("the state does not match its hash");
 }
