@@ -257,7 +257,7 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick,
     }
     costed += c != nullptr;
     stats_.costed += c != nullptr;
-    jobs.push_back({q.ticket, q.agent, mesh, {t.x[i], t.y[i]}, goal, std::move(c)});
+    jobs.push_back({q.ticket, q.agent, mesh, {t.x[i], t.y[i]}, goal, std::move(c), k});
   }
   if (!jobs.empty()) {
     stats_.dispatched += jobs.size();
@@ -316,12 +316,9 @@ void Navigation::save(ByteWriter& out) const {
     out.u64(due);
     out.u64(jobs.size());
     for (const PathJob& j : jobs) {
-      int k = j.key;
-      for (const auto& [c, m] : meshes_)
-        if (j.mesh && m.get() == j.mesh) k = c;
       out.u64(j.ticket);
       out.u64(j.agent);
-      out.u32(static_cast<uint32_t>(k));  // -class for a narrow mesh (two's complement)
+      out.u32(static_cast<uint32_t>(j.key));  // -class for a narrow mesh (two's complement)
       for (double v : {j.start.x, j.start.y, j.goal.x, j.goal.y}) out.f64(v);
       out.u64(j.costs ? j.costs->entries.size() : 0);
       if (j.costs)
@@ -383,8 +380,6 @@ void Navigation::restore(ByteReader& in, uint64_t tick, const World& world) {
         if (k != (k < 0 ? narrow_key(r) : class_of(r)))
           in.fail("a path search on mesh class " + std::to_string(k) + ", not its agent's");
         j.mesh = &mesh_of_class(k);
-      } else if (const auto it = meshes_.find(k); it != meshes_.end() && it->second) {
-        j.mesh = it->second.get();
       }
       j.start = {in.f64(), in.f64()};
       j.goal = {in.f64(), in.f64()};

@@ -28,20 +28,18 @@ struct PathJob {
   uint64_t ticket = 0;  // caller's request number
   uint64_t agent = 0;   // AgentId::value()
   // The mesh to search; none for a search restored from a checkpoint that nobody will take
-  // (Navigation::restore): it is answered with no path, and `key` keeps its mesh class.
+  // (Navigation::restore): it is answered with no path.
   const NavMesh* mesh = nullptr;
   Vec2 start{}, goal{};
   // Polygon costs of the search (congestion; shared by the jobs of one dispatch), or none.
   std::shared_ptr<const PolygonCosts> costs;
-  int32_t key = 0;  // the mesh class, for a restored search without a mesh (see `mesh`)
+  int32_t key = 0;  // the mesh's class (Navigation: -class for a narrow mesh), for checkpoints
 };
 
 struct PathReply {
   uint64_t ticket = 0;
   uint64_t agent = 0;
   PathResult result;
-  // The mesh to search; none for a search restored from a checkpoint that nobody will take
-  // (Navigation::restore): it is answered with no path, and `key` keeps its mesh class.
   const NavMesh* mesh = nullptr;  // the job's
 };
 

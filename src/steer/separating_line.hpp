@@ -18,6 +18,7 @@
 // circle's lines are its tangents, chosen the same way (the second overload).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "world/geometry.hpp"
@@ -28,6 +29,22 @@ struct SeparatingLine {
   double nx = 0, ny = 0;  // unit normal, towards the agent
   double d = 0;           // the agent's centre's distance from the line
 };
+
+namespace detail {
+// Lines through a point at q from the agent's centre (q = p - point, |q| = ql >= clear): the one
+// square to g = w + q / tau (the most room for the wish among all lines through the point) and
+// the two that touch the disc of radius `clear` around the agent; offer(nx, ny) for each.
+template <class Offer>
+void offer_through(double qx, double qy, double ql, double clear, double wx, double wy, double tau,
+                   Offer&& offer) {
+  const double gx = wx + qx / tau, gy = wy + qy / tau, gl = std::sqrt(gx * gx + gy * gy);
+  if (gl > 0) offer(gx / gl, gy / gl);
+  const double c = clear / ql, s = std::sqrt(std::max(0.0, 1 - c * c));
+  const double hx = qx / ql, hy = qy / ql;
+  offer(c * hx - s * hy, c * hy + s * hx);
+  offer(c * hx + s * hy, c * hy - s * hx);
+}
+}  // namespace detail
 
 // The line agent (px, py) of radius r with wish (wx, wy) keeps from the edge a0-a1 for tau.
 // `skin` is added to r where a candidate must clear the disc.
@@ -70,13 +87,8 @@ inline SeparatingLine separating_line(const Vec2& a0, const Vec2& a1, double px,
     const Vec2& other = k == 0 ? a1 : a0;
     const double qx = px - e.x, qy = py - e.y, ql = std::sqrt(qx * qx + qy * qy);
     if (!(ql >= clear)) continue;
-    const double gx = wx + qx / tau, gy = wy + qy / tau, gl = std::sqrt(gx * gx + gy * gy);
-    if (gl > 0) offer(e, other, gx / gl, gy / gl);
-    // The two lines through e touching the disc widened by skin.
-    const double c = clear / ql, s = std::sqrt(std::max(0.0, 1 - c * c));
-    const double hx = qx / ql, hy = qy / ql;
-    offer(e, other, c * hx - s * hy, c * hy + s * hx);
-    offer(e, other, c * hx + s * hy, c * hy - s * hx);
+    detail::offer_through(qx, qy, ql, clear, wx, wy, tau,
+                          [&](double nx, double ny) { offer(e, other, nx, ny); });
   }
   return best;
 }
@@ -105,12 +117,7 @@ inline SeparatingLine separating_line(double cx, double cy, double R, double px,
       best = {nx, ny, d - R};
     }
   };
-  const double gx = wx + qx / tau, gy = wy + qy / tau, gl = std::sqrt(gx * gx + gy * gy);
-  if (gl > 0) offer(gx / gl, gy / gl);
-  const double c = clear / ql, s = std::sqrt(std::max(0.0, 1 - c * c));
-  const double hx = qx / ql, hy = qy / ql;
-  offer(c * hx - s * hy, c * hy + s * hx);
-  offer(c * hx + s * hy, c * hy - s * hx);
+  detail::offer_through(qx, qy, ql, clear, wx, wy, tau, offer);
   return best;
 }
 

@@ -35,6 +35,27 @@ double line_room(const SeparatingLine& l, double wx, double wy, double r, double
   return wx * l.nx + wy * l.ny + (l.d - r) / tau;
 }
 
+// Permitted velocities (v . n >= -(d - r) / tau, up to 3 m/s), the wish among them when it is
+// permitted: gap(q), how far the path p -> q of the next tau keeps the centre from the feature,
+// stays at least `clear`.
+template <class Gap>
+void expect_permitted_clear(const SeparatingLine& l, Vec2 p, double r, double tau, double wx,
+                            double wy, double clear, std::mt19937_64& rng, Gap gap) {
+  std::uniform_real_distribution<double> ang(0, 2 * std::acos(-1.0)), mag(0, 3);
+  const double bound = -(l.d - r) / tau;
+  for (int k = 0; k < 64; ++k) {
+    double vx = wx, vy = wy;
+    if (k > 0) {
+      const double a = ang(rng), m = mag(rng);
+      vx = m * std::cos(a);
+      vy = m * std::sin(a);
+    }
+    if (vx * l.nx + vy * l.ny < bound) continue;
+    EXPECT_GE(gap(Vec2{p.x + vx * tau, p.y + vy * tau}), clear - 1e-9)
+        << "velocity (" << vx << ", " << vy << ")";
+  }
+}
+
 // One case: the line's own claims, then the swept disc for permitted velocities.
 void check_line(Vec2 a0, Vec2 a1, Vec2 p, double r, double tau, double wx, double wy,
                 std::mt19937_64& rng) {
@@ -52,21 +73,9 @@ void check_line(Vec2 a0, Vec2 a1, Vec2 p, double r, double tau, double wx, doubl
   const Vec2 c = closest_on_segment(a0, a1, p.x, p.y);
   const SeparatingLine tangent{(p.x - c.x) / nearest, (p.y - c.y) / nearest, nearest};
   EXPECT_GE(line_room(l, wx, wy, r, tau), line_room(tangent, wx, wy, r, tau) - 1e-12);
-  // Permitted velocities (v . n >= -(d - r) / tau, up to 3 m/s), the wish among them when it is
-  // permitted: the disc stays clear of the edge for tau.
-  std::uniform_real_distribution<double> ang(0, 2 * std::acos(-1.0)), mag(0, 3);
-  const double bound = -(l.d - r) / tau;
-  for (int k = 0; k < 64; ++k) {
-    double vx = wx, vy = wy;
-    if (k > 0) {
-      const double a = ang(rng), m = mag(rng);
-      vx = m * std::cos(a);
-      vy = m * std::sin(a);
-    }
-    if (vx * l.nx + vy * l.ny < bound) continue;
-    const Vec2 q{p.x + vx * tau, p.y + vy * tau};
-    EXPECT_GE(swept_gap(p, q, a0, a1), r - 1e-9) << "velocity (" << vx << ", " << vy << ")";
-  }
+  // The disc stays clear of the edge for tau.
+  expect_permitted_clear(l, p, r, tau, wx, wy, r, rng,
+                         [&](Vec2 q) { return swept_gap(p, q, a0, a1); });
 }
 
 TEST(SeparatingLine, EveryPermittedVelocityKeepsTheDiscClearOfTheEdge) {
@@ -127,7 +136,7 @@ TEST(SeparatingLine, LetsAnAgentPassADoorPostsCorner) {
 TEST(SeparatingLine, EveryPermittedVelocityKeepsTheDiscClearOfTheCircle) {
   std::mt19937_64 rng(13);
   std::uniform_real_distribution<double> u(-3, 3), rad(0.05, 0.6), big(0.01, 2), speed(0, 2),
-      ang(0, 2 * std::acos(-1.0)), mag(0, 3);
+      ang(0, 2 * std::acos(-1.0));
   const double taus[] = {0.1, 0.5, 2};
   int cases = 0;
   while (cases < 4000) {
@@ -151,19 +160,8 @@ TEST(SeparatingLine, EveryPermittedVelocityKeepsTheDiscClearOfTheCircle) {
     EXPECT_NEAR(qx * l.nx + qy * l.ny - R, l.d, 1e-12);  // a tangent: the circle behind it
     const SeparatingLine tangent{qx / ql, qy / ql, ql - R};
     EXPECT_GE(line_room(l, wx, wy, r, tau), line_room(tangent, wx, wy, r, tau) - 1e-12);
-    const double bound = -(l.d - r) / tau;
-    for (int k = 0; k < 64; ++k) {
-      double vx = wx, vy = wy;
-      if (k > 0) {
-        const double a = ang(rng), m = mag(rng);
-        vx = m * std::cos(a);
-        vy = m * std::sin(a);
-      }
-      if (vx * l.nx + vy * l.ny < bound) continue;
-      const Vec2 q{p.x + vx * tau, p.y + vy * tau};
-      EXPECT_GE(std::sqrt(dist2_to_segment(p, q, c.x, c.y)), R + r - 1e-9)
-          << "velocity (" << vx << ", " << vy << ")";
-    }
+    expect_permitted_clear(l, p, r, tau, wx, wy, R + r, rng,
+                           [&](Vec2 q) { return std::sqrt(dist2_to_segment(p, q, c.x, c.y)); });
     ++cases;
   }
 }
