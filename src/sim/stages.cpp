@@ -134,6 +134,19 @@ int out_before_in(const AgentTable& t, std::span<const Goal> goals, std::size_t 
   return i_out == j_out ? 0 : (i_out ? 1 : -1);
 }
 
+AheadInput ahead_input(const AgentTable& t, std::span<const Goal> goals, std::size_t i) {
+  AheadInput h;
+  const double dx = t.target_x[i] - t.x[i], dy = t.target_y[i] - t.y[i];
+  const double to_target = std::sqrt(dx * dx + dy * dy);
+  h.way_x = to_target > 0 ? dx / to_target : 0;
+  h.way_y = to_target > 0 ? dy / to_target : 0;
+  const Goal& g = goals[t.goal[i]];
+  h.goal_x = g.x - t.x[i];
+  h.goal_y = g.y - t.y[i];
+  h.goal2 = h.goal_x * h.goal_x + h.goal_y * h.goal_y;
+  return h;
+}
+
 void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,
                 uint64_t tick, std::span<const uint32_t> demand, Preferred& pref, Executor& ex,
                 const path::Navigation* nav, AimMemo* aims) {

@@ -217,14 +217,19 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     const auto j = static_cast<std::size_t>(blocker[q]);
     const bool blocker_stalled = blocker[q] >= 0 && t.stall_ticks[j] >= after &&
                                  !(bpos[q] >= 0 && queueing[static_cast<std::size_t>(bpos[q])]);
-    // The one with less of its path left goes first (at a clogged door: the one nearest to
-    // getting through), as in orca's right of way; ties by the seeded rank.
-    // Out before in (sim::out_before_in) comes before that.
+    // As in orca's right of way: out before in (sim::out_before_in), then, of two bound for
+    // different goals the same way, the one ahead (sim::ahead), then the one with less of its
+    // path left (at a clogged door: the one nearest to getting through); ties by the seeded rank.
     const double li = path_left(t, goals, i), lj = blocker_stalled ? path_left(t, goals, j) : 0;
     const int out = blocker_stalled ? out_before_in(t, goals, i, j) : 0;
+    bool i_ahead = false;
+    const bool by_place = blocker_stalled && out == 0 && t.goal[i] != t.goal[j] &&
+                          ahead(ahead_input(t, goals, i), ahead_input(t, goals, j), t.x[i], t.y[i],
+                                t.x[j], t.y[j], i_ahead);
     bool j_first =
-        out != 0
-            ? out < 0
+        out != 0 ? out < 0
+        : by_place
+            ? !i_ahead
             : lj < li || (lj == li && priority(cfg.seed, t.id[j]) > priority(cfg.seed, t.id[i]));
     // Taking turns: a pair both stalled for reverse_after swaps the order in every other period
     // (the same for both of them: it depends on the pair and the tick only).

@@ -20,9 +20,9 @@
 //     nothing acted).
 // Resolution (deterministic: it depends on the committed state, the seed and the ids only). Of
 // two stalled agents one coming out of the goal the other heads for goes first (out before in,
-// sim::out_before_in), else the one with less of its path left (at a clogged door: the one
-// nearest to getting through), as in orca's right of way; ties go by a seeded rank (a hash of
-// seed and id):
+// sim::out_before_in), else, of two bound for different goals the same way, the one ahead
+// (sim::ahead), else the one with less of its path left (at a clogged door: the one nearest to
+// getting through), as in orca's right of way; ties go by a seeded rank (a hash of seed and id):
 //   - the blocker is stalled too and goes first: yield, i.e. step back from it and to the side
 //     away from it at half speed; when the chain of stalled blockers in front ends in people
 //     going its way or across (an arch at a door, not two streams head-on), the yield lasts

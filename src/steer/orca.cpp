@@ -288,11 +288,7 @@ class OrcaModel final : public Model {
       arrive_.resize(n);
       yielding_.resize(n);
       rank_.resize(n);
-      head_x_.resize(n);
-      head_y_.resize(n);
-      bound_x_.resize(n);
-      bound_y_.resize(n);
-      bound2_.resize(n);
+      heading_.resize(n);
       avoid_x_.resize(n);
       avoid_y_.resize(n);
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
@@ -312,14 +308,7 @@ class OrcaModel final : public Model {
           ay += held * (in.pref_vy[i] - ay);
           avoid_x_[i] = ax;
           avoid_y_[i] = ay;
-          const double dx = t.target_x[i] - t.x[i], dy = t.target_y[i] - t.y[i];
-          const double to_target = std::sqrt(dx * dx + dy * dy);
-          head_x_[i] = to_target > 0 ? dx / to_target : 0;
-          head_y_[i] = to_target > 0 ? dy / to_target : 0;
-          const Goal& g = in.goals[t.goal[i]];
-          bound_x_[i] = g.x - t.x[i];
-          bound_y_[i] = g.y - t.y[i];
-          bound2_[i] = bound_x_[i] * bound_x_[i] + bound_y_[i] * bound_y_[i];
+          heading_[i] = sim::ahead_input(t, in.goals, i);
           uint64_t h = in.cfg.seed ^ (t.id[i] * 0x9e3779b97f4a7c15ull);
           rank_[i] = splitmix64(h);
         }
@@ -621,8 +610,8 @@ class OrcaModel final : public Model {
   }
 
   // Does i go before j? An agent yielding to a stalemate (see the top), then out before in
-  // (sim::out_before_in), then, for two walking to different goals, the one ahead (see the top),
-  // then less path left, then the seeded rank.
+  // (sim::out_before_in), then, for two walking to different goals, the one ahead (see the top;
+  // sim::ahead), then less path left, then the seeded rank.
   bool first(const TickInput& in, std::size_t i, std::size_t j) const {
     if (yielding_[i] != yielding_[j]) return yielding_[i];
     const AgentTable& t = in.agents;
@@ -635,23 +624,10 @@ class OrcaModel final : public Model {
     const bool by_path = (remaining_[i] < remaining_[j]) |
                          ((remaining_[i] == remaining_[j]) & (rank_[i] > rank_[j]));
     bool by_place;
-    return ahead(in, i, j, by_place) ? by_place : by_path;
-  }
-  // The one ahead (see the top): true when the rule decides, with `i_first` true when i is ahead
-  // of j along their summed headings; it does not decide for the same goal, either idle, goals
-  // not the same way, headings more than 120 degrees apart, or level. Antisymmetric bit for bit:
-  // the tests are symmetric, and the sum and the offset only change sign.
-  bool ahead(const TickInput& in, std::size_t i, std::size_t j, bool& i_first) const {
-    const AgentTable& t = in.agents;
-    const double sx = head_x_[i] + head_x_[j], sy = head_y_[i] + head_y_[j];
-    const double d = sx * (t.x[i] - t.x[j]) + sy * (t.y[i] - t.y[j]);
-    i_first = d > 0;
-    // Bound the same way: the straight lines to the goals within 60 degrees (kSameWay; squared,
-    // so no root per row); the headings within 120 degrees: |u_i + u_j| >= 1.
-    const double dot = bound_x_[i] * bound_x_[j] + bound_y_[i] * bound_y_[j];
-    return (t.goal[i] != t.goal[j]) & std::isfinite(remaining_[i]) & std::isfinite(remaining_[j]) &
-           (dot > 0) & (dot * dot >= kSameWay * kSameWay * (bound2_[i] * bound2_[j])) &
-           (sx * sx + sy * sy >= 1) & (d != 0);
+    const bool decides =
+        (t.goal[i] != t.goal[j]) & std::isfinite(remaining_[i]) & std::isfinite(remaining_[j]) &
+        sim::ahead(heading_[i], heading_[j], t.x[i], t.y[i], t.x[j], t.y[j], by_place);
+    return decides ? by_place : by_path;
   }
 
   NeighbourLists nb_;
@@ -668,9 +644,7 @@ class OrcaModel final : public Model {
   std::vector<uint8_t> yielding_;
   std::vector<uint64_t> rank_;
   std::vector<double> avoid_x_, avoid_y_;
-  // Per row: the unit direction to its waypoint (or 0); the offset to its goal's point and its
-  // square.
-  std::vector<double> head_x_, head_y_, bound_x_, bound_y_, bound2_;
+  std::vector<sim::AheadInput> heading_;  // per row: what the one ahead reads of it
   std::vector<uint64_t> infeasible_;
   StreamMarks streams_;  // who is at or behind a meeting of streams (stream gap)
   std::map<std::string, std::unique_ptr<NeighbourPath>> neighbour_paths_;
