@@ -3,9 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
 #include <tuple>
+#include <utility>
 
 #include "sim/stages.hpp"
+#include "util/rng.hpp"
 
 namespace crowddb::sim {
 namespace {
@@ -113,6 +117,7 @@ struct Pair {
     w.add_goal({"W", 0, 5, 0.5, 1, {}});
     w.add_goal({"E", 39, 5, 0.5, 1, {}});
     w.add_goal({"S", 5, -20, 0.5, 1, {}});
+    w.add_goal({"WS", 0, -5, 0.5, 1, {}});
     for (auto [x, y, g] : {std::tuple{ax, ay, ga}, std::tuple{bx, by, gb}}) {
       AgentSpec a;
       a.x = x;
@@ -194,6 +199,78 @@ TEST(Stalemates, OneComingOutOfTheOthersGoalGoesFirst) {
   EXPECT_EQ(s.run().yielding, 1u);
   EXPECT_EQ(s.w.agents().stall_action[0], StallAction::yield);
   EXPECT_EQ(s.w.agents().stall_action[1], StallAction::none);
+}
+
+// The one ahead: a (10 m from W) has less path left than b, which stands in front of it (0.55 m
+// further west) bound for WS (0, -5), 13.8 m away, the same way (45 degrees apart). By path left
+// a would go on and b yield; b is ahead, so a yields.
+TEST(Stalemates, OfTwoBoundTheSameWayForDifferentGoalsTheOneAheadGoesOn) {
+  Pair s(10, 5, 0, 9.45, 5, 3);
+  const AgentTable& t = s.w.agents();
+  ASSERT_LT(path_left(t, s.w.goals(), 0), path_left(t, s.w.goals(), 1));
+  bool a_first = true;
+  ASSERT_TRUE(ahead(ahead_input(t, s.w.goals(), 0), ahead_input(t, s.w.goals(), 1), t.x[0], t.y[0],
+                    t.x[1], t.y[1], a_first));
+  EXPECT_FALSE(a_first);
+  EXPECT_GE(s.run().yielding, 1u);
+  EXPECT_TRUE(t.stall_action[0] == StallAction::yield ||
+              t.stall_action[0] == StallAction::yield_ahead);
+  EXPECT_NE(t.stall_action[1], StallAction::yield);
+  EXPECT_NE(t.stall_action[1], StallAction::yield_ahead);
+}
+
+// sim::ahead is antisymmetric bit for bit (orca's shares add up to one only then), and decides
+// only for goals within 60 degrees and headings within 120 degrees, against a naive twin in
+// angles on random and rounded inputs.
+TEST(Stalemates, TheOneAheadIsAntisymmetricAndDecidesWhereItShould) {
+  Rng rng = Rng::stream(7, 1);
+  int decided = 0;
+  for (int k = 0; k < 20000; ++k) {
+    auto unit = [&] {
+      const double a = rng.uniform(0, 2 * std::numbers::pi);
+      return std::pair{std::cos(a), std::sin(a)};
+    };
+    // Every fourth input on a coarse grid, so that ties and exact boundaries come up.
+    const bool coarse = k % 4 == 0;
+    auto coord = [&](double lo, double hi) {
+      const double v = rng.uniform(lo, hi);
+      return coarse ? std::round(v) : v;
+    };
+    AheadInput a, b;
+    std::tie(a.way_x, a.way_y) = unit();
+    std::tie(b.way_x, b.way_y) = unit();
+    a.goal_x = coord(-50, 50), a.goal_y = coord(-50, 50), b.goal_x = coord(-50, 50),
+    b.goal_y = coord(-50, 50);
+    a.goal2 = a.goal_x * a.goal_x + a.goal_y * a.goal_y;
+    b.goal2 = b.goal_x * b.goal_x + b.goal_y * b.goal_y;
+    const double ax = coord(-5, 5), ay = coord(-5, 5), bx = coord(-5, 5), by = coord(-5, 5);
+    bool a_first = false, b_first = false;
+    const bool ab = ahead(a, b, ax, ay, bx, by, a_first);
+    const bool ba = ahead(b, a, bx, by, ax, ay, b_first);
+    ASSERT_EQ(ab, ba) << k;
+    if (ab) {
+      ASSERT_NE(a_first, b_first) << k;
+    }
+    decided += ab;
+    // The naive twin: angles, away from the boundaries (1e-9 rad).
+    const double goals_apart = std::abs(std::remainder(
+        std::atan2(a.goal_y, a.goal_x) - std::atan2(b.goal_y, b.goal_x), 2 * std::numbers::pi));
+    const double ways_apart = std::abs(std::remainder(
+        std::atan2(a.way_y, a.way_x) - std::atan2(b.way_y, b.way_x), 2 * std::numbers::pi));
+    const double sx = a.way_x + b.way_x, sy = a.way_y + b.way_y;
+    const double along = sx * (ax - bx) + sy * (ay - by);
+    const double margin = 1e-9;
+    if (a.goal2 == 0 || b.goal2 == 0 || std::abs(goals_apart - std::numbers::pi / 3) < margin ||
+        std::abs(ways_apart - 2 * std::numbers::pi / 3) < margin || std::abs(along) < margin)
+      continue;
+    const bool expected =
+        goals_apart < std::numbers::pi / 3 && ways_apart < 2 * std::numbers::pi / 3;
+    ASSERT_EQ(ab, expected) << k << ": goals " << goals_apart << " ways " << ways_apart;
+    if (ab) {
+      ASSERT_EQ(a_first, along > 0) << k;
+    }
+  }
+  EXPECT_GT(decided, 1000);  // the random inputs reach both answers
 }
 
 TEST(Stalemates, OutBeforeInOnlyForTheOneNearerTheGoalAndBothWalking) {
