@@ -75,30 +75,33 @@ double path_left(const AgentTable& t, std::span<const Goal> goals, std::size_t i
 // tradeshow of 1,025 visitors with booth waits: 1,744 -> 1,271 visits in 300 s, seeds 1-3).
 int out_before_in(const AgentTable& t, std::span<const Goal> goals, std::size_t i, std::size_t j);
 
+// Cos 60 degrees: two directions this close are "the same way".
+inline constexpr double kSameWay = 0.5;
+
 // The one ahead (orca's right of way, docs/steering.md item 3): path left to different goals
 // does not say who is in front. Of two walking rows bound for different goals the same way (the
 // straight lines to their goals within 60 degrees) whose headings (unit vectors to their
 // waypoints) are less than 120 degrees apart, the one further along the sum of the headings
 // goes first: their paths left, linearised. What a row brings to the test, from its columns:
 struct AheadInput {
+  double x = 0, y = 0;                       // [m] its position
   double way_x = 0, way_y = 0;               // the unit vector to its waypoint (0 on it)
   double goal_x = 0, goal_y = 0, goal2 = 0;  // [m] the offset to its goal's point, its square
+  uint32_t goal = 0;
 };
 AheadInput ahead_input(const AgentTable& t, std::span<const Goal> goals, std::size_t i);
-// The test for rows a and b (at (ax, ay) and (bx, by)), bound for different goals and walking
-// (the caller's part): true when it decides, with a_first true when a is ahead. Antisymmetric
-// bit for bit. Without branches: which of two goes first is a coin toss to the predictor, and
-// orca asks it for every neighbour of every row.
-inline bool ahead(const AheadInput& a, const AheadInput& b, double ax, double ay, double bx,
-                  double by, bool& a_first) {
+// The test for two walking rows (that they walk is the caller's part): true when it decides,
+// with a_first true when a is ahead. Antisymmetric bit for bit. Without branches: which of two
+// goes first is a coin toss to the predictor, and orca asks it for every neighbour of every row.
+inline bool ahead(const AheadInput& a, const AheadInput& b, bool& a_first) {
   const double sx = a.way_x + b.way_x, sy = a.way_y + b.way_y;
-  const double d = sx * (ax - bx) + sy * (ay - by);
+  const double d = sx * (a.x - b.x) + sy * (a.y - b.y);
   a_first = d > 0;
-  // Bound the same way: 60 degrees is kSameWay = 0.5 (steer/streams.hpp), squared here so that
-  // no root is taken per row; the headings within 120 degrees: |u_a + u_b| >= 1.
+  // Bound the same way, squared so that no root is taken per row; the headings within 120
+  // degrees: |u_a + u_b| >= 1.
   const double dot = a.goal_x * b.goal_x + a.goal_y * b.goal_y;
-  return (dot > 0) & (dot * dot >= 0.5 * 0.5 * (a.goal2 * b.goal2)) & (sx * sx + sy * sy >= 1) &
-         (d != 0);
+  return (a.goal != b.goal) & (dot > 0) & (dot * dot >= kSameWay * kSameWay * (a.goal2 * b.goal2)) &
+         (sx * sx + sy * sy >= 1) & (d != 0);
 }
 
 // The goal stage: per row, the preferred velocity pref_speed towards its current target (slower

@@ -12,7 +12,6 @@ namespace crowddb::sim {
 namespace {
 
 constexpr double kBlockGap = 0.6;  // [m] a blocker's disc is this close to the agent's, or less
-constexpr double kSameWay = 0.5;   // cos 60 degrees: directions this close are the same way
 constexpr double kFreeWalk = 0.5;  // walking at half the preferred speed towards the target
 constexpr double kOpposed = -0.5;  // cos 120 degrees: directions further apart head at each other
 constexpr std::size_t kWatchGrain = 256;  // rows per chunk of the progress watch
@@ -223,9 +222,8 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     const double li = path_left(t, goals, i), lj = blocker_stalled ? path_left(t, goals, j) : 0;
     const int out = blocker_stalled ? out_before_in(t, goals, i, j) : 0;
     bool i_ahead = false;
-    const bool by_place = blocker_stalled && out == 0 && t.goal[i] != t.goal[j] &&
-                          ahead(ahead_input(t, goals, i), ahead_input(t, goals, j), t.x[i], t.y[i],
-                                t.x[j], t.y[j], i_ahead);
+    const bool by_place = blocker_stalled && out == 0 &&
+                          ahead(ahead_input(t, goals, i), ahead_input(t, goals, j), i_ahead);
     bool j_first =
         out != 0 ? out < 0
         : by_place

@@ -624,9 +624,8 @@ class OrcaModel final : public Model {
     const bool by_path = (remaining_[i] < remaining_[j]) |
                          ((remaining_[i] == remaining_[j]) & (rank_[i] > rank_[j]));
     bool by_place;
-    const bool decides =
-        (t.goal[i] != t.goal[j]) & std::isfinite(remaining_[i]) & std::isfinite(remaining_[j]) &
-        sim::ahead(heading_[i], heading_[j], t.x[i], t.y[i], t.x[j], t.y[j], by_place);
+    const bool decides = std::isfinite(remaining_[i]) & std::isfinite(remaining_[j]) &
+                         sim::ahead(heading_[i], heading_[j], by_place);
     return decides ? by_place : by_path;
   }
 

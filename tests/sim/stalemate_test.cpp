@@ -209,8 +209,7 @@ TEST(Stalemates, OfTwoBoundTheSameWayForDifferentGoalsTheOneAheadGoesOn) {
   const AgentTable& t = s.w.agents();
   ASSERT_LT(path_left(t, s.w.goals(), 0), path_left(t, s.w.goals(), 1));
   bool a_first = true;
-  ASSERT_TRUE(ahead(ahead_input(t, s.w.goals(), 0), ahead_input(t, s.w.goals(), 1), t.x[0], t.y[0],
-                    t.x[1], t.y[1], a_first));
+  ASSERT_TRUE(ahead(ahead_input(t, s.w.goals(), 0), ahead_input(t, s.w.goals(), 1), a_first));
   EXPECT_FALSE(a_first);
   EXPECT_GE(s.run().yielding, 1u);
   EXPECT_TRUE(t.stall_action[0] == StallAction::yield ||
@@ -244,9 +243,11 @@ TEST(Stalemates, TheOneAheadIsAntisymmetricAndDecidesWhereItShould) {
     a.goal2 = a.goal_x * a.goal_x + a.goal_y * a.goal_y;
     b.goal2 = b.goal_x * b.goal_x + b.goal_y * b.goal_y;
     const double ax = coord(-5, 5), ay = coord(-5, 5), bx = coord(-5, 5), by = coord(-5, 5);
+    a.x = ax, a.y = ay, b.x = bx, b.y = by;
+    a.goal = 0, b.goal = 1;
     bool a_first = false, b_first = false;
-    const bool ab = ahead(a, b, ax, ay, bx, by, a_first);
-    const bool ba = ahead(b, a, bx, by, ax, ay, b_first);
+    const bool ab = ahead(a, b, a_first);
+    const bool ba = ahead(b, a, b_first);
     ASSERT_EQ(ab, ba) << k;
     if (ab) {
       ASSERT_NE(a_first, b_first) << k;
