@@ -111,10 +111,13 @@
 // (686 and 164 of 2,000 and 480 arrived). So the agent looks pass_look (10 m) ahead for someone
 // passing, through a grid of its own (steer/passing.hpp), and turns 30 degrees: the streams move
 // to their sides before they meet (2,000 of 2,000 and 480 of 480; docs/steering.md). Not within
-// kTurnNearWaypoint (2 m) of its waypoint: there the path bends (a corridor's mouth, a door), and
-// a turned wish pressed people coming out of a room against the wall beside the mouth while the
-// other stream took the whole corridor (a corridor between two rooms lost a sixth of its
-// arrivals).
+// kTurnNearWaypoint (2 m) of a waypoint where the path bends sharply (steer::bends_sharply: more
+// than 45 degrees), or of the goal: there (a corridor's mouth, a door) a turned wish pressed
+// people coming out of a room against the wall beside the mouth while the other stream took the
+// whole corridor (a corridor between two rooms lost a sixth of its arrivals). A route round a
+// pillar bends gently at corners a metre apart, so until 2026-12-01 (no turn within 2 m of any
+// waypoint) nobody kept to a side on a pillar's face, where the knots with airport-5000's longest
+// stalls formed (docs/steering.md).
 //
 // No sweeping back (ours): avoiding a stream that goes first, ORCA's closest permitted velocity
 // can point backwards, and a lone agent against a group (or a traveller crossing a queue for a
@@ -410,7 +413,8 @@ class OrcaModel final : public Model {
       os << " turned " << explain_number(kSideTurn * 180 / std::numbers::pi) << " deg to the "
          << (p.pass_side == OrcaParams::PassSide::right ? "right" : "left")
          << " when someone passing comes towards the agent in its lane (not within "
-         << explain_number(kTurnNearWaypoint) << " m of its waypoint)";
+         << explain_number(kTurnNearWaypoint) << " m of a waypoint where its path bends more than "
+         << explain_number(kSharpBend) << " deg, or of its goal)";
     if (p.time_gap > 0)
       os << " capped at spacing / " << explain_number(p.time_gap)
          << " s to the agent ahead going the same way";
@@ -478,6 +482,18 @@ class OrcaModel final : public Model {
     py = ny;
   }
 
+  // Does row i's path bend sharply at its waypoint (dx, dy away)? The goal counts as a bend (a
+  // gate, a door).
+  static bool bends_there(const TickInput& in, std::size_t i, double dx, double dy) {
+    const AgentTable& t = in.agents;
+    const auto& route = t.route[i];
+    if (route.empty()) return true;
+    const Vec2 after = route.size() > 1 ? route[1]
+                                        : goal_target(in.goals[t.goal[i]], t.target_x[i],
+                                                      t.target_y[i], t.radius[i]);
+    return bends_sharply(dx, dy, after.x - t.target_x[i], after.y - t.target_y[i]);
+  }
+
   static PassingView passing_view(const TickInput& in) {
     const AgentTable& t = in.agents;
     return {t.x, t.y, t.radius, in.pref_vx, in.pref_vy, t.target_x, t.target_y};
@@ -509,7 +525,8 @@ class OrcaModel final : public Model {
         const double w = std::sqrt(wx * wx + wy * wy);
         if (!(w > kStanding)) continue;  // (a wish this small has no reliable direction)
         const double dx = t.target_x[i] - t.x[i], dy = t.target_y[i] - t.y[i];
-        if (dx * dx + dy * dy < kTurnNearWaypoint * kTurnNearWaypoint) continue;
+        if (dx * dx + dy * dy < kTurnNearWaypoint * kTurnNearWaypoint && bends_there(in, i, dx, dy))
+          continue;
         const double ux = wx / w, uy = wy / w;
         bool seen = false;
         if (neighbours) {

@@ -58,6 +58,19 @@ inline bool passing(const PassingView& v, std::size_t i, std::size_t j, double u
   return (v.target_x[i] - v.x[j]) * wx + (v.target_y[i] - v.y[j]) * wy < 0;
 }
 
+// Keeping to one side stops near a waypoint where the path bends sharply (a corridor's mouth, a
+// door; steer/orca.cpp), not where it bends gently (the corners of a route round a pillar, a
+// metre apart and 15-25 degrees each). (dx, dy): from the agent to its waypoint; (ex, ey): from
+// the waypoint to the point after it. Sharp: turning by more than kSharpBend degrees, or no
+// direction after it (the waypoint is the last point). Squared, so that no root is taken.
+inline constexpr double kSharpBend = 45;                      // [degrees]
+inline constexpr double kSharpBendCos = 0.70710678118654752;  // its cosine
+inline bool bends_sharply(double dx, double dy, double ex, double ey) {
+  const double dot = dx * ex + dy * ey;
+  return dot <= 0 ||
+         dot * dot < kSharpBendCos * kSharpBendCos * (dx * dx + dy * dy) * (ex * ex + ey * ey);
+}
+
 // The naive twin: is any row passing row i within `look` ahead?
 bool passing_ahead_naive(const PassingView& v, std::size_t i, double ux, double uy, double look);
 

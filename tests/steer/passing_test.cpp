@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "util/executor.hpp"
@@ -230,6 +231,33 @@ TEST(PassingLookahead, ConvergingBehindOrStandingIsNotPassing) {
   EXPECT_FALSE(passing_ahead_naive(d.view(), 0, 1, 0, 9.99));  // beyond the look-ahead
   compare(c, kLooks);
   compare(d, kLooks);
+}
+
+// Keeping to one side stops near a sharp bend only: a route's corners round a pillar (15-25
+// degrees each) are gentle, a corridor's mouth or a door (90 degrees) is sharp, and so is a
+// waypoint with nothing after it. The test turns a leg by every angle, at any length and in any
+// direction, against the angle computed with a root.
+TEST(BendsSharply, AtMoreThan45DegreesOrWithNothingAfter) {
+  EXPECT_NEAR(std::cos(kSharpBend * std::numbers::pi / 180), kSharpBendCos, 1e-15);
+  EXPECT_FALSE(bends_sharply(1, 0, 1, 0));        // straight on
+  EXPECT_FALSE(bends_sharply(1, 0, 0.94, 0.34));  // 20 degrees: round a pillar
+  EXPECT_TRUE(bends_sharply(1, 0, 0, 1));         // 90: a corridor's mouth
+  EXPECT_TRUE(bends_sharply(1, 0, -1, 0));        // back the way it came
+  EXPECT_TRUE(bends_sharply(1, 0, 0, 0));         // the last point
+  EXPECT_TRUE(bends_sharply(0, 0, 1, 0));         // on the waypoint
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (int k = 0; k < 20000; ++k) {
+    const double heading = 2 * std::numbers::pi * unit(rng);
+    const double turn = std::numbers::pi * (2 * unit(rng) - 1);
+    const double a = 0.01 + 10 * unit(rng), b = 0.01 + 10 * unit(rng);
+    const double degrees = std::abs(turn) * 180 / std::numbers::pi;
+    if (std::abs(degrees - kSharpBend) < 1e-6) continue;  // rounding decides on the boundary
+    EXPECT_EQ(bends_sharply(a * std::cos(heading), a * std::sin(heading),
+                            b * std::cos(heading + turn), b * std::sin(heading + turn)),
+              degrees > kSharpBend)
+        << degrees << " degrees";
+  }
 }
 
 }  // namespace
