@@ -194,9 +194,22 @@ std::size_t Navigation::apply_results(World& world, uint64_t tick) {
 }
 
 std::size_t Navigation::request_paths(World& world, uint64_t tick,
-                                      const std::vector<uint32_t>& head_on) {
+                                      const std::vector<uint32_t>& head_on,
+                                      const std::vector<uint64_t>& lost_sight) {
   AgentTable& t = world.agents_for_tick();
   std::size_t made = 0;
+  // Per row, when anyone lost sight. Not those whose route ends short of the goal (walled in, or
+  // no path): a search from anywhere ends there again, and they stand pressed against its end.
+  // Nor those on a narrow mesh's route: its passages are barely wider than the agent, a ray
+  // through one is blocked as often as not, and one squeezing into an aircraft's aisle was
+  // re-planned at its entrance every second and never got in.
+  std::vector<uint8_t> lost;
+  if (!lost_sight.empty()) {
+    lost.assign(t.size(), 0);
+    for (uint64_t id : lost_sight)
+      if (const auto row = world.row_of(AgentId::from_value(id)))
+        lost[*row] = short_routes_.count(id) == 0 && narrow_routes_.count(id) == 0;
+  }
   // Requests are numbered and queued in agent id order, not row order: who is served first
   // within the budget must not depend on where a row happens to sit (src/sim/row_order.hpp).
   struct Due {
@@ -207,8 +220,10 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick,
   std::vector<Due> due;
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (standing(t.state[i])) continue;  // idle or waiting at its goal
-    // The progress watch (stalemate.cpp) counts the ticks without progress since the last request.
-    const bool stalled = replan_ticks_ > 0 && t.replan_ticks[i] >= replan_ticks_;
+    // The progress watch (stalemate.cpp) counts the ticks without progress since the last request;
+    // the goal stage saw some lose sight of their targets (sim::goal_stage).
+    const bool stalled =
+        (replan_ticks_ > 0 && t.replan_ticks[i] >= replan_ticks_) || (!lost.empty() && lost[i]);
     const bool new_goal = t.path_goal[i] != t.goal[i];
     if (!new_goal && !stalled) continue;
     if (stalled) {

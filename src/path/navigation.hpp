@@ -4,11 +4,12 @@
 //
 //   start of tick t:  apply_results  — results due at t become the agents' routes
 //   Q1 attraction:    visible        — skip a waypoint when the one after it is in sight
-//   after commit:     request_paths  — progress watch, new requests, dispatch within the budget
+//   after commit:     request_paths  — progress watch, lost sight, new requests, dispatch
 //
 // Requests: an agent asks for a path when its route was not planned for its current goal (a
 // new agent, a changed goal) or when it made no progress towards its current waypoint for
-// `replan_after` seconds (the progress watch of src/sim/stalemate.hpp counts the ticks). Requests
+// `replan_after` seconds (the progress watch of src/sim/stalemate.hpp counts the ticks), or lost
+// sight of it (sim::goal_stage: pushed behind an obstacle). Requests
 // wait in FIFO order; each tick at most `budget` of them are dispatched to the worker, with the
 // agent's position at that moment, due `latency` ticks later. A newer request for the same agent
 // supersedes an older one (tickets). Everything here is decided from simulation state only, so runs
@@ -83,7 +84,10 @@ class Navigation {
   // After the commit of `tick`: progress watch, requests, dispatch. Returns requests made.
   // `head_on`: rows stalled where streams meet head-on (sim::StallCounts), in row order; the
   // searches dispatched plan round them.
-  std::size_t request_paths(World& world, uint64_t tick, const std::vector<uint32_t>& head_on = {});
+  // `lost_sight`: ids of walkers that lost sight of their targets (sim::goal_stage): re-planned
+  // now (counted as re-plans), unless a search for them is on its way.
+  std::size_t request_paths(World& world, uint64_t tick, const std::vector<uint32_t>& head_on = {},
+                            const std::vector<uint64_t>& lost_sight = {});
 
   // Line of sight for agent `agent` (AgentId value) of `radius`: on its class mesh, or on the
   // narrow one when its route came from there. False when that mesh is not built yet.

@@ -524,6 +524,7 @@ const TickMetrics& Simulation::step() {
 
   // 5. commit: swap in the next state, advance waypoints, arrivals, goal sequences
   const uint64_t gridlock_ticks = cfg.ticks_for(cfg.gridlock_time);
+  std::vector<uint64_t> lost_sight;  // ids of the walkers that lost sight of their targets
   log.timed("commit", n, [&] {
     t.x.swap(e.next.x);
     t.y.swap(e.next.y);
@@ -535,6 +536,7 @@ const TickMetrics& Simulation::step() {
     struct Part {
       std::size_t frozen = 0, gridlock_started = 0, longest_frozen = 0, gridlocked = 0, arrived = 0;
       std::vector<std::size_t> leaving;
+      std::vector<uint64_t> lost_sight;  // ids (rows leave before the path requests)
     };
     std::vector<Part> parts((n + kCommitGrain - 1) / kCommitGrain);
     e.ex.for_each_chunk(n, kCommitGrain, [&](std::size_t begin, std::size_t end) {
@@ -585,7 +587,8 @@ const TickMetrics& Simulation::step() {
           t.frozen_ticks[i] = 0;
         }
         if (t.frozen_ticks[i] >= gridlock_ticks) ++c.gridlocked;
-        if (e.pref.skip[i] && !t.route[i].empty()) {  // the goal stage saw the waypoint after
+        if (e.pref.skip[i] == sim::kLostSight) c.lost_sight.push_back(t.id[i]);
+        if (e.pref.skip[i] == sim::kSkipWaypoint && !t.route[i].empty()) {  // saw the one after
           t.route[i].erase(t.route[i].begin());
           world_.refresh_target(i);
         }
@@ -625,6 +628,7 @@ const TickMetrics& Simulation::step() {
       m.gridlocked += c.gridlocked;
       m.arrived += c.arrived;
       leaving.insert(leaving.end(), c.leaving.begin(), c.leaving.end());
+      lost_sight.insert(lost_sight.end(), c.lost_sight.begin(), c.lost_sight.end());
     }
     world_.remove_rows(std::move(leaving));
   });
@@ -649,7 +653,8 @@ const TickMetrics& Simulation::step() {
   // 7. path requests: new requests, re-plans, dispatch to the worker within the budget
   if (e.nav) {
     std::size_t made = 0;
-    log.timed("path requests", 0, [&] { made = e.nav->request_paths(world_, m.tick, head_on); });
+    log.timed("path requests", 0,
+              [&] { made = e.nav->request_paths(world_, m.tick, head_on, lost_sight); });
     log.at("path requests").rows += made;
   }
   m.agents = world_.agents().size();
@@ -739,15 +744,19 @@ std::string Simulation::explain() const {
      << num(cfg.stall.after) << " s without getting " << num(cfg.stall.progress) << " m closer"
      << (cfg.stall.resolve ? "; resolve: yield by seeded priority, else sidestep" : "; resolve off")
      << "\n";
-  if (e.nav)
-    os << "  " << step++ << " path requests      new goal or no progress for "
-       << num(nv.replan_after) << " s -> FIFO queue; <= " << nv.budget
-       << " dispatched per tick, due " << latency << " tick" << (latency == 1 ? "" : "s")
-       << " later; congestion "
+  if (e.nav) {
+    os << "  " << step++ << " path requests      new goal";
+    if (nv.replan_after > 0)
+      os << ", or no progress for " << num(nv.replan_after) << " s, or no sight "
+         << num(sim::kLostSightLook)
+         << " m towards its target (walking slower than half its speed)";
+    os << " -> FIFO queue; <= " << nv.budget << " dispatched per tick, due " << latency << " tick"
+       << (latency == 1 ? "" : "s") << " later; congestion "
        << (nv.congestion_cost > 0
                ? "+" + num(nv.congestion_cost) + " m per agent stalled head-on in a polygon"
                : std::string("off"))
        << "\n";
+  }
   return os.str();
 }
 

@@ -156,6 +156,8 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
   const double dt = cfg.dt;
   const bool sight = nav && cfg.navigation.skip_visible;
   const uint64_t sight_ticks = cfg.ticks_for(cfg.navigation.sight_interval);
+  const bool lost_sight = nav && cfg.navigation.replan_after > 0;
+  const uint64_t lost_ticks = cfg.ticks_for(kLostSightInterval);
   const uint64_t nudge_ticks = cfg.nudge_after > 0 ? cfg.ticks_for(cfg.nudge_after) : 0;
   const double noise = cfg.steering.perturbation;
   const NeededDiscs needed(t, goals, demand);
@@ -217,9 +219,19 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
                               ? route[1]
                               : goal_target(goals[t.goal[i]], t.x[i], t.y[i], t.radius[i]);
         if (nav->visible(t.radius[i], t.id[i], {t.x[i], t.y[i]}, next)) {
-          pref.skip[i] = 1;
+          pref.skip[i] = kSkipWaypoint;
           target = next;
         }
+      }
+      if (lost_sight && !pref.skip[i] && (tick + t.id[i]) % lost_ticks == 0 &&
+          t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i] < 0.25 * t.pref_speed[i] * t.pref_speed[i]) {
+        const double dx = target.x - t.x[i], dy = target.y - t.y[i];
+        const double dist = std::sqrt(dx * dx + dy * dy);
+        const double look = std::min(kLostSightLook, dist);
+        if (look > t.radius[i] &&
+            !nav->visible(t.radius[i], t.id[i], {t.x[i], t.y[i]},
+                          {t.x[i] + dx / dist * look, t.y[i] + dy / dist * look}))
+          pref.skip[i] = kLostSight;
       }
       const double dx = target.x - t.x[i], dy = target.y - t.y[i];
       const double dist = std::sqrt(dx * dx + dy * dy);

@@ -18,10 +18,18 @@ class Navigation;
 namespace crowddb::sim {
 
 // Preferred velocities: the goal stage's output, every model's input.
+inline constexpr uint8_t kSkipWaypoint = 1, kLostSight = 2;
+// Lost sight: a walker slower than half its preferred speed looks this far towards its target
+// once every kLostSightInterval, through the navigation mesh (Detour raycast).
+inline constexpr double kLostSightLook = 3;      // [m]
+inline constexpr double kLostSightInterval = 1;  // [s]
+
 struct Preferred {
   std::vector<double> vx, vy;  // [m/s]
-  std::vector<uint8_t> skip;   // route waypoints passed by line of sight (popped at commit)
-  std::vector<double> left;    // [m] path_left of each row; infinite for those standing
+  // kSkipWaypoint: the waypoint after the current one is in sight (popped at commit);
+  // kLostSight: the way towards the current target is not (a re-plan is asked for at commit).
+  std::vector<uint8_t> skip;
+  std::vector<double> left;  // [m] path_left of each row; infinite for those standing
   void reset(std::size_t n);
 };
 
@@ -117,6 +125,12 @@ inline bool ahead(const AheadInput& a, const AheadInput& b, bool& a_first) {
 // the widest of them needs to reach it) steps off that one the same way (the first in goal order).
 // Waypoint following: with `nav` (and skip_visible, every sight interval per agent), an agent whose
 // waypoint after the current one is in sight steers at that one and records the skip.
+// Lost sight (with `nav`): a walker pushed so that an obstacle stands between it and its target
+// (a straight last leg to a far goal, seen past a pillar, then pressed behind it by a crowd)
+// presses against the obstacle; the progress watch re-plans it only when it stops getting
+// closer, and sliding along the obstacle still gets it closer. So a walker slower than half its
+// preferred speed looks kLostSightLook towards its target every kLostSightInterval (staggered by
+// id); blocked, it records kLostSight and is re-planned from where it stands.
 void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfig& cfg,
                 uint64_t tick, std::span<const uint32_t> demand, Preferred& pref, Executor& ex,
                 const path::Navigation* nav = nullptr, AimMemo* aims = nullptr);

@@ -247,7 +247,7 @@ TEST(ScenarioGeometry, CliExplainShowsThePathService) {
   const test::CliResult on = test::run_cli("run " + file + " --explain", dir);
   EXPECT_EQ(on.status, 0) << on.err;
   EXPECT_NE(on.out.find("path service: Recast/Detour"), std::string::npos) << on.out;
-  EXPECT_NE(on.out.find("path requests      new goal or no progress for 4 s"), std::string::npos)
+  EXPECT_NE(on.out.find("path requests      new goal, or no progress for 4 s"), std::string::npos)
       << on.out;
   const test::CliResult off = test::run_cli("run " + file + " --explain --no-navigation", dir);
   EXPECT_EQ(off.status, 0) << off.err;

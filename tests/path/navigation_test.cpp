@@ -135,6 +135,35 @@ TEST(Navigation, NoProgressTriggersReplanning) {
   EXPECT_NE(ea.find("partial"), std::string::npos);
 }
 
+// A walker on its last leg (its goal in sight, no route left) pushed behind a pillar (put there
+// with no speed) looks towards its goal, sees the pillar and is re-planned at once, long before
+// the progress watch (30 s here) would; one walking at speed is left alone, as is one with
+// nothing in its way.
+TEST(Navigation, AWalkerPushedBehindAnObstacleIsReplanned) {
+  const auto pushed = [](double x, double y, double speed) {
+    World w(Bounds{0, 0, 60, 40});
+    w.add_goal({"east", 55, 20, 1, 1, {}});
+    w.add_obstacle(CircleObstacle{30, 20, 3});
+    w.insert(walker(10, 30));
+    SimConfig c = nav_config(1);
+    c.navigation.replan_after = 30;
+    Simulation sim(std::move(w), c);
+    AgentTable& t = sim.world().agents_for_tick();
+    for (int k = 0; k < 3; ++k) sim.step();
+    EXPECT_TRUE(t.route[0].empty()) << "the goal is in sight from the start";
+    EXPECT_EQ(t.path_ticket[0], 0u);
+    t.x[0] = x;
+    t.y[0] = y;
+    t.vx[0] = speed;
+    t.vy[0] = 0;
+    sim.step();
+    return t.path_ticket[0] != 0 || !t.route[0].empty();
+  };
+  EXPECT_TRUE(pushed(25.5, 20.5, 0));     // pressed against the pillar's west face
+  EXPECT_FALSE(pushed(25.5, 20.5, 0.9));  // walking (it will slide round or slow down)
+  EXPECT_FALSE(pushed(25.5, 30, 0));      // standing, with the way free
+}
+
 TEST(Navigation, WaypointsAreSkippedWhenTheNextOneIsInSight) {
   for (bool skip : {false, true}) {
     World w = walled_world();
