@@ -16,6 +16,9 @@ constexpr double kNarrowStep = 0.01;  // [m] narrow meshes are per radius to the
 // mesh (SteerSuite's scenarioSpace: 5,000 agents re-planning across a forest of 5,000 boxes,
 // where without a bound the path worker took 4.5 times as long); the rest plan as before.
 constexpr std::size_t kCostedPerTick = 8;
+// blocked_ahead: how far to look for the mesh's nearest point, and how far off it is off it.
+constexpr double kBlockedReach = 2;  // [m]
+constexpr double kOnMesh = 1e-3;     // [m] (the mesh is in floats)
 
 // Where row i walks now: the unit vector to its waypoint (World::refresh_target's).
 Vec2 heading(const AgentTable& t, std::size_t i) {
@@ -117,6 +120,21 @@ int Navigation::narrow_key(double radius) const {
 bool Navigation::visible(double radius, uint64_t agent, Vec2 from, Vec2 to) const {
   auto it = meshes_.find(narrow_routes_.count(agent) ? narrow_key(radius) : class_of(radius));
   return it != meshes_.end() && it->second->visible(from, to);
+}
+
+bool Navigation::blocked_ahead(double radius, uint64_t agent, Vec2 from, Vec2 to) const {
+  auto it = meshes_.find(narrow_routes_.count(agent) ? narrow_key(radius) : class_of(radius));
+  if (it == meshes_.end()) return false;
+  const NavMesh& m = *it->second;
+  const std::optional<Vec2> on = m.nearest(from, kBlockedReach);
+  if (!on) return false;
+  const double nx = from.x - on->x, ny = from.y - on->y, n2 = nx * nx + ny * ny;
+  if (n2 > kOnMesh * kOnMesh) {  // off the mesh: does the way lead into what lies beyond its edge?
+    const double ux = to.x - from.x, uy = to.y - from.y;
+    const double dot = ux * nx + uy * ny;
+    if (!(dot > 0 && dot * dot >= 0.25 * (ux * ux + uy * uy) * n2)) return false;
+  }
+  return !m.visible(from, to);
 }
 
 std::size_t Navigation::without_path(const World& world) const {

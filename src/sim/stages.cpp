@@ -227,10 +227,11 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
           t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i] < 0.25 * t.pref_speed[i] * t.pref_speed[i]) {
         const double dx = target.x - t.x[i], dy = target.y - t.y[i];
         const double dist = std::sqrt(dx * dx + dy * dy);
-        const double look = std::min(kLostSightLook, dist);
-        if (look > t.radius[i] &&
-            !nav->visible(t.radius[i], t.id[i], {t.x[i], t.y[i]},
-                          {t.x[i] + dx / dist * look, t.y[i] + dy / dist * look}))
+        // (A target nearer than that is a corner at the obstacle itself, a door's post: the
+        // search would give it again.)
+        if (dist > kLostSightLook && nav->blocked_ahead(t.radius[i], t.id[i], {t.x[i], t.y[i]},
+                                                        {t.x[i] + dx / dist * kLostSightLook,
+                                                         t.y[i] + dy / dist * kLostSightLook}))
           pref.skip[i] = kLostSight;
       }
       const double dx = target.x - t.x[i], dy = target.y - t.y[i];
