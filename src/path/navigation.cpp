@@ -117,15 +117,26 @@ int Navigation::narrow_key(double radius) const {
   return k >= 1e9 ? -1'000'000'000 : -std::max(1, static_cast<int>(k));
 }
 
-bool Navigation::visible(double radius, uint64_t agent, Vec2 from, Vec2 to) const {
+const NavMesh* Navigation::mesh_of_agent(double radius, uint64_t agent) const {
   auto it = meshes_.find(narrow_routes_.count(agent) ? narrow_key(radius) : class_of(radius));
-  return it != meshes_.end() && it->second->visible(from, to);
+  return it != meshes_.end() ? it->second.get() : nullptr;
+}
+
+bool Navigation::visible(double radius, uint64_t agent, Vec2 from, Vec2 to) const {
+  const NavMesh* m = mesh_of_agent(radius, agent);
+  return m && m->visible(from, to);
 }
 
 bool Navigation::blocked_ahead(double radius, uint64_t agent, Vec2 from, Vec2 to) const {
-  auto it = meshes_.find(narrow_routes_.count(agent) ? narrow_key(radius) : class_of(radius));
-  if (it == meshes_.end()) return false;
-  const NavMesh& m = *it->second;
+  // Not for those whose last route ends short of the goal (walled in, or no path: a search ends
+  // there again, and they stand pressed against its end), nor for those on a narrow mesh's route
+  // (its passages are barely wider than the agent, a ray through one is blocked as often as not,
+  // and one squeezing into an aircraft's aisle was re-planned at its entrance every second and
+  // never got in).
+  if (short_routes_.count(agent) || narrow_routes_.count(agent)) return false;
+  const NavMesh* mesh = mesh_of_agent(radius, agent);
+  if (!mesh) return false;
+  const NavMesh& m = *mesh;
   const std::optional<Vec2> on = m.nearest(from, kBlockedReach);
   if (!on) return false;
   const double nx = from.x - on->x, ny = from.y - on->y, n2 = nx * nx + ny * ny;
@@ -216,17 +227,11 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick,
                                       const std::vector<uint64_t>& lost_sight) {
   AgentTable& t = world.agents_for_tick();
   std::size_t made = 0;
-  // Per row, when anyone lost sight. Not those whose route ends short of the goal (walled in, or
-  // no path): a search from anywhere ends there again, and they stand pressed against its end.
-  // Nor those on a narrow mesh's route: its passages are barely wider than the agent, a ray
-  // through one is blocked as often as not, and one squeezing into an aircraft's aisle was
-  // re-planned at its entrance every second and never got in.
-  std::vector<uint8_t> lost;
+  std::vector<uint8_t> lost;  // per row, when anyone lost sight (blocked_ahead)
   if (!lost_sight.empty()) {
     lost.assign(t.size(), 0);
     for (uint64_t id : lost_sight)
-      if (const auto row = world.row_of(AgentId::from_value(id)))
-        lost[*row] = short_routes_.count(id) == 0 && narrow_routes_.count(id) == 0;
+      if (const auto row = world.row_of(AgentId::from_value(id))) lost[*row] = 1;
   }
   // Requests are numbered and queued in agent id order, not row order: who is served first
   // within the budget must not depend on where a row happens to sit (src/sim/row_order.hpp).

@@ -98,7 +98,8 @@ class Navigation {
   // that edge towards a corner on it is blocked as often as not (a queue along a wall towards a
   // door lost sight 9,000 times in 400 s). So when `from` is off the mesh, the way must also lead
   // into what lies beyond the edge (within 60 degrees of the line from the mesh's nearest point
-  // to `from`), as it does for one pressed against a pillar it wants to walk through.
+  // to `from`), as it does for one pressed against a pillar it wants to walk through. False for
+  // agents whose route ends short of their goal or came from a narrow mesh (navigation.cpp).
   bool blocked_ahead(double radius, uint64_t agent, Vec2 from, Vec2 to) const;
   // Agents still walking whose last route does not reach their goal: the search ended short
   // of it (no way there on the mesh: a goal walled in) or found no path at all (the agent
@@ -126,6 +127,8 @@ class Navigation {
 
  private:
   int class_of(double radius) const;
+  // The mesh agent `agent`'s sight checks use: its class's, or the narrow one its route came from.
+  const NavMesh* mesh_of_agent(double radius, uint64_t agent) const;
   const NavMesh& mesh_for(double radius);  // builds on first use
   // Class k's mesh; k < 0: the narrow mesh for radius -k cm (narrow_key). Builds on first use.
   const NavMesh& mesh_of_class(int k);
