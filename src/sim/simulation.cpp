@@ -747,9 +747,9 @@ std::string Simulation::explain() const {
   if (e.nav) {
     os << "  " << step++ << " path requests      new goal";
     if (nv.replan_after > 0)
-      os << ", or no progress for " << num(nv.replan_after) << " s, or no sight "
-         << num(sim::kLostSightLook)
-         << " m towards its target (walking slower than half its speed)";
+      os << ", or no progress for " << num(nv.replan_after) << " s, or an obstacle within "
+         << num(sim::kLostSightLook) << " m towards a target farther than "
+         << num(sim::kLostSightFar) << " m (walking slower than half its speed)";
     os << " -> FIFO queue; <= " << nv.budget << " dispatched per tick, due " << latency << " tick"
        << (latency == 1 ? "" : "s") << " later; congestion "
        << (nv.congestion_cost > 0

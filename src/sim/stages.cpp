@@ -229,9 +229,9 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
         const double dist = std::sqrt(dx * dx + dy * dy);
         // (A target nearer than that is a corner at the obstacle itself, a door's post: the
         // search would give it again.)
-        if (dist > kLostSightLook && nav->blocked_ahead(t.radius[i], t.id[i], {t.x[i], t.y[i]},
-                                                        {t.x[i] + dx / dist * kLostSightLook,
-                                                         t.y[i] + dy / dist * kLostSightLook}))
+        if (dist > kLostSightFar && nav->blocked_ahead(t.radius[i], t.id[i], {t.x[i], t.y[i]},
+                                                       {t.x[i] + dx / dist * kLostSightLook,
+                                                        t.y[i] + dy / dist * kLostSightLook}))
           pref.skip[i] = kLostSight;
       }
       const double dx = target.x - t.x[i], dy = target.y - t.y[i];
