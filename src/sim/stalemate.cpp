@@ -86,6 +86,64 @@ std::vector<uint8_t> jammed_ahead(const AgentTable& t, std::span<const Goal> goa
 
 }  // namespace
 
+std::vector<uint8_t> queue_members(std::span<const uint8_t> same_way,
+                                   std::span<const uint8_t> moves, std::span<const int64_t> next) {
+  const std::size_t m = same_way.size();
+  enum : uint8_t { kUnseen, kOnPath, kDone };
+  std::vector<uint8_t> seen(m, kUnseen), member(m, 0);
+  std::vector<std::size_t> path;
+  for (std::size_t q0 = 0; q0 < m; ++q0) {
+    if (seen[q0] != kUnseen) continue;
+    // Follow the same-way blockers that are looked at and do not move, until the chain ends.
+    path.clear();
+    int64_t q = static_cast<int64_t>(q0);
+    uint8_t verdict = 0;
+    while (true) {
+      const auto u = static_cast<std::size_t>(q);
+      if (seen[u] == kDone) {
+        verdict = member[u];
+        break;
+      }
+      if (seen[u] == kOnPath || !same_way[u]) break;  // a cycle, or not walking its blocker's way
+      if (moves[u] || next[u] < 0) {                  // the head of a queue: it moves
+        verdict = 1;
+        path.push_back(u);
+        break;
+      }
+      seen[u] = kOnPath;
+      path.push_back(u);
+      q = next[u];
+    }
+    for (std::size_t u : path) {
+      seen[u] = kDone;
+      member[u] = verdict;
+    }
+    if (seen[q0] != kDone) {  // q0 itself ended the walk (not its blocker's way)
+      seen[q0] = kDone;
+      member[q0] = 0;
+    }
+  }
+  return member;
+}
+
+std::vector<uint8_t> queue_members_naive(std::span<const uint8_t> same_way,
+                                         std::span<const uint8_t> moves,
+                                         std::span<const int64_t> next) {
+  const std::size_t m = same_way.size();
+  std::vector<uint8_t> member(m, 0);
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::size_t q = 0; q < m; ++q) {
+      if (member[q] || !same_way[q]) continue;
+      if (moves[q] || next[q] < 0 || member[static_cast<std::size_t>(next[q])]) {
+        member[q] = 1;
+        changed = true;
+      }
+    }
+  }
+  return member;
+}
+
 StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, NeighbourPath& path,
                        Executor& ex, QueryStats& stats, AimMemo* aim) {
   AgentTable& t = world.agents_for_tick();
@@ -171,16 +229,12 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   // A queue ends in someone who moves: an agent waits in one when its same-way blocker is
   // progressing (not looked at) or waits in one itself. Chains resolve outwards from a moving
   // head; a cycle of mutual blockers (people arching in a door) never does: it is a stalemate.
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (std::size_t q = 0; q < looked_at.size(); ++q) {
-      if (queueing[q] || !same_way[q]) continue;
-      const auto j = static_cast<std::size_t>(blocker[q]);
-      if (standing(t.state[j]) || bpos[q] < 0 || queueing[static_cast<std::size_t>(bpos[q])]) {
-        queueing[q] = 1;
-        changed = true;
-      }
-    }
+  {
+    std::vector<uint8_t> moves(looked_at.size(), 0);
+    for (std::size_t q = 0; q < looked_at.size(); ++q)
+      moves[q] =
+          same_way[q] && (standing(t.state[static_cast<std::size_t>(blocker[q])]) || bpos[q] < 0);
+    queueing = queue_members(same_way, moves, bpos);
   }
   // Waiting in a queue is no stalemate: no action, and the clock is held at the threshold (so
   // a queueing agent never passes for a moving head, and should it become a stalled head, its

@@ -50,6 +50,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "crowddb/simulation.hpp"
@@ -68,6 +69,19 @@ struct StallCounts {
   // Filled only with cfg.stall.resolve.
   std::vector<uint32_t> head_on;
 };
+
+// The queueing test over the rows looked at: q waits in a queue when it walks the same way as
+// its blocker (same_way[q]) and that blocker moves (moves[q]: it is not looked at, or stands idle)
+// or waits in a queue itself (next[q]: the blocker's place among the rows looked at, -1 when
+// none). A cycle of blockers has no moving head: nobody in it queues (the least fixed point).
+// One walk along the chains, O(n) (the repeated sweeps it replaced took a sweep per link of a
+// chain that runs against the row order: O(n^2) for a long queue). queue_members_naive: those
+// sweeps, its twin in tests.
+std::vector<uint8_t> queue_members(std::span<const uint8_t> same_way,
+                                   std::span<const uint8_t> moves, std::span<const int64_t> next);
+std::vector<uint8_t> queue_members_naive(std::span<const uint8_t> same_way,
+                                         std::span<const uint8_t> moves,
+                                         std::span<const int64_t> next);
 
 // The progress watch, the queueing test and (with cfg.stall.resolve) the actions, for the tick
 // `tick` just committed.

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <tuple>
@@ -312,6 +313,41 @@ TEST(Stalemates, TurnsStartWhenBothHaveBeenStalledReverseAfter) {
   off.stalled_for(60, 60);
   off.run(30);
   EXPECT_EQ(off.w.agents().stall_action[1], StallAction::yield);
+}
+
+// The queueing test's chain walk against its twin, the repeated sweeps: random blocker graphs
+// (chains, cycles, trees into cycles, heads that move, people not walking their blocker's way),
+// and long chains that run against the row order (the sweeps' worst case).
+TEST(QueueMembers, MatchesTheRepeatedSweeps) {
+  Rng rng(7);
+  for (int trial = 0; trial < 400; ++trial) {
+    const std::size_t m = 1 + rng.below(trial < 300 ? 40 : 2000);
+    const double p_same = rng.uniform(0.3, 1.0), p_moves = rng.uniform(0, 0.3);
+    std::vector<uint8_t> same_way(m), moves(m);
+    std::vector<int64_t> next(m);
+    for (std::size_t q = 0; q < m; ++q) {
+      same_way[q] = rng.uniform() < p_same;
+      next[q] = rng.uniform() < 0.1 ? -1 : static_cast<int64_t>(rng.below(m));
+      moves[q] = same_way[q] && (next[q] < 0 || rng.uniform() < p_moves);
+    }
+    EXPECT_EQ(queue_members(same_way, moves, next), queue_members_naive(same_way, moves, next))
+        << "trial " << trial << ", " << m << " rows";
+  }
+  // One queue of 3,000 whose blockers sit at lower rows, its head moving; then the same closed
+  // into a ring (an arch: nobody queues).
+  const std::size_t m = 3000;
+  std::vector<uint8_t> same_way(m, 1), moves(m, 0);
+  std::vector<int64_t> next(m);
+  for (std::size_t q = 0; q < m; ++q) next[q] = static_cast<int64_t>(q) - 1;
+  moves[0] = 1;
+  const auto line = queue_members(same_way, moves, next);
+  EXPECT_EQ(line, queue_members_naive(same_way, moves, next));
+  EXPECT_EQ(std::count(line.begin(), line.end(), 1), static_cast<long>(m));
+  moves[0] = 0;
+  next[0] = static_cast<int64_t>(m - 1);
+  const auto ring = queue_members(same_way, moves, next);
+  EXPECT_EQ(ring, queue_members_naive(same_way, moves, next));
+  EXPECT_EQ(std::count(ring.begin(), ring.end(), 1), 0);
 }
 
 }  // namespace
