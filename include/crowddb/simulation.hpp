@@ -128,6 +128,13 @@ struct NavigationParams {
   // them (not heading the searcher's way) in a mesh polygon it enters, so that a way round the
   // jam wins when it is shorter than that; 0: off. src/path/navigation.hpp has the detail.
   double congestion_cost = 5;
+  // [1/(m s)] Queues at doors: a path search counts, at the first door on the agent's way (a
+  // place narrower than 2.5 m within 15 m of it), the slow people ahead of it there bound for
+  // its goal, each as the time the door takes to let one through at this specific flow (1.3
+  // /(m s): the bottleneck flows of docs/validation.md), walked at the agent's preferred speed;
+  // a way through another door wins when it is shorter than that. 0: off.
+  // src/path/navigation.hpp has the detail.
+  double queue_flow = 1.3;
   double radius_step = 0.25;  // [m] radius classes: an agent's radius rounded up to a multiple
   double cell_size = 0;       // [m] navmesh cell; 0: auto (a quarter of the class radius, at
                               // most 4096 x 4096 cells over the world's area)

@@ -1037,6 +1037,7 @@ Scenario parse_document(std::string_view text, const std::string& source, const 
     if (nav.budget < 1) n.fail("budget", "must be >= 1");
     nav.replan_after = n.non_negative("replan_after", nav.replan_after);
     nav.congestion_cost = n.non_negative("congestion_cost", nav.congestion_cost);
+    nav.queue_flow = n.non_negative("queue_flow", nav.queue_flow);
     nav.radius_step = n.positive("radius_step", nav.radius_step);
     nav.cell_size = n.non_negative("cell_size", nav.cell_size);
     nav.clearance = n.non_negative("clearance", nav.clearance);

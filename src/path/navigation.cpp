@@ -271,6 +271,8 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick,
   std::vector<std::size_t> stalled;  // rows, in row order (only counted, so the order is moot)
   std::map<const NavMesh*, std::vector<StalledAt>> located;  // this tick's, per mesh
   std::size_t costed = 0;
+  bool slow_ready = false;  // slow walkers: found once, for the first search that needs them
+  std::vector<std::size_t> slow;
   if (params_.congestion_cost > 0 && !queue_.empty())
     for (uint32_t i : head_on)
       if (i < t.size() && !standing(t.state[i])) stalled.push_back(i);
@@ -293,6 +295,23 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick,
       if (fresh) it->second = locate(world, *mesh, stalled);
       c = congestion(it->second, heading(t, i));
     }
+    // (Only for those held up themselves: one walking freely is not in a queue yet; a new one
+    // standing at its source is.)
+    if (params_.queue_flow > 0 && costed < kCostedPerTick &&
+        t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i] < 0.25 * t.pref_speed[i] * t.pref_speed[i]) {
+      if (!slow_ready) {
+        slow = slow_walkers(t);
+        slow_ready = true;
+      }
+      if (!slow.empty())
+        if (std::vector<DoorCut> cuts = queues_ahead(t, *mesh, i, goal, slow, c.get());
+            !cuts.empty()) {
+          auto pc = std::make_shared<PolygonCosts>(c ? *c : PolygonCosts{});
+          pc->cuts = std::move(cuts);
+          c = std::move(pc);
+          ++stats_.queue_costed;
+        }
+    }
     costed += c != nullptr;
     stats_.costed += c != nullptr;
     jobs.push_back({q.ticket, q.agent, mesh, {t.x[i], t.y[i]}, goal, std::move(c), k});
@@ -302,6 +321,69 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick,
     service_->submit(tick + latency_ticks_, std::move(jobs));
   }
   return made;
+}
+
+std::vector<std::size_t> Navigation::slow_walkers(const AgentTable& t) {
+  std::vector<std::size_t> out;
+  for (std::size_t j = 0; j < t.size(); ++j)
+    if (!standing(t.state[j]) &&
+        t.vx[j] * t.vx[j] + t.vy[j] * t.vy[j] < 0.25 * t.pref_speed[j] * t.pref_speed[j])
+      out.push_back(j);
+  return out;
+}
+
+std::vector<DoorCut> Navigation::queues_ahead(const AgentTable& t, const NavMesh& m, std::size_t i,
+                                              Vec2 goal, const std::vector<std::size_t>& slow,
+                                              const PolygonCosts* base) {
+  auto& finder = finders_[&m];
+  if (!finder) finder = std::make_unique<PathFinder>(m);
+  const Vec2 at{t.x[i], t.y[i]};
+  // The people queued at a door for row i: slow, bound for its goal, on its side of the door,
+  // nearer to the door's middle than row i and heading towards it.
+  const auto queued = [&](const DoorCut& cut) {
+    const double ex = cut.b.x - cut.a.x, ey = cut.b.y - cut.a.y;
+    const double mx = 0.5 * (cut.a.x + cut.b.x), my = 0.5 * (cut.a.y + cut.b.y);
+    const auto side = [&](double x, double y) {
+      return ex * (y - cut.a.y) - ey * (x - cut.a.x) >= 0;
+    };
+    const bool mine = side(at.x, at.y);
+    const double reach2 = (at.x - mx) * (at.x - mx) + (at.y - my) * (at.y - my);
+    std::size_t n = 0;
+    for (std::size_t j : slow) {
+      if (j == i || t.goal[j] != t.goal[i] || side(t.x[j], t.y[j]) != mine) continue;
+      const double dx = mx - t.x[j], dy = my - t.y[j];
+      if (!(dx * dx + dy * dy < reach2)) continue;
+      const Vec2 h = heading(t, j);
+      n += h.x * dx + h.y * dy > 0;
+    }
+    return n;
+  };
+  // Detour's route, and the first door on it with its queue; then the way the search takes
+  // with that door's queue charged, and the first door on that one (another door's queue), and
+  // so on, until a way's first door is charged already or has nobody queued.
+  std::vector<DoorCut> cuts;
+  PolygonCosts costs = base ? *base : PolygonCosts{};
+  for (int round = 0; round < kDoorRounds; ++round) {
+    const PathResult r = finder->find(at, goal, costs.empty() ? nullptr : &costs);
+    if (r.status == PathStatus::no_start || r.status == PathStatus::no_goal) break;
+    std::vector<Vec2> way{at};
+    way.insert(way.end(), r.corners.begin(), r.corners.end());
+    way.push_back(r.end);
+    std::optional<DoorCut> cut = m.first_narrows(way, kDoorLook, kDoorWidth);
+    if (!cut) break;
+    const Vec2 mid{0.5 * (cut->a.x + cut->b.x), 0.5 * (cut->a.y + cut->b.y)};
+    const bool known = std::any_of(cuts.begin(), cuts.end(), [&](const DoorCut& c) {
+      return std::hypot(0.5 * (c.a.x + c.b.x) - mid.x, 0.5 * (c.a.y + c.b.y) - mid.y) < kSameDoor;
+    });
+    if (known) break;
+    const std::size_t ahead = queued(*cut);
+    if (ahead == 0) break;
+    const double width = std::hypot(cut->b.x - cut->a.x, cut->b.y - cut->a.y) + 2 * m.clearance();
+    cut->cost = static_cast<double>(ahead) / (params_.queue_flow * width) * t.pref_speed[i];
+    cuts.push_back(*cut);
+    costs.cuts.push_back(*cut);
+  }
+  return cuts;
 }
 
 std::vector<Navigation::StalledAt> Navigation::locate(const World& world, const NavMesh& m,
@@ -336,7 +418,7 @@ void Navigation::save(ByteWriter& out) const {
   out.u64(next_ticket_);
   for (uint64_t v : {stats_.requests, stats_.replans, stats_.dispatched, stats_.superseded,
                      stats_.applied, stats_.failed, stats_.partial, stats_.sight_checks,
-                     stats_.narrow, stats_.narrow_routes, stats_.costed})
+                     stats_.narrow, stats_.narrow_routes, stats_.costed, stats_.queue_costed})
     out.u64(v);
   out.u64(queue_.size());
   for (const Queued& q : queue_) {
@@ -364,6 +446,10 @@ void Navigation::save(ByteWriter& out) const {
           out.u32(ref);
           out.f64(cost);
         }
+      out.u64(j.costs ? j.costs->cuts.size() : 0);
+      if (j.costs)
+        for (const DoorCut& c : j.costs->cuts)
+          for (double v : {c.a.x, c.a.y, c.b.x, c.b.y, c.cost}) out.f64(v);
     }
   }
 }
@@ -373,7 +459,7 @@ void Navigation::restore(ByteReader& in, uint64_t tick, const World& world) {
   next_ticket_ = in.u64();
   for (uint64_t* v : {&stats_.requests, &stats_.replans, &stats_.dispatched, &stats_.superseded,
                       &stats_.applied, &stats_.failed, &stats_.partial, &stats_.sight_checks,
-                      &stats_.narrow, &stats_.narrow_routes, &stats_.costed})
+                      &stats_.narrow, &stats_.narrow_routes, &stats_.costed, &stats_.queue_costed})
     *v = in.u64();
   queue_.resize(in.count(17));
   for (Queued& q : queue_) {
@@ -425,8 +511,8 @@ void Navigation::restore(ByteReader& in, uint64_t tick, const World& world) {
           !std::isfinite(j.goal.y))
         in.fail("a path search with a point that is not finite");
       const uint64_t entries = in.count(12);
+      auto pc = std::make_shared<PolygonCosts>();
       if (entries > 0) {
-        auto pc = std::make_shared<PolygonCosts>();
         pc->entries.resize(entries);
         for (std::size_t e = 0; e < pc->entries.size(); ++e) {
           auto& [ref, cost] = pc->entries[e];
@@ -437,8 +523,15 @@ void Navigation::restore(ByteReader& in, uint64_t tick, const World& world) {
           if (!std::isfinite(cost) || cost < 0)
             in.fail("a path search's congestion with a cost that is not finite and >= 0");
         }
-        j.costs = std::move(pc);
       }
+      pc->cuts.resize(in.count(40));
+      for (DoorCut& cut : pc->cuts) {
+        for (double* v : {&cut.a.x, &cut.a.y, &cut.b.x, &cut.b.y, &cut.cost}) *v = in.f64();
+        if (!std::isfinite(cut.a.x) || !std::isfinite(cut.a.y) || !std::isfinite(cut.b.x) ||
+            !std::isfinite(cut.b.y) || !std::isfinite(cut.cost) || cut.cost < 0)
+          in.fail("a path search's door cut that is not finite, or costs less than 0");
+      }
+      if (!pc->empty()) j.costs = std::move(pc);
     }
     service_->submit(due, std::move(jobs));
   }

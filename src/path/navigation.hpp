@@ -26,6 +26,17 @@
 // it only sent people along the wall to its posts (SteerSuite's bottleneck-evacuation lost a
 // tenth of its arrivals over 10 seeds when every stalled agent counted).
 //
+// Queues at doors (`queue_flow`): a room's floor is one or a few mesh polygons, so costs on
+// polygons cannot tell a way through one door from a way through another; a door is found on
+// the agent's way instead. For a search dispatched (among the tick's first 8 with costs),
+// Detour's route is found on the tick's thread, and along it the first place narrower than
+// kDoorWidth within kDoorLook (NavMesh::first_narrows); the people queued ahead there (slow,
+// bound for the same goal, on this side, nearer to it and heading into it) make crossing that
+// cut cost their number over (queue_flow x the door's width) seconds, at the agent's preferred
+// speed. The search (PathFinder::find) charges every step that crosses the cut: a way through
+// another door wins when it is shorter by more. The other door's own queue is not charged; who
+// plans there next sees it.
+//
 // Narrow passages: each class's mesh keeps the class radius plus a few cells of rounding from
 // every obstacle, so a passage less than about 3.25 class radii wide is not on it (an aircraft's
 // 0.46 m aisle for people of radius 0.21, a 0.9 m door for a radius of 0.3 rounded up to the 0.5
@@ -46,6 +57,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -55,6 +67,15 @@
 #include "util/executor.hpp"
 
 namespace crowddb::path {
+
+// Queues at doors (NavigationParams::queue_flow): how far from the agent the first door on its
+// route may be, and how narrow a place must be to be a door.
+inline constexpr double kDoorLook = 15;    // [m]
+inline constexpr double kDoorWidth = 2.5;  // [m]
+// At most this many doors are charged for one search; two cuts whose middles lie nearer than
+// kSameDoor are one door.
+inline constexpr int kDoorRounds = 3;
+inline constexpr double kSameDoor = 1;  // [m]
 
 struct NavigationStats {
   uint64_t requests = 0;    // requests made (new goals + re-plans)
@@ -70,6 +91,7 @@ struct NavigationStats {
   uint64_t narrow = 0;         // searches repeated on a narrow mesh
   uint64_t narrow_routes = 0;  // of which gave the route (the goal reached)
   uint64_t costed = 0;         // searches dispatched with congestion costs (agents stalled)
+  uint64_t queue_costed = 0;   // of which with a queue at a door on the way
 };
 
 class Navigation {
@@ -146,6 +168,14 @@ class Navigation {
   // not heading its way in the polygon it stands in; null when there is none.
   std::shared_ptr<const PolygonCosts> congestion(const std::vector<StalledAt>& stalled,
                                                  Vec2 dir) const;
+  // Rows walking slower than half their preferred speed, in row order.
+  static std::vector<std::size_t> slow_walkers(const AgentTable& t);
+  // The door cuts costed for row i's search to `goal` on mesh m (NavigationParams::queue_flow),
+  // on top of `base` (or none): the first door on its way with the queue ahead of it there, then
+  // the first door on the way the search takes with that charged, and so on (at most
+  // kDoorRounds); empty when the first door has no queue, or there is none.
+  std::vector<DoorCut> queues_ahead(const AgentTable& t, const NavMesh& m, std::size_t i, Vec2 goal,
+                                    const std::vector<std::size_t>& slow, const PolygonCosts* base);
   // Drops the leading waypoints the agent has already passed (the one after is in sight).
   void trim_passed(World& world, std::size_t row);
 
@@ -166,6 +196,8 @@ class Navigation {
   std::deque<Queued> queue_;
   uint64_t next_ticket_ = 0;
   NavigationStats stats_;
+  // Searches on the tick's thread (queue_ahead's first door), one per mesh.
+  std::map<const NavMesh*, std::unique_ptr<PathFinder>> finders_;
   std::unique_ptr<PathService> service_;  // declared last: stopped before the meshes go
 };
 

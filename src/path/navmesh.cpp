@@ -462,6 +462,86 @@ std::vector<MeshPortal> NavMesh::portals() const {
   return out;
 }
 
+bool cut_crossed(Vec2 a, Vec2 b, Vec2 p, Vec2 q) {
+  const auto cross = [](Vec2 o, Vec2 u, Vec2 v) {
+    return (u.x - o.x) * (v.y - o.y) - (u.y - o.y) * (v.x - o.x);
+  };
+  if ((cross(a, b, p) >= 0) == (cross(a, b, q) >= 0)) return false;
+  const double oa = cross(p, q, a), ob = cross(p, q, b);
+  return (oa <= 0 && ob >= 0) || (oa >= 0 && ob <= 0);
+}
+
+std::optional<DoorCut> NavMesh::first_narrows(const std::vector<Vec2>& path, double look,
+                                              double max_width) const {
+  const double reach = max_width - 2 * clearance();
+  if (!(reach > 0) || path.size() < 2) return std::nullopt;
+  const double step = std::max(params_.cell_size, 0.2);
+  std::optional<DoorCut> best;
+  double best_width = INFINITY;
+  double walked = 0;
+  // The way across the mesh at p, walking along (dx, dy), when narrow: across the walk's
+  // direction (a path along a wall runs on the mesh's edge, where the nearest wall's direction is
+  // not known), or straight away from the nearest wall (a path crossing a door at a slant).
+  const auto across = [&](Vec2 p, double dx, double dy) -> std::optional<DoorCut> {
+    const float a[3] = {lx(p.x), 0, ly(p.y)};
+    float s[3];
+    const dtPolyRef ref = locate(*shared_query_, a, s);
+    if (!ref) return std::nullopt;
+    const Vec2 from = world(s);
+    // How far from `from` along (ux, uy) the mesh reaches, up to `len`; infinite beyond.
+    const auto ray = [&](double ux, double uy, double len) {
+      const float e[3] = {lx(from.x + ux * len), s[1], ly(from.y + uy * len)};
+      dtRaycastHit h;
+      std::memset(&h, 0, sizeof h);
+      if (dtStatusFailed(shared_query_->raycast(ref, s, e, filter_.get(), 0, &h)) || h.t == FLT_MAX)
+        return static_cast<double>(INFINITY);
+      return static_cast<double>(h.t) * len;
+    };
+    float d = 0, hit[3], normal[3];
+    if (dtStatusFailed(shared_query_->findDistanceToWall(ref, s, static_cast<float>(reach),
+                                                         filter_.get(), &d, hit, normal)) ||
+        !(2 * d <= reach))
+      return std::nullopt;  // every way across is at least twice as long as to the nearest wall
+    std::optional<DoorCut> narrow;
+    double width = INFINITY;
+    const double l1 = ray(-dy, dx, reach), l2 = ray(dy, -dx, reach);
+    if (l1 + l2 <= reach) {
+      width = l1 + l2;
+      narrow =
+          DoorCut{{from.x + dy * l2, from.y - dx * l2}, {from.x - dy * l1, from.y + dx * l1}, 0};
+    }
+    if (d > 0.01) {
+      // Away from the wall (Detour's normal points from the wall to the point).
+      const double far = ray(normal[0], normal[2], reach - d);
+      if (d + far < width) {
+        width = d + far;
+        narrow = DoorCut{world(hit), {from.x + normal[0] * far, from.y + normal[2] * far}, 0};
+      }
+    }
+    if (!(width > 0.5 * params_.cell_size)) return std::nullopt;  // a corner, not a way across
+    return narrow;
+  };
+  for (std::size_t k = 0; k + 1 < path.size() && walked <= look; ++k) {
+    const Vec2 u = path[k], v = path[k + 1];
+    const double len = std::hypot(v.x - u.x, v.y - u.y);
+    for (double at = step; at < len && walked + at <= look; at += step) {
+      const Vec2 p{u.x + (v.x - u.x) * at / len, u.y + (v.y - u.y) * at / len};
+      const std::optional<DoorCut> cut = across(p, (v.x - u.x) / len, (v.y - u.y) / len);
+      if (!cut) {
+        if (best) return best;  // the end of the first narrow run
+        continue;
+      }
+      const double w = std::hypot(cut->b.x - cut->a.x, cut->b.y - cut->a.y);
+      if (w < best_width) {
+        best_width = w;
+        best = cut;
+      }
+    }
+    walked += len;
+  }
+  return best;
+}
+
 double PolygonCosts::of(uint32_t ref) const {
   const auto it = std::lower_bound(entries.begin(), entries.end(), ref,
                                    [](const auto& e, uint32_t r) { return e.first < r; });
@@ -509,10 +589,11 @@ PathResult PathFinder::find(Vec2 start, Vec2 goal, const PolygonCosts* costs) {
   // one: costs only make other corridors dearer, so one that avoids them stays the least (and a
   // search over a 200 m forest of obstacles, SteerSuite's scenarioSpace, is not repeated for
   // every agent while a jam stands somewhere else).
-  if (costs && !costs->entries.empty() && !dtStatusDetail(st, DT_PARTIAL_RESULT) &&
+  // (Door cuts: searched again whenever there are some; they come a few a tick.)
+  if (costs && !costs->empty() && !dtStatusDetail(st, DT_PARTIAL_RESULT) &&
       polys_[static_cast<std::size_t>(npolys - 1)] == gref &&
-      std::any_of(polys_.begin() + 1, polys_.begin() + npolys,
-                  [&](dtPolyRef p) { return costs->of(p) > 0; }))
+      (!costs->cuts.empty() || std::any_of(polys_.begin() + 1, polys_.begin() + npolys,
+                                           [&](dtPolyRef p) { return costs->of(p) > 0; })))
     if (const int n = costed_corridor(sref, gref, s, g, *costs, r.cost); n > 0) npolys = n;
   r.status = PathStatus::ok;
   float end[3] = {g[0], g[1], g[2]};
@@ -559,6 +640,19 @@ int PathFinder::costed_corridor(unsigned int sref, unsigned int gref, const floa
     return std::hypot(bx - ax, bz - az);
   };
   const double gx = g[0], gz = g[2];
+  // The door cuts in the search's local coordinates, and what a step from (ax, az) to (bx, bz)
+  // pays for those it crosses (cut_crossed).
+  std::vector<DoorCut> cuts = costs.cuts;
+  for (DoorCut& c : cuts) {
+    c.a = {mesh_.lx(c.a.x), mesh_.ly(c.a.y)};
+    c.b = {mesh_.lx(c.b.x), mesh_.ly(c.b.y)};
+  }
+  const auto step_cost = [&](double ax, double az, double bx, double bz) {
+    double extra = 0;
+    for (const DoorCut& c : cuts)
+      if (cut_crossed(c.a, c.b, {ax, az}, {bx, bz})) extra += c.cost;
+    return extra;
+  };
   std::vector<CostNode>& nodes = cost_nodes_;
   auto& index = cost_index_;  // (from << 32 | to) of a portal -> node
   auto& open = cost_open_;    // (cost + heuristic, node), least first
@@ -586,7 +680,7 @@ int PathFinder::costed_corridor(unsigned int sref, unsigned int gref, const floa
     if (++expanded > max_nodes_) return 0;
     const CostNode here = nodes[static_cast<std::size_t>(n)];  // nodes may grow below
     if (here.poly == gref) {
-      const double c = here.g + dist(here.x, here.z, gx, gz);
+      const double c = here.g + dist(here.x, here.z, gx, gz) + step_cost(here.x, here.z, gx, gz);
       if (c < goal_cost) {
         goal_cost = c;
         goal_node = n;
@@ -610,7 +704,8 @@ int PathFinder::costed_corridor(unsigned int sref, unsigned int gref, const floa
       link_portal(*tile, *poly, link, l, r);
       const double mx = 0.5 * (static_cast<double>(l[0]) + r[0]);
       const double mz = 0.5 * (static_cast<double>(l[2]) + r[2]);
-      const double c = here.g + dist(here.x, here.z, mx, mz) + costs.of(next);
+      const double c = here.g + dist(here.x, here.z, mx, mz) + costs.of(next) +
+                       step_cost(here.x, here.z, mx, mz);
       const uint64_t key = static_cast<uint64_t>(here.poly) << 32 | next;
       const auto [it, fresh] = index.try_emplace(key, static_cast<int32_t>(nodes.size()));
       if (fresh) {

@@ -102,12 +102,26 @@ struct PathResult {
   double cost = 0;
 };
 
-// Extra costs [m] of entering mesh polygons, for a search that should avoid some (congestion-
-// aware re-planning, src/path/navigation.hpp): sorted by polygon ref, each ref once, costs
-// finite and >= 0.
+// A segment across a narrow place of the mesh, from a wall to a wall (NavMesh::door_at), and
+// what crossing it costs [m].
+struct DoorCut {
+  Vec2 a{}, b{};
+  double cost = 0;
+};
+
+// Does the step from p to q cross the cut from a to b? A point on the cut's line counts as lying
+// on its left (half-open sides), so a path through a point of the cut crosses it once.
+bool cut_crossed(Vec2 a, Vec2 b, Vec2 p, Vec2 q);
+
+// Extra costs [m] for a search that should avoid some places (congestion-aware re-planning and
+// queues at doors, src/path/navigation.hpp): of entering mesh polygons (`entries`, sorted by
+// polygon ref, each ref once) and of crossing door cuts (`cuts`: a step of the search that
+// crosses one pays its cost). Costs finite and >= 0.
 struct PolygonCosts {
   std::vector<std::pair<uint32_t, double>> entries;
+  std::vector<DoorCut> cuts;
   double of(uint32_t ref) const;
+  bool empty() const { return entries.empty() && cuts.empty(); }
 };
 
 // The shared edge between two adjacent mesh polygons, as the search sees it.
@@ -133,6 +147,15 @@ class NavMesh {
 
   // The closest point on the mesh within `reach` of p (searching a square of half-side reach).
   std::optional<Vec2> nearest(Vec2 p, double reach) const;
+  // The first narrow place along a path (`path`: points, the first where the walker stands),
+  // within `look` of its start: sampled every cell (at least 0.2 apart), the way across the mesh
+  // at a sample is the shorter of two: across the path's direction from edge to edge, and from
+  // the nearest wall (Detour's distance to wall) straight away from it to the wall beyond
+  // (raycasts); a place is narrow where that way, plus the clearance on either side, is at most
+  // `max_width`. Of the first run of narrow samples, the narrowest way: a door's
+  // cut from post to post. None when no sample is narrow. DoorCut::cost is 0.
+  std::optional<DoorCut> first_narrows(const std::vector<Vec2>& path, double look,
+                                       double max_width) const;
   // Line of sight for a disc of the mesh's radius: from the mesh point nearest `from` to `to`
   // without leaving the walkable polygons. False when `from` is off the mesh.
   bool visible(Vec2 from, Vec2 to) const;
@@ -176,7 +199,8 @@ class PathFinder {
   // findPath + findStraightPath). Deterministic: the same mesh and inputs give the same result.
   // With `costs` (not empty), when Detour's corridor enters a polygon with a cost: the corridor
   // of least cost instead, where a step from one portal to the next (or from the start, or to
-  // the goal) costs its length, plus the cost of the polygon it enters; the corners then come
+  // the goal) costs its length, plus the cost of the polygon it enters and of the door cuts it
+  // crosses; the corners then come
   // from Detour's funnel over that corridor as usual. When that search cannot reach the goal
   // within the node budget, Detour's corridor stays.
   PathResult find(Vec2 start, Vec2 goal, const PolygonCosts* costs = nullptr);

@@ -117,6 +117,8 @@ void SimConfig::validate() const {
           "must be >= 0");
   require(std::isfinite(n.congestion_cost) && n.congestion_cost >= 0, "navigation/congestion_cost",
           "must be >= 0");
+  require(std::isfinite(n.queue_flow) && n.queue_flow >= 0, "navigation/queue_flow",
+          "must be >= 0");
   require(std::isfinite(n.radius_step) && n.radius_step > 0, "navigation/radius_step",
           "must be > 0");
   require(std::isfinite(n.cell_size) && n.cell_size >= 0, "navigation/cell_size", "must be >= 0");
@@ -325,7 +327,8 @@ constexpr std::string_view kCheckpointMagic = "crowddb-checkpoint";
 // 2: narrow meshes in the path service's state; 3: goal waits (the wait_until column); 4: the
 // goal each agent left last (the left_goal column); 5: congestion costs of the path searches in
 // flight.
-constexpr uint32_t kCheckpointVersion = 6;  // 6: the navigation's routes that fall short
+constexpr uint32_t kCheckpointVersion =
+    7;  // 7: door cuts in the searches in flight; 6: the navigation's routes that fall short
 
 // What a checkpoint must agree on with the simulation it is restored into: the static tables
 // and the settings that change what a tick computes (not the thread count).
@@ -755,6 +758,11 @@ std::string Simulation::explain() const {
        << (nv.congestion_cost > 0
                ? "+" + num(nv.congestion_cost) + " m per agent stalled head-on in a polygon"
                : std::string("off"))
+       << "; queues at doors "
+       << (nv.queue_flow > 0 ? "(the first within " + num(path::kDoorLook) + " m, narrower than " +
+                                   num(path::kDoorWidth) + " m) at " + num(nv.queue_flow) +
+                                   " /(m s) per person ahead"
+                             : std::string("off"))
        << "\n";
   }
   return os.str();
@@ -812,14 +820,16 @@ std::string Simulation::explain_analyze() const {
         "  path service: %llu requests (%llu re-plans), %llu dispatched, %llu superseded, %llu "
         "queued; "
         "%llu routes applied (%llu partial, %llu without a path); %llu searches on a narrow mesh, "
-        "%llu of them reaching the goal; %llu searched round congestion\n",
+        "%llu of them reaching the goal; %llu searched round congestion, %llu of them with a "
+        "queue at a door\n",
         static_cast<unsigned long long>(ns.requests), static_cast<unsigned long long>(ns.replans),
         static_cast<unsigned long long>(ns.dispatched),
         static_cast<unsigned long long>(ns.superseded), static_cast<unsigned long long>(ns.queued),
         static_cast<unsigned long long>(ns.applied), static_cast<unsigned long long>(ns.partial),
         static_cast<unsigned long long>(ns.failed), static_cast<unsigned long long>(ns.narrow),
         static_cast<unsigned long long>(ns.narrow_routes),
-        static_cast<unsigned long long>(ns.costed));
+        static_cast<unsigned long long>(ns.costed),
+        static_cast<unsigned long long>(ns.queue_costed));
     os << line;
     std::snprintf(line, sizeof line,
                   "  worker: %llu searches in %.3f ms; the tick waited for it %llu times, %.3f ms; "

@@ -260,8 +260,8 @@ std::vector<Case> make_cases() {
     d["navigation"] = json::object();
     all.push_back({"exit-choice",
                    "RiMEA 10/11 (route choice)",
-                   "40 people leave through the nearer of two 1.2 m exits (routes are chosen at "
-                   "the start; no switching)",
+                   "40 people leave through the nearer of two 1.2 m exits (goals chosen at the "
+                   "start; a queue at a door may send a re-planned route through the other)",
                    {d.dump()},
                    [](const std::vector<RunStats>& r) { return standard_checks(r[0], kCrowd); }});
   }

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
@@ -274,10 +275,12 @@ uint64_t costed_searches(const Simulation& sim) {
 TEST(Navigation, PeopleStalledInAPassageAreWalkedRound) {
   for (const char* cost : {"5", "0"})
     for (int seed = 1; seed <= 3; ++seed) {
+      // (Queues at doors off: this is about the people stalled head-on alone.)
       Scenario sc = load_scenario(test::source_path("tests/data/passage.json"),
                                   LoadOptions{{},
                                               {"seed=" + std::to_string(seed),
-                                               std::string("navigation.congestion_cost=") + cost}});
+                                               std::string("navigation.congestion_cost=") + cost,
+                                               "navigation.queue_flow=0"}});
       Simulation sim(std::move(sc.world), sc.config);
       while (sim.arrived_total() < 60 && sim.ticks() < 1000) sim.step();
       if (std::string(cost) == "5") {
@@ -287,6 +290,56 @@ TEST(Navigation, PeopleStalledInAPassageAreWalkedRound) {
         EXPECT_EQ(costed_searches(sim), 0u);
       }
     }
+}
+
+// Queues at doors: a wall across a room with two 1.2 m doors 10 m apart and the goal below the
+// west one; 40 people stand queued above the west door. One more coming from above plans through
+// the east door (a detour of about 11 m against 40 people ahead at a 1.2 m door: about 33 m);
+// with queue_flow 0, or with the queue gone, through the west one.
+TEST(Navigation, AQueueAtTheNearDoorSendsTheNextOneToTheOther) {
+  const auto route_x = [](double queue_flow, bool queue) {
+    World w(Bounds{0, 0, 30, 20});
+    w.add_goal({"out", 10.6, 2, 0.5, 1, {}});
+    for (auto [x0, x1] : {std::pair{0.0, 10.0}, {11.2, 20.0}, {21.2, 30.0}})
+      w.add_obstacle(PolygonObstacle{{{x0, 8}, {x1, 8}, {x1, 9}, {x0, 9}}, 1});
+    const auto person = [](double x, double y) {
+      AgentSpec s;
+      s.x = x;
+      s.y = y;
+      s.radius = 0.25;
+      s.pref_speed = 1.3;
+      s.max_speed = 1.3;
+      s.goal = 0;
+      return s;
+    };
+    // The one to plan comes first: at most 8 searches a tick get costs, in id order, and here
+    // everyone asks at the start.
+    const AgentId first = w.insert(person(10.6, 15));
+    std::size_t queued = 0;
+    if (queue) {
+      for (double y = 9.6; y < 13; y += 0.55)
+        for (double x = 7.5; x < 14; x += 0.55)
+          if (std::hypot(x - 10.6, y - 9) < 3.6) {
+            w.insert(person(x, y));
+            ++queued;
+          }
+      EXPECT_GE(queued, 35u);
+    }
+    SimConfig c;  // orca, the defaults
+    c.navigation.enabled = true;
+    c.navigation.latency = c.dt;
+    c.navigation.queue_flow = queue_flow;
+    Simulation sim(std::move(w), c);
+    sim.step();  // the routes requested at the start arrive
+    const AgentTable& t = sim.world().agents();
+    const auto row = sim.world().row_of(first);
+    double east = 0;
+    for (const Vec2& p : t.route[*row]) east = std::max(east, p.x);
+    return east;
+  };
+  EXPECT_GT(route_x(1.3, true), 19) << "through the east door";
+  EXPECT_LT(route_x(0, true), 12) << "queues off: the west door";
+  EXPECT_LT(route_x(1.3, false), 12) << "no queue: the west door";
 }
 
 TEST(Navigation, RadiusClassesRoundUp) {

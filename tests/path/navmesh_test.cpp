@@ -70,6 +70,22 @@ double dist(Vec2 a, Vec2 b) {
 // the next one, over the start, the goal and every portal's midpoint (one node per direction),
 // with the same steps: to a portal out of the polygon one stands in, its length plus the cost
 // of the polygon entered; to the goal from anywhere in the goal's polygon, its length.
+// Door cuts crossed by the step from p to q, the naive way: the step's ends on strictly opposite
+// sides of the cut's line, or one on it and the other right of it (a point on the line counts
+// as left of it), and the cut's ends not on the same side of the step's line.
+double naive_cut_costs(const PolygonCosts& costs, Vec2 p, Vec2 q) {
+  double sum = 0;
+  for (const DoorCut& c : costs.cuts) {
+    const double sp = (c.b.x - c.a.x) * (p.y - c.a.y) - (c.b.y - c.a.y) * (p.x - c.a.x);
+    const double sq = (c.b.x - c.a.x) * (q.y - c.a.y) - (c.b.y - c.a.y) * (q.x - c.a.x);
+    const bool opposite = (sp >= 0 && sq < 0) || (sp < 0 && sq >= 0);
+    const double ta = (q.x - p.x) * (c.a.y - p.y) - (q.y - p.y) * (c.a.x - p.x);
+    const double tb = (q.x - p.x) * (c.b.y - p.y) - (q.y - p.y) * (c.b.x - p.x);
+    if (opposite && !(ta > 0 && tb > 0) && !(ta < 0 && tb < 0)) sum += c.cost;
+  }
+  return sum;
+}
+
 double naive_costed(const NavMesh& mesh, uint32_t sref, Vec2 s, uint32_t gref, Vec2 g,
                     const PolygonCosts& costs) {
   const std::vector<MeshPortal> portals = mesh.portals();
@@ -85,11 +101,13 @@ double naive_costed(const NavMesh& mesh, uint32_t sref, Vec2 s, uint32_t gref, V
     done[u] = true;
     const Vec2 at = u == start ? s : midpoint(portals[u]);
     const uint32_t poly = u == start ? sref : portals[u].to;
-    if (poly == gref) best[goal] = std::min(best[goal], best[u] + dist(at, g));
+    if (poly == gref)
+      best[goal] = std::min(best[goal], best[u] + dist(at, g) + naive_cut_costs(costs, at, g));
     for (std::size_t k = 0; k < portals.size(); ++k)
       if (portals[k].from == poly)
         best[k] =
-            std::min(best[k], best[u] + dist(at, midpoint(portals[k])) + costs.of(portals[k].to));
+            std::min(best[k], best[u] + dist(at, midpoint(portals[k])) + costs.of(portals[k].to) +
+                                  naive_cut_costs(costs, at, midpoint(portals[k])));
   }
   return best[goal];
 }
@@ -358,6 +376,47 @@ TEST(NavMesh, RandomWorldsAgreeWithTheVisibilityGraphOracle) {
       compared, worst_clearance, worst_excess);
 }
 
+// A step crosses a cut once when its ends lie on either side and the cut's ends on either side
+// of it; a point on the cut's line counts as left of it, so a path through a point of the cut
+// (a portal's midpoint on a door's cut) crosses it once.
+TEST(NavMesh, CutCrossing) {
+  const Vec2 a{0, 0}, b{2, 0};
+  EXPECT_TRUE(cut_crossed(a, b, {1, -1}, {1, 1}));
+  EXPECT_TRUE(cut_crossed(a, b, {1, 1}, {1, -1}));
+  EXPECT_FALSE(cut_crossed(a, b, {3, -1}, {3, 1}));  // beyond the cut's end
+  EXPECT_FALSE(cut_crossed(a, b, {0.5, 1}, {1.5, 2}));
+  EXPECT_FALSE(cut_crossed(a, b, {0.5, 0}, {1.5, 0}));  // along it
+  // Through a point of the cut in two steps: once.
+  EXPECT_NE(cut_crossed(a, b, {1, -1}, {1, 0}), cut_crossed(a, b, {1, 0}, {1, 1}));
+  EXPECT_NE(cut_crossed(a, b, {1, 1}, {1, 0}), cut_crossed(a, b, {1, 0}, {1, -1}));
+}
+
+// The first narrow place along a path: a wall across a room with a 1.2 m door; walking down
+// through it, the cut runs across the door from post to post; along the open floor, none.
+TEST(NavMesh, FirstNarrowsIsTheDoorOnTheWay) {
+  NavGeometry g{{0, 0, 30, 16}, {}, {}};
+  g.polygons = {rect(0, 8, 10, 9), rect(11.2, 8, 30, 9)};
+  for (int tile : {32, 256}) {
+    auto mesh = NavMesh::build(g, {0.3, 0.1, tile});
+    const auto cut = mesh->first_narrows({{10.6, 14}, {10.6, 2}}, 15, 2.5);
+    ASSERT_TRUE(cut) << "tile " << tile;
+    for (const Vec2& e : {cut->a, cut->b}) {
+      EXPECT_GT(e.x, 10) << "tile " << tile;
+      EXPECT_LT(e.x, 11.2) << "tile " << tile;
+      EXPECT_GE(e.y, 7.5) << "tile " << tile;
+      EXPECT_LE(e.y, 9.5) << "tile " << tile;
+    }
+    const double w = std::hypot(cut->b.x - cut->a.x, cut->b.y - cut->a.y) + 2 * mesh->clearance();
+    EXPECT_NEAR(w, 1.2, 0.25) << "tile " << tile;
+    EXPECT_EQ(cut->cost, 0);
+    // Not within the look, and not along the open floor.
+    EXPECT_FALSE(mesh->first_narrows({{10.6, 14}, {10.6, 2}}, 4, 2.5));
+    EXPECT_FALSE(mesh->first_narrows({{2, 14}, {28, 12}}, 30, 2.5));
+    // A place is narrow when no wider than asked: the 1.2 m door is not narrower than 1 m.
+    EXPECT_FALSE(mesh->first_narrows({{10.6, 14}, {10.6, 2}}, 15, 1.0));
+  }
+}
+
 // Random worlds over small tiles (links across tile borders), random costs on a third of the
 // polygons: where Detour's corridor enters one, the search finds the least cost the naive twin
 // finds, along a corridor of adjacent polygons from the start's to the goal's, whose cost it
@@ -365,7 +424,7 @@ TEST(NavMesh, RandomWorldsAgreeWithTheVisibilityGraphOracle) {
 TEST(PathFinder, CostedSearchAgreesWithDijkstraOverEveryPortal) {
   Rng rng(20261129);
   int compared = 0, detours = 0, kept = 0;
-  for (int world = 0; world < 5; ++world) {
+  for (int world = 0; world < 8; ++world) {
     NavGeometry g{{0, 0, 40, 30}, {}, {}};
     for (int k = 0; k < 6; ++k) {
       const double x = rng.uniform(4, 34), y = rng.uniform(4, 24);
@@ -386,6 +445,13 @@ TEST(PathFinder, CostedSearchAgreesWithDijkstraOverEveryPortal) {
     PolygonCosts costs;
     for (uint32_t ref : refs)
       if (rng.below(3) == 0) costs.entries.emplace_back(ref, rng.uniform(0, 25));
+    // and, in every other world, three random cuts (any segments: the search only asks which
+    // of its steps cross them)
+    if (world % 2 == 1)
+      for (int k = 0; k < 3; ++k)
+        costs.cuts.push_back({{rng.uniform(0, 40), rng.uniform(0, 30)},
+                              {rng.uniform(0, 40), rng.uniform(0, 30)},
+                              rng.uniform(0, 25)});
     PathFinder f(*mesh);
     for (int q = 0; q < 6; ++q) {
       const Vec2 a{rng.uniform(1, 39), rng.uniform(1, 29)},
@@ -395,8 +461,8 @@ TEST(PathFinder, CostedSearchAgreesWithDijkstraOverEveryPortal) {
       const PathResult r = f.find(a, b, &costs);
       ASSERT_EQ(r.status, PathStatus::ok);
       ASSERT_FALSE(r.corridor.empty());
-      if (std::none_of(plain.corridor.begin() + 1, plain.corridor.end(),
-                       [&](uint32_t p) { return costs.of(p) > 0; })) {
+      if (costs.cuts.empty() && std::none_of(plain.corridor.begin() + 1, plain.corridor.end(),
+                                             [&](uint32_t p) { return costs.of(p) > 0; })) {
         EXPECT_EQ(r.corridor, plain.corridor);
         EXPECT_EQ(r.cost, 0);
         ++kept;
@@ -415,11 +481,12 @@ TEST(PathFinder, CostedSearchAgreesWithDijkstraOverEveryPortal) {
       for (std::size_t k = 0; k + 1 < r.corridor.size(); ++k)
         for (const MeshPortal& p : portals)
           if (p.from == r.corridor[k] && p.to == r.corridor[k + 1]) {
-            along += dist(at, midpoint(p)) + costs.of(p.to);
+            along +=
+                dist(at, midpoint(p)) + costs.of(p.to) + naive_cut_costs(costs, at, midpoint(p));
             at = midpoint(p);
             break;
           }
-      along += dist(at, r.end);
+      along += dist(at, r.end) + naive_cut_costs(costs, at, r.end);
       EXPECT_NEAR(along, r.cost, 1e-6 * r.cost);
       detours += r.corridor != plain.corridor;
       ++compared;
@@ -447,7 +514,7 @@ TEST(PathFinder, APassageThatCostsMoreThanTheWayRoundIsWalkedRound) {
   ASSERT_TRUE(mesh->valid_polygon(passage));
   EXPECT_FALSE(mesh->valid_polygon(0));
   // The way round is 42.7 m against 30 (the search's midpoint measure puts them closer).
-  PolygonCosts cheap{{{passage, 1}}}, dear{{{passage, 40}}};
+  PolygonCosts cheap{{{passage, 1}}, {}}, dear{{{passage, 40}}, {}};
   const PathResult through = f.find(a, b, &cheap), round = f.find(a, b, &dear);
   ASSERT_EQ(through.status, PathStatus::ok);
   ASSERT_EQ(round.status, PathStatus::ok);
@@ -461,7 +528,7 @@ TEST(PathFinder, APassageThatCostsMoreThanTheWayRoundIsWalkedRound) {
   closed.polygons.push_back(rect(14, 27, 26, 30));
   auto cm = NavMesh::build(closed, {0.25, 0.0625});
   PathFinder fc(*cm);
-  const PolygonCosts blocked{{{cm->polygon_at({20, 15}, 0.1), 1000}}};
+  const PolygonCosts blocked{{{cm->polygon_at({20, 15}, 0.1), 1000}}, {}};
   const PathResult only = fc.find(a, b, &blocked);
   ASSERT_EQ(only.status, PathStatus::ok);
   EXPECT_NEAR(only.length, fc.find(a, b).length, 0.05);
