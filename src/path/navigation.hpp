@@ -76,6 +76,8 @@ inline constexpr double kDoorWidth = 2.5;  // [m]
 // kSameDoor are one door.
 inline constexpr int kDoorRounds = 3;
 inline constexpr double kSameDoor = 1;  // [m]
+// Nodes of the searches that find the doors on an agent's way (PathFinder's max_nodes).
+inline constexpr int kDoorSearchNodes = 1024;
 
 struct NavigationStats {
   uint64_t requests = 0;    // requests made (new goals + re-plans)
