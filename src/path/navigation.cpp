@@ -20,6 +20,11 @@ constexpr std::size_t kCostedPerTick = 8;
 constexpr double kBlockedReach = 2;  // [m]
 constexpr double kOnMesh = 1e-3;     // [m] (the mesh is in floats)
 
+// Row i walks slower than half its preferred speed (as sim::goal_stage's lost-sight look asks).
+bool held_up(const AgentTable& t, std::size_t i) {
+  return t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i] < 0.25 * t.pref_speed[i] * t.pref_speed[i];
+}
+
 // Where row i walks now: the unit vector to its waypoint (World::refresh_target's).
 Vec2 heading(const AgentTable& t, std::size_t i) {
   return unit_towards(t.x[i], t.y[i], {t.target_x[i], t.target_y[i]});
@@ -297,8 +302,7 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick,
     }
     // (Only for those held up themselves: one walking freely is not in a queue yet; a new one
     // standing at its source is.)
-    if (params_.queue_flow > 0 && costed < kCostedPerTick &&
-        t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i] < 0.25 * t.pref_speed[i] * t.pref_speed[i]) {
+    if (params_.queue_flow > 0 && costed < kCostedPerTick && held_up(t, i)) {
       if (!slow_ready) {
         slow = slow_walkers(t);
         slow_ready = true;
@@ -326,9 +330,7 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick,
 std::vector<std::size_t> Navigation::slow_walkers(const AgentTable& t) {
   std::vector<std::size_t> out;
   for (std::size_t j = 0; j < t.size(); ++j)
-    if (!standing(t.state[j]) &&
-        t.vx[j] * t.vx[j] + t.vy[j] * t.vy[j] < 0.25 * t.pref_speed[j] * t.pref_speed[j])
-      out.push_back(j);
+    if (!standing(t.state[j]) && held_up(t, j)) out.push_back(j);
   return out;
 }
 
@@ -365,8 +367,7 @@ std::vector<DoorCut> Navigation::queues_ahead(const AgentTable& t, const NavMesh
   // Detour's route, and the first door on it with its queue; then the way the search takes
   // with that door's queue charged, and the first door on that one (another door's queue), and
   // so on, until a way's first door is charged already or has nobody queued.
-  std::vector<DoorCut> cuts;
-  PolygonCosts costs = base ? *base : PolygonCosts{};
+  PolygonCosts costs = base ? *base : PolygonCosts{};  // (base has no cuts: congestion only)
   for (int round = 0; round < kDoorRounds; ++round) {
     const PathResult r = finder->find(at, goal, costs.empty() ? nullptr : &costs);
     if (r.status == PathStatus::no_start || r.status == PathStatus::no_goal) break;
@@ -376,7 +377,7 @@ std::vector<DoorCut> Navigation::queues_ahead(const AgentTable& t, const NavMesh
     std::optional<DoorCut> cut = m.first_narrows(way, kDoorLook, kDoorWidth);
     if (!cut) break;
     const Vec2 mid{0.5 * (cut->a.x + cut->b.x), 0.5 * (cut->a.y + cut->b.y)};
-    const bool known = std::any_of(cuts.begin(), cuts.end(), [&](const DoorCut& c) {
+    const bool known = std::any_of(costs.cuts.begin(), costs.cuts.end(), [&](const DoorCut& c) {
       return std::hypot(0.5 * (c.a.x + c.b.x) - mid.x, 0.5 * (c.a.y + c.b.y) - mid.y) < kSameDoor;
     });
     if (known) break;
@@ -384,10 +385,9 @@ std::vector<DoorCut> Navigation::queues_ahead(const AgentTable& t, const NavMesh
     if (ahead == 0) break;
     const double width = std::hypot(cut->b.x - cut->a.x, cut->b.y - cut->a.y) + 2 * m.clearance();
     cut->cost = static_cast<double>(ahead) / (params_.queue_flow * width) * t.pref_speed[i];
-    cuts.push_back(*cut);
     costs.cuts.push_back(*cut);
   }
-  return cuts;
+  return std::move(costs.cuts);
 }
 
 std::vector<Navigation::StalledAt> Navigation::locate(const World& world, const NavMesh& m,
