@@ -11,6 +11,7 @@ packages=(
   libcgal-dev libboost-dev                     # Delaunay heuristic; Boost.Geometry for WKT
   librecast-dev                                # navigation meshes
   libpugixml-dev                               # SDF3 XML
+  libxsimd-dev                                 # SIMD inner loops (header-only)
   gnuplot-nox graphviz                         # experiment plots, DOT rendering
   clang libclang-rt-14-dev                     # libFuzzer targets (scripts/fuzz.sh)
   python3-dev pybind11-dev python3-numpy       # the Python module

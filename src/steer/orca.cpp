@@ -160,6 +160,7 @@
 #include "plan/access_path.hpp"
 #include "sim/stages.hpp"
 #include "steer/model.hpp"
+#include "steer/orca_planes.hpp"
 #include "steer/passing.hpp"
 #include "steer/separating_line.hpp"
 #include "steer/streams.hpp"
@@ -176,63 +177,6 @@ namespace {
 constexpr double kSideTurn = 30 * std::numbers::pi / 180;
 constexpr double kTurnNearWaypoint = 2;  // [m]
 constexpr double kStanding = 1e-100;     // [m/s] a wish below this does not look for anyone
-
-// The half-plane agent i gets from neighbour j (relative position p = p_j - p_i, relative
-// velocity v = v_i - v_j, combined radius r), with agent i's velocity (vix, viy).
-HalfPlane agent_plane(double px, double py, double vx, double vy, double r, double tau, double dt,
-                      double vix, double viy, double share) {
-  const double d2 = px * px + py * py, r2 = r * r;
-  double ux, uy, nx, ny;
-  if (d2 > r2) {
-    // Truncated cone: apex 0, legs tangent to the disc of radius r around p, cut off by the disc
-    // of radius r / tau around p / tau. w: from the cut-off disc's centre to v.
-    const double wx = vx - px / tau, wy = vy - py / tau;
-    const double w2 = wx * wx + wy * wy;
-    const double wp = wx * px + wy * py;
-    if (wp < 0 && wp * wp > r2 * w2) {
-      // Nearest boundary point on the cut-off arc.
-      const double wl = std::sqrt(w2);
-      nx = wx / wl;
-      ny = wy / wl;
-      const double s = r / tau - wl;
-      ux = s * nx;
-      uy = s * ny;
-    } else {
-      // Nearest boundary point on a leg: the legs make the angle asin(r / |p|) with p.
-      const double leg = std::sqrt(d2 - r2);
-      double lx, ly;
-      if (px * wy - py * wx > 0) {  // w is counter-clockwise of p: the left leg
-        lx = (px * leg - py * r) / d2;
-        ly = (px * r + py * leg) / d2;
-        nx = -ly;  // outward: counter-clockwise of the left leg
-        ny = lx;
-      } else {  // the right leg
-        lx = (px * leg + py * r) / d2;
-        ly = (-px * r + py * leg) / d2;
-        nx = ly;  // outward: clockwise of the right leg
-        ny = -lx;
-      }
-      const double along = vx * lx + vy * ly;
-      ux = along * lx - vx;
-      uy = along * ly - vy;
-    }
-  } else {
-    // Already overlapping: leave the disc of radius r / dt around p / dt (separate in one tick).
-    const double wx = vx - px / dt, wy = vy - py / dt;
-    const double wl = std::sqrt(wx * wx + wy * wy);
-    if (wl > 0) {
-      nx = wx / wl;
-      ny = wy / wl;
-    } else {  // coincident centres and velocities: any direction, deterministic
-      nx = 1;
-      ny = 0;
-    }
-    const double s = r / dt - wl;
-    ux = s * nx;
-    uy = s * ny;
-  }
-  return {vix + share * ux, viy + share * uy, nx, ny};
-}
 
 class OrcaModel final : public Model {
  public:
@@ -319,6 +263,7 @@ class OrcaModel final : public Model {
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
         std::vector<HalfPlane> planes;
         std::vector<uint8_t> goes_first;  // per neighbour of the row: does the row go first?
+        std::vector<double> ipx, ipy, ivx, ivy, ir, itau, ishare;  // agent_planes' inputs
         for (std::size_t i = b; i < e; ++i) {
           planes.clear();
           obstacle_planes(in, i, planes);
@@ -342,20 +287,30 @@ class OrcaModel final : public Model {
           }
           retreat_plane(in, i, planes);
           const std::size_t hard = planes.size();
-          for (uint32_t a = nb_.offset[i]; a < nb_.offset[i + 1]; ++a) {
-            const uint32_t j = nb_.row[a];
+          // The agent planes: the inputs gathered per neighbour, the planes built several at a
+          // time (steer/orca_planes.hpp).
+          const std::size_t m = nb_.offset[i + 1] - lo;
+          for (auto* col : {&ipx, &ipy, &ivx, &ivy, &ir, &itau, &ishare}) col->resize(m);
+          for (std::size_t a = 0; a < m; ++a) {
+            const uint32_t j = nb_.row[lo + a];
             // Right of way: a neighbour that goes first is avoided where it wants to go, as far as
             // it is held up (walking as it wishes, its velocity says it already).
-            const bool i_first = goes_first[a - lo];
+            const bool i_first = goes_first[a];
             const double vjx = i_first ? t.vx[j] : avoid_x_[j];
             const double vjy = i_first ? t.vy[j] : avoid_y_[j];
+            ipx[a] = t.x[j] - t.x[i];
+            ipy[a] = t.y[j] - t.y[i];
+            ivx[a] = vix - vjx;
+            ivy[a] = viy - vjy;
+            ir[a] = t.radius[i] + t.radius[j];
             // The pair's horizon: no longer than until one of them arrives (see the top).
-            const double tau =
-                std::clamp(std::min(arrive_[i], arrive_[j]), in.cfg.dt, p.time_horizon);
-            planes.push_back(agent_plane(t.x[j] - t.x[i], t.y[j] - t.y[i], vix - vjx, viy - vjy,
-                                         t.radius[i] + t.radius[j], tau, in.cfg.dt, vix, viy,
-                                         i_first ? hi_share : 1 - hi_share));
+            itau[a] = std::clamp(std::min(arrive_[i], arrive_[j]), in.cfg.dt, p.time_horizon);
+            ishare[a] = i_first ? hi_share : 1 - hi_share;
           }
+          planes.resize(hard + m);
+          agent_planes({ipx.data(), ipy.data(), ivx.data(), ivy.data(), ir.data(), itau.data(),
+                        ishare.data()},
+                       m, in.cfg.dt, vix, viy, planes.data() + hard);
           double px = in.pref_vx[i], py = in.pref_vy[i];
           if (p.pass_side != OrcaParams::PassSide::none) keep_to_side(in, i, px, py);
           if (p.time_gap > 0 || (p.stream_gap > 0 && streams_.marked[i]))
