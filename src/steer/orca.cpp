@@ -593,11 +593,12 @@ class OrcaModel final : public Model {
       if (const int o = sim::out_before_in(t, in.goals, i, j); o != 0) return o > 0;
     // The rest without branches: which way a pair goes is a coin toss to the branch predictor,
     // and the rule runs once per neighbour of every row.
-    const bool by_path = (remaining_[i] < remaining_[j]) |
-                         ((remaining_[i] == remaining_[j]) & (rank_[i] > rank_[j]));
+    // (The tests as ints: & and | on them is meant, not && and ||.)
+    const bool by_path = int{remaining_[i] < remaining_[j]} |
+                         (int{remaining_[i] == remaining_[j]} & int{rank_[i] > rank_[j]});
     bool by_place;
-    const bool decides = std::isfinite(remaining_[i]) & std::isfinite(remaining_[j]) &
-                         sim::ahead(heading_[i], heading_[j], by_place);
+    const bool decides = int{std::isfinite(remaining_[i])} & int{std::isfinite(remaining_[j])} &
+                         int{sim::ahead(heading_[i], heading_[j], by_place)};
     return decides ? by_place : by_path;
   }
 
