@@ -104,7 +104,6 @@ void NeighbourGrid::rows_permuted(std::span<const uint32_t> order) {
   }
   slot_count_.swap(count);
   slot_row_.swap(rows);
-  slot_d2_.resize(n * k);  // (only a call's own compaction reads it)
 }
 
 void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, double range,
@@ -138,7 +137,9 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
     if (!hints) slot_count_.assign(d.n, 0);
     slot_count_.resize(d.n, 0);  // rows new since the last call have no hints
     slot_row_.resize(d.n * k);
-    slot_d2_.resize(d.n * k);
+    // The distances go straight into the output's slots (a second array of n k doubles was the
+    // largest item of memory at 10^6 agents), compacted in place afterwards.
+    out.dist2.resize(d.n * k);
   }
   hint_k_ = hintable ? k : 0;
   ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
@@ -310,7 +311,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         std::copy(best.rows().begin(), best.rows().end(),
                   slot_row_.begin() + static_cast<std::ptrdiff_t>(i * k));
         std::copy(best.dist2().begin(), best.dist2().end(),
-                  slot_d2_.begin() + static_cast<std::ptrdiff_t>(i * k));
+                  out.dist2.begin() + static_cast<std::ptrdiff_t>(i * k));
         continue;
       }
       lists.counts[c].push_back(static_cast<uint32_t>(best.size()));
@@ -323,15 +324,17 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
     out.offset[0] = 0;
     for (std::size_t i = 0; i < d.n; ++i) out.offset[i + 1] = out.offset[i] + slot_count_[i];
     out.row.resize(out.offset[d.n]);
-    out.dist2.resize(out.offset[d.n]);
     ex.for_each_chunk(d.n, kCopyGrain, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) {
+      for (std::size_t i = b; i < e; ++i)
         std::copy_n(slot_row_.begin() + static_cast<std::ptrdiff_t>(i * k), slot_count_[i],
                     out.row.begin() + out.offset[i]);
-        std::copy_n(slot_d2_.begin() + static_cast<std::ptrdiff_t>(i * k), slot_count_[i],
-                    out.dist2.begin() + out.offset[i]);
-      }
     });
+    // In place, forwards from the first short list (each list moves to an earlier place, after
+    // the lists before it have moved): one pass on one thread.
+    double* const d2 = out.dist2.data();
+    for (std::size_t i = 0; i < d.n; ++i)
+      if (out.offset[i] != i * k) std::copy_n(d2 + i * k, slot_count_[i], d2 + out.offset[i]);
+    out.dist2.resize(out.offset[d.n]);
   } else {
     lists.gather(out, &NeighbourLists::row);
   }

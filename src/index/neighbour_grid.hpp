@@ -57,10 +57,11 @@ class NeighbourGrid final : public NeighbourPath {
   std::vector<uint32_t> rows_;   // table rows in cell order
   std::vector<double> x_, y_;    // their positions, copied in cell order
   std::vector<uint64_t> id_;
-  std::vector<int64_t> cell_of_;                 // scratch: cell per row
-  std::vector<uint32_t> fill_;                   // scratch: next free place per cell
-  std::vector<uint32_t> slot_count_, slot_row_;  // scratch: per-row lists of k (spatial order)
-  std::vector<double> slot_d2_;
+  std::vector<int64_t> cell_of_;  // scratch: cell per row
+  std::vector<uint32_t> fill_;    // scratch: next free place per cell
+  // Per-row lists of k (spatial order): the rows, kept as the next call's hints; their distances
+  // are written into the output's slots.
+  std::vector<uint32_t> slot_count_, slot_row_;
   uint32_t hint_k_ = 0;  // k of the last call when its lists are in the slots (hints), else 0
 };
 
