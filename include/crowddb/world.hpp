@@ -188,6 +188,12 @@ struct AgentTable {
   bool empty() const { return x.empty(); }
 };
 
+// Row i walks slower than half its preferred speed: held up (the goal stage's lost-sight look,
+// the path service's queue counting at doors).
+inline bool held_up(const AgentTable& t, std::size_t i) {
+  return t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i] < 0.25 * t.pref_speed[i] * t.pref_speed[i];
+}
+
 class World {
  public:
   // A world without bounds (nothing is outside it), or one inside `bounds` (set_bounds' checks).

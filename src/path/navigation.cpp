@@ -20,11 +20,6 @@ constexpr std::size_t kCostedPerTick = 8;
 constexpr double kBlockedReach = 2;  // [m]
 constexpr double kOnMesh = 1e-3;     // [m] (the mesh is in floats)
 
-// Row i walks slower than half its preferred speed (as sim::goal_stage's lost-sight look asks).
-bool held_up(const AgentTable& t, std::size_t i) {
-  return t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i] < 0.25 * t.pref_speed[i] * t.pref_speed[i];
-}
-
 // Where row i walks now: the unit vector to its waypoint (World::refresh_target's).
 Vec2 heading(const AgentTable& t, std::size_t i) {
   return unit_towards(t.x[i], t.y[i], {t.target_x[i], t.target_y[i]});

@@ -223,8 +223,7 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
           target = next;
         }
       }
-      if (lost_sight && !pref.skip[i] && (tick + t.id[i]) % lost_ticks == 0 &&
-          t.vx[i] * t.vx[i] + t.vy[i] * t.vy[i] < 0.25 * t.pref_speed[i] * t.pref_speed[i]) {
+      if (lost_sight && !pref.skip[i] && (tick + t.id[i]) % lost_ticks == 0 && held_up(t, i)) {
         const double dx = target.x - t.x[i], dy = target.y - t.y[i];
         const double dist = std::sqrt(dx * dx + dy * dy);
         // (A target nearer than that is a corner at the obstacle itself, a door's post: the
