@@ -4,7 +4,9 @@
 // state hash (which must not depend on the thread count; a difference fails the run).
 //
 // Each case runs in a child process of its own, so that its peak memory is its own
-// (getrusage of the child) and one case's allocations do not slow the next.
+// (getrusage of the child) and one case's allocations do not slow the next. `--fork no` runs
+// them in this process instead, for profilers that do not follow a fork (heaptrack, perf); the
+// peak memory printed is then the process's so far.
 //
 //   build/bench/tick_speed                          # every case but airport-1m and -10m
 //   build/bench/tick_speed --cases airport-20k --models orca --threads 1,2 --ticks 100
@@ -188,7 +190,7 @@ int usage(const char* why) {
   std::fprintf(
       stderr,
       "tick_speed: %s\nusage: tick_speed [--cases all|NAME,...] [--models orca,cfsm,thesis] "
-      "[--threads 1,2] [--ticks N] [--csv FILE]\ncases:",
+      "[--threads 1,2] [--ticks N] [--csv FILE] [--fork yes|no]\ncases:",
       why);
   for (const Case& c : kCases) std::fprintf(stderr, " %s", c.name);
   std::fprintf(stderr, "\n");
@@ -202,6 +204,7 @@ int main(int argc, char** argv) {
   std::vector<int> thread_counts = {1, 2};
   uint64_t ticks = 0;
   std::string csv;
+  bool fork_cases = true;
   for (int a = 1; a < argc; a += 2) {
     const std::string k = argv[a];
     if (a + 1 >= argc) return usage(("missing value after " + k).c_str());
@@ -216,6 +219,9 @@ int main(int argc, char** argv) {
     } else if (k == "--ticks") {
       ticks = std::strtoull(v.c_str(), nullptr, 10);
       if (ticks == 0) return usage("--ticks must be a positive number");
+    } else if (k == "--fork") {
+      if (v != "yes" && v != "no") return usage("--fork takes yes or no");
+      fork_cases = v == "yes";
     } else if (k == "--csv") {
       csv = v;
     } else {
@@ -251,23 +257,29 @@ int main(int argc, char** argv) {
     for (const std::string& model : models) {
       for (int threads : thread_counts) {
         const uint64_t n = ticks ? ticks : c->ticks;
-        int fd[2];
-        if (pipe(fd) != 0) return usage("pipe failed");
         const double load_before = load_average();
-        const pid_t pid = fork();
-        if (pid == 0) {
-          close(fd[0]);
-          const Result r = run_case(*c, model, threads, n);
-          const ssize_t w = write(fd[1], &r, sizeof r);
-          _exit(w == static_cast<ssize_t>(sizeof r) ? 0 : 1);
-        }
-        close(fd[1]);
         Result r;
-        const bool got = read(fd[0], &r, sizeof r) == static_cast<ssize_t>(sizeof r);
-        close(fd[0]);
-        int wstatus = 0;
+        bool got = true;
         rusage ru{};
-        wait4(pid, &wstatus, 0, &ru);
+        if (fork_cases) {
+          int fd[2];
+          if (pipe(fd) != 0) return usage("pipe failed");
+          const pid_t pid = fork();
+          if (pid == 0) {
+            close(fd[0]);
+            const Result child = run_case(*c, model, threads, n);
+            const ssize_t w = write(fd[1], &child, sizeof child);
+            _exit(w == static_cast<ssize_t>(sizeof child) ? 0 : 1);
+          }
+          close(fd[1]);
+          got = read(fd[0], &r, sizeof r) == static_cast<ssize_t>(sizeof r);
+          close(fd[0]);
+          int wstatus = 0;
+          wait4(pid, &wstatus, 0, &ru);
+        } else {
+          r = run_case(*c, model, threads, n);
+          getrusage(RUSAGE_SELF, &ru);  // the process's peak so far, every earlier case included
+        }
         const double load_after = load_average();
         if (!got || r.error[0]) {
           std::printf("%-14s %-7s %3d  failed: %s\n", c->name, model.c_str(), threads,
