@@ -268,7 +268,11 @@ std::vector<uint32_t> collision_set(const DiscView& discs, const StaticScene& sc
 struct NeighbourLists {
   std::vector<uint32_t> offset;  // queries + 1
   std::vector<uint32_t> row;     // rows of the DiscView
-  std::vector<double> dist2;     // squared distance of centres [m^2]
+  std::vector<double> dist2;     // squared distance of centres [m^2]; empty if !with_dist2
+  // Set by the caller before a run: false leaves dist2 empty, for a caller that recomputes the
+  // distances it needs from the positions (the k-nearest lists of 10^6 agents with k = 10 hold
+  // 80 MB of them).
+  bool with_dist2 = true;
   std::size_t queries() const { return offset.empty() ? 0 : offset.size() - 1; }
   std::span<const uint32_t> rows_of(std::size_t q) const {
     return {row.data() + offset[q], row.data() + offset[q + 1]};

@@ -139,7 +139,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
     slot_row_.resize(d.n * k);
     // The distances go straight into the output's slots (a second array of n k doubles was the
     // largest item of memory at 10^6 agents), compacted in place afterwards.
-    out.dist2.resize(d.n * k);
+    if (out.with_dist2) out.dist2.resize(d.n * k);
   }
   hint_k_ = hintable ? k : 0;
   ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
@@ -310,13 +310,15 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         slot_count_[i] = static_cast<uint32_t>(best.size());
         std::copy(best.rows().begin(), best.rows().end(),
                   slot_row_.begin() + static_cast<std::ptrdiff_t>(i * k));
-        std::copy(best.dist2().begin(), best.dist2().end(),
-                  out.dist2.begin() + static_cast<std::ptrdiff_t>(i * k));
+        if (out.with_dist2)
+          std::copy(best.dist2().begin(), best.dist2().end(),
+                    out.dist2.begin() + static_cast<std::ptrdiff_t>(i * k));
         continue;
       }
       lists.counts[c].push_back(static_cast<uint32_t>(best.size()));
       lists.items[c].insert(lists.items[c].end(), best.rows().begin(), best.rows().end());
-      lists.d2[c].insert(lists.d2[c].end(), best.dist2().begin(), best.dist2().end());
+      if (out.with_dist2)
+        lists.d2[c].insert(lists.d2[c].end(), best.dist2().begin(), best.dist2().end());
     }
   });
   if (spatial) {
@@ -331,10 +333,14 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
     });
     // In place, forwards from the first short list (each list moves to an earlier place, after
     // the lists before it have moved): one pass on one thread.
-    double* const d2 = out.dist2.data();
-    for (std::size_t i = 0; i < d.n; ++i)
-      if (out.offset[i] != i * k) std::copy_n(d2 + i * k, slot_count_[i], d2 + out.offset[i]);
-    out.dist2.resize(out.offset[d.n]);
+    if (out.with_dist2) {
+      double* const d2 = out.dist2.data();
+      for (std::size_t i = 0; i < d.n; ++i)
+        if (out.offset[i] != i * k) std::copy_n(d2 + i * k, slot_count_[i], d2 + out.offset[i]);
+      out.dist2.resize(out.offset[d.n]);
+    } else {
+      out.dist2.clear();
+    }
   } else {
     lists.gather(out, &NeighbourLists::row);
   }

@@ -155,12 +155,13 @@ struct ListChunks {
   template <class Lists>
   void gather(Lists& out, std::vector<uint32_t> Lists::*items_member) const {
     out.offset.assign(1, 0);
-    std::size_t total = 0;
+    std::size_t total = 0, total_d2 = 0;  // no distances when the caller asked for none
     for (const auto& c : items) total += c.size();
+    for (const auto& c : d2) total_d2 += c.size();
     (out.*items_member).clear();
     (out.*items_member).reserve(total);
     out.dist2.clear();
-    out.dist2.reserve(total);
+    out.dist2.reserve(total_d2);
     for (std::size_t c = 0; c < counts.size(); ++c) {
       for (uint32_t n : counts[c]) out.offset.push_back(out.offset.back() + n);
       (out.*items_member).insert((out.*items_member).end(), items[c].begin(), items[c].end());

@@ -35,7 +35,8 @@ void NeighbourNaive::run(const DiscView& d, std::span<const uint32_t> queries, d
       tests[c] += d.n;
       lists.counts[c].push_back(static_cast<uint32_t>(best.size()));
       lists.items[c].insert(lists.items[c].end(), best.rows().begin(), best.rows().end());
-      lists.d2[c].insert(lists.d2[c].end(), best.dist2().begin(), best.dist2().end());
+      if (out.with_dist2)
+        lists.d2[c].insert(lists.d2[c].end(), best.dist2().begin(), best.dist2().end());
     }
   });
   lists.gather(out, &NeighbourLists::row);

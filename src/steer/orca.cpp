@@ -178,6 +178,13 @@ constexpr double kSideTurn = 30 * std::numbers::pi / 180;
 constexpr double kTurnNearWaypoint = 2;  // [m]
 constexpr double kStanding = 1e-100;     // [m/s] a wish below this does not look for anyone
 
+// The squared distance of rows i and j as the neighbour lists computed it (same operands, same
+// order: the same double), so the lists need not store it.
+inline double dist2_of(const AgentTable& t, std::size_t i, std::size_t j) {
+  const double dx = t.x[j] - t.x[i], dy = t.y[j] - t.y[i];
+  return dx * dx + dy * dy;
+}
+
 class OrcaModel final : public Model {
  public:
   void velocities(const TickInput& in, std::span<double> vx, std::span<double> vy, Executor& ex,
@@ -193,6 +200,7 @@ class OrcaModel final : public Model {
     log.timed("ORCA neighbours", n, [&] {
       auto& path = neighbour_paths_[nm.info.name];
       if (!path) path = nm.make();
+      nb_.with_dist2 = false;  // recomputed where needed (dist2_of): 80 MB fewer at 10^6 agents
       path->run(view, {}, p.neighbor_dist, p.max_neighbors, nb_, ex, nop.query);
     });
     const bool obstacles = in.scene.feature_count() > 0;
@@ -276,7 +284,7 @@ class OrcaModel final : public Model {
           const double reach = 2 * in.cfg.dt * t.max_speed[i];
           for (uint32_t a = nb_.offset[i]; a < nb_.offset[i + 1]; ++a) {
             const uint32_t j = nb_.row[a];
-            const double d = std::sqrt(nb_.dist2[a]);
+            const double d = std::sqrt(dist2_of(t, i, j));
             const double gap = d - t.radius[i] - t.radius[j] - kSkin;
             if (gap >= reach || d == 0) continue;
             const double nx = (t.x[j] - t.x[i]) / d, ny = (t.y[j] - t.y[i]) / d;
@@ -414,7 +422,7 @@ class OrcaModel final : public Model {
       const bool headway = p.time_gap > 0 && follows(view, i, j, ux, uy);
       const bool gap = stream && follows_within_gap(view, i, a, ux, uy, v0);
       if (!headway && !gap) continue;
-      const double s = std::max(std::sqrt(nb_.dist2[a]) - (t.radius[i] + t.radius[j]), 0.0);
+      const double s = std::max(std::sqrt(dist2_of(t, i, j)) - (t.radius[i] + t.radius[j]), 0.0);
       if (headway) v = std::min(v, s / p.time_gap);
       if (gap) v = std::min(v, std::max(t.vx[j] * ux + t.vy[j] * uy, 0.0) + s / p.stream_gap);
     }

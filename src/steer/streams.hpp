@@ -57,7 +57,8 @@ inline bool follows_within_gap(const StreamView& v, std::size_t i, uint32_t a, d
                                double w) {
   const uint32_t j = v.nb->row[a];
   const double reach = w * v.gap + v.radius[i] + v.radius[j];
-  return v.nb->dist2[a] < reach * reach && follows(v, i, j, ux, uy);
+  const double dx = v.x[j] - v.x[i], dy = v.y[j] - v.y[i];  // the list's own distance, bit for bit
+  return dx * dx + dy * dy < reach * reach && follows(v, i, j, ux, uy);
 }
 
 // The marking; the vectors keep their capacity from call to call.

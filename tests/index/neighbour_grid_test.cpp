@@ -10,10 +10,11 @@ namespace crowddb::index {
 namespace {
 
 NeighbourLists run(NeighbourPath& p, const DiscView& d, double range, uint32_t k,
-                   std::span<const uint32_t> q = {}, int threads = 1) {
+                   std::span<const uint32_t> q = {}, int threads = 1, bool with_dist2 = true) {
   Executor ex(threads);
   QueryStats st;
   NeighbourLists out;
+  out.with_dist2 = with_dist2;
   p.run(d, q, range, k, out, ex, st);
   return out;
 }
@@ -75,6 +76,49 @@ TEST(NeighbourGrid, EqualsNaiveOnRandomShapes) {
     for (std::size_t i = 0; i < n; i += 1 + rng.below(5)) q.push_back(static_cast<uint32_t>(i));
     std::reverse(q.begin(), q.end());
     expect_same(run(grid, d, range, k, q), run(naive, d, range, k, q));
+  }
+}
+
+// Lists asked for without their distances (ORCA recomputes them from the positions): the same
+// rows, no distances, for the grid (spatial order with hints, and query order) and the naive
+// twin; and every stored distance is the one recomputed from the positions, bit for bit.
+TEST(NeighbourGrid, ListsWithoutDistancesAreTheSameLists) {
+  Rng rng(17);
+  NeighbourNaive naive;
+  NeighbourGrid grid;
+  for (int c = 0; c < 30; ++c) {
+    const std::size_t n = 1 + rng.below(500);
+    const double side = rng.uniform(5, 200);
+    const DiscTable t = test::random_shape_table(rng, n, side, 300 + static_cast<uint64_t>(c));
+    const DiscView d = t.view();
+    const double range = side * std::pow(10, rng.uniform(-2, 0.3));
+    const uint32_t k = rng.below(4) == 0 ? 0 : static_cast<uint32_t>(1 + rng.below(12));
+    SCOPED_TRACE("case " + std::to_string(c) + " n " + std::to_string(n) + " k " +
+                 std::to_string(k));
+    const NeighbourLists want = run(naive, d, range, k);
+    ASSERT_EQ(want.dist2.size(), want.row.size());
+    for (std::size_t i = 0; i < want.queries(); ++i)
+      for (uint32_t a = want.offset[i]; a < want.offset[i + 1]; ++a) {
+        const uint32_t j = want.row[a];
+        const double dx = d.x[j] - d.x[i], dy = d.y[j] - d.y[i];
+        ASSERT_EQ(want.dist2[a], dx * dx + dy * dy);
+      }
+    std::vector<uint32_t> q;
+    for (std::size_t i = 0; i < n; i += 1 + rng.below(4)) q.push_back(static_cast<uint32_t>(i));
+    for (int pass = 0; pass < 2; ++pass) {  // the second pass is seeded with the first's hints
+      for (NeighbourPath* path :
+           {static_cast<NeighbourPath*>(&grid), static_cast<NeighbourPath*>(&naive)}) {
+        const NeighbourLists bare = run(*path, d, range, k, {}, 2, false);
+        EXPECT_EQ(bare.offset, want.offset);
+        EXPECT_EQ(bare.row, want.row);
+        EXPECT_TRUE(bare.dist2.empty());
+        const NeighbourLists some = run(*path, d, range, k, q, 1, false);
+        const NeighbourLists some_want = run(naive, d, range, k, q);
+        EXPECT_EQ(some.offset, some_want.offset);
+        EXPECT_EQ(some.row, some_want.row);
+        EXPECT_TRUE(some.dist2.empty());
+      }
+    }
   }
 }
 
