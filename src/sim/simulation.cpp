@@ -19,6 +19,7 @@
 #include "util/hash.hpp"
 #include "util/rng.hpp"
 #include "util/stopwatch.hpp"
+#include "world/geometry.hpp"
 
 namespace crowddb {
 namespace {
@@ -597,7 +598,7 @@ const TickMetrics& Simulation::step() {
         }
         const double reach = cfg.waypoint_radius > 0 ? cfg.waypoint_radius : t.radius[i];
         while (!t.route[i].empty() &&
-               std::hypot(t.route[i].front().x - t.x[i], t.route[i].front().y - t.y[i]) <= reach) {
+               length(t.route[i].front().x - t.x[i], t.route[i].front().y - t.y[i]) <= reach) {
           t.route[i].erase(t.route[i].begin());
           world_.refresh_target(i);
         }

@@ -24,7 +24,7 @@ bool idle(const AgentTable& t, std::size_t i) {
 
 // Does idle row i stand on (or touch) disc goal g?
 bool on_disc(const AgentTable& t, const Goal& g, std::size_t i) {
-  return std::hypot(g.x - t.x[i], g.y - t.y[i]) < g.arrival_radius + t.radius[i];
+  return length(g.x - t.x[i], g.y - t.y[i]) < g.arrival_radius + t.radius[i];
 }
 
 // The preferred velocity of idle row i stepping off disc goal g: away from its centre at half
@@ -192,7 +192,7 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
           for (uint32_t k : near) {
             const CircleObstacle& c = needed.area[k];
             if (needed.goal[k] == t.goal[i] ||
-                !(std::hypot(c.x - t.x[i], c.y - t.y[i]) < c.radius + t.radius[i]))
+                !(length(c.x - t.x[i], c.y - t.y[i]) < c.radius + t.radius[i]))
               continue;
             const Vec2 v = step_off(t, goals[needed.goal[k]], cfg, i);
             px = v.x;
@@ -256,9 +256,10 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
       }
       if (noise > 0) {
         Rng rng = Rng::stream(cfg.seed ^ (tick * 0x94d049bb133111ebull), t.id[i] ^ 0xa11ce);
-        const double a = rng.uniform(0, 2 * std::numbers::pi);
-        px += noise * std::cos(a);
-        py += noise * std::sin(a);
+        double ux, uy;
+        rng.direction(ux, uy);
+        px += noise * ux;
+        py += noise * uy;
       }
       pref.vx[i] = px;
       pref.vy[i] = py;

@@ -530,7 +530,7 @@ class OrcaModel final : public Model {
     const AgentTable& t = in.agents;
     const double back = in.cfg.steering.orca.max_retreat * t.pref_speed[i];
     if (back >= t.max_speed[i]) return;  // cannot bind
-    const double w = std::hypot(in.pref_vx[i], in.pref_vy[i]);
+    const double w = length(in.pref_vx[i], in.pref_vy[i]);
     if (w == 0) return;  // no direction to keep to (idle, or on its target)
     const double ux = in.pref_vx[i] / w, uy = in.pref_vy[i] / w;
     out.push_back({-ux * back, -uy * back, ux, uy});
@@ -584,7 +584,7 @@ class OrcaModel final : public Model {
     if (g.is_polygon()) {
       d = inside_goal(g, t.x[i], t.y[i]) ? 0 : std::sqrt(dist2_to_boundary(g.area, t.x[i], t.y[i]));
     } else {
-      d = std::max(0.0, std::hypot(g.x - t.x[i], g.y - t.y[i]) - g.arrival_radius);
+      d = std::max(0.0, length(g.x - t.x[i], g.y - t.y[i]) - g.arrival_radius);
     }
     return d / t.pref_speed[i];
   }

@@ -57,6 +57,24 @@ class Rng {
   // Uniform in [lo, hi).
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
 
+  // A direction uniform on the circle, (x, y) of unit length, without a sine or a cosine (glibc's
+  // sincos was 2 % of an ORCA tick at 2 * 10^4 agents, drawing every wish's perturbation): a
+  // point uniform in the unit disc, by rejection from the square (1.27 tries on average; should
+  // 64 in a row fail, a chance of 10^-43, it gives (1, 0)), scaled to unit length.
+  void direction(double& x, double& y) {
+    for (int k = 0; k < 64; ++k) {
+      const double u = uniform(-1, 1), v = uniform(-1, 1), r2 = u * u + v * v;
+      if (r2 > 1e-12 && r2 <= 1) {
+        const double r = std::sqrt(r2);
+        x = u / r;
+        y = v / r;
+        return;
+      }
+    }
+    x = 1;
+    y = 0;
+  }
+
   // Uniform integer in [0, n), unbiased (Lemire's multiply-and-reject), n > 0.
   uint64_t below(uint64_t n) {
     __extension__ using u128 = unsigned __int128;

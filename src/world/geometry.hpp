@@ -13,6 +13,13 @@
 
 namespace crowddb {
 
+// sqrt(x^2 + y^2). Not std::hypot: its guard against overflow costs about 20 ns a call (3 % of
+// an ORCA tick at 2 * 10^4 agents), and coordinates (|x| <= 10^9 m, the loader's bound), speeds
+// and their differences stay far from where x^2 overflows.
+inline double length(double x, double y) {
+  return std::sqrt(x * x + y * y);
+}
+
 // Twice the signed area (positive when counter-clockwise), halved.
 inline double signed_area(std::span<const Vec2> ring) {
   double a = 0;
@@ -116,7 +123,7 @@ inline Vec2 unit_towards(double px, double py, Vec2 p) {
 // goal: inside or on the boundary (within a micrometre, so that an agent that steps exactly onto
 // the nearest boundary point arrives whatever the rounding).
 inline bool inside_goal(const Goal& g, double px, double py) {
-  if (!g.is_polygon()) return std::hypot(g.x - px, g.y - py) <= g.arrival_radius;
+  if (!g.is_polygon()) return length(g.x - px, g.y - py) <= g.arrival_radius;
   // A point a millimetre outside the area's box is outside (and far beyond the micrometre): this
   // runs for every walking agent and tick, and the boundary distance divides once per edge.
   constexpr double kFar = 1e-3;

@@ -279,30 +279,39 @@ TEST(Orca, AnArchOfMixedDestinationsInFrontOfADoorBreaks) {
 // The westbound block went first and swept the eastbound one back against the west wall, onto
 // its own goal: the people pressed there cannot yield (the wall is behind them) and the
 // westbound ones cannot reach the wall, so 46 of 100 arrived in 120 s and nothing moved after
-// 60 s. When a pair has been stalled for 12 s the two take turns to yield, and all 100 arrive.
+// 60 s. When a pair has been stalled for 12 s the two take turns to yield.
+// Over seeds, not on one: which seeds jam swings with the last bit of a distance (seed 1 got
+// 67 of 100 home without the turns, then 100 once two distances were computed as sqrt(x^2 +
+// y^2) instead of std::hypot). Measured on seeds 1-6 without / with the turns: 413 / 600 (with
+// std::hypot), 444 / 541 (sqrt; seed 5: 24 / 41); seeds 1-12: 944 / 1,138 and 979 / 1,078.
 TEST(Orca, ABlockSweptAgainstTheOthersGoalGetsOut) {
-  const std::string text = R"({"bounds": [0, 0, 16, 4], "duration": 120, "seed": 1,
+  const std::string text = R"(, "duration": 120,
     "goals": [{"name": "E", "area": [[15, 0], [16, 0], [16, 4], [15, 4]]},
               {"name": "W", "area": [[0, 0], [1, 0], [1, 4], [0, 4]]}],
     "groups": [{"name": "eastbound", "count": 50, "goal": "E", "radius": [0.2, 0.25], "pref_speed": [1.2, 1.4],
                 "placement": {"type": "uniform", "region": [1, 0, 7.5, 4], "gap": 0.05}},
                {"name": "westbound", "count": 50, "goal": "W", "radius": [0.2, 0.25], "pref_speed": [1.2, 1.4],
                 "placement": {"type": "uniform", "region": [8.5, 0, 15, 4], "gap": 0.05}}]})";
-  for (double reverse_after : {0.0, 12.0}) {
-    Scenario sc = parse_scenario(text, "t.json");
-    sc.config.stall.reverse_after = reverse_after;
-    // The turns alone (keeping to the right, on seeds 1-20 of this hallway 1,887 -> 1,998 of
-    // 2,000 arrive, gets 98 of these 100 home in 120 s).
-    sc.config.steering.orca.pass_side = OrcaParams::PassSide::none;
-    Simulation sim(std::move(sc.world), sc.config);
-    for (uint64_t tick = 0; tick < sc.ticks && !sim.world().agents().empty(); ++tick)
-      EXPECT_EQ(sim.step().overlapping_pairs, 0u);
-    if (reverse_after == 0)
-      EXPECT_LT(sim.arrived_total(), 90u);  // measured: 67 (46 before the lines through
-                                            // wall edges' ends, steer/separating_line.hpp)
-    else
-      EXPECT_EQ(sim.arrived_total(), 100u);
+  uint64_t home[2] = {0, 0};  // seeds 1-6 without, with the turns
+  int all_home[2] = {0, 0};   // seeds on which all 100 arrived
+  for (const bool turns : {false, true}) {
+    for (uint64_t seed = 1; seed <= 6; ++seed) {
+      Scenario sc = parse_scenario(
+          R"({"bounds": [0, 0, 16, 4], "seed": )" + std::to_string(seed) + text, "t.json");
+      sc.config.stall.reverse_after = turns ? 12.0 : 0.0;
+      // The turns alone (keeping to the right, on seeds 1-20 of this hallway 1,887 -> 1,998 of
+      // 2,000 arrive, gets 98 of 100 home in 120 s on seed 1).
+      sc.config.steering.orca.pass_side = OrcaParams::PassSide::none;
+      Simulation sim(std::move(sc.world), sc.config);
+      for (uint64_t tick = 0; tick < sc.ticks && !sim.world().agents().empty(); ++tick)
+        EXPECT_EQ(sim.step().overlapping_pairs, 0u);
+      home[turns] += sim.arrived_total();
+      all_home[turns] += sim.arrived_total() == 100;
+    }
   }
+  EXPECT_LT(home[false], 500u);  // jams on some seeds (two of six, 20-30 home, both builds)
+  EXPECT_GE(home[true], home[false] + 60);
+  EXPECT_GE(all_home[true], 5);
 }
 
 // Two people strolling towards each other on one line (0.6 m/s) pass on the side pass_side sets:
