@@ -57,6 +57,7 @@ class CfsmModel final : public Model {
     log.timed("CFSM neighbours", n, [&] {
       auto& path = neighbour_paths_[nm.info.name];
       if (!path) path = nm.make();
+      nb_.with_dist2 = false;  // recomputed where needed (dist2_of)
       path->run(view, {}, p.cutoff, 0, nb_, ex, nop.query);
     });
     const bool obstacles = in.scene.feature_count() > 0;
@@ -141,7 +142,7 @@ class CfsmModel final : public Model {
     const uint32_t lo = nb_.offset[i], hi = nb_.offset[i + 1];
     for (uint32_t a = lo; a < hi; ++a) {
       const uint32_t j = nb_.row[a];
-      const double d = std::sqrt(nb_.dist2[a]);
+      const double d = std::sqrt(dist2_of(t, i, j));
       if (d == 0 || hidden(in, i, j)) continue;
       const double s = p.strength_neighbor * std::exp((r + t.radius[j] - d) / p.range_neighbor);
       dx += s * (x - t.x[j]) / d;
@@ -182,14 +183,14 @@ class CfsmModel final : public Model {
       const double l = r + t.radius[j];
       if (std::abs(ry * dx - rx * dy) > l) continue;  // beside the corridor
       if (hidden(in, i, j)) continue;
-      spacing = std::min(spacing, std::sqrt(nb_.dist2[a]) - l);
+      spacing = std::min(spacing, std::sqrt(dist2_of(t, i, j)) - l);
     }
     double speed = std::min(std::max(spacing / p.time_gap, 0.0), v0);
     // Contact clipping: at most half the gap to a neighbour, all of it to an obstacle, per tick.
     const double dt = in.cfg.dt;
     for (uint32_t a = lo; a < hi && speed > 0; ++a) {
       const uint32_t j = nb_.row[a];
-      const double d = std::sqrt(nb_.dist2[a]);
+      const double d = std::sqrt(dist2_of(t, i, j));
       if (d == 0) continue;
       const double along = ((t.x[j] - x) * dx + (t.y[j] - y) * dy) / d;  // e . n_ij
       if (along <= 0) continue;

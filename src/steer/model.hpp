@@ -31,6 +31,14 @@ inline constexpr std::size_t kGrain = 128;
 // the new positions cannot turn an exact touch into an overlap the backoff would freeze.
 inline constexpr double kSkin = 1e-6;
 
+// The squared distance of rows i and j as the neighbour lists compute it (same operands, same
+// order: the same double), so that a model's lists need not store it (NeighbourLists::with_dist2:
+// 80 MB at 10^6 agents with 10 neighbours each).
+inline double dist2_of(const AgentTable& t, std::size_t i, std::size_t j) {
+  const double dx = t.x[j] - t.x[i], dy = t.y[j] - t.y[i];
+  return dx * dx + dy * dy;
+}
+
 // A parameter as EXPLAIN prints it (ostream's default formatting, as every model printed it).
 std::string explain_number(double v);
 

@@ -178,13 +178,6 @@ constexpr double kSideTurn = 30 * std::numbers::pi / 180;
 constexpr double kTurnNearWaypoint = 2;  // [m]
 constexpr double kStanding = 1e-100;     // [m/s] a wish below this does not look for anyone
 
-// The squared distance of rows i and j as the neighbour lists computed it (same operands, same
-// order: the same double), so the lists need not store it.
-inline double dist2_of(const AgentTable& t, std::size_t i, std::size_t j) {
-  const double dx = t.x[j] - t.x[i], dy = t.y[j] - t.y[i];
-  return dx * dx + dy * dy;
-}
-
 class OrcaModel final : public Model {
  public:
   void velocities(const TickInput& in, std::span<double> vx, std::span<double> vy, Executor& ex,
