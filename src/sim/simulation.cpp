@@ -311,7 +311,7 @@ Simulation::Simulation(World world, SimConfig config)
   }
   last_.agents = world_.agents().size();
   for (AgentState st : world_.agents().state) last_.active += st != AgentState::arrived;
-  last_.state_hash = sim::state_hash(world_.agents(), 0);
+  last_.state_hash = sim::state_hash(world_.agents(), 0, &engine_->ex);
 }
 
 Simulation::~Simulation() = default;
@@ -319,7 +319,7 @@ Simulation::Simulation(Simulation&&) noexcept = default;
 Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 
 uint64_t Simulation::state_hash() const {
-  return sim::state_hash(world_.agents(), last_.tick);
+  return sim::state_hash(world_.agents(), last_.tick, &engine_->ex);
 }
 
 namespace {
@@ -327,9 +327,9 @@ namespace {
 constexpr std::string_view kCheckpointMagic = "crowddb-checkpoint";
 // 2: narrow meshes in the path service's state; 3: goal waits (the wait_until column); 4: the
 // goal each agent left last (the left_goal column); 5: congestion costs of the path searches in
-// flight.
-constexpr uint32_t kCheckpointVersion =
-    7;  // 7: door cuts in the searches in flight; 6: the navigation's routes that fall short
+// flight; 6: the navigation's routes that fall short; 7: door cuts in the searches in flight;
+// 8: the state hash in blocks and lanes (sim::state_hash).
+constexpr uint32_t kCheckpointVersion = 8;
 
 // What a checkpoint must agree on with the simulation it is restored into: the static tables
 // and the settings that change what a tick computes (not the thread count).
@@ -664,7 +664,7 @@ const TickMetrics& Simulation::step() {
   m.agents = world_.agents().size();
   m.active = 0;
   for (AgentState st : world_.agents().state) m.active += st != AgentState::arrived;
-  m.state_hash = sim::state_hash(world_.agents(), m.tick);
+  m.state_hash = sim::state_hash(world_.agents(), m.tick, &e.ex);
   arrived_total_ += m.arrived;
   entered_total_ += m.entered;
   m.seconds = tick_clock.seconds();

@@ -276,18 +276,45 @@ void integrate(const AgentTable& t, NextState& next, double dt, Executor& ex) {
   });
 }
 
-uint64_t state_hash(const AgentTable& t, uint64_t tick) {
-  StateHasher h;
-  h.add(tick);
-  h.add(static_cast<uint64_t>(t.size()));
-  for (std::size_t i = 0; i < t.size(); ++i) {
+uint64_t state_hash(const AgentTable& t, uint64_t tick, Executor* ex) {
+  const std::size_t n = t.size();
+  const std::size_t blocks = (n + kHashBlock - 1) / kHashBlock;
+  std::vector<uint64_t> digest(blocks);
+  auto add_row = [&](StateHasher& h, std::size_t i) {
     h.add(t.id[i]);
     h.add(t.x[i]);
     h.add(t.y[i]);
     h.add(t.vx[i]);
     h.add(t.vy[i]);
     h.add(static_cast<uint64_t>(t.state[i]));
-  }
+  };
+  static_assert(kHashLanes == 4 && kHashBlock % kHashLanes == 0);
+  auto hash_blocks = [&](std::size_t b, std::size_t e) {
+    // The lanes as four locals (an array indexed by row kept them in memory); b is a multiple of
+    // the lane count, so row i goes to lane i mod 4.
+    StateHasher l0, l1, l2, l3;
+    std::size_t i = b;
+    for (; i + 4 <= e; i += 4) {
+      add_row(l0, i);
+      add_row(l1, i + 1);
+      add_row(l2, i + 2);
+      add_row(l3, i + 3);
+    }
+    if (i < e) add_row(l0, i++);
+    if (i < e) add_row(l1, i++);
+    if (i < e) add_row(l2, i++);
+    StateHasher block;
+    for (const StateHasher* h : {&l0, &l1, &l2, &l3}) block.add(h->digest());
+    digest[b / kHashBlock] = block.digest();
+  };
+  if (ex)
+    ex->for_each_chunk(n, kHashBlock, hash_blocks);
+  else
+    for (std::size_t b = 0; b < n; b += kHashBlock) hash_blocks(b, std::min(n, b + kHashBlock));
+  StateHasher h;
+  h.add(tick);
+  h.add(static_cast<uint64_t>(n));
+  for (const uint64_t d : digest) h.add(d);
   return h.digest();
 }
 

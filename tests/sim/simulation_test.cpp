@@ -5,8 +5,11 @@
 #include <cmath>
 
 #include "crowddb/scenario.hpp"
+#include "sim/stages.hpp"
 #include "support/cli.hpp"
 #include "support/configs.hpp"
+#include "util/executor.hpp"
+#include "util/rng.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb {
@@ -46,6 +49,66 @@ TEST(Determinism, SameSeedTwiceGivesTheSameHashEveryTick) {
 
 TEST(Determinism, OneAndTwoThreadsGiveTheSameHashEveryTick) {
   EXPECT_EQ(hashes(small_airport(5, 1), 40), hashes(small_airport(5, 2), 40));
+}
+
+// The state hash in blocks and lanes (sim::state_hash): the same on any executor, and any one
+// changed word of any row (first, last, either side of a block's end, the tail) changes it, as
+// do the tick, the row order and the sign of a zero.
+TEST(Determinism, TheStateHashSeesEveryWordOnAnyThreadCount) {
+  for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{7}, sim::kHashBlock,
+                              2 * sim::kHashBlock + 13}) {
+    AgentTable t;
+    Rng rng(n + 1);
+    for (std::size_t i = 0; i < n; ++i) {
+      t.id.push_back(1000 + i);
+      t.x.push_back(rng.uniform(-50, 50));
+      t.y.push_back(rng.uniform(-50, 50));
+      t.vx.push_back(rng.uniform(-1, 1));
+      t.vy.push_back(rng.uniform(-1, 1));
+      t.state.push_back(i % 5 == 0 ? AgentState::arrived : AgentState::active);
+    }
+    const uint64_t h = sim::state_hash(t, 9);
+    for (int threads : {1, 2, 3}) {
+      Executor ex(threads);
+      EXPECT_EQ(sim::state_hash(t, 9, &ex), h) << n << " rows, " << threads << " threads";
+    }
+    EXPECT_NE(sim::state_hash(t, 10), h) << n;
+    if (n == 0) continue;
+    std::vector<std::size_t> rows = {0, n - 1, n / 2};
+    if (n > sim::kHashBlock) rows.insert(rows.end(), {sim::kHashBlock - 1, sim::kHashBlock});
+    for (const std::size_t i : rows) {
+      auto changes = [&](auto& column, auto other) {
+        const auto keep = column[i];
+        column[i] = other;
+        Executor ex(2);
+        const bool seen = sim::state_hash(t, 9) != h && sim::state_hash(t, 9, &ex) != h;
+        column[i] = keep;
+        return seen;
+      };
+      EXPECT_TRUE(changes(t.id, t.id[i] + 1)) << "id of row " << i << " of " << n;
+      EXPECT_TRUE(changes(t.x, std::nextafter(t.x[i], 1e9))) << "x of row " << i << " of " << n;
+      EXPECT_TRUE(changes(t.y, std::nextafter(t.y[i], 1e9))) << "y of row " << i << " of " << n;
+      EXPECT_TRUE(changes(t.vx, -t.vx[i])) << "vx of row " << i << " of " << n;
+      EXPECT_TRUE(changes(t.vy, t.vy[i] == 0.0 ? -0.0 : 0.0)) << "vy of row " << i << " of " << n;
+      EXPECT_TRUE(changes(
+          t.state, t.state[i] == AgentState::arrived ? AgentState::active : AgentState::arrived))
+          << "state of row " << i << " of " << n;
+    }
+    if (n > 1) {  // two rows swapped: the same set of agents in another order
+      for (auto* c : {&t.x, &t.y, &t.vx, &t.vy}) std::swap((*c)[0], (*c)[n - 1]);
+      std::swap(t.id[0], t.id[n - 1]);
+      std::swap(t.state[0], t.state[n - 1]);
+      EXPECT_NE(sim::state_hash(t, 9), h) << n;
+    }
+  }
+  AgentTable zero;  // -0.0 and 0.0 differ
+  zero.id = {1};
+  zero.x = {0.0};
+  zero.y = zero.vx = zero.vy = {0.0};
+  zero.state = {AgentState::active};
+  const uint64_t plus = sim::state_hash(zero, 0);
+  zero.x[0] = -0.0;
+  EXPECT_NE(sim::state_hash(zero, 0), plus);
 }
 
 TEST(Simulation, BackoffKeepsAnOverlapFreeWorldOverlapFree) {
