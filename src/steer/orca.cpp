@@ -177,6 +177,7 @@ namespace {
 constexpr double kSideTurn = 30 * std::numbers::pi / 180;
 constexpr double kTurnNearWaypoint = 2;  // [m]
 constexpr double kStanding = 1e-100;     // [m/s] a wish below this does not look for anyone
+constexpr uint32_t kCapBatch = 32;       // neighbours filtered at once for the headway caps
 
 class OrcaModel final : public Model {
  public:
@@ -409,15 +410,29 @@ class OrcaModel final : public Model {
     const bool stream = p.stream_gap > 0 && streams_.marked[i] &&
                         !(t.stall_action[i] != StallAction::none && in.tick < t.stall_until[i]);
     const StreamView view = stream_view(in);
+    // In batches: first the neighbours that cap it, without branches (see follows()), then
+    // their caps in list order.
+    const int headway = p.time_gap > 0, gap = stream;
     double v = INFINITY;
-    for (uint32_t a = nb_.offset[i]; a < nb_.offset[i + 1]; ++a) {
-      const uint32_t j = nb_.row[a];
-      const bool headway = p.time_gap > 0 && follows(view, i, j, ux, uy);
-      const bool gap = stream && follows_within_gap(view, i, a, ux, uy, v0);
-      if (!headway && !gap) continue;
-      const double s = std::max(std::sqrt(dist2_of(t, i, j)) - (t.radius[i] + t.radius[j]), 0.0);
-      if (headway) v = std::min(v, s / p.time_gap);
-      if (gap) v = std::min(v, std::max(t.vx[j] * ux + t.vy[j] * uy, 0.0) + s / p.stream_gap);
+    for (uint32_t a0 = nb_.offset[i]; a0 < nb_.offset[i + 1]; a0 += kCapBatch) {
+      const uint32_t a1 = std::min(nb_.offset[i + 1], a0 + kCapBatch);
+      uint32_t pick[kCapBatch];
+      uint8_t caps[kCapBatch];  // per picked neighbour: bit 0 headway, bit 1 gap
+      uint32_t m = 0;
+      for (uint32_t a = a0; a < a1; ++a) {
+        const int h = headway & int{follows(view, i, nb_.row[a], ux, uy)};
+        const int g = gap & int{follows_within_gap(view, i, a, ux, uy, v0)};
+        pick[m] = a;
+        caps[m] = static_cast<uint8_t>(h | g << 1);
+        m += static_cast<uint32_t>(h | g);
+      }
+      for (uint32_t u = 0; u < m; ++u) {
+        const uint32_t j = nb_.row[pick[u]];
+        const double s = std::max(std::sqrt(dist2_of(t, i, j)) - (t.radius[i] + t.radius[j]), 0.0);
+        if (caps[u] & 1) v = std::min(v, s / p.time_gap);
+        if (caps[u] & 2)
+          v = std::min(v, std::max(t.vx[j] * ux + t.vy[j] * uy, 0.0) + s / p.stream_gap);
+      }
     }
     if (v >= v0) return;
     px = ux * v;

@@ -37,14 +37,19 @@ struct StreamView {
 
 // Is j ahead of i in its corridor, going its way or standing (see the top; the distance is the
 // caller's)? (ux, uy) is i's unit wish. Exposed for the opt-in headway, which uses the same
-// corridor. Squares instead of roots: "within 60 degrees" is dot >= cos 60 |w|.
+// corridor. Squares instead of roots: "within 60 degrees" is dot >= cos 60 |w|. Without
+// branches: whether a neighbour is followed is a coin toss to the predictor, and the stream gap
+// asks it of every neighbour of nearly every row in a crowd where streams cross. (The tests as
+// ints: & and | on them is meant.)
 inline bool follows(const StreamView& v, std::size_t i, std::size_t j, double ux, double uy) {
   const double rx = v.x[j] - v.x[i], ry = v.y[j] - v.y[i];
-  if (rx * ux + ry * uy <= 0) return false;                                   // behind or beside
-  if (std::abs(ry * ux - rx * uy) > v.radius[i] + v.radius[j]) return false;  // off the corridor
   const double wx = v.wish_x[j], wy = v.wish_y[j];
   const double w2 = wx * wx + wy * wy, dot = wx * ux + wy * uy;
-  return w2 == 0 || (dot >= 0 && dot * dot >= kSameWay * kSameWay * w2);  // stands, or i's way
+  return int{!(rx * ux + ry * uy <= 0)} &                                   // not behind or beside
+         int{!(std::abs(ry * ux - rx * uy) > v.radius[i] + v.radius[j])} &  // in the corridor
+         (int{w2 == 0} |
+          (int{dot >= 0} & int{dot * dot >= kSameWay * kSameWay * w2}));  // stands,
+                                                                          // or i's way
 }
 
 // Is row i at a meeting (see the top)?
@@ -58,7 +63,7 @@ inline bool follows_within_gap(const StreamView& v, std::size_t i, uint32_t a, d
   const uint32_t j = v.nb->row[a];
   const double reach = w * v.gap + v.radius[i] + v.radius[j];
   const double dx = v.x[j] - v.x[i], dy = v.y[j] - v.y[i];  // the list's own distance, bit for bit
-  return dx * dx + dy * dy < reach * reach && follows(v, i, j, ux, uy);
+  return int{dx * dx + dy * dy < reach * reach} & int{follows(v, i, j, ux, uy)};
 }
 
 // The marking; the vectors keep their capacity from call to call.
