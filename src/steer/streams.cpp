@@ -18,16 +18,19 @@ bool at_meeting(const StreamView& v, std::size_t i) {
   const double wix = v.wish_x[i], wiy = v.wish_y[i];
   const double wi2 = wix * wix + wiy * wiy;
   if (wi2 == 0) return false;
+  // Every neighbour asked, without branches (which one answers is a coin toss to the predictor);
+  // the tests as ints: & and | on them is meant.
+  int meets = 0;
   for (uint32_t a = nb.offset[i]; a < nb.offset[i + 1]; ++a) {
     const uint32_t j = nb.row[a];
-    if (v.goal[j] == v.goal[i]) continue;  // one stream
     const double wjx = v.wish_x[j], wjy = v.wish_y[j];
     const double wj2 = wjx * wjx + wjy * wjy;
-    if (wj2 == 0) continue;  // stands: no stream
     const double dot = wix * wjx + wiy * wjy;
-    if (dot < 0 || dot * dot < kSameWay * kSameWay * wi2 * wj2) return true;
+    meets |= int{v.goal[j] != v.goal[i]} &  // another stream
+             int{!(wj2 == 0)} &             // walking (standing: no stream)
+             (int{dot < 0} | int{dot * dot < kSameWay * kSameWay * wi2 * wj2});
   }
-  return false;
+  return meets != 0;
 }
 
 namespace {
