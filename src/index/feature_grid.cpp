@@ -76,8 +76,8 @@ void FeatureGrid::build(const StaticScene& scene, double cell) {
         reg_feature.push_back(static_cast<uint32_t>(f));
       }
   }
-  std::vector<uint32_t> order, scratch;
-  bucket_rows(reg_cell, cells, start_, order, scratch);
+  std::vector<uint32_t> order;
+  bucket_rows(reg_cell, cells, start_, order);
   items_.resize(order.size());
   for (std::size_t a = 0; a < order.size(); ++a) items_[a] = reg_feature[order[a]];
   // Chebyshev distance transform (two passes, each cell from its four earlier neighbours).
@@ -175,7 +175,7 @@ void FeatureGrid::run(const DiscView& p, std::span<const double> reach, const St
       lists.counts[c].push_back(count);
     }
   });
-  lists.gather(out, &FeatureLists::feature);
+  lists.gather(out, &FeatureLists::feature, &ex);
   stats.rows += p.n;
   for (uint64_t t : tests) stats.pair_tests += t;
   stats.query_seconds += sw.seconds();

@@ -63,7 +63,7 @@ void NeighbourGrid::build(const DiscView& d, double range, uint32_t k, Executor&
   ex.for_each_chunk(d.n, kBuildGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) cell_of_[i] = row(d.y[i]) * W_ + col(d.x[i]);
   });
-  bucket_rows(cell_of_, cells, start_, rows_, fill_);
+  bucket_rows(cell_of_, cells, start_, rows_);
   x_.resize(d.n);
   y_.resize(d.n);
   id_.resize(d.n);
@@ -342,7 +342,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
       out.dist2.clear();
     }
   } else {
-    lists.gather(out, &NeighbourLists::row);
+    lists.gather(out, &NeighbourLists::row, &ex);
   }
   stats.rows += q;
   for (std::size_t c = 0; c < chunks; ++c) {

@@ -34,15 +34,15 @@ Box bounding_box(std::span<const double> x, std::span<const double> y, Executor&
 }
 
 void bucket_rows(std::span<const int64_t> cell_of, std::size_t cells, std::vector<uint32_t>& start,
-                 std::vector<uint32_t>& rows, std::vector<uint32_t>& scratch) {
+                 std::vector<uint32_t>& rows) {
   const std::size_t n = cell_of.size();
   start.assign(cells + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) ++start[static_cast<std::size_t>(cell_of[i]) + 1];
-  for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
-  scratch.assign(start.begin(), start.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) ++start[static_cast<std::size_t>(cell_of[i])];
+  for (std::size_t c = 1; c < cells; ++c) start[c] += start[c - 1];  // start[c]: cell c's end
+  start[cells] = static_cast<uint32_t>(n);
   rows.resize(n);
-  for (std::size_t i = 0; i < n; ++i)
-    rows[scratch[static_cast<std::size_t>(cell_of[i])]++] = static_cast<uint32_t>(i);
+  for (std::size_t i = n; i-- > 0;)
+    rows[--start[static_cast<std::size_t>(cell_of[i])]] = static_cast<uint32_t>(i);
 }
 
 }  // namespace crowddb::index

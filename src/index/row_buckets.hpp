@@ -23,9 +23,11 @@ Box bounding_box(std::span<const double> x, std::span<const double> y, Executor&
 
 // A counting sort of rows into `cells` cells, cell_of[i] being row i's (in [0, cells)): rows
 // lists the rows cell by cell, row order within a cell, and cell c's rows are
-// rows[start[c] .. start[c + 1]). One pass in row order (a few instructions per row), so the
-// layout is that of one thread. `scratch` is reused between calls.
+// rows[start[c] .. start[c + 1]). The rows are placed backwards from each cell's end, which
+// leaves `start` holding the beginnings (no copy of the offsets to place with: a grid may have
+// several cells per row). One pass (a few instructions per row), so the layout is that of one
+// thread.
 void bucket_rows(std::span<const int64_t> cell_of, std::size_t cells, std::vector<uint32_t>& start,
-                 std::vector<uint32_t>& rows, std::vector<uint32_t>& scratch);
+                 std::vector<uint32_t>& rows);
 
 }  // namespace crowddb::index

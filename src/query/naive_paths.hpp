@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "plan/access_path.hpp"
+#include "util/executor.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb {
@@ -152,21 +153,39 @@ struct ListChunks {
     items.assign(chunks, {});
     d2.assign(chunks, {});
   }
+  // Concatenates the chunks' lists into out's CSR in chunk order. With an executor the chunks are
+  // copied on its threads (each into its own place; the same result).
   template <class Lists>
-  void gather(Lists& out, std::vector<uint32_t> Lists::*items_member) const {
-    out.offset.assign(1, 0);
-    std::size_t total = 0, total_d2 = 0;  // no distances when the caller asked for none
-    for (const auto& c : items) total += c.size();
-    for (const auto& c : d2) total_d2 += c.size();
-    (out.*items_member).clear();
-    (out.*items_member).reserve(total);
-    out.dist2.clear();
-    out.dist2.reserve(total_d2);
-    for (std::size_t c = 0; c < counts.size(); ++c) {
-      for (uint32_t n : counts[c]) out.offset.push_back(out.offset.back() + n);
-      (out.*items_member).insert((out.*items_member).end(), items[c].begin(), items[c].end());
-      out.dist2.insert(out.dist2.end(), d2[c].begin(), d2[c].end());
+  void gather(Lists& out, std::vector<uint32_t> Lists::*items_member,
+              Executor* ex = nullptr) const {
+    const std::size_t chunks = counts.size();
+    // Where each chunk's rows, items and distances (none when the caller asked for none) begin.
+    std::vector<std::size_t> row0(chunks + 1, 0), item0(chunks + 1, 0), d20(chunks + 1, 0);
+    for (std::size_t c = 0; c < chunks; ++c) {
+      row0[c + 1] = row0[c] + counts[c].size();
+      item0[c + 1] = item0[c] + items[c].size();
+      d20[c + 1] = d20[c] + d2[c].size();
     }
+    std::vector<uint32_t>& all = out.*items_member;
+    out.offset.resize(row0[chunks] + 1);
+    out.offset[0] = 0;
+    all.resize(item0[chunks]);
+    out.dist2.resize(d20[chunks]);
+    auto copy = [&](std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c) {
+        auto at = static_cast<uint32_t>(item0[c]);
+        uint32_t* const offsets = out.offset.data() + row0[c] + 1;
+        for (std::size_t k = 0; k < counts[c].size(); ++k) offsets[k] = at += counts[c][k];
+        std::copy(items[c].begin(), items[c].end(),
+                  all.begin() + static_cast<std::ptrdiff_t>(item0[c]));
+        std::copy(d2[c].begin(), d2[c].end(),
+                  out.dist2.begin() + static_cast<std::ptrdiff_t>(d20[c]));
+      }
+    };
+    if (ex)
+      ex->for_each_chunk(chunks, 1, copy);
+    else
+      copy(0, chunks);
   }
 };
 

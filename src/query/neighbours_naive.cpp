@@ -39,7 +39,7 @@ void NeighbourNaive::run(const DiscView& d, std::span<const uint32_t> queries, d
         lists.d2[c].insert(lists.d2[c].end(), best.dist2().begin(), best.dist2().end());
     }
   });
-  lists.gather(out, &NeighbourLists::row);
+  lists.gather(out, &NeighbourLists::row, &ex);
   stats.rows += q;
   for (uint64_t t : tests) stats.pair_tests += t;
 }
@@ -66,7 +66,7 @@ void FeatureNaive::run(const DiscView& p, std::span<const double> reach, const S
       lists.counts[c].push_back(count);
     }
   });
-  lists.gather(out, &FeatureLists::feature);
+  lists.gather(out, &FeatureLists::feature, &ex);
   stats.rows += p.n;
   stats.pair_tests += p.n * features;
 }

@@ -204,8 +204,10 @@ class OrcaModel final : public Model {
       sim::OperatorStats& fop = log.at("ORCA obstacles");
       log.timed("ORCA obstacles", n, [&] {
         reach_.resize(n);
-        for (std::size_t i = 0; i < n; ++i)
-          reach_[i] = p.time_horizon_obst * t.max_speed[i] + t.radius[i];
+        ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
+          for (std::size_t i = b; i < e; ++i)
+            reach_[i] = p.time_horizon_obst * t.max_speed[i] + t.radius[i];
+        });
         auto& path = feature_paths_[fm.info.name];
         if (!path) path = fm.make();
         path->run(view, reach_, in.scene, features_, ex, fop.query);

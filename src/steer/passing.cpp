@@ -131,7 +131,7 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
                          : uint16_t{0xFFFF};
     }
   });
-  index::bucket_rows(cell_of_, cells, start_, rows_, fill_);
+  index::bucket_rows(cell_of_, cells, start_, rows_);
   copy_.resize(n);
   ex.for_each_chunk(n, kBuildGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {

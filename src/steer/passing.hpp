@@ -108,7 +108,6 @@ class PassingLookahead {
   std::vector<uint16_t> classes_;   // per cell: bit k set when a row's heading is in class k
   std::vector<int64_t> cell_of_;    // scratch: cell per row
   std::vector<uint16_t> class_of_;  // scratch: heading class bit per row (0: standing)
-  std::vector<uint32_t> fill_;      // scratch
 };
 
 }  // namespace crowddb::steer

@@ -50,7 +50,7 @@ void mark_meetings(const StreamView& v, StreamMarks& out, Executor& ex) {
   const NeighbourLists& nb = *v.nb;
   const std::size_t n = nb.queries();
   std::vector<uint8_t>& marked = out.marked;
-  marked.assign(n, 0);
+  marked.resize(n);  // every row written below
   out.follows.assign(nb.row.size(), 0);
   // Per row, in parallel (each chunk writes its own rows and list entries): the meetings, and
   // whom the others follow.
@@ -79,10 +79,18 @@ void mark_meetings(const StreamView& v, StreamMarks& out, Executor& ex) {
     if (!marked[i])
       for (uint32_t a = nb.offset[i]; a < nb.offset[i + 1]; ++a)
         if (out.follows[a]) out.follower[out.cursor[nb.row[a]]++] = static_cast<uint32_t>(i);
-  // Breadth first from the meetings: the set reached does not depend on the order.
+  // Breadth first from the meetings: the set reached does not depend on the order. Meetings
+  // nobody follows are counted, not queued (where nearly everyone is at a meeting, queueing
+  // them all was most of this pass).
   out.queue.clear();
-  for (std::size_t i = 0; i < n; ++i)
-    if (marked[i]) out.queue.push_back(static_cast<uint32_t>(i));
+  std::size_t idle_meetings = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!marked[i]) continue;
+    if (offset[i] < offset[i + 1])
+      out.queue.push_back(static_cast<uint32_t>(i));
+    else
+      ++idle_meetings;
+  }
   for (std::size_t q = 0; q < out.queue.size(); ++q) {
     const uint32_t j = out.queue[q];
     for (uint32_t f = offset[j]; f < offset[j + 1]; ++f) {
@@ -92,7 +100,7 @@ void mark_meetings(const StreamView& v, StreamMarks& out, Executor& ex) {
       out.queue.push_back(i);
     }
   }
-  out.count = out.queue.size();
+  out.count = idle_meetings + out.queue.size();
 }
 
 void mark_meetings_naive(const StreamView& v, std::vector<uint8_t>& marked) {

@@ -16,14 +16,14 @@ namespace {
 
 TEST(RowBuckets, PlacesRowsAsAStableSortByCell) {
   std::mt19937_64 rng(3);
-  std::vector<uint32_t> start, rows, scratch;  // reused between rounds, as the grids do
+  std::vector<uint32_t> start, rows;  // reused between rounds, as the grids do
   for (const std::size_t n : {0, 1, 2, 17, 1000, 20000}) {
     for (const std::size_t cells : {1, 2, 7, 5000}) {
       std::uniform_int_distribution<int64_t> pick(0, static_cast<int64_t>(cells) - 1);
       std::vector<int64_t> cell_of(n);
       for (int64_t& c : cell_of) c = pick(rng);
       if (n > 0) cell_of[n / 2] = static_cast<int64_t>(cells) - 1;  // the last cell too
-      bucket_rows(cell_of, cells, start, rows, scratch);
+      bucket_rows(cell_of, cells, start, rows);
       std::vector<uint32_t> want(n);
       std::iota(want.begin(), want.end(), 0u);
       std::stable_sort(want.begin(), want.end(),
