@@ -29,13 +29,16 @@ constexpr std::size_t kBuildGrain = 8192;  // rows per chunk of the grid's build
 
 }  // namespace
 
+// Monotone in x (a product by a positive constant, then truncation, which is the floor for c >= 0;
+// below 0 clamps to 0): all the probes need, with the slack that covers rounding. A division here
+// was a quarter of the probes' time.
 inline int64_t NeighbourGrid::col(double x) const {
-  const double c = std::floor((x - x0_) / cell_);
+  const double c = (x - x0_) * inv_cell_;
   return c < 0 ? 0 : (c >= static_cast<double>(W_) ? W_ - 1 : static_cast<int64_t>(c));
 }
 
 inline int64_t NeighbourGrid::row(double y) const {
-  const double c = std::floor((y - y0_) / cell_);
+  const double c = (y - y0_) * inv_cell_;
   return c < 0 ? 0 : (c >= static_cast<double>(H_) ? H_ - 1 : static_cast<int64_t>(c));
 }
 
@@ -53,6 +56,7 @@ void NeighbourGrid::build(const DiscView& d, double range, uint32_t k, Executor&
   x0_ = xmin;
   y0_ = ymin;
   cell_ = cell;
+  inv_cell_ = 1 / cell;
   W_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(w / cell)) + 1);
   H_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(h / cell)) + 1);
   // Rounding of the cell coordinates (x0 + c * cell) is relative to the grid's origin and

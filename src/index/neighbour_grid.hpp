@@ -50,8 +50,8 @@ class NeighbourGrid final : public NeighbourPath {
   int64_t col(double x) const;
   int64_t row(double y) const;
 
-  double x0_ = 0, y0_ = 0, cell_ = 1;
-  double slack_ = 0;  // rounding of cell coordinates (see build)
+  double x0_ = 0, y0_ = 0, cell_ = 1, inv_cell_ = 1;  // (a product, not a division, per probe)
+  double slack_ = 0;                                  // rounding of cell coordinates (see build)
   int64_t W_ = 1, H_ = 1;
   std::vector<uint32_t> start_;  // W * H + 1 offsets into the cell-ordered arrays
   std::vector<uint32_t> rows_;   // table rows in cell order
