@@ -67,7 +67,8 @@ void CellIndex::build(const DiscView& d, std::span<const uint32_t> rows, const F
         packed[k] = key << 32 | k;
       }
     });
-    radix_sort(packed, scratch2_, 32, 32 + key_bits, par);
+    radix_sort(packed, scratch2_, 32, 32 + key_bits,
+               n >= CellIndex::kParallelRadix ? par : nullptr);
     each([&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
         key_[k] = packed[k] >> 32;

@@ -153,8 +153,10 @@ struct ListChunks {
     items.assign(chunks, {});
     d2.assign(chunks, {});
   }
-  // Concatenates the chunks' lists into out's CSR in chunk order. With an executor the chunks are
-  // copied on its threads (each into its own place; the same result).
+  // Concatenates the chunks' lists into out's CSR in chunk order. With an executor, and from
+  // kParallelGather rows, the chunks are copied on its threads (each into its own place; the same
+  // result; fewer rows cost more to hand out than to copy).
+  static constexpr std::size_t kParallelGather = 8192;
   template <class Lists>
   void gather(Lists& out, std::vector<uint32_t> Lists::*items_member,
               Executor* ex = nullptr) const {
@@ -182,7 +184,7 @@ struct ListChunks {
                   out.dist2.begin() + static_cast<std::ptrdiff_t>(d20[c]));
       }
     };
-    if (ex)
+    if (ex && row0[chunks] >= kParallelGather)
       ex->for_each_chunk(chunks, 1, copy);
     else
       copy(0, chunks);

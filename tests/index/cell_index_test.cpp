@@ -7,8 +7,9 @@
 namespace crowddb::index {
 namespace {
 
-// A large build runs its passes in chunks on the executor's threads; the index (keys, rows in
-// key order, the copied columns) must be the one thread's, entry for entry.
+// A large build runs its passes in chunks on the executor's threads (the uniform square is large
+// enough for the radix sort's too); the index (keys, rows in key order, the copied columns) must
+// be the one thread's, entry for entry.
 TEST(CellIndex, ThreadsBuildTheSameIndex) {
   for (int shape = 0; shape < 3; ++shape) {
     DiscTable t;
@@ -17,8 +18,9 @@ TEST(CellIndex, ThreadsBuildTheSameIndex) {
         for (int j = 0; j < 200; ++j)
           t.push_back(static_cast<uint64_t>(i * 200 + j), i * 0.25, j * 0.25, 0, 0, 0.2);
     } else {
-      t = build::uniform(shape == 0 ? 50000 : 34000, {0, 0, 300, shape == 0 ? 300.0 : 60.0}, 1,
-                         0.25, 0.25, 7 + static_cast<uint64_t>(shape));
+      t = build::uniform(shape == 0 ? 2 * CellIndex::kParallelRadix + 99 : 34000,
+                         {0, 0, shape == 0 ? 600.0 : 300.0, shape == 0 ? 600.0 : 60.0}, 1, 0.25,
+                         0.25, 7 + static_cast<uint64_t>(shape));
     }
     const DiscView d = t.view();
     const Frame frame = Frame::of(d);
