@@ -45,11 +45,10 @@ inline bool follows(const StreamView& v, std::size_t i, std::size_t j, double ux
   const double rx = v.x[j] - v.x[i], ry = v.y[j] - v.y[i];
   const double wx = v.wish_x[j], wy = v.wish_y[j];
   const double w2 = wx * wx + wy * wy, dot = wx * ux + wy * uy;
-  return int{!(rx * ux + ry * uy <= 0)} &                                   // not behind or beside
-         int{!(std::abs(ry * ux - rx * uy) > v.radius[i] + v.radius[j])} &  // in the corridor
-         (int{w2 == 0} |
-          (int{dot >= 0} & int{dot * dot >= kSameWay * kSameWay * w2}));  // stands,
-                                                                          // or i's way
+  // Ahead (not behind or beside), in the corridor, and standing or going i's way.
+  return int{!(rx * ux + ry * uy <= 0)} &
+         int{!(std::abs(ry * ux - rx * uy) > v.radius[i] + v.radius[j])} &
+         (int{w2 == 0} | (int{dot >= 0} & int{dot * dot >= kSameWay * kSameWay * w2}));
 }
 
 // Is row i at a meeting (see the top)?
