@@ -12,6 +12,14 @@
 //   build/bench/tick_speed --cases airport-20k --models orca --threads 1,2 --ticks 100
 //   build/bench/tick_speed --cases all --csv docs/bench/tick_speed.csv   # all but airport-10m
 //   build/bench/tick_speed --cases airport-10m --models orca --threads 2   # ~9 GB, minutes
+//   build/bench/tick_speed --cases airport-20k --models orca --threads 1,2 --rounds 6
+//
+// `--rounds N` runs every case N times, the thread counts in turn forwards and backwards (1 2,
+// 2 1, 1 2, ...), and ends with a summary per case, model and thread count: the median, least
+// and greatest of the rounds' medians, and the speed-up over the first thread count taken
+// within each round (pairs run minutes apart compare the host's states, not the code). On a
+// shared machine whose speed swings from run to run, one pair of runs can put the speed-up
+// anywhere between 1.6 and 2.0 (docs/benchmarks.md).
 //
 // Cases (docs/benchmarks.md): airport-1k/20k/100k/1m are the agents of bench/rvo2_side_by_side
 // (uniform at 0.5 people/m^2 in a walled square, radius 0.25 m, 1.3 m/s, four goals on the
@@ -186,11 +194,52 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
+// The median, least and greatest of v (not empty).
+struct Spread {
+  double median, least, greatest;
+};
+Spread spread(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size();
+  return {m % 2 ? v[m / 2] : (v[m / 2 - 1] + v[m / 2]) / 2, v.front(), v.back()};
+}
+
+// After several rounds: per case/model and thread count the spread of the rounds' medians, and
+// the speed-up over the first thread count within each round that ran both.
+void print_summary(const std::map<std::string, std::vector<std::map<int, double>>>& medians,
+                   const std::vector<int>& thread_counts, int rounds) {
+  std::printf(
+      "\nover %d rounds (ms per tick: median of the rounds' medians, least - greatest; "
+      "speed-up over %d thread%s within each round)\n",
+      rounds, thread_counts.front(), thread_counts.front() == 1 ? "" : "s");
+  for (const auto& [key, per_round] : medians) {
+    for (int threads : thread_counts) {
+      std::vector<double> ms, ratio;
+      for (const auto& round : per_round) {
+        const auto it = round.find(threads);
+        if (it == round.end()) continue;
+        ms.push_back(it->second);
+        const auto base = round.find(thread_counts.front());
+        if (base != round.end() && it->second > 0) ratio.push_back(base->second / it->second);
+      }
+      if (ms.empty()) continue;
+      const Spread t = spread(ms);
+      std::printf("%-22s %3d  %10.2f  %8.2f - %8.2f", key.c_str(), threads, t.median, t.least,
+                  t.greatest);
+      if (threads != thread_counts.front() && !ratio.empty()) {
+        const Spread r = spread(ratio);
+        std::printf("  speed-up %.2f (%.2f - %.2f)", r.median, r.least, r.greatest);
+      }
+      std::printf("\n");
+    }
+  }
+}
+
 int usage(const char* why) {
   std::fprintf(
       stderr,
       "tick_speed: %s\nusage: tick_speed [--cases all|NAME,...] [--models orca,cfsm,thesis] "
-      "[--threads 1,2] [--ticks N] [--csv FILE] [--fork yes|no]\ncases:",
+      "[--threads 1,2] [--ticks N] [--rounds N] [--csv FILE] [--fork yes|no]\ncases:",
       why);
   for (const Case& c : kCases) std::fprintf(stderr, " %s", c.name);
   std::fprintf(stderr, "\n");
@@ -203,6 +252,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> cases, models = {"orca", "cfsm", "thesis"};
   std::vector<int> thread_counts = {1, 2};
   uint64_t ticks = 0;
+  int rounds = 1;
   std::string csv;
   bool fork_cases = true;
   for (int a = 1; a < argc; a += 2) {
@@ -219,6 +269,9 @@ int main(int argc, char** argv) {
     } else if (k == "--ticks") {
       ticks = std::strtoull(v.c_str(), nullptr, 10);
       if (ticks == 0) return usage("--ticks must be a positive number");
+    } else if (k == "--rounds") {
+      rounds = std::atoi(v.c_str());
+      if (rounds < 1 || rounds > 1000) return usage("--rounds takes a count from 1 to 1000");
     } else if (k == "--fork") {
       if (v != "yes" && v != "no") return usage("--fork takes yes or no");
       fork_cases = v == "yes";
@@ -247,69 +300,80 @@ int main(int argc, char** argv) {
   if (out)
     std::fprintf(out,
                  "case,model,threads,agents,ticks,median_ms,min_ms,first_tenth_ms,last_tenth_ms,"
-                 "agent_ticks_per_s,peak_mb,load_before,load_after,state_hash\n");
+                 "agent_ticks_per_s,peak_mb,load_before,load_after,state_hash,round\n");
   std::printf("%-14s %-7s %3s %9s %6s %10s %10s %10s %10s %12s %8s %11s  %s\n", "case", "model",
               "thr", "agents", "ticks", "median ms", "min ms", "first 1/10", "last 1/10",
               "agent-t/s", "peak MB", "load", "state hash");
   int status = 0;
   std::map<std::string, uint64_t> hash_of;  // case/model -> hash of the first thread count
-  for (const Case* c : chosen) {
-    for (const std::string& model : models) {
-      for (int threads : thread_counts) {
-        const uint64_t n = ticks ? ticks : c->ticks;
-        const double load_before = load_average();
-        Result r;
-        bool got = true;
-        rusage ru{};
-        if (fork_cases) {
-          int fd[2];
-          if (pipe(fd) != 0) return usage("pipe failed");
-          const pid_t pid = fork();
-          if (pid == 0) {
+  // Per case/model, per round: the median ms of each thread count (for the summary).
+  std::map<std::string, std::vector<std::map<int, double>>> medians;
+  for (int round = 0; round < rounds; ++round) {
+    for (const Case* c : chosen) {
+      for (const std::string& model : models) {
+        std::vector<int> order = thread_counts;
+        if (round % 2 == 1) std::reverse(order.begin(), order.end());
+        for (int threads : order) {
+          const uint64_t n = ticks ? ticks : c->ticks;
+          const double load_before = load_average();
+          Result r;
+          bool got = true;
+          rusage ru{};
+          if (fork_cases) {
+            int fd[2];
+            if (pipe(fd) != 0) return usage("pipe failed");
+            const pid_t pid = fork();
+            if (pid == 0) {
+              close(fd[0]);
+              const Result child = run_case(*c, model, threads, n);
+              const ssize_t w = write(fd[1], &child, sizeof child);
+              _exit(w == static_cast<ssize_t>(sizeof child) ? 0 : 1);
+            }
+            close(fd[1]);
+            got = read(fd[0], &r, sizeof r) == static_cast<ssize_t>(sizeof r);
             close(fd[0]);
-            const Result child = run_case(*c, model, threads, n);
-            const ssize_t w = write(fd[1], &child, sizeof child);
-            _exit(w == static_cast<ssize_t>(sizeof child) ? 0 : 1);
+            int wstatus = 0;
+            wait4(pid, &wstatus, 0, &ru);
+          } else {
+            r = run_case(*c, model, threads, n);
+            getrusage(RUSAGE_SELF, &ru);  // the process's peak so far, every earlier case included
           }
-          close(fd[1]);
-          got = read(fd[0], &r, sizeof r) == static_cast<ssize_t>(sizeof r);
-          close(fd[0]);
-          int wstatus = 0;
-          wait4(pid, &wstatus, 0, &ru);
-        } else {
-          r = run_case(*c, model, threads, n);
-          getrusage(RUSAGE_SELF, &ru);  // the process's peak so far, every earlier case included
+          const double load_after = load_average();
+          if (!got || r.error[0]) {
+            std::printf("%-14s %-7s %3d  failed: %s\n", c->name, model.c_str(), threads,
+                        got ? r.error : "the child process died");
+            status = 1;
+            continue;
+          }
+          const double peak_mb = static_cast<double>(ru.ru_maxrss) / 1024.0;
+          const double rate = r.agents * static_cast<double>(r.ticks) / r.seconds;
+          char hash[17];
+          std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(r.hash));
+          const std::string key = std::string(c->name) + "/" + model;
+          const auto [it, first] = hash_of.emplace(key, r.hash);
+          const bool same = first || it->second == r.hash;
+          std::printf(
+              "%-14s %-7s %3d %9.0f %6llu %10.2f %10.2f %10.2f %10.2f %12.3g %8.0f %5.2f-%5.2f  "
+              "%s%s\n",
+              c->name, model.c_str(), threads, r.agents, static_cast<unsigned long long>(r.ticks),
+              r.median_ms, r.min_ms, r.first_ms, r.last_ms, rate, peak_mb, load_before, load_after,
+              hash, same ? "" : "  DIFFERS FROM THE FIRST THREAD COUNT");
+          std::fflush(stdout);
+          if (!same) status = 1;
+          auto& per_round = medians[key];
+          per_round.resize(static_cast<std::size_t>(rounds));
+          per_round[static_cast<std::size_t>(round)][threads] = r.median_ms;
+          if (out)
+            std::fprintf(out, "%s,%s,%d,%.0f,%llu,%.3f,%.3f,%.3f,%.3f,%.4g,%.0f,%.2f,%.2f,%s,%d\n",
+                         c->name, model.c_str(), threads, r.agents,
+                         static_cast<unsigned long long>(r.ticks), r.median_ms, r.min_ms,
+                         r.first_ms, r.last_ms, rate, peak_mb, load_before, load_after, hash,
+                         round + 1);
         }
-        const double load_after = load_average();
-        if (!got || r.error[0]) {
-          std::printf("%-14s %-7s %3d  failed: %s\n", c->name, model.c_str(), threads,
-                      got ? r.error : "the child process died");
-          status = 1;
-          continue;
-        }
-        const double peak_mb = static_cast<double>(ru.ru_maxrss) / 1024.0;
-        const double rate = r.agents * static_cast<double>(r.ticks) / r.seconds;
-        char hash[17];
-        std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(r.hash));
-        const std::string key = std::string(c->name) + "/" + model;
-        const auto [it, first] = hash_of.emplace(key, r.hash);
-        const bool same = first || it->second == r.hash;
-        std::printf(
-            "%-14s %-7s %3d %9.0f %6llu %10.2f %10.2f %10.2f %10.2f %12.3g %8.0f %5.2f-%5.2f  "
-            "%s%s\n",
-            c->name, model.c_str(), threads, r.agents, static_cast<unsigned long long>(r.ticks),
-            r.median_ms, r.min_ms, r.first_ms, r.last_ms, rate, peak_mb, load_before, load_after,
-            hash, same ? "" : "  DIFFERS FROM THE FIRST THREAD COUNT");
-        std::fflush(stdout);
-        if (!same) status = 1;
-        if (out)
-          std::fprintf(out, "%s,%s,%d,%.0f,%llu,%.3f,%.3f,%.3f,%.3f,%.4g,%.0f,%.2f,%.2f,%s\n",
-                       c->name, model.c_str(), threads, r.agents,
-                       static_cast<unsigned long long>(r.ticks), r.median_ms, r.min_ms, r.first_ms,
-                       r.last_ms, rate, peak_mb, load_before, load_after, hash);
       }
     }
   }
   if (out) std::fclose(out);
+  if (rounds > 1) print_summary(medians, thread_counts, rounds);
   return status;
 }
