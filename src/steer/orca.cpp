@@ -266,40 +266,32 @@ class OrcaModel final : public Model {
       });
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
         std::vector<HalfPlane> planes;
-        std::vector<uint8_t> goes_first;  // per neighbour of the row: does the row go first?
         std::vector<double> ipx, ipy, ivx, ivy, ir, itau, ishare;  // agent_planes' inputs
         for (std::size_t i = b; i < e; ++i) {
           planes.clear();
           obstacle_planes(in, i, planes);
           const double vix = t.vx[i], viy = t.vy[i];
           const uint32_t lo = nb_.offset[i];
-          goes_first.resize(nb_.offset[i + 1] - lo);
-          for (uint32_t a = lo; a < nb_.offset[i + 1]; ++a)
-            goes_first[a - lo] = first(in, i, nb_.row[a]);
-          // Contact planes of the neighbours within one tick's reach (hard).
-          const double reach = 2 * in.cfg.dt * t.max_speed[i];
-          for (uint32_t a = nb_.offset[i]; a < nb_.offset[i + 1]; ++a) {
-            const uint32_t j = nb_.row[a];
-            const double d = std::sqrt(dist2_of(t, i, j));
-            const double gap = d - t.radius[i] - t.radius[j] - kSkin;
-            if (gap >= reach || d == 0) continue;
-            const double nx = (t.x[j] - t.x[i]) / d, ny = (t.y[j] - t.y[i]) / d;
-            // v . n <= g  <=>  v . (-n) >= -g: the plane through -n g with normal -n.
-            const double share = goes_first[a - lo] ? 1 - hi_share : hi_share;
-            const double g = std::max(0.0, gap) * share / in.cfg.dt;
-            planes.push_back({nx * g, ny * g, -nx, -ny});
-          }
-          retreat_plane(in, i, planes);
-          const std::size_t hard = planes.size();
-          // The agent planes: the inputs gathered per neighbour, the planes built several at a
-          // time (steer/orca_planes.hpp).
           const std::size_t m = nb_.offset[i + 1] - lo;
+          // One pass over the neighbours: who goes first, the contact plane of those within one
+          // tick's reach (hard), and the inputs of the agent planes, which are built several at a
+          // time afterwards (steer/orca_planes.hpp).
+          const double reach = 2 * in.cfg.dt * t.max_speed[i];
           for (auto* col : {&ipx, &ipy, &ivx, &ivy, &ir, &itau, &ishare}) col->resize(m);
           for (std::size_t a = 0; a < m; ++a) {
             const uint32_t j = nb_.row[lo + a];
+            const bool i_first = first(in, i, j);
+            const double d = std::sqrt(dist2_of(t, i, j));
+            const double gap = d - t.radius[i] - t.radius[j] - kSkin;
+            if (!(gap >= reach || d == 0)) {
+              const double nx = (t.x[j] - t.x[i]) / d, ny = (t.y[j] - t.y[i]) / d;
+              // v . n <= g  <=>  v . (-n) >= -g: the plane through -n g with normal -n.
+              const double share = i_first ? 1 - hi_share : hi_share;
+              const double g = std::max(0.0, gap) * share / in.cfg.dt;
+              planes.push_back({nx * g, ny * g, -nx, -ny});
+            }
             // Right of way: a neighbour that goes first is avoided where it wants to go, as far as
             // it is held up (walking as it wishes, its velocity says it already).
-            const bool i_first = goes_first[a];
             const double vjx = i_first ? t.vx[j] : avoid_x_[j];
             const double vjy = i_first ? t.vy[j] : avoid_y_[j];
             ipx[a] = t.x[j] - t.x[i];
@@ -311,6 +303,8 @@ class OrcaModel final : public Model {
             itau[a] = std::clamp(std::min(arrive_[i], arrive_[j]), in.cfg.dt, p.time_horizon);
             ishare[a] = i_first ? hi_share : 1 - hi_share;
           }
+          retreat_plane(in, i, planes);
+          const std::size_t hard = planes.size();
           planes.resize(hard + m);
           agent_planes({ipx.data(), ipy.data(), ivx.data(), ivy.data(), ir.data(), itau.data(),
                         ishare.data()},
