@@ -375,27 +375,200 @@ std::unique_ptr<NavMesh> NavMesh::build(const NavGeometry& g, const NavMeshParam
   if (!nm->shared_query_ || dtStatusFailed(nm->shared_query_->init(nm->mesh_, 16)))
     bad("out of memory");
   nm->filter_ = std::make_unique<dtQueryFilter>();
+  nm->build_poly_grid();
   nm->stats_.seconds = clock.seconds();
   return nm;
+}
+
+// ------------------------------------------------------------------------- point location
+//
+// Detour's findNearestPoly computes, for every polygon whose box meets the search square, its
+// point nearest p and a distance, and keeps the first of least distance in its traversal order.
+// A point over a polygon and within climb of its floor is at distance 0, the least there is. So
+// when p lies inside a polygon P by a margin that no float rounding bridges, P is the only
+// polygon at distance 0 (the mesh is one layer: polygons meet only along their edges, and every
+// other polygon, its nearest point included, lies at least the margin away), and findNearestPoly
+// answers P and closestPointOnPoly(P, p) whatever its order. A grid of the polygons' boxes finds
+// P without the search (a few point-in-polygon tests instead of Detour's distance to the edges of
+// every polygon near p); anything else (near an edge, off the mesh, above a floor beyond climb)
+// goes to Detour. tests/path/navmesh_test.cpp compares the two on random and adversarial points.
+
+namespace {
+
+// [m] How far inside its polygon a point must lie for the grid's answer: the float rounding of
+// local coordinates (below 10^-3 m up to 10 km from the mesh's corner) many times over.
+double inside_margin(const float* p) {
+  return 1e-3 * std::max(1.0, (std::fabs(double{p[0]}) + std::fabs(double{p[2]})) / 1000.0);
+}
+
+// Is (x, z) inside the polygon by at least `margin` from the line of every edge? (Then it lies
+// in the polygon's kernel, at least `margin` from its boundary.) Either winding; edges of length
+// 0 are skipped (their ends are the neighbouring edges' ends).
+bool inside_by(const dtMeshTile& t, const dtPoly& poly, double x, double z, double margin) {
+  const int n = poly.vertCount;
+  double area2 = 0;
+  for (int i = 0, j = n - 1; i < n; j = i++) {
+    const float* a = &t.verts[poly.verts[j] * 3];
+    const float* b = &t.verts[poly.verts[i] * 3];
+    area2 += double{a[0]} * b[2] - double{b[0]} * a[2];
+  }
+  if (!(area2 != 0)) return false;
+  const double side = area2 > 0 ? 1 : -1;
+  for (int i = 0, j = n - 1; i < n; j = i++) {
+    const float* a = &t.verts[poly.verts[j] * 3];
+    const float* b = &t.verts[poly.verts[i] * 3];
+    const double ex = double{b[0]} - a[0], ez = double{b[2]} - a[2];
+    const double len = std::sqrt(ex * ex + ez * ez);
+    if (len == 0) continue;
+    const double cross = ex * (z - a[2]) - ez * (x - a[0]);
+    if (!(side * cross >= margin * len)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void NavMesh::build_poly_grid() {
+  struct Box {
+    float x0, z0, x1, z1;
+    uint32_t ref;
+  };
+  std::vector<Box> boxes;
+  float x0 = FLT_MAX, z0 = FLT_MAX, x1 = -FLT_MAX, z1 = -FLT_MAX;
+  const dtNavMesh& m = *mesh_;
+  for (int i = 0; i < m.getMaxTiles(); ++i) {
+    const dtMeshTile* t = m.getTile(i);
+    if (!t || !t->header) continue;
+    const dtPolyRef base = m.getPolyRefBase(t);
+    for (int k = 0; k < t->header->polyCount; ++k) {
+      const dtPoly& p = t->polys[k];
+      if (p.getType() != DT_POLYTYPE_GROUND) continue;
+      Box b{FLT_MAX, FLT_MAX, -FLT_MAX, -FLT_MAX, base | static_cast<dtPolyRef>(k)};
+      for (int v = 0; v < p.vertCount; ++v) {
+        const float* q = &t->verts[p.verts[v] * 3];
+        b.x0 = std::min(b.x0, q[0]);
+        b.z0 = std::min(b.z0, q[2]);
+        b.x1 = std::max(b.x1, q[0]);
+        b.z1 = std::max(b.z1, q[2]);
+      }
+      x0 = std::min(x0, b.x0);
+      z0 = std::min(z0, b.z0);
+      x1 = std::max(x1, b.x1);
+      z1 = std::max(z1, b.z1);
+      boxes.push_back(b);
+    }
+  }
+  grid_ = {};
+  if (boxes.empty()) return;
+  // About one polygon per cell.
+  const double w = std::max(double{x1} - x0, 1e-3), h = std::max(double{z1} - z0, 1e-3);
+  const double cell = std::sqrt(w * h / static_cast<double>(boxes.size()));
+  PolyGrid& g = grid_;
+  g.x0 = x0;
+  g.z0 = z0;
+  g.cell = static_cast<float>(cell);
+  g.inv_cell = static_cast<float>(1 / cell);
+  g.w = static_cast<int>(std::min(w / cell + 1, 1e6));
+  g.h = static_cast<int>(std::min(h / cell + 1, 1e6));
+  const auto cx = [&](float v) {
+    return std::clamp(static_cast<int>((v - g.x0) * g.inv_cell), 0, g.w - 1);
+  };
+  const auto cz = [&](float v) {
+    return std::clamp(static_cast<int>((v - g.z0) * g.inv_cell), 0, g.h - 1);
+  };
+  g.start.assign(static_cast<std::size_t>(g.w) * static_cast<std::size_t>(g.h) + 1, 0);
+  for (const Box& b : boxes)
+    for (int z = cz(b.z0); z <= cz(b.z1); ++z)
+      for (int x = cx(b.x0); x <= cx(b.x1); ++x)
+        ++g.start[static_cast<std::size_t>(z) * g.w + x + 1];
+  for (std::size_t c = 1; c < g.start.size(); ++c) g.start[c] += g.start[c - 1];
+  g.refs.resize(g.start.back());
+  std::vector<uint32_t> fill(g.start.begin(), g.start.end() - 1);
+  for (const Box& b : boxes)
+    for (int z = cz(b.z0); z <= cz(b.z1); ++z)
+      for (int x = cx(b.x0); x <= cx(b.x1); ++x)
+        g.refs[fill[static_cast<std::size_t>(z) * g.w + x]++] = b.ref;
+}
+
+unsigned int NavMesh::inside_poly(const dtNavMeshQuery& q, const float* p, const float* ext,
+                                  float* snapped) const {
+  const PolyGrid& g = grid_;
+  // (NaN fails these too.)
+  if (!(p[0] >= g.x0 && p[2] >= g.z0)) return 0;
+  const float fx = (p[0] - g.x0) * g.inv_cell, fz = (p[2] - g.z0) * g.inv_cell;
+  if (!(fx < static_cast<float>(g.w) && fz < static_cast<float>(g.h))) return 0;
+  // The same cell arithmetic as the build's (monotone in p), so a box holding p lists its
+  // polygon in p's cell.
+  const int x = std::clamp(static_cast<int>(fx), 0, g.w - 1);
+  const int z = std::clamp(static_cast<int>(fz), 0, g.h - 1);
+  const std::size_t c = static_cast<std::size_t>(z) * g.w + x;
+  const double margin = inside_margin(p);
+  for (uint32_t k = g.start[c]; k < g.start[c + 1]; ++k) {
+    const dtPolyRef ref = g.refs[k];
+    const dtMeshTile* tile = nullptr;
+    const dtPoly* poly = nullptr;
+    mesh_->getTileAndPolyByRefUnsafe(ref, &tile, &poly);
+    if (!inside_by(*tile, *poly, p[0], p[2], margin)) continue;
+    // Detour's own terms for this polygon: the filter, the point over it and its distance.
+    // (dtQueryFilter::passFilter is Detour's inline, not exported: the same test.)
+    if (!((poly->flags & filter_->getIncludeFlags()) != 0 &&
+          (poly->flags & filter_->getExcludeFlags()) == 0))
+      return 0;
+    float at[3];
+    bool over = false;
+    if (dtStatusFailed(q.closestPointOnPoly(ref, p, at, &over)) || !over) return 0;
+    float diff[3];
+    dtVsub(diff, p, at);
+    float d = dtAbs(diff[1]) - tile->header->walkableClimb;
+    d = d > 0 ? d * d : 0;
+    if (d != 0 || !(dtAbs(diff[1]) <= ext[1])) return 0;
+    dtVcopy(snapped, at);
+    return ref;
+  }
+  return 0;
+}
+
+unsigned int NavMesh::nearest_poly(const dtNavMeshQuery& q, const float* p, const float* ext,
+                                   float* snapped) const {
+  if (const unsigned int ref = inside_poly(q, p, ext, snapped)) return ref;
+  dtPolyRef ref = 0;
+  if (dtStatusFailed(q.findNearestPoly(p, ext, filter_.get(), &ref, snapped))) return 0;
+  return ref;
+}
+
+NavMesh::Located NavMesh::locate_point(Vec2 p, double reach, bool naive) const {
+  const float c[3] = {lx(p.x), 0, ly(p.y)};
+  const float ext[3] = {static_cast<float>(reach), 2 * kFloorAbove, static_cast<float>(reach)};
+  float s[3];
+  dtPolyRef ref = 0;
+  if (naive) {
+    if (dtStatusFailed(shared_query_->findNearestPoly(c, ext, filter_.get(), &ref, s))) ref = 0;
+  } else {
+    ref = nearest_poly(*shared_query_, c, ext, s);
+  }
+  return ref ? Located{ref, world(s)} : Located{};
+}
+
+NavMesh::Located NavMesh::locate_inside(Vec2 p) const {
+  const float c[3] = {lx(p.x), 0, ly(p.y)};
+  const float ext[3] = {0, 2 * kFloorAbove, 0};
+  float s[3];
+  const unsigned int ref = inside_poly(*shared_query_, c, ext, s);
+  return ref ? Located{ref, world(s)} : Located{};
 }
 
 unsigned int NavMesh::locate(const dtNavMeshQuery& q, const float* p, float* snapped) const {
   for (float reach = reach_; reach <= reach_ * 16; reach *= 4) {
     const float ext[3] = {reach, 2 * kFloorAbove, reach};
-    dtPolyRef ref = 0;
-    if (dtStatusSucceed(q.findNearestPoly(p, ext, filter_.get(), &ref, snapped)) && ref) return ref;
+    if (const unsigned int ref = nearest_poly(q, p, ext, snapped)) return ref;
   }
   return 0;
 }
 
 std::optional<Vec2> NavMesh::nearest(Vec2 p, double reach) const {
-  const float c[3] = {lx(p.x), 0, ly(p.y)};
-  const float ext[3] = {static_cast<float>(reach), 2 * kFloorAbove, static_cast<float>(reach)};
-  dtPolyRef ref = 0;
-  float s[3];
-  if (dtStatusFailed(shared_query_->findNearestPoly(c, ext, filter_.get(), &ref, s)) || !ref)
-    return std::nullopt;
-  return world(s);
+  const Located l = locate_point(p, reach);
+  if (!l.ref) return std::nullopt;
+  return l.at;
 }
 
 bool NavMesh::visible(Vec2 from, Vec2 to) const {
@@ -428,12 +601,7 @@ std::vector<std::vector<Vec2>> NavMesh::polygons() const {
 }
 
 uint32_t NavMesh::polygon_at(Vec2 p, double reach) const {
-  const float c[3] = {lx(p.x), 0, ly(p.y)};
-  const float ext[3] = {static_cast<float>(reach), 2 * kFloorAbove, static_cast<float>(reach)};
-  dtPolyRef ref = 0;
-  float s[3];
-  if (dtStatusFailed(shared_query_->findNearestPoly(c, ext, filter_.get(), &ref, s))) return 0;
-  return ref;
+  return locate_point(p, reach).ref;
 }
 
 bool NavMesh::valid_polygon(uint32_t ref) const {

@@ -164,6 +164,17 @@ class NavMesh {
   std::vector<std::vector<Vec2>> polygons() const;
   // The polygon (ref) under or nearest to p within `reach`; 0 when none.
   uint32_t polygon_at(Vec2 p, double reach) const;
+  // The polygon under or nearest to p within `reach` (a square of that half-side) and its point
+  // nearest p: Detour's findNearestPoly, bit for bit. A point well inside a polygon is answered
+  // from a grid of the polygons' boxes; `naive`: always Detour's search (the twin the tests
+  // compare with). ref 0 when none.
+  struct Located {
+    uint32_t ref = 0;
+    Vec2 at{};
+  };
+  Located locate_point(Vec2 p, double reach, bool naive = false) const;
+  // The grid's answer alone: the polygon p lies well inside, or ref 0 when that is not certain.
+  Located locate_inside(Vec2 p) const;
   bool valid_polygon(uint32_t ref) const;
   // Every link between adjacent polygons, each direction once, in mesh order (for tests: the
   // naive twin of the search with polygon costs).
@@ -177,6 +188,13 @@ class NavMesh {
   Vec2 world(const float* p) const { return {origin_.x + p[0], origin_.y + p[2]}; }
   // Nearest polygon to a local point, searching squares of growing half-side.
   unsigned int locate(const dtNavMeshQuery& q, const float* p, float* snapped) const;
+  // Detour's findNearestPoly (local point, half-extents): the grid's answer when p lies well
+  // inside a polygon (see navmesh.cpp), else Detour's search. 0 when none.
+  unsigned int nearest_poly(const dtNavMeshQuery& q, const float* p, const float* ext,
+                            float* snapped) const;
+  unsigned int inside_poly(const dtNavMeshQuery& q, const float* p, const float* ext,
+                           float* snapped) const;
+  void build_poly_grid();
 
   NavMeshParams params_;
   NavMeshStats stats_;
@@ -185,6 +203,14 @@ class NavMesh {
   dtNavMesh* mesh_ = nullptr;
   dtNavMeshQuery* shared_query_ = nullptr;  // read-only queries only
   std::unique_ptr<dtQueryFilter> filter_;
+  // The ground polygons whose bounding boxes meet each cell of a uniform grid (local x, z):
+  // refs of cell c in refs[start[c], start[c + 1]).
+  struct PolyGrid {
+    float x0 = 0, z0 = 0, cell = 1, inv_cell = 1;
+    int w = 0, h = 0;
+    std::vector<uint32_t> start, refs;
+  };
+  PolyGrid grid_;
 };
 
 // A path search context over one mesh (Detour's node pool and open list). One per thread.

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -550,6 +551,65 @@ TEST(NavMesh, TilesJoinSeamlessly) {
     EXPECT_NEAR(rm.length, r1.length, 0.02 * r1.length);
     EXPECT_TRUE(many->visible(a, {a.x + 3, a.y}));  // a ray across a tile edge
   }
+}
+
+// Point location's grid against its twin, Detour's findNearestPoly: the same polygon and the same
+// snapped point, bit for bit, on one-tile and many-tile meshes with obstacles, for random points
+// (on and off the mesh, beyond the bounds), every polygon's corners and edge midpoints and points
+// a hair either side of them, and square reaches from 0 to 4 m. The grid alone (locate_inside)
+// must answer only where it is certain, and must answer well inside polygons: at their centroids.
+TEST(NavMesh, PointLocationAgreesWithDetoursSearch) {
+  Rng rng(77031);
+  const NavGeometry g{
+      {0, 0, 80, 60},
+      {{40, 30, 6, 1}, {12.3, 47.1, 2.2, 1}},
+      {rect(20, 10, 24, 50), rect(56, 10, 60, 50), {{{30, 5}, {36, 7}, {31, 12}}, 1}}};
+  std::size_t compared = 0, located = 0, by_grid = 0, centroids = 0, centroid_hits = 0;
+  for (const NavMeshParams params : {NavMeshParams{1.0, 0.25, 512}, NavMeshParams{0.25, 0.1, 32},
+                                     NavMeshParams{0.5, 0.25, 16}}) {
+    auto mesh = NavMesh::build(g, params);
+    std::vector<Vec2> points;
+    for (int k = 0; k < 4000; ++k) points.push_back({rng.uniform(-2, 82), rng.uniform(-2, 62)});
+    for (const auto& ring : mesh->polygons()) {
+      Vec2 c{0, 0};
+      for (std::size_t v = 0; v < ring.size(); ++v) {
+        const Vec2 a = ring[v], b = ring[(v + 1) % ring.size()];
+        c.x += a.x / static_cast<double>(ring.size());
+        c.y += a.y / static_cast<double>(ring.size());
+        for (const Vec2 q : {a, Vec2{0.5 * (a.x + b.x), 0.5 * (a.y + b.y)}})
+          for (const double h : {0.0, 1e-7, 1e-5, 1e-3, 2e-3})
+            for (const Vec2 d : {Vec2{h, 0}, Vec2{-h, 0}, Vec2{0, h}, Vec2{0, -h}, Vec2{h, h}})
+              points.push_back({q.x + d.x, q.y + d.y});
+      }
+      // Well inside a convex polygon: the grid must answer (a polygon thinner than the margin
+      // cannot hold its centroid that far from its edges; none here is).
+      ++centroids;
+      const NavMesh::Located in = mesh->locate_inside(c);
+      centroid_hits += in.ref != 0;
+      points.push_back(c);
+    }
+    for (const Vec2 p : points) {
+      const NavMesh::Located in = mesh->locate_inside(p);
+      by_grid += in.ref != 0;
+      ++located;
+      for (const double reach : {0.0, 0.05, 0.5, 4.0}) {
+        const NavMesh::Located fast = mesh->locate_point(p, reach);
+        const NavMesh::Located naive = mesh->locate_point(p, reach, true);
+        ASSERT_EQ(fast.ref, naive.ref) << p.x << " " << p.y << " reach " << reach;
+        ASSERT_EQ(std::bit_cast<uint64_t>(fast.at.x), std::bit_cast<uint64_t>(naive.at.x));
+        ASSERT_EQ(std::bit_cast<uint64_t>(fast.at.y), std::bit_cast<uint64_t>(naive.at.y));
+        if (in.ref != 0) {
+          ASSERT_EQ(in.ref, naive.ref) << p.x << " " << p.y;
+          ASSERT_EQ(std::bit_cast<uint64_t>(in.at.x), std::bit_cast<uint64_t>(naive.at.x));
+        }
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(centroid_hits, centroids);
+  EXPECT_GT(by_grid, located / 20);  // most points are the adversarial ones near edges
+  std::printf("[ navmesh  ] %zu point locations compared; %zu of %zu points answered by the grid\n",
+              compared, by_grid, located);
 }
 
 TEST(NavMesh, BuildAndQueriesAreDeterministicOnAnyThreadCount) {
