@@ -268,14 +268,7 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick,
   }
   // Dispatch the queue head within the budget, from the agents' current positions.
   std::vector<PathJob> jobs;
-  std::vector<std::size_t> stalled;  // rows, in row order (only counted, so the order is moot)
-  std::map<const NavMesh*, std::vector<StalledAt>> located;  // this tick's, per mesh
-  std::size_t costed = 0;
-  bool slow_ready = false;  // slow walkers: found once, for the first search that needs them
-  std::vector<std::size_t> slow;
-  if (params_.congestion_cost > 0 && !queue_.empty())
-    for (uint32_t i : head_on)
-      if (i < t.size() && !standing(t.state[i])) stalled.push_back(i);
+  std::vector<std::size_t> rows;  // each job's row
   while (!queue_.empty() && jobs.size() < params_.budget) {
     const Queued q = queue_.front();
     queue_.pop_front();
@@ -288,32 +281,67 @@ std::size_t Navigation::request_paths(World& world, uint64_t tick,
     const Vec2 goal = goal_target(world.goals()[t.goal[i]], t.x[i], t.y[i], t.radius[i]);
     const int k = q.narrow ? narrow_key(t.radius[i]) : class_of(t.radius[i]);
     stats_.narrow += q.narrow;
-    const NavMesh* mesh = &mesh_of_class(k);
-    std::shared_ptr<const PolygonCosts> c;
-    if (!stalled.empty() && costed < kCostedPerTick) {
-      auto [it, fresh] = located.try_emplace(mesh);
-      if (fresh) it->second = locate(world, *mesh, stalled);
-      c = congestion(it->second, heading(t, i));
-    }
-    // (Only for those held up themselves: one walking freely is not in a queue yet; a new one
-    // standing at its source is.)
-    if (params_.queue_flow > 0 && costed < kCostedPerTick && held_up(t, i)) {
-      if (!slow_ready) {
-        slow = slow_walkers(t);
-        slow_ready = true;
+    jobs.push_back({q.ticket, q.agent, &mesh_of_class(k), {t.x[i], t.y[i]}, goal, nullptr, k});
+    rows.push_back(i);
+  }
+  // Costs, job by job while fewer than kCostedPerTick have some: congestion, then queues at
+  // doors. Each job adds at most one to the count, so the next (kCostedPerTick - costed) jobs
+  // are all costed whatever the others find: their door searches (the expensive part) run at
+  // once on every thread, each with scratch of its own, and the results are taken in job order,
+  // as one job after another would.
+  std::vector<std::size_t> stalled;  // rows, in row order (only counted, so the order is moot)
+  std::map<const NavMesh*, std::vector<StalledAt>> located;  // this tick's, per mesh
+  std::vector<std::size_t> slow;  // slow walkers: found once, for the first search that needs them
+  bool slow_ready = false;
+  if (params_.congestion_cost > 0)
+    for (uint32_t i : head_on)
+      if (i < t.size() && !standing(t.state[i])) stalled.push_back(i);
+  std::size_t costed = 0;
+  std::vector<std::vector<DoorCut>> cuts;
+  std::vector<std::size_t> door_jobs;
+  for (std::size_t next = 0; next < jobs.size() && costed < kCostedPerTick;) {
+    const std::size_t end = std::min(jobs.size(), next + (kCostedPerTick - costed));
+    door_jobs.clear();
+    for (std::size_t j = next; j < end; ++j) {
+      const std::size_t i = rows[j];
+      if (!stalled.empty()) {
+        auto [it, fresh] = located.try_emplace(jobs[j].mesh);
+        if (fresh) it->second = locate(world, *jobs[j].mesh, stalled);
+        jobs[j].costs = congestion(it->second, heading(t, i));
       }
-      if (!slow.empty())
-        if (std::vector<DoorCut> cuts = queues_ahead(t, *mesh, i, goal, slow, c.get());
-            !cuts.empty()) {
-          auto pc = std::make_shared<PolygonCosts>(c ? *c : PolygonCosts{});
-          pc->cuts = std::move(cuts);
-          c = std::move(pc);
-          ++stats_.queue_costed;
+      // (Only for those held up themselves: one walking freely is not in a queue yet; a new one
+      // standing at its source is.)
+      if (params_.queue_flow > 0 && held_up(t, i)) {
+        if (!slow_ready) {
+          slow = slow_walkers(t);
+          slow_ready = true;
         }
+        if (!slow.empty()) door_jobs.push_back(j);
+      }
     }
-    costed += c != nullptr;
-    stats_.costed += c != nullptr;
-    jobs.push_back({q.ticket, q.agent, mesh, {t.x[i], t.y[i]}, goal, std::move(c), k});
+    cuts.assign(door_jobs.size(), {});
+    while (door_scratch_.size() < door_jobs.size())
+      door_scratch_.push_back(std::make_unique<DoorScratch>());
+    ex_.for_each_chunk(door_jobs.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t u = b; u < e; ++u) {
+        const PathJob& job = jobs[door_jobs[u]];
+        cuts[u] = queues_ahead(t, *job.mesh, rows[door_jobs[u]], job.goal, slow, job.costs.get(),
+                               *door_scratch_[u]);
+      }
+    });
+    for (std::size_t u = 0; u < door_jobs.size(); ++u) {
+      if (cuts[u].empty()) continue;
+      PathJob& job = jobs[door_jobs[u]];
+      auto pc = std::make_shared<PolygonCosts>(job.costs ? *job.costs : PolygonCosts{});
+      pc->cuts = std::move(cuts[u]);
+      job.costs = std::move(pc);
+      ++stats_.queue_costed;
+    }
+    for (std::size_t j = next; j < end; ++j) {
+      costed += jobs[j].costs != nullptr;
+      stats_.costed += jobs[j].costs != nullptr;
+    }
+    next = end;
   }
   if (!jobs.empty()) {
     stats_.dispatched += jobs.size();
@@ -331,8 +359,11 @@ std::vector<std::size_t> Navigation::slow_walkers(const AgentTable& t) {
 
 std::vector<DoorCut> Navigation::queues_ahead(const AgentTable& t, const NavMesh& m, std::size_t i,
                                               Vec2 goal, const std::vector<std::size_t>& slow,
-                                              const PolygonCosts* base) {
-  auto& finder = finders_[&m];
+                                              const PolygonCosts* base,
+                                              DoorScratch& scratch) const {
+  auto& finder = scratch.finders[&m];
+  auto& context = scratch.contexts[&m];
+  if (!context) context = std::make_unique<NavMesh::Context>(m);
   // (A bounded search: a door within kDoorLook is found by a few hundred nodes; a search
   // over a large mesh to a far goal took milliseconds: SteerSuite's scenarioSpace, 5,000 agents
   // among 5,000 boxes, spent 45 ms a tick on them. Beyond the bound the route is Detour's partial
@@ -369,7 +400,7 @@ std::vector<DoorCut> Navigation::queues_ahead(const AgentTable& t, const NavMesh
     std::vector<Vec2> way{at};
     way.insert(way.end(), r.corners.begin(), r.corners.end());
     way.push_back(r.end);
-    std::optional<DoorCut> cut = m.first_narrows(way, kDoorLook, kDoorWidth);
+    std::optional<DoorCut> cut = m.first_narrows(way, kDoorLook, kDoorWidth, context.get());
     if (!cut) break;
     const Vec2 mid{0.5 * (cut->a.x + cut->b.x), 0.5 * (cut->a.y + cut->b.y)};
     const bool known = std::any_of(costs.cuts.begin(), costs.cuts.end(), [&](const DoorCut& c) {

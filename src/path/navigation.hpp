@@ -176,8 +176,15 @@ class Navigation {
   // on top of `base` (or none): the first door on its way with the queue ahead of it there, then
   // the first door on the way the search takes with that charged, and so on (at most
   // kDoorRounds); empty when the first door has no queue, or there is none.
+  // Runs on any thread: `scratch` is the caller's own (a path search and a query context per
+  // mesh, made on first use).
+  struct DoorScratch {
+    std::map<const NavMesh*, std::unique_ptr<PathFinder>> finders;
+    std::map<const NavMesh*, std::unique_ptr<NavMesh::Context>> contexts;
+  };
   std::vector<DoorCut> queues_ahead(const AgentTable& t, const NavMesh& m, std::size_t i, Vec2 goal,
-                                    const std::vector<std::size_t>& slow, const PolygonCosts* base);
+                                    const std::vector<std::size_t>& slow, const PolygonCosts* base,
+                                    DoorScratch& scratch) const;
   // Drops the leading waypoints the agent has already passed (the one after is in sight).
   void trim_passed(World& world, std::size_t row);
 
@@ -199,7 +206,8 @@ class Navigation {
   uint64_t next_ticket_ = 0;
   NavigationStats stats_;
   // Searches on the tick's thread (queue_ahead's first door), one per mesh.
-  std::map<const NavMesh*, std::unique_ptr<PathFinder>> finders_;
+  // One per search costed at once (request_paths), kept between ticks.
+  std::vector<std::unique_ptr<DoorScratch>> door_scratch_;
   std::unique_ptr<PathService> service_;  // declared last: stopped before the meshes go
 };
 

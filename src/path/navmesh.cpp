@@ -33,6 +33,9 @@ constexpr int kWalkableHeight = 2, kWalkableClimb = 1;  // [cells]
 constexpr int kErodeMargin = 1;
 constexpr unsigned short kWalkFlag = 1;
 constexpr int kMaxPathPolys = 4096;
+// Node pool of the mesh's own query context and of NavMesh::Context: the distance to walls
+// explores this many polygons at most (the same number everywhere, so the same answers).
+constexpr int kSharedNodes = 16;
 constexpr int kMaxStraight = 512;
 static_assert(sizeof(dtPolyRef) == sizeof(uint32_t), "polygon refs are stored as 32 bits");
 
@@ -372,7 +375,7 @@ std::unique_ptr<NavMesh> NavMesh::build(const NavGeometry& g, const NavMeshParam
   }
   if (!first_error.empty()) bad("Recast failed: " + first_error);
   nm->shared_query_ = dtAllocNavMeshQuery();
-  if (!nm->shared_query_ || dtStatusFailed(nm->shared_query_->init(nm->mesh_, 16)))
+  if (!nm->shared_query_ || dtStatusFailed(nm->shared_query_->init(nm->mesh_, kSharedNodes)))
     bad("out of memory");
   nm->filter_ = std::make_unique<dtQueryFilter>();
   nm->build_poly_grid();
@@ -639,8 +642,21 @@ bool cut_crossed(Vec2 a, Vec2 b, Vec2 p, Vec2 q) {
   return (oa <= 0 && ob >= 0) || (oa >= 0 && ob <= 0);
 }
 
+NavMesh::Context::Context(const NavMesh& mesh) {
+  query_ = dtAllocNavMeshQuery();
+  if (!query_ || dtStatusFailed(query_->init(mesh.mesh_, kSharedNodes))) {
+    dtFreeNavMeshQuery(query_);
+    throw Error(Error::Kind::input, "navigation mesh: out of memory for a query context");
+  }
+}
+
+NavMesh::Context::~Context() {
+  dtFreeNavMeshQuery(query_);
+}
+
 std::optional<DoorCut> NavMesh::first_narrows(const std::vector<Vec2>& path, double look,
-                                              double max_width) const {
+                                              double max_width, Context* ctx) const {
+  const dtNavMeshQuery& query = ctx ? *ctx->query_ : *shared_query_;
   const double reach = max_width - 2 * clearance();
   if (!(reach > 0) || path.size() < 2) return std::nullopt;
   const double step = std::max(params_.cell_size, 0.2);
@@ -653,7 +669,7 @@ std::optional<DoorCut> NavMesh::first_narrows(const std::vector<Vec2>& path, dou
   const auto across = [&](Vec2 p, double dx, double dy) -> std::optional<DoorCut> {
     const float a[3] = {lx(p.x), 0, ly(p.y)};
     float s[3];
-    const dtPolyRef ref = locate(*shared_query_, a, s);
+    const dtPolyRef ref = locate(query, a, s);
     if (!ref) return std::nullopt;
     const Vec2 from = world(s);
     // How far from `from` along (ux, uy) the mesh reaches, up to `len`; infinite beyond.
@@ -661,13 +677,13 @@ std::optional<DoorCut> NavMesh::first_narrows(const std::vector<Vec2>& path, dou
       const float e[3] = {lx(from.x + ux * len), s[1], ly(from.y + uy * len)};
       dtRaycastHit h;
       std::memset(&h, 0, sizeof h);
-      if (dtStatusFailed(shared_query_->raycast(ref, s, e, filter_.get(), 0, &h)) || h.t == FLT_MAX)
+      if (dtStatusFailed(query.raycast(ref, s, e, filter_.get(), 0, &h)) || h.t == FLT_MAX)
         return static_cast<double>(INFINITY);
       return static_cast<double>(h.t) * len;
     };
     float d = 0, hit[3], normal[3];
-    if (dtStatusFailed(shared_query_->findDistanceToWall(ref, s, static_cast<float>(reach),
-                                                         filter_.get(), &d, hit, normal)) ||
+    if (dtStatusFailed(query.findDistanceToWall(ref, s, static_cast<float>(reach), filter_.get(),
+                                                &d, hit, normal)) ||
         !(2 * d <= reach))
       return std::nullopt;  // every way across is at least twice as long as to the nearest wall
     std::optional<DoorCut> narrow;

@@ -154,8 +154,11 @@ class NavMesh {
   // (raycasts); a place is narrow where that way, plus the clearance on either side, is at most
   // `max_width`. Of the first run of narrow samples, the narrowest way: a door's
   // cut from post to post. None when no sample is narrow. DoorCut::cost is 0.
-  std::optional<DoorCut> first_narrows(const std::vector<Vec2>& path, double look,
-                                       double max_width) const;
+  // `ctx`: a context of the caller's own (one per thread: distance to walls uses Detour's
+  // node pool); none: the mesh's own, for one thread at a time.
+  class Context;
+  std::optional<DoorCut> first_narrows(const std::vector<Vec2>& path, double look, double max_width,
+                                       Context* ctx = nullptr) const;
   // Line of sight for a disc of the mesh's radius: from the mesh point nearest `from` to `to`
   // without leaving the walkable polygons. False when `from` is off the mesh.
   bool visible(Vec2 from, Vec2 to) const;
@@ -211,6 +214,20 @@ class NavMesh {
     std::vector<uint32_t> start, refs;
   };
   PolyGrid grid_;
+};
+
+// A query context over one mesh for first_narrows on several threads (one each): the same
+// node pool size as the mesh's own, so the same answers.
+class NavMesh::Context {
+ public:
+  explicit Context(const NavMesh& mesh);
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+ private:
+  friend class NavMesh;
+  dtNavMeshQuery* query_ = nullptr;
 };
 
 // A path search context over one mesh (Detour's node pool and open list). One per thread.

@@ -1,6 +1,6 @@
 // Reference shortest paths (the oracle of the navigation mesh in tests, and the yardstick of
-// crowddb verify's path-length criteria) for a disc among static obstacles, independent of Recast/Detour:
-// a visibility graph over the obstacles inflated by the disc radius, then Dijkstra.
+// crowddb verify's path-length criteria) for a disc among static obstacles, independent of
+// Recast/Detour: a visibility graph over the obstacles inflated by the disc radius, then Dijkstra.
 //
 // The free space for a disc of radius r is the plane minus every obstacle grown by r (and, with
 // walls, the bounds shrunk by r). A shortest path runs along straight tangents and arcs of
