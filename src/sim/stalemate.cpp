@@ -15,6 +15,7 @@ constexpr double kBlockGap = 0.6;  // [m] a blocker's disc is this close to the 
 constexpr double kFreeWalk = 0.5;  // walking at half the preferred speed towards the target
 constexpr double kOpposed = -0.5;  // cos 120 degrees: directions further apart head at each other
 constexpr std::size_t kWatchGrain = 256;  // rows per chunk of the progress watch
+constexpr std::size_t kLookGrain = 64;    // looked-at rows per chunk of blockers and actions
 
 uint64_t priority(uint64_t seed, uint64_t id) {
   uint64_t s = seed ^ (id * 0x9e3779b97f4a7c15ull);
@@ -206,26 +207,29 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     const auto it = std::lower_bound(looked_at.begin(), looked_at.end(), j);
     return it != looked_at.end() && *it == j ? it - looked_at.begin() : -1;
   };
-  for (std::size_t q = 0; q < looked_at.size(); ++q) {
-    const uint32_t i = looked_at[q];
-    dir[q] = heading(t, goals, i);
-    for (uint32_t j : nb.rows_of(q)) {
-      const double rx = t.x[j] - t.x[i], ry = t.y[j] - t.y[i];
-      const double gap = std::sqrt(rx * rx + ry * ry) - t.radius[i] - t.radius[j];
-      if (gap < kBlockGap && rx * dir[q].x + ry * dir[q].y > 0) {
-        blocker[q] = j;
-        break;
+  // Each looked-at row on its own (in chunks, on every thread).
+  ex.for_each_chunk(looked_at.size(), kLookGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t q = b; q < e; ++q) {
+      const uint32_t i = looked_at[q];
+      dir[q] = heading(t, goals, i);
+      for (uint32_t j : nb.rows_of(q)) {
+        const double rx = t.x[j] - t.x[i], ry = t.y[j] - t.y[i];
+        const double gap = std::sqrt(rx * rx + ry * ry) - t.radius[i] - t.radius[j];
+        if (gap < kBlockGap && rx * dir[q].x + ry * dir[q].y > 0) {
+          blocker[q] = j;
+          break;
+        }
       }
+      if (blocker[q] < 0) continue;
+      const auto j = static_cast<std::size_t>(blocker[q]);
+      const Vec2 dj = heading(t, goals, j);
+      // Someone idle heads a queue only at i's own goal: idle on another goal (arrivals of
+      // the other stream) or anywhere else, it is an obstacle that does not move away by itself.
+      same_way[q] = t.goal[j] == t.goal[i] ||
+                    (!standing(t.state[j]) && dj.x * dir[q].x + dj.y * dir[q].y >= kSameWay);
+      bpos[q] = pos(j);
     }
-    if (blocker[q] < 0) continue;
-    const auto j = static_cast<std::size_t>(blocker[q]);
-    const Vec2 dj = heading(t, goals, j);
-    // Someone idle heads a queue only at i's own goal: idle on another goal (arrivals of
-    // the other stream) or anywhere else, it is an obstacle that does not move away by itself.
-    same_way[q] = t.goal[j] == t.goal[i] ||
-                  (!standing(t.state[j]) && dj.x * dir[q].x + dj.y * dir[q].y >= kSameWay);
-    bpos[q] = pos(j);
-  }
+  });
   // A queue ends in someone who moves: an agent waits in one when its same-way blocker is
   // progressing (not looked at) or waits in one itself. Chains resolve outwards from a moving
   // head; a cycle of mutual blockers (people arching in a door) never does: it is a stalemate.
@@ -257,16 +261,18 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
       jammed_ahead(t, goals, looked_at, blocker, bpos, queueing, dir);
   for (std::size_t q = 0; q < looked_at.size(); ++q)
     if (!queueing[q] && !jammed[q]) c.head_on.push_back(looked_at[q]);
-  // 3. actions for the stalled ones that have none running
-  for (std::size_t q = 0; q < looked_at.size(); ++q) {
+  // 3. actions for the stalled ones that have none running: each row's own columns only, read
+  // from the others what this loop does not write (in chunks, on every thread; counts summed in
+  // chunk order).
+  auto act = [&](std::size_t q, std::size_t& yields, std::size_t& sidesteps) {
     const uint32_t i = looked_at[q];
-    if (queueing[q] || t.stall_action[i] != StallAction::none) continue;
+    if (queueing[q] || t.stall_action[i] != StallAction::none) return;
     const double dx = dir[q].x, dy = dir[q].y;
-    if (dx == 0 && dy == 0) continue;
+    if (dx == 0 && dy == 0) return;
     // Nobody in front and walking towards the target: it is making its way back to where it
     // was pushed from (a counter-stream carried it backwards), not stuck; a sidestep would only
     // slow it down.
-    if (blocker[q] < 0 && t.vx[i] * dx + t.vy[i] * dy >= kFreeWalk * t.pref_speed[i]) continue;
+    if (blocker[q] < 0 && t.vx[i] * dx + t.vy[i] * dy >= kFreeWalk * t.pref_speed[i]) return;
     const auto j = static_cast<std::size_t>(blocker[q]);
     const bool blocker_stalled = blocker[q] >= 0 && t.stall_ticks[j] >= after &&
                                  !(bpos[q] >= 0 && queueing[static_cast<std::size_t>(bpos[q])]);
@@ -308,9 +314,9 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
       t.stall_dir_y[i] = yy;
       t.stall_until[i] =
           tick + cfg.ticks_for(jammed[q] ? cfg.stall.yield_time : cfg.stall.head_on_yield_time);
-      ++c.yielding;
+      ++yields;
     } else if (blocker_stalled) {
-      continue;  // the blocker yields to this one
+      return;  // the blocker yields to this one
     } else {
       Rng rng = Rng::stream(cfg.seed ^ (tick * 0xbf58476d1ce4e5b9ull), t.id[i]);
       const double turn =
@@ -320,8 +326,17 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
       t.stall_dir_x[i] = cs * dx - sn * dy;
       t.stall_dir_y[i] = sn * dx + cs * dy;
       t.stall_until[i] = tick + cfg.ticks_for(cfg.stall.sidestep_time);
-      ++c.sidestepping;
+      ++sidesteps;
     }
+  };
+  const std::size_t chunks = (looked_at.size() + kLookGrain - 1) / kLookGrain;
+  std::vector<std::size_t> yields(chunks, 0), sidesteps(chunks, 0);
+  ex.for_each_chunk(looked_at.size(), kLookGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t q = b; q < e; ++q) act(q, yields[b / kLookGrain], sidesteps[b / kLookGrain]);
+  });
+  for (std::size_t k = 0; k < chunks; ++k) {
+    c.yielding += yields[k];
+    c.sidestepping += sidesteps[k];
   }
   return c;
 }
