@@ -25,6 +25,7 @@ namespace crowddb {
 class ObstacleLookup;
 
 class ByteWriter;  // src/util/byte_codec.hpp
+class Executor;    // src/util/executor.hpp
 class ByteReader;
 
 struct Vec2 {
@@ -254,8 +255,9 @@ class World {
   // whatever the rows' order, so the ids of agents inserted later do not depend on it.
   void remove_rows(std::vector<std::size_t> rows);
   // Puts the rows in the order `order` (order[new row] = old row, a permutation of the rows);
-  // every agent keeps its handle and its values. Throws std::invalid_argument otherwise.
-  void permute_rows(std::span<const uint32_t> order);
+  // every agent keeps its handle and its values. Throws std::invalid_argument otherwise. With
+  // `ex`, the columns are gathered on its threads (the same result).
+  void permute_rows(std::span<const uint32_t> order, Executor* ex = nullptr);
   // The current waypoint of a row: next route point, else the nearest point of its goal area.
   // Restarts the row's progress watch because the waypoint may have changed.
   void refresh_target(std::size_t row);

@@ -81,7 +81,7 @@ void NeighbourGrid::build(const DiscView& d, double range, uint32_t k, Executor&
   });
 }
 
-void NeighbourGrid::rows_permuted(std::span<const uint32_t> order) {
+void NeighbourGrid::rows_permuted(std::span<const uint32_t> order, Executor* ex) {
   const uint32_t k = hint_k_;
   if (k == 0) return;
   // Rows removed or added since the last call (arrivals, sources) do not stop this: the hints of
@@ -98,14 +98,27 @@ void NeighbourGrid::rows_permuted(std::span<const uint32_t> order) {
     new_of[order[r]] = static_cast<uint32_t>(r);
   }
   std::vector<uint32_t> count(n, 0), rows(n * k);
-  for (std::size_t r = 0; r < n; ++r) {
-    const std::size_t old = order[r];
-    if (old >= last_n) continue;
-    for (uint32_t u = 0; u < slot_count_[old]; ++u) {
-      const uint32_t e = slot_row_[old * k + u];
-      if (e < n) rows[r * k + count[r]++] = new_of[e];
+  const auto move = [&](std::size_t b, std::size_t end) {
+    // (Locals: the stores into `rows` could alias the vectors' elements read here.)
+    const uint32_t* const last_count = slot_count_.data();
+    const uint32_t* const last_row = slot_row_.data();
+    const uint32_t* const renamed = new_of.data();
+    uint32_t* const out = rows.data();
+    for (std::size_t r = b; r < end; ++r) {
+      const std::size_t old = order[r];
+      if (old >= last_n) continue;
+      uint32_t c = 0;
+      for (uint32_t u = 0, m = last_count[old]; u < m; ++u) {
+        const uint32_t e = last_row[old * k + u];
+        if (e < n) out[r * k + c++] = renamed[e];
+      }
+      count[r] = c;
     }
-  }
+  };
+  if (ex)
+    ex->for_each_chunk(n, kCopyGrain, move);
+  else
+    move(0, n);
   slot_count_.swap(count);
   slot_row_.swap(rows);
 }

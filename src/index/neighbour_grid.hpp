@@ -43,7 +43,7 @@ class NeighbourGrid final : public NeighbourPath {
            NeighbourLists& out, Executor& ex, QueryStats& stats) override;
   // Carries the hints along: each row's list moves to the row's new place and names the new
   // rows of its entries.
-  void rows_permuted(std::span<const uint32_t> order) override;
+  void rows_permuted(std::span<const uint32_t> order, Executor* ex = nullptr) override;
 
  private:
   void build(const DiscView& d, double range, uint32_t k, Executor& ex);

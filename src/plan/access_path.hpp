@@ -56,8 +56,9 @@ class NeighbourPath {
   virtual void run(const DiscView& discs, std::span<const uint32_t> queries, double range,
                    uint32_t k, NeighbourLists& out, Executor& ex, QueryStats& stats) = 0;
   // The table's rows were permuted (order[new row] = old row) since the last run: a method that
-  // keeps per-row state across runs (the grid's hints) carries it along. Never changes a result.
-  virtual void rows_permuted(std::span<const uint32_t> /*order*/) {}
+  // keeps per-row state across runs (the grid's hints) carries it along, on `ex`'s threads when
+  // given. Never changes a result.
+  virtual void rows_permuted(std::span<const uint32_t> /*order*/, Executor* /*ex*/ = nullptr) {}
 };
 
 class FeaturePath {

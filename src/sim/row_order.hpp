@@ -13,6 +13,10 @@
 
 #include "crowddb/world.hpp"
 
+namespace crowddb {
+class Executor;
+}
+
 namespace crowddb::sim {
 
 // [s] How often the rows are put in curve order (at least every tick).
@@ -21,7 +25,8 @@ inline constexpr double kReorderInterval = 2.0;
 inline constexpr std::size_t kReorderMinRows = 4096;
 
 // The rows in Morton (Z-curve) order of their positions in cells of 1 m from the table's lowest
-// corner, ties by agent id: order[new row] = old row, for World::permute_rows. O(n log n).
-std::vector<uint32_t> curve_order(const AgentTable& t);
+// corner, ties by agent id: order[new row] = old row, for World::permute_rows. O(n log n); with
+// `ex`, on its threads (the same order).
+std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex = nullptr);
 
 }  // namespace crowddb::sim

@@ -65,8 +65,9 @@ class Model {
   // EXPLAIN: one line per operator the model runs, numbered from `step` (advanced).
   virtual void explain(std::ostream& os, const TickInput& in, int& step) const = 0;
   // The agents' rows were permuted (order[new row] = old row) since the last tick; passed on to
-  // access paths that keep per-row state across ticks. Never changes a result.
-  virtual void rows_permuted(std::span<const uint32_t> /*order*/) {}
+  // access paths that keep per-row state across ticks (on `ex`'s threads when given). Never
+  // changes a result.
+  virtual void rows_permuted(std::span<const uint32_t> /*order*/, Executor* /*ex*/ = nullptr) {}
 };
 
 struct ModelInfo {

@@ -378,17 +378,23 @@ class OrcaModel final : public Model {
     os << ", 3-D fallback when infeasible\n";
   }
 
-  void rows_permuted(std::span<const uint32_t> order) override {
-    for (auto& [name, path] : neighbour_paths_) path->rows_permuted(order);
+  void rows_permuted(std::span<const uint32_t> order, Executor* ex = nullptr) override {
+    for (auto& [name, path] : neighbour_paths_) path->rows_permuted(order, ex);
     // The witnesses move with their rows and are renamed (anything else costs time, not answers).
     const std::size_t n = order.size();
     std::vector<uint32_t> new_of(witness_.size(), PassingLookahead::kNobody);
     for (std::size_t r = 0; r < n; ++r)
       if (order[r] < new_of.size()) new_of[order[r]] = static_cast<uint32_t>(r);
     std::vector<uint32_t> moved(n, PassingLookahead::kNobody);
-    for (std::size_t r = 0; r < n; ++r)
-      if (order[r] < witness_.size() && witness_[order[r]] < new_of.size())
-        moved[r] = new_of[witness_[order[r]]];
+    const auto move = [&](std::size_t b, std::size_t e) {
+      for (std::size_t r = b; r < e; ++r)
+        if (order[r] < witness_.size() && witness_[order[r]] < new_of.size())
+          moved[r] = new_of[witness_[order[r]]];
+    };
+    if (ex)
+      ex->for_each_chunk(n, kGrain * 64, move);
+    else
+      move(0, n);
     witness_.swap(moved);
   }
 

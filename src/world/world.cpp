@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
 
 #include "util/byte_codec.hpp"
+#include "util/executor.hpp"
 #include "world/geometry.hpp"
 #include "world/obstacle_lookup.hpp"
 
@@ -311,42 +313,51 @@ namespace {
 
 // Every column of the agents table, for the row moves (remove_row, permute_rows). A new column
 // goes here and into columns() (checkpoints); the assertion catches one forgotten.
+// Rows per chunk of permute_rows's gather.
+constexpr std::size_t kPermuteGrain = 8192;
+
+template <class F>
+void each_member(F&& f) {
+  f(&AgentTable::x);
+  f(&AgentTable::y);
+  f(&AgentTable::vx);
+  f(&AgentTable::vy);
+  f(&AgentTable::radius);
+  f(&AgentTable::pref_speed);
+  f(&AgentTable::max_speed);
+  f(&AgentTable::max_accel);
+  f(&AgentTable::charge);
+  f(&AgentTable::target_x);
+  f(&AgentTable::target_y);
+  f(&AgentTable::goal);
+  f(&AgentTable::state);
+  f(&AgentTable::frozen_ticks);
+  f(&AgentTable::progress_best);
+  f(&AgentTable::stall_ticks);
+  f(&AgentTable::id);
+  f(&AgentTable::route);
+  f(&AgentTable::then);
+  f(&AgentTable::left_goal);
+  f(&AgentTable::stall_action);
+  f(&AgentTable::stall_until);
+  f(&AgentTable::stall_dir_x);
+  f(&AgentTable::stall_dir_y);
+  f(&AgentTable::path_goal);
+  f(&AgentTable::path_ticket);
+  f(&AgentTable::replan_ticks);
+  f(&AgentTable::wait_until);
+}
+
 template <class F>
 void each_column(AgentTable& t, F&& f) {
-  f(t.x);
-  f(t.y);
-  f(t.vx);
-  f(t.vy);
-  f(t.radius);
-  f(t.pref_speed);
-  f(t.max_speed);
-  f(t.max_accel);
-  f(t.charge);
-  f(t.target_x);
-  f(t.target_y);
-  f(t.goal);
-  f(t.state);
-  f(t.frozen_ticks);
-  f(t.progress_best);
-  f(t.stall_ticks);
-  f(t.id);
-  f(t.route);
-  f(t.then);
-  f(t.left_goal);
-  f(t.stall_action);
-  f(t.stall_until);
-  f(t.stall_dir_x);
-  f(t.stall_dir_y);
-  f(t.path_goal);
-  f(t.path_ticket);
-  f(t.replan_ticks);
-  f(t.wait_until);
+  each_member([&](auto m) { f(t.*m); });
 }
+
 static_assert(sizeof(AgentTable) == 28 * sizeof(std::vector<double>));
 
 }  // namespace
 
-void World::permute_rows(std::span<const uint32_t> order) {
+void World::permute_rows(std::span<const uint32_t> order, Executor* ex) {
   AgentTable& t = agents_;
   const std::size_t n = t.size();
   if (order.size() != n) throw std::invalid_argument("permute_rows: not one entry per row");
@@ -355,15 +366,30 @@ void World::permute_rows(std::span<const uint32_t> order) {
     if (r >= n || seen[r]) throw std::invalid_argument("permute_rows: not a permutation");
     seen[r] = 1;
   }
-  auto gather = [&](auto& column) {
-    std::remove_reference_t<decltype(column)> out;
-    out.reserve(n);
-    for (uint32_t r : order) out.push_back(std::move(column[r]));
-    column.swap(out);
+  // Column by column, each into a new one in one pass; with `ex`, the columns on its threads
+  // (each task owns its column; distinct old rows, a permutation).
+  std::vector<std::function<void()>> gather;
+  each_column(t, [&](auto& column) {
+    gather.push_back([&column, order, n] {
+      std::remove_reference_t<decltype(column)> out;
+      out.reserve(n);
+      for (uint32_t r : order) out.push_back(std::move(column[r]));
+      column.swap(out);
+    });
+  });
+  const auto run = [&](std::size_t count, std::size_t grain, const auto& body) {
+    if (ex)
+      ex->for_each_chunk(count, grain, body);
+    else
+      body(0, count);
   };
-  each_column(t, gather);
-  for (std::size_t r = 0; r < n; ++r)
-    slots_[AgentId::from_value(t.id[r]).index].row = static_cast<uint32_t>(r);
+  run(gather.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c) gather[c]();
+  });
+  run(n, kPermuteGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t r = b; r < e; ++r)
+      slots_[AgentId::from_value(t.id[r]).index].row = static_cast<uint32_t>(r);
+  });
 }
 
 void World::remove_rows(std::vector<std::size_t> rows) {
