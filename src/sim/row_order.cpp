@@ -8,7 +8,7 @@
 namespace crowddb::sim {
 namespace {
 
-constexpr std::size_t kGrain = 16384;           // rows per chunk of the passes over the table
+constexpr std::size_t kOrderGrain = 16384;      // rows per chunk of the passes over the table
 constexpr std::size_t kParallelSort = 1 << 15;  // from this many rows, sorted in kPieces pieces
 constexpr std::size_t kPieces = 8;
 
@@ -39,16 +39,16 @@ std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
       body(0, count);
   };
   // The lowest corner: a minimum per chunk, then over the chunks (exact, so any split).
-  const std::size_t chunks = (n + kGrain - 1) / kGrain;
+  const std::size_t chunks = (n + kOrderGrain - 1) / kOrderGrain;
   std::vector<double> cx(chunks, INFINITY), cy(chunks, INFINITY);
-  run(n, kGrain, [&](std::size_t b, std::size_t e) {
+  run(n, kOrderGrain, [&](std::size_t b, std::size_t e) {
     double xlo = INFINITY, ylo = INFINITY;
     for (std::size_t i = b; i < e; ++i) {
       xlo = std::min(xlo, t.x[i]);
       ylo = std::min(ylo, t.y[i]);
     }
-    cx[b / kGrain] = xlo;
-    cy[b / kGrain] = ylo;
+    cx[b / kOrderGrain] = xlo;
+    cy[b / kOrderGrain] = ylo;
   });
   double xlo = INFINITY, ylo = INFINITY;
   for (std::size_t c = 0; c < chunks; ++c) {
@@ -60,7 +60,7 @@ std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
     uint32_t row;
   };
   std::vector<Entry> e(n);
-  run(n, kGrain, [&](std::size_t b, std::size_t end) {
+  run(n, kOrderGrain, [&](std::size_t b, std::size_t end) {
     for (std::size_t i = b; i < end; ++i)
       e[i] = {spread(cell(t.x[i], xlo)) | (spread(cell(t.y[i], ylo)) << 1), t.id[i],
               static_cast<uint32_t>(i)};
@@ -89,7 +89,7 @@ std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
     });
   }
   std::vector<uint32_t> order(n);
-  run(n, kGrain, [&](std::size_t b, std::size_t end) {
+  run(n, kOrderGrain, [&](std::size_t b, std::size_t end) {
     for (std::size_t i = b; i < end; ++i) order[i] = e[i].row;
   });
   return order;
