@@ -469,9 +469,10 @@ const TickMetrics& Simulation::step() {
   if (reorders(cfg, world_.agents().size()) &&
       (m.tick - 1) % cfg.ticks_for(sim::kReorderInterval) == 0)
     log.timed("reorder rows", world_.agents().size(), [&] {
-      const std::vector<uint32_t> order = sim::curve_order(world_.agents(), &e.ex);
-      world_.permute_rows(order, &e.ex);
-      e.model->rows_permuted(order, &e.ex);
+      Executor* const ex = world_.agents().size() >= sim::kParallelReorder ? &e.ex : nullptr;
+      const std::vector<uint32_t> order = sim::curve_order(world_.agents(), ex);
+      world_.permute_rows(order, ex);
+      e.model->rows_permuted(order, ex);
     });
   e.refresh_scene(world_, cfg);
   const TickPlan plan = e.plan(world_, cfg);
