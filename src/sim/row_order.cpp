@@ -32,6 +32,7 @@ uint32_t cell(double v, double lo) {
 
 std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
   const std::size_t n = t.size();
+  if (n == 0) return {};
   const auto run = [&](std::size_t count, std::size_t grain, const auto& body) {
     if (ex)
       ex->for_each_chunk(count, grain, body);

@@ -177,6 +177,14 @@ TEST(RowOrder, CurveOrderFollowsTheZCurveThenTheId) {
 // same order and the same table as on the calling thread alone, for a table large enough for
 // the pieces (70,000 agents, many sharing their 1 m cell, so ties by id decide).
 TEST(RowOrder, CurveOrderAndPermutationAreTheSameOnAnyThreadCount) {
+  // An empty table (everyone arrived and removed) on the calling thread and on an executor.
+  World empty(Bounds{0, 0, 10, 10});
+  Executor two(2);
+  EXPECT_TRUE(sim::curve_order(empty.agents()).empty());
+  EXPECT_TRUE(sim::curve_order(empty.agents(), &two).empty());
+  empty.permute_rows({});
+  empty.permute_rows({}, &two);
+  EXPECT_EQ(empty.agents().size(), 0u);
   World base(Bounds{0, 0, 120, 90});
   base.add_goal({"g", 60, 45, 1, 1, {}});
   std::mt19937 rng(5);
