@@ -398,6 +398,20 @@ std::unique_ptr<NavMesh> NavMesh::build(const NavGeometry& g, const NavMeshParam
 
 namespace {
 
+// Calls fn(tile, polygon, ref) for every ground polygon of the mesh, in mesh order.
+template <class F>
+void for_each_ground_polygon(const dtNavMesh& m, F&& fn) {
+  for (int i = 0; i < m.getMaxTiles(); ++i) {
+    const dtMeshTile* t = m.getTile(i);
+    if (!t || !t->header) continue;
+    const dtPolyRef base = m.getPolyRefBase(t);
+    for (int k = 0; k < t->header->polyCount; ++k) {
+      const dtPoly& p = t->polys[k];
+      if (p.getType() == DT_POLYTYPE_GROUND) fn(*t, p, base | static_cast<dtPolyRef>(k));
+    }
+  }
+}
+
 // [m] How far inside its polygon a point must lie for the grid's answer: the float rounding of
 // local coordinates (below 10^-3 m up to 10 km from the mesh's corner) many times over.
 double inside_margin(const float* p) {
@@ -438,29 +452,21 @@ void NavMesh::build_poly_grid() {
   };
   std::vector<Box> boxes;
   float x0 = FLT_MAX, z0 = FLT_MAX, x1 = -FLT_MAX, z1 = -FLT_MAX;
-  const dtNavMesh& m = *mesh_;
-  for (int i = 0; i < m.getMaxTiles(); ++i) {
-    const dtMeshTile* t = m.getTile(i);
-    if (!t || !t->header) continue;
-    const dtPolyRef base = m.getPolyRefBase(t);
-    for (int k = 0; k < t->header->polyCount; ++k) {
-      const dtPoly& p = t->polys[k];
-      if (p.getType() != DT_POLYTYPE_GROUND) continue;
-      Box b{FLT_MAX, FLT_MAX, -FLT_MAX, -FLT_MAX, base | static_cast<dtPolyRef>(k)};
-      for (int v = 0; v < p.vertCount; ++v) {
-        const float* q = &t->verts[p.verts[v] * 3];
-        b.x0 = std::min(b.x0, q[0]);
-        b.z0 = std::min(b.z0, q[2]);
-        b.x1 = std::max(b.x1, q[0]);
-        b.z1 = std::max(b.z1, q[2]);
-      }
-      x0 = std::min(x0, b.x0);
-      z0 = std::min(z0, b.z0);
-      x1 = std::max(x1, b.x1);
-      z1 = std::max(z1, b.z1);
-      boxes.push_back(b);
+  for_each_ground_polygon(*mesh_, [&](const dtMeshTile& t, const dtPoly& p, dtPolyRef ref) {
+    Box b{FLT_MAX, FLT_MAX, -FLT_MAX, -FLT_MAX, ref};
+    for (int v = 0; v < p.vertCount; ++v) {
+      const float* q = &t.verts[p.verts[v] * 3];
+      b.x0 = std::min(b.x0, q[0]);
+      b.z0 = std::min(b.z0, q[2]);
+      b.x1 = std::max(b.x1, q[0]);
+      b.z1 = std::max(b.z1, q[2]);
     }
-  }
+    x0 = std::min(x0, b.x0);
+    z0 = std::min(z0, b.z0);
+    x1 = std::max(x1, b.x1);
+    z1 = std::max(z1, b.z1);
+    boxes.push_back(b);
+  });
   grid_ = {};
   if (boxes.empty()) return;
   // About one polygon per cell.
@@ -561,9 +567,14 @@ NavMesh::Located NavMesh::locate_inside(Vec2 p) const {
 }
 
 unsigned int NavMesh::locate(const dtNavMeshQuery& q, const float* p, float* snapped) const {
+  // The grid's answer holds for every square below (they share the vertical extent); Detour's
+  // search only if it has none.
+  const float column[3] = {0, 2 * kFloorAbove, 0};
+  if (const unsigned int ref = inside_poly(q, p, column, snapped)) return ref;
   for (float reach = reach_; reach <= reach_ * 16; reach *= 4) {
     const float ext[3] = {reach, 2 * kFloorAbove, reach};
-    if (const unsigned int ref = nearest_poly(q, p, ext, snapped)) return ref;
+    dtPolyRef ref = 0;
+    if (dtStatusSucceed(q.findNearestPoly(p, ext, filter_.get(), &ref, snapped)) && ref) return ref;
   }
   return 0;
 }
@@ -588,18 +599,11 @@ bool NavMesh::visible(Vec2 from, Vec2 to) const {
 
 std::vector<std::vector<Vec2>> NavMesh::polygons() const {
   std::vector<std::vector<Vec2>> out;
-  const dtNavMesh& m = *mesh_;
-  for (int i = 0; i < m.getMaxTiles(); ++i) {
-    const dtMeshTile* t = m.getTile(i);
-    if (!t || !t->header) continue;
-    for (int k = 0; k < t->header->polyCount; ++k) {
-      const dtPoly& p = t->polys[k];
-      if (p.getType() != DT_POLYTYPE_GROUND) continue;
-      std::vector<Vec2> ring;
-      for (int v = 0; v < p.vertCount; ++v) ring.push_back(world(&t->verts[p.verts[v] * 3]));
-      out.push_back(std::move(ring));
-    }
-  }
+  for_each_ground_polygon(*mesh_, [&](const dtMeshTile& t, const dtPoly& p, dtPolyRef) {
+    std::vector<Vec2> ring;
+    for (int v = 0; v < p.vertCount; ++v) ring.push_back(world(&t.verts[p.verts[v] * 3]));
+    out.push_back(std::move(ring));
+  });
   return out;
 }
 
@@ -613,23 +617,15 @@ bool NavMesh::valid_polygon(uint32_t ref) const {
 
 std::vector<MeshPortal> NavMesh::portals() const {
   std::vector<MeshPortal> out;
-  const dtNavMesh& m = *mesh_;
-  for (int i = 0; i < m.getMaxTiles(); ++i) {
-    const dtMeshTile* t = m.getTile(i);
-    if (!t || !t->header) continue;
-    const dtPolyRef base = m.getPolyRefBase(t);
-    for (int k = 0; k < t->header->polyCount; ++k) {
-      const dtPoly& p = t->polys[k];
-      if (p.getType() != DT_POLYTYPE_GROUND) continue;
-      for (unsigned int l = p.firstLink; l != DT_NULL_LINK; l = t->links[l].next) {
-        const dtLink& link = t->links[l];
-        if (!link.ref) continue;
-        float a[3], b[3];
-        link_portal(*t, p, link, a, b);
-        out.push_back({base | static_cast<dtPolyRef>(k), link.ref, world(a), world(b)});
-      }
+  for_each_ground_polygon(*mesh_, [&](const dtMeshTile& t, const dtPoly& p, dtPolyRef ref) {
+    for (unsigned int l = p.firstLink; l != DT_NULL_LINK; l = t.links[l].next) {
+      const dtLink& link = t.links[l];
+      if (!link.ref) continue;
+      float a[3], b[3];
+      link_portal(t, p, link, a, b);
+      out.push_back({ref, link.ref, world(a), world(b)});
     }
-  }
+  });
   return out;
 }
 

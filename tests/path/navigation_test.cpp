@@ -260,13 +260,17 @@ TEST(Navigation, AGoalDownANarrowAisleIsReachedThroughItsEntrance) {
   EXPECT_EQ(walk_alone(std::move(w), 10, 1, 0.21, 600).arrived, 1u);  // 60 s
 }
 
-// The number N of "N searched round congestion" in EXPLAIN ANALYZE.
-uint64_t costed_searches(const Simulation& sim) {
-  const std::string a = sim.explain_analyze(), key = " searched round congestion";
+// The number N of "N<key>" in EXPLAIN ANALYZE (0 when the key is not there).
+uint64_t explain_count(const Simulation& sim, const std::string& key) {
+  const std::string a = sim.explain_analyze();
   const std::size_t at = a.find(key);
   if (at == std::string::npos) return 0;
   const std::size_t from = a.rfind(' ', at - 1) + 1;
   return std::stoull(a.substr(from, at - from));
+}
+
+uint64_t costed_searches(const Simulation& sim) {
+  return explain_count(sim, " searched round congestion");
 }
 
 // tests/data/passage.json: two groups of 30 meet in a 1.2 m passage between two stands, with
@@ -344,11 +348,7 @@ TEST(Navigation, AQueueAtTheNearDoorSendsTheNextOneToTheOther) {
 }
 
 uint64_t door_costed_searches(const Simulation& sim) {
-  const std::string a = sim.explain_analyze(), key = " of them with a queue at a door";
-  const std::size_t at = a.find(key);
-  if (at == std::string::npos) return 0;
-  const std::size_t from = a.rfind(' ', at - 1) + 1;
-  return std::stoull(a.substr(from, at - from));
+  return explain_count(sim, " of them with a queue at a door");
 }
 
 // The door searches of one tick run on every thread (request_paths): a room of 240 emptying
