@@ -86,6 +86,36 @@ TEST(HalfPlaneLp, FeasibleProgramsMatchTheBruteForceOptimum) {
   EXPECT_LT(feasible, 3800);
 }
 
+// Normals from eight compass directions only: many lines parallel or opposite (a line lying
+// outside a parallel plane has no room at all), as duplicated or mirrored planes give in a crowd.
+TEST(HalfPlaneLp, ProgramsWithParallelLinesMatchTheBruteForceOptimum) {
+  Rng rng(29);
+  int feasible = 0, infeasible = 0;
+  for (int c = 0; c < 4000; ++c) {
+    const double R = rng.uniform(0.5, 3);
+    std::vector<HalfPlane> p;
+    const std::size_t m = 2 + rng.below(8);
+    for (std::size_t i = 0; i < m; ++i) {
+      const double a = static_cast<double>(rng.below(8)) * std::numbers::pi / 4;
+      p.push_back({rng.uniform(-R, R), rng.uniform(-R, R), std::cos(a), std::sin(a)});
+    }
+    const double px = rng.uniform(-2 * R, 2 * R), py = rng.uniform(-2 * R, 2 * R);
+    const Oracle o = brute_force(p, R, px, py);
+    const LpResult r = solve_velocity_lp(p, 0, R, px, py);
+    ASSERT_EQ(r.feasible, o.feasible) << "case " << c;
+    if (!o.feasible) {
+      ++infeasible;
+      continue;
+    }
+    ++feasible;
+    for (const HalfPlane& h : p) EXPECT_LE(violation(h, r.vx, r.vy), 1e-9) << "case " << c;
+    EXPECT_NEAR(r.vx, o.x, 1e-7) << "case " << c;
+    EXPECT_NEAR(r.vy, o.y, 1e-7) << "case " << c;
+  }
+  EXPECT_GT(feasible, 1000);
+  EXPECT_GT(infeasible, 1000);
+}
+
 // Infeasible programs: the hard planes hold, and the largest violation of the soft ones is
 // no worse than the best a fine search of the disc finds (the 3-D program's optimum).
 TEST(HalfPlaneLp, InfeasibleProgramsKeepTheHardPlanesAndMinimiseTheWorstViolation) {
