@@ -654,7 +654,8 @@ NavMesh::Context::~Context() {
 }
 
 std::optional<DoorCut> NavMesh::first_narrows(const std::vector<Vec2>& path, double look,
-                                              double max_width, Context* ctx) const {
+                                              double max_width, Context* ctx, bool every_sample,
+                                              std::vector<Sample>* trace) const {
   const dtNavMeshQuery& query = ctx ? *ctx->query_ : *shared_query_;
   const double reach = max_width - 2 * clearance();
   if (!(reach > 0) || path.size() < 2) return std::nullopt;
@@ -662,6 +663,15 @@ std::optional<DoorCut> NavMesh::first_narrows(const std::vector<Vec2>& path, dou
   std::optional<DoorCut> best;
   double best_width = INFINITY;
   double walked = 0;
+  // Samples that cannot be narrow are skipped: the distance to the nearest wall (capped at
+  // `reach`) is 1-Lipschitz, so from a sample whose nearest wall lies d > reach / 2 away, every
+  // point within d - reach / 2 of it has its nearest wall farther than reach / 2 too. Only a
+  // complete search sets this window (one cut short by the node pool may have missed a wall);
+  // the margin covers Detour's float arithmetic. A sample inside it is not narrow, as its own
+  // search would have said, so the answer is the same.
+  Vec2 open_at{};
+  double open_for = 0;          // the window's radius around open_at (0: none)
+  Sample kind = Sample::other;  // what across() made of the sample (for `trace`)
   // The way across the mesh at p, walking along (dx, dy), when narrow: across the walk's
   // direction (a path along a wall runs on the mesh's edge, where the nearest wall's direction is
   // not known), or straight away from the nearest wall (a path crossing a door at a slant).
@@ -671,6 +681,10 @@ std::optional<DoorCut> NavMesh::first_narrows(const std::vector<Vec2>& path, dou
     const dtPolyRef ref = locate(query, a, s);
     if (!ref) return std::nullopt;
     const Vec2 from = world(s);
+    if (std::hypot(from.x - open_at.x, from.y - open_at.y) < open_for) {
+      kind = Sample::skipped;
+      return std::nullopt;
+    }
     // How far from `from` along (ux, uy) the mesh reaches, up to `len`; infinite beyond.
     const auto ray = [&](double ux, double uy, double len) {
       const float e[3] = {lx(from.x + ux * len), s[1], ly(from.y + uy * len)};
@@ -681,10 +695,17 @@ std::optional<DoorCut> NavMesh::first_narrows(const std::vector<Vec2>& path, dou
       return static_cast<double>(h.t) * len;
     };
     float d = 0, hit[3], normal[3];
-    if (dtStatusFailed(query.findDistanceToWall(ref, s, static_cast<float>(reach), filter_.get(),
-                                                &d, hit, normal)) ||
-        !(2 * d <= reach))
-      return std::nullopt;  // every way across is at least twice as long as to the nearest wall
+    const dtStatus found =
+        query.findDistanceToWall(ref, s, static_cast<float>(reach), filter_.get(), &d, hit, normal);
+    if (dtStatusFailed(found)) return std::nullopt;
+    if (!(2 * d <= reach)) {  // every way across is at least twice as long as to the nearest wall
+      kind = Sample::open;
+      if (!(found & DT_OUT_OF_NODES) && !every_sample) {
+        open_at = from;
+        open_for = d - reach / 2 - (1e-3 + 4e-7 * (std::abs(s[0]) + std::abs(s[2]) + reach));
+      }
+      return std::nullopt;
+    }
     std::optional<DoorCut> narrow;
     double width = INFINITY;
     const double l1 = ray(-dy, dx, reach), l2 = ray(dy, -dx, reach);
@@ -709,7 +730,9 @@ std::optional<DoorCut> NavMesh::first_narrows(const std::vector<Vec2>& path, dou
     const double len = std::hypot(v.x - u.x, v.y - u.y);
     for (double at = step; at < len && walked + at <= look; at += step) {
       const Vec2 p{u.x + (v.x - u.x) * at / len, u.y + (v.y - u.y) * at / len};
+      kind = Sample::other;
       const std::optional<DoorCut> cut = across(p, (v.x - u.x) / len, (v.y - u.y) / len);
+      if (trace) trace->push_back(cut ? Sample::narrow : kind);
       if (!cut) {
         if (best) return best;  // the end of the first narrow run
         continue;

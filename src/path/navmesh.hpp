@@ -155,10 +155,15 @@ class NavMesh {
   // `max_width`. Of the first run of narrow samples, the narrowest way: a door's
   // cut from post to post. None when no sample is narrow. DoorCut::cost is 0.
   // `ctx`: a context of the caller's own (one per thread: distance to walls uses Detour's
-  // node pool); none: the mesh's own, for one thread at a time.
+  // node pool); none: the mesh's own, for one thread at a time. A sample near an open one (whose
+  // nearest wall lies farther than max_width / 2 minus the clearance) is skipped when no wall can
+  // be near enough there to make it narrow; `every_sample`: none is (the twin the tests compare
+  // with). `trace`: what became of each sample, in order (for tests).
   class Context;
+  enum class Sample : uint8_t { skipped, open, other, narrow };
   std::optional<DoorCut> first_narrows(const std::vector<Vec2>& path, double look, double max_width,
-                                       Context* ctx = nullptr) const;
+                                       Context* ctx = nullptr, bool every_sample = false,
+                                       std::vector<Sample>* trace = nullptr) const;
   // Line of sight for a disc of the mesh's radius: from the mesh point nearest `from` to `to`
   // without leaving the walkable polygons. False when `from` is off the mesh.
   bool visible(Vec2 from, Vec2 to) const;
