@@ -421,42 +421,55 @@ double inside_margin(const float* p) {
   return 1e-3 * std::max(1.0, (std::fabs(double{p[0]}) + std::fabs(double{p[2]})) / 1000.0);
 }
 
+}  // namespace
+
 // Is (x, z) inside the polygon by at least `margin` from the line of every edge? (Then it lies
-// in the polygon's kernel, at least `margin` from its boundary.) Either winding; edges of length
-// 0 are skipped (their ends are the neighbouring edges' ends).
-bool inside_by(const dtMeshTile& t, const dtPoly& poly, double x, double z, double margin) {
-  const int n = poly.vertCount;
-  double area2 = 0;
-  for (int i = 0, j = n - 1; i < n; j = i++) {
-    const float* a = &t.verts[poly.verts[j] * 3];
-    const float* b = &t.verts[poly.verts[i] * 3];
-    area2 += double{a[0]} * b[2] - double{b[0]} * a[2];
-  }
-  if (!(area2 != 0)) return false;
-  const double side = area2 > 0 ? 1 : -1;
-  for (int i = 0, j = n - 1; i < n; j = i++) {
-    const float* a = &t.verts[poly.verts[j] * 3];
-    const float* b = &t.verts[poly.verts[i] * 3];
-    const double ex = double{b[0]} - a[0], ez = double{b[2]} - a[2];
-    const double len = std::sqrt(ex * ex + ez * ez);
-    if (len == 0) continue;
-    const double cross = ex * (z - a[2]) - ez * (x - a[0]);
-    if (!(side * cross >= margin * len)) return false;
-  }
+// in the polygon's kernel, at least `margin` from its boundary.) Either winding (the edges carry
+// its sign); edges of length 0 were left out (their ends are the neighbouring edges' ends).
+bool NavMesh::inside_by(const PolyGrid::Edge* e, uint32_t count, double x, double z,
+                        double margin) {
+  if (count == 0) return false;
+  for (uint32_t i = 0; i < count; ++i)
+    if (!(e[i].ex * (z - e[i].az) - e[i].ez * (x - e[i].ax) >= margin * e[i].len)) return false;
   return true;
 }
-
-}  // namespace
 
 void NavMesh::build_poly_grid() {
   struct Box {
     float x0, z0, x1, z1;
-    uint32_t ref;
+    uint32_t poly;  // its index in grid_.poly
   };
   std::vector<Box> boxes;
   float x0 = FLT_MAX, z0 = FLT_MAX, x1 = -FLT_MAX, z1 = -FLT_MAX;
+  grid_ = {};
+  PolyGrid& g = grid_;
   for_each_ground_polygon(*mesh_, [&](const dtMeshTile& t, const dtPoly& p, dtPolyRef ref) {
-    Box b{FLT_MAX, FLT_MAX, -FLT_MAX, -FLT_MAX, ref};
+    // Its edges for inside_by: the winding's sign (twice the signed area, from the float
+    // vertices in double), then each edge's start, direction times that sign, and length.
+    const int n = p.vertCount;
+    double area2 = 0;
+    for (int i = 0, j = n - 1; i < n; j = i++) {
+      const float* a = &t.verts[p.verts[j] * 3];
+      const float* c = &t.verts[p.verts[i] * 3];
+      area2 += double{a[0]} * c[2] - double{c[0]} * a[2];
+    }
+    const auto first = static_cast<uint32_t>(g.edges.size());
+    if (area2 != 0) {
+      const double side = area2 > 0 ? 1 : -1;
+      for (int i = 0, j = n - 1; i < n; j = i++) {
+        const float* a = &t.verts[p.verts[j] * 3];
+        const float* c = &t.verts[p.verts[i] * 3];
+        const double ex = double{c[0]} - a[0], ez = double{c[2]} - a[2];
+        const double len = std::sqrt(ex * ex + ez * ez);
+        if (len == 0) continue;
+        // (side * (ex * dz - ez * dx) == (side * ex) * dz - (side * ez) * dx bit for bit: the
+        // sign changes no rounding.)
+        g.edges.push_back({a[0], a[2], side * ex, side * ez, len});
+      }
+    }
+    const auto index = static_cast<uint32_t>(g.poly.size());
+    g.poly.push_back({ref, first, static_cast<uint32_t>(g.edges.size()) - first});
+    Box b{FLT_MAX, FLT_MAX, -FLT_MAX, -FLT_MAX, index};
     for (int v = 0; v < p.vertCount; ++v) {
       const float* q = &t.verts[p.verts[v] * 3];
       b.x0 = std::min(b.x0, q[0]);
@@ -470,12 +483,10 @@ void NavMesh::build_poly_grid() {
     z1 = std::max(z1, b.z1);
     boxes.push_back(b);
   });
-  grid_ = {};
   if (boxes.empty()) return;
   // About one polygon per cell.
   const double w = std::max(double{x1} - x0, 1e-3), h = std::max(double{z1} - z0, 1e-3);
   const double cell = std::sqrt(w * h / static_cast<double>(boxes.size()));
-  PolyGrid& g = grid_;
   g.x0 = x0;
   g.z0 = z0;
   g.cell = static_cast<float>(cell);
@@ -494,12 +505,12 @@ void NavMesh::build_poly_grid() {
       for (int x = cx(b.x0); x <= cx(b.x1); ++x)
         ++g.start[static_cast<std::size_t>(z) * g.w + x + 1];
   for (std::size_t c = 1; c < g.start.size(); ++c) g.start[c] += g.start[c - 1];
-  g.refs.resize(g.start.back());
+  g.polys.resize(g.start.back());
   std::vector<uint32_t> fill(g.start.begin(), g.start.end() - 1);
   for (const Box& b : boxes)
     for (int z = cz(b.z0); z <= cz(b.z1); ++z)
       for (int x = cx(b.x0); x <= cx(b.x1); ++x)
-        g.refs[fill[static_cast<std::size_t>(z) * g.w + x]++] = b.ref;
+        g.polys[fill[static_cast<std::size_t>(z) * g.w + x]++] = b.poly;
 }
 
 unsigned int NavMesh::inside_poly(const dtNavMeshQuery& q, const float* p, const float* ext,
@@ -516,11 +527,12 @@ unsigned int NavMesh::inside_poly(const dtNavMeshQuery& q, const float* p, const
   const std::size_t c = static_cast<std::size_t>(z) * g.w + x;
   const double margin = inside_margin(p);
   for (uint32_t k = g.start[c]; k < g.start[c + 1]; ++k) {
-    const dtPolyRef ref = g.refs[k];
+    const PolyGrid::Poly& candidate = g.poly[g.polys[k]];
+    if (!inside_by(g.edges.data() + candidate.first, candidate.count, p[0], p[2], margin)) continue;
+    const dtPolyRef ref = candidate.ref;
     const dtMeshTile* tile = nullptr;
     const dtPoly* poly = nullptr;
     mesh_->getTileAndPolyByRefUnsafe(ref, &tile, &poly);
-    if (!inside_by(*tile, *poly, p[0], p[2], margin)) continue;
     // Detour's own terms for this polygon: the filter, the point over it and its distance.
     // (dtQueryFilter::passFilter is Detour's inline, not exported: the same test.)
     if (!((poly->flags & filter_->getIncludeFlags()) != 0 &&

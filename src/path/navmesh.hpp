@@ -216,9 +216,21 @@ class NavMesh {
   struct PolyGrid {
     float x0 = 0, z0 = 0, cell = 1, inv_cell = 1;
     int w = 0, h = 0;
-    std::vector<uint32_t> start, refs;
+    std::vector<uint32_t> start, polys;  // cell c lists polys[start[c], start[c + 1])
+    // Per polygon its ref and edges; per edge (mesh-local x, z) its start and its direction
+    // times the winding's sign (+-1: the inside is on the left either way), and its length.
+    struct Edge {
+      double ax, az, ex, ez, len;
+    };
+    struct Poly {
+      uint32_t ref, first, count;  // count 0: no area (nothing lies inside it)
+    };
+    std::vector<Poly> poly;
+    std::vector<Edge> edges;
   };
   PolyGrid grid_;
+  // Is (x, z) inside the polygon of edges e[0, count) by at least `margin`?
+  static bool inside_by(const PolyGrid::Edge* e, uint32_t count, double x, double z, double margin);
 };
 
 // A query context over one mesh for first_narrows on several threads (one each): the same
