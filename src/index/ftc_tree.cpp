@@ -129,8 +129,7 @@ typedef int64_t V2m __attribute__((vector_size(16)));
 // slice_bound with the x and the y edges side by side in the lanes of a vector: the same
 // operations on the same operands, so the same bound bit for bit, without a branch per edge
 // (whether an edge is within reach is a coin toss to the predictor). The lanes of `lo`: edges
-// 0 and 2 (the box's low sides), of `hi`: edges 1 and 3. (Every value is finite: no NaN takes the
-// other side of a comparison.)
+// 0 and 2 (the box's low sides), of `hi`: edges 1 and 3.
 inline double slice_bound_lanes(const Slice& b, double qx, double qy, const Probe& q, double R,
                                 double t0, double span) {
   V2d lo, hi, slo, shi;
@@ -149,7 +148,9 @@ inline double slice_bound_lanes(const Slice& b, double qx, double qy, const Prob
   if (bad[0] | bad[1]) return INFINITY;
   const V2d zero = {0, 0};
   const V2d tl = out_l ? (pl - R) / -vl : zero, th = out_h ? (ph - R) / -vh : zero;
-  const double t = std::max(std::max(tl[0], tl[1]), std::max(th[0], th[1]));
+  // In edge order from 0, as slice_bound takes it (a NaN quotient, of infinities, is passed
+  // over the same way; a lane within reach holds 0, which changes nothing).
+  const double t = std::max(std::max(std::max(std::max(0.0, tl[0]), th[0]), tl[1]), th[1]);
   const V2m leave =
       ((pl <= R) & (vl > 0) & (pl + vl * t > R)) | ((ph <= R) & (vh > 0) & (ph + vh * t > R));
   return !(leave[0] | leave[1]) && t <= span ? t0 + t : INFINITY;
@@ -952,8 +953,9 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, ProbeScratch& sc, Count
                  ey1 = ay + std::fmax(0.0, avy * horizon) + ar;
     if (ex1 < bx.xmin || ex0 > bx.xmax || ey1 < bx.ymin || ey0 > bx.ymax) continue;
     const double cap = best.kind == Kind::none ? horizon : std::min(horizon, best.t);
-    static const Frame static_frame{0, 0, {0.0, INFINITY}, false, 0, 0};
-    const double b = node_bound(&polygon_boxes[p], 1, static_frame, q, ar, cap);
+    static const Frame static_frames[2] = {{0, 0, {0.0, INFINITY}, false, 0, 0, false},
+                                           {0, 0, {0.0, INFINITY}, false, 0, 0, true}};
+    const double b = node_bound(&polygon_boxes[p], 1, static_frames[opt.lane_bounds], q, ar, cap);
     if (b == INFINITY || best.beats(b, Kind::polygon, p)) continue;
     ++c.pair_tests;
     best.offer(ray_polygon_time(polys[p].vertices, ax, ay, avx, avy, ar, horizon), Kind::polygon, p,
