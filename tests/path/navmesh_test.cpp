@@ -465,7 +465,7 @@ TEST(NavMesh, FirstNarrowsSkipsOnlySamplesThatCannotBeNarrow) {
         const auto naive = mesh->first_narrows(way, look, width, nullptr, true, &naive_trace);
         ASSERT_EQ(fast.has_value(), naive.has_value()) << "world " << world << " query " << q;
         // A sample skipped is one its own search finds open; the others are searched alike.
-        ASSERT_LE(fast_trace.size(), naive_trace.size());
+        ASSERT_EQ(fast_trace.size(), naive_trace.size());
         for (std::size_t k = 0; k < fast_trace.size(); ++k) {
           const bool skipped = fast_trace[k] == NavMesh::Sample::skipped;
           ASSERT_EQ(skipped ? NavMesh::Sample::open : fast_trace[k], naive_trace[k])
@@ -501,7 +501,7 @@ TEST(NavMesh, FirstNarrowsSkipsOnlySamplesThatCannotBeNarrow) {
 TEST(PathFinder, CostedSearchAgreesWithDijkstraOverEveryPortal) {
   Rng rng(20261129);
   int compared = 0, detours = 0, kept = 0;
-  for (int world = 0; world < 12; ++world) {
+  for (int world = 0; world < 8; ++world) {
     NavGeometry g{{0, 0, 40, 30}, {}, {}};
     for (int k = 0; k < 6; ++k) {
       const double x = rng.uniform(4, 34), y = rng.uniform(4, 24);
