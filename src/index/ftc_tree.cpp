@@ -7,7 +7,9 @@
 #include <limits>
 #include <mutex>
 #include <numeric>
+#include <type_traits>
 #include <vector>
+#include <xsimd/xsimd.hpp>
 
 #include "crowddb/error.hpp"
 #include "query/ftc_geometry.hpp"
@@ -30,7 +32,7 @@ struct Frame {
   std::vector<double> knots;  // chord: 0 = t_0 < ... < t_K = horizon; frustum: {0, +inf}
   bool chord = true;
   double delta0 = 0, delta1 = 0;  // every node box is inflated by delta0 + delta1 * t
-  bool lanes = true;              // slice_bound_lanes (else the scalar reference, slice_bound)
+  bool lanes = true;  // slice_bound_lanes and lanes_pair_times (else the scalar references)
   int slices() const { return static_cast<int>(knots.size()) - 1; }
 };
 
@@ -197,6 +199,51 @@ struct Member {
   uint64_t key;
   uint32_t row;
 };
+
+// An agent leaf's pair times several at a time (lanes_scan below), up to this many members;
+// larger leaves (leaf_size is an option) are scanned one by one.
+constexpr uint32_t kLaneLeaf = 64;
+
+// ray_disc_time of the query against members m[0, n), several at a time in the lanes of xsimd's
+// batches: every case computed in every lane, then selected; the same operations on the same
+// operands as AgentSource::time, lane by lane (IEEE square roots and divisions; -ffp-contract=off
+// keeps products and sums apart), so the same bits. Which case a pair falls in is a coin toss to
+// the predictor: receding, missing, hitting.
+void lanes_pair_times(const Member* m, uint32_t n, const Probe& q, double horizon, double* out) {
+  using B = xsimd::batch<double>;
+  constexpr uint32_t L = B::size;
+  const B ax(q.ax), ay(q.ay), avx(q.avx), avy(q.avy), ar(q.ar), hz(horizon), zero(0.0),
+      inf(INFINITY);
+  uint32_t k = 0;
+  for (; k + L <= n; k += L) {
+    alignas(64) double x[L], y[L], vx[L], vy[L], r[L];
+    for (uint32_t l = 0; l < L; ++l) {
+      const Member& u = m[k + l];
+      x[l] = u.x;
+      y[l] = u.y;
+      vx[l] = u.vx;
+      vy[l] = u.vy;
+      r[l] = u.r;
+    }
+    const B dx = B::load_aligned(x) - ax, dy = B::load_aligned(y) - ay;
+    const B wx = B::load_aligned(vx) - avx, wy = B::load_aligned(vy) - avy;
+    const B R = ar + B::load_aligned(r);
+    const B c = dx * dx + dy * dy - R * R;
+    const B b = dx * wx + dy * wy;
+    const B a = wx * wx + wy * wy;
+    const B cross = dx * wy - dy * wx;
+    const B disc = a * (R * R) - cross * cross;
+    const B t = c / (-b + xsimd::sqrt(disc));
+    B time = xsimd::select(t <= hz, t, inf);
+    time = xsimd::select(disc > zero, time, inf);
+    time = xsimd::select(b < zero, time, inf);
+    time = xsimd::select(c < zero, zero, time);
+    time.store_unaligned(out + k);
+  }
+  for (; k < n; ++k)  // the tail, one at a time
+    out[k] = ray_disc_time(m[k].x - q.ax, m[k].y - q.ay, m[k].vx - q.avx, m[k].vy - q.avy,
+                           q.ar + m[k].r, horizon);
+}
 
 struct ProbeScratch {
   std::vector<Entry> heap;
@@ -561,6 +608,23 @@ template <bool OverlapOnly>
 void KineticTree<Src>::scan(uint32_t node, const Probe& q, double horizon, Best& best,
                             Counters& c) const {
   const TreeNode& nd = nodes_[node];
+  if constexpr (!OverlapOnly && std::is_same_v<Src, AgentSource>) {
+    // The pair times first, all of the leaf's in lanes (those after a break are wasted work,
+    // not a different answer), then offered in key order as below.
+    const uint32_t n = nd.end - nd.begin;
+    if (f_->lanes && n <= kLaneLeaf) {
+      double times[kLaneLeaf];
+      lanes_pair_times(&items_[nd.begin], n, q, horizon, times);
+      for (uint32_t k = 0; k < n; ++k) {
+        const Member& m = items_[nd.begin + k];
+        if (best.beats(0, Src::kind, m.key)) break;
+        if (m.row == q.self) continue;
+        ++c.pair_tests;
+        best.offer(times[k], Src::kind, m.key, m.row);
+      }
+      return;
+    }
+  }
   for (uint32_t i = nd.begin; i < nd.end; ++i) {
     const Member& m = items_[i];
     // Leaves are sorted by key: once the answer beats (t = 0, key), it beats the rest too.
@@ -895,7 +959,7 @@ void FtcIndex::Impl::make_frame() {
   const double vmax = 2 * v;
   f.delta0 = kSlack * m0;
   f.delta1 = kSlack * vmax;
-  f.lanes = opt.lane_bounds;
+  f.lanes = opt.lanes;
   const int K = std::max(opt.slices, 1);
   f.chord = opt.bound == FtcIndexOptions::Bound::chord && horizon > 0 && std::isfinite(horizon) &&
             std::isfinite(m0 + vmax * horizon) && m0 + vmax * horizon < 1e300;
@@ -955,7 +1019,7 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, ProbeScratch& sc, Count
     const double cap = best.kind == Kind::none ? horizon : std::min(horizon, best.t);
     static const Frame static_frames[2] = {{0, 0, {0.0, INFINITY}, false, 0, 0, false},
                                            {0, 0, {0.0, INFINITY}, false, 0, 0, true}};
-    const double b = node_bound(&polygon_boxes[p], 1, static_frames[opt.lane_bounds], q, ar, cap);
+    const double b = node_bound(&polygon_boxes[p], 1, static_frames[opt.lanes], q, ar, cap);
     if (b == INFINITY || best.beats(b, Kind::polygon, p)) continue;
     ++c.pair_tests;
     best.offer(ray_polygon_time(polys[p].vertices, ax, ay, avx, avy, ar, horizon), Kind::polygon, p,

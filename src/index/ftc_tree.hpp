@@ -36,8 +36,9 @@
 // the first non-empty interval in [0, min(horizon, best)] is the node's bound: a true lower bound
 // on every member's pair time. Rejection needs only multiplications; within reach at the slice
 // start (the common case near the query) costs four comparisons. The four edges are computed two
-// at a time, x and y in the lanes of a vector (lane_bounds; the scalar version is kept as the
-// reference, and the tests check the two give the same bounds bit for bit).
+// at a time, x and y in the lanes of a vector, and an agent leaf's pair times several at a time
+// (`lanes`; the scalar versions are kept as the reference, and the tests check that the two give
+// the same bounds, times and search bit for bit).
 //
 // FLOATING POINT. The bound must stay below the pair time that ray_disc_time computes, rounding
 // included. For near-grazing pairs that time carries a position error of order sqrt(eps) M,
@@ -135,9 +136,10 @@ struct FtcIndexOptions {
   // overlaps_first: find them leaf by leaf, all members of a leaf against the members of the
   // leaves within reach (set-at-a-time); false: by the tree search in `order` (t = 0 bounds).
   bool overlap_join = true;
-  // The bounds' edges two at a time in the lanes of a vector; false: one by one (the reference
-  // the tests compare with: the same bounds bit for bit, so the same search).
-  bool lane_bounds = true;
+  // The bounds' edges two at a time and an agent leaf's pair times several at a time, in the
+  // lanes of a vector; false: one by one (the reference the tests compare with: the same bounds
+  // and times bit for bit, so the same search).
+  bool lanes = true;
 };
 
 // Thread-safety: build() and query() change the index (one caller at a time); query_all() may

@@ -126,7 +126,7 @@ std::vector<Opt> some_options() {
           Opt{.slices = 1, .order = Opt::Order::bottom_up},
           Opt{.leaf_size = 3, .slices = 7, .order = Opt::Order::nearer_first},
           Opt{.slices = 2, .overlap_join = false},
-          Opt{.lane_bounds = false},
+          Opt{.lanes = false},
           thesis};
 }
 
@@ -358,10 +358,12 @@ TEST(FtcIndex, RejectsNonFiniteRows) {
   }
 }
 
-// The bounds computed two edges at a time are the scalar ones bit for bit: the same answers and
-// the same search (every counter equal), on tables that reach every branch of the bound (near,
-// far, approaching, leaving, static boxes) with both bound kinds and several slice counts.
-TEST(FtcIndex, LaneBoundsAreTheScalarOnesBitForBit) {
+// The bounds computed two edges at a time and the leaves' pair times computed several at a time
+// are the scalar ones bit for bit: the same answers and the same search (every counter equal), on
+// tables that reach every branch of the bound (near, far, approaching, leaving, static boxes) and
+// of the pair time (overlapping, receding, missing, hitting, beyond the horizon), with both bound
+// kinds, several slice counts and leaves of 1-64 members.
+TEST(FtcIndex, LanesAreTheScalarReferenceBitForBit) {
   std::vector<std::pair<DiscTable, StaticScene>> cases;
   cases.emplace_back(build::uniform(3000, {}, 50, 1, 3, 5), StaticScene{});
   cases.emplace_back(build::uniform(2000, {0, 0, 4000, 3000}, 20, 0.2, 0.5, 6), StaticScene{});
@@ -372,11 +374,12 @@ TEST(FtcIndex, LaneBoundsAreTheScalarOnesBitForBit) {
   int compared = 0;
   for (const auto& [t, scene] : cases)
     for (const double horizon : {0.5, 30.0, double{INFINITY}})
-      for (Opt o : {Opt{}, Opt{.slices = 1}, Opt{.slices = 7}, Opt{.bound = Opt::Bound::frustum},
+      for (Opt o : {Opt{}, Opt{.slices = 1}, Opt{.leaf_size = 3, .slices = 7},
+                    Opt{.leaf_size = 64, .bound = Opt::Bound::frustum},
                     Opt{.order = Opt::Order::best_first, .overlaps_first = false}}) {
         QueryStats lanes, scalar;
         EXPECT_EQ(compare(t, scene, horizon, o, 1, &lanes), 0);
-        o.lane_bounds = false;
+        o.lanes = false;
         EXPECT_EQ(compare(t, scene, horizon, o, 1, &scalar), 0);
         EXPECT_EQ(lanes.nodes_visited, scalar.nodes_visited) << compared;
         EXPECT_EQ(lanes.queue_pushes, scalar.queue_pushes) << compared;
