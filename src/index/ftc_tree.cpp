@@ -204,6 +204,39 @@ struct Member {
 // larger leaves (leaf_size is an option) are scanned one by one.
 constexpr uint32_t kLaneLeaf = 64;
 
+struct ProbeScratch {
+  std::vector<Entry> heap;
+  // The overlap phase of one leaf of the agent tree (see leaf_overlaps()): its candidates'
+  // columns, a per-candidate buffer, and each member's answer (a row, or kNoRow).
+  std::vector<double> cx, cy, cr, cc;
+  std::vector<uint32_t> cpos, pick, hit;  // candidates' positions in tree order
+  uint32_t leaf = kNoRow;
+  std::size_t ncand = 0;      // candidates of that leaf (the member itself included)
+  bool crowded = false;       // more than the join's cap: that leaf uses the tree search
+  uint64_t join_visited = 0;  // nodes its walk visited
+};
+
+struct AgentSource {
+  static constexpr Kind kind = Kind::agent;
+  const DiscView* d = nullptr;
+  std::size_t size() const { return d->n; }
+  double x(uint32_t i) const { return d->x[i]; }
+  double y(uint32_t i) const { return d->y[i]; }
+  double vx(uint32_t i) const { return d->vx[i]; }
+  double vy(uint32_t i) const { return d->vy[i]; }
+  double r(uint32_t i) const { return d->radius[i]; }
+  uint64_t key(uint32_t i) const { return d->id[i]; }
+  // Exactly the naive path's expressions (ftc_naive.cpp, ray_disc_time), so times are
+  // bit-identical: overlaps() is ray_disc_time's own test for time 0.
+  static bool overlaps(const Probe& a, const Member& b) {
+    const double dx = b.x - a.ax, dy = b.y - a.ay, R = a.ar + b.r;
+    return dx * dx + dy * dy - R * R < 0;
+  }
+  static double time(const Probe& a, const Member& b, double horizon) {
+    return ray_disc_time(b.x - a.ax, b.y - a.ay, b.vx - a.avx, b.vy - a.avy, a.ar + b.r, horizon);
+  }
+};
+
 // ray_disc_time of the query against members m[0, n), several at a time in the lanes of xsimd's
 // batches: every case computed in every lane, then selected; the same operations on the same
 // operands as AgentSource::time, lane by lane (IEEE square roots and divisions; -ffp-contract=off
@@ -240,43 +273,8 @@ void lanes_pair_times(const Member* m, uint32_t n, const Probe& q, double horizo
     time = xsimd::select(c < zero, zero, time);
     time.store_unaligned(out + k);
   }
-  for (; k < n; ++k)  // the tail, one at a time
-    out[k] = ray_disc_time(m[k].x - q.ax, m[k].y - q.ay, m[k].vx - q.avx, m[k].vy - q.avy,
-                           q.ar + m[k].r, horizon);
+  for (; k < n; ++k) out[k] = AgentSource::time(q, m[k], horizon);  // the tail, one at a time
 }
-
-struct ProbeScratch {
-  std::vector<Entry> heap;
-  // The overlap phase of one leaf of the agent tree (see leaf_overlaps()): its candidates'
-  // columns, a per-candidate buffer, and each member's answer (a row, or kNoRow).
-  std::vector<double> cx, cy, cr, cc;
-  std::vector<uint32_t> cpos, pick, hit;  // candidates' positions in tree order
-  uint32_t leaf = kNoRow;
-  std::size_t ncand = 0;      // candidates of that leaf (the member itself included)
-  bool crowded = false;       // more than the join's cap: that leaf uses the tree search
-  uint64_t join_visited = 0;  // nodes its walk visited
-};
-
-struct AgentSource {
-  static constexpr Kind kind = Kind::agent;
-  const DiscView* d = nullptr;
-  std::size_t size() const { return d->n; }
-  double x(uint32_t i) const { return d->x[i]; }
-  double y(uint32_t i) const { return d->y[i]; }
-  double vx(uint32_t i) const { return d->vx[i]; }
-  double vy(uint32_t i) const { return d->vy[i]; }
-  double r(uint32_t i) const { return d->radius[i]; }
-  uint64_t key(uint32_t i) const { return d->id[i]; }
-  // Exactly the naive path's expressions (ftc_naive.cpp, ray_disc_time), so times are
-  // bit-identical: overlaps() is ray_disc_time's own test for time 0.
-  static bool overlaps(const Probe& a, const Member& b) {
-    const double dx = b.x - a.ax, dy = b.y - a.ay, R = a.ar + b.r;
-    return dx * dx + dy * dy - R * R < 0;
-  }
-  static double time(const Probe& a, const Member& b, double horizon) {
-    return ray_disc_time(b.x - a.ax, b.y - a.ay, b.vx - a.avx, b.vy - a.avy, a.ar + b.r, horizon);
-  }
-};
 
 struct CircleSource {
   static constexpr Kind kind = Kind::circle;
