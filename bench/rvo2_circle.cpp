@@ -1,0 +1,184 @@
+// A circle swap run by crowddb's default orca and by RVO2 on the same agents, side by side: who
+// gets everyone home, how fast the knot in the middle dissolves, and how far discs overlap.
+//
+// Built with rvo2_side_by_side, only when CROWDDB_RVO2_DIR names a checkout of RVO2 (nothing of
+// it is in this repository). `agents` people evenly spaced on a circle of `radius` metres, each
+// heading for the point opposite (RVO2's Circle example in metres, tick_speed's ring-1k by
+// default): radius 0.25 m, 1.34 m/s (also the top speed), ORCA's neighbour distance 5 m, 10
+// neighbours, horizons 2 s and 0.5 s, dt 0.1 s, arrival within 0.3 m. crowddb runs the scenario
+// with its defaults otherwise (contact planes, backoff, the behaviour rules, stalemates; arrived
+// people stand); RVO2 gets the same start positions and goals, its preferred velocity towards
+// the goal at 1.34 m/s (slower within the last tick's step) plus a perturbation of at most
+// 10^-4 m/s as in its examples (crowddb's own is 10^-4 m/s too). Overlapping pairs are counted
+// from the positions of both every `--sample` seconds (all pairs: keep `agents` to a few
+// thousand). Measures the crowds, not the speed: one thread each.
+//
+// `--seed` seeds both perturbations (crowddb's scenario seed, RVO2's stream).
+//
+//   rvo2_circle [--agents 1000] [--radius 100] [--seconds 600] [--sample 2] [--seed 7]
+#include <RVO.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "crowddb/scenario.hpp"
+#include "crowddb/simulation.hpp"
+
+using namespace crowddb;
+
+namespace {
+
+struct Tally {
+  std::size_t arrived = 0, centre = 0;  // arrived so far; within 10 m of the centre now
+  std::size_t overlaps = 0;             // overlapping pairs now (at a sample)
+  double deepest = 0;                   // [m] deepest overlap now
+};
+
+// Pairs of discs of radius r closer than 2 r, from positions (x, y).
+void count_overlaps(const std::vector<double>& x, const std::vector<double>& y, double r,
+                    Tally& t) {
+  t.overlaps = 0;
+  t.deepest = 0;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    for (std::size_t j = i + 1; j < x.size(); ++j) {
+      const double d = std::hypot(x[j] - x[i], y[j] - y[i]);
+      if (d < 2 * r) {
+        ++t.overlaps;
+        t.deepest = std::max(t.deepest, 2 * r - d);
+      }
+    }
+}
+
+std::size_t near_centre(const std::vector<double>& x, const std::vector<double>& y) {
+  std::size_t c = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) c += std::hypot(x[i], y[i]) < 10;
+  return c;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int agents = 1000;
+  double radius = 100, seconds = 600, sample = 2;
+  unsigned seed = 7;
+  for (int a = 1; a + 1 < argc; a += 2) {
+    const std::string k = argv[a];
+    if (k == "--agents")
+      agents = std::atoi(argv[a + 1]);
+    else if (k == "--radius")
+      radius = std::atof(argv[a + 1]);
+    else if (k == "--seconds")
+      seconds = std::atof(argv[a + 1]);
+    else if (k == "--sample")
+      sample = std::atof(argv[a + 1]);
+    else if (k == "--seed")
+      seed = static_cast<unsigned>(std::strtoul(argv[a + 1], nullptr, 10));
+    else {
+      std::fprintf(stderr, "rvo2_circle: unknown option %s\n", argv[a]);
+      return 2;
+    }
+  }
+  if (agents < 2 || agents > 20000 || !(radius > 0) || !(seconds > 0) || !(sample >= 0.1)) {
+    std::fprintf(stderr,
+                 "rvo2_circle: --agents 2..20000, --radius and --seconds positive, --sample at "
+                 "least one tick (0.1 s)\n");
+    return 2;
+  }
+  const double side = radius + 10;
+  char doc[1024];
+  std::snprintf(doc, sizeof doc, R"({"bounds": [%.17g, %.17g, %.17g, %.17g], "dt": 0.1,
+    "seed": %u, "threads": 1, "steering": {"model": "orca", "orca": {"neighbor_dist": 5,
+    "max_neighbors": 10, "time_horizon": 2, "time_horizon_obst": 0.5}}, "arrival": "idle",
+    "groups": [{"count": %d, "placement": {"type": "circle", "center": [0, 0], "radius": %.17g},
+                "radius": 0.25, "pref_speed": 1.34,
+                "goals": {"assign": "antipodal", "arrival_radius": 0.3}}]})",
+                -side, -side, side, side, seed, agents, radius);
+  Scenario sc = parse_scenario(doc, "rvo2-circle");
+  const AgentTable& t0 = sc.world.agents();
+  const std::size_t n = t0.size();
+
+  omp_set_num_threads(1);
+  RVO::RVOSimulator rvo;
+  rvo.setTimeStep(0.1f);
+  rvo.setAgentDefaults(5.0f, 10, 2.0f, 0.5f, 0.25f, 1.34f);
+  std::vector<RVO::Vector2> goal;
+  for (std::size_t i = 0; i < n; ++i) {
+    rvo.addAgent(RVO::Vector2(static_cast<float>(t0.x[i]), static_cast<float>(t0.y[i])));
+    const Goal& g = sc.world.goals()[t0.goal[i]];
+    goal.emplace_back(static_cast<float>(g.x), static_cast<float>(g.y));
+  }
+  std::vector<char> rvo_home(n, 0);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> angle(0, 2 * static_cast<float>(M_PI)), small(0, 1e-4f);
+
+  Simulation sim(std::move(sc.world), sc.config);
+  const auto ticks = static_cast<long>(std::llround(seconds / 0.1));
+  const auto every = std::max<long>(1, std::lround(sample / 0.1));
+  Tally ours, theirs, ours_max, theirs_max;
+  double ours_last = -1, theirs_last = -1;
+  std::vector<double> x, y;
+  std::printf("%8s | %25s | %25s\n", "", "crowddb orca", "RVO2");
+  std::printf("%8s | %8s %8s %7s | %8s %8s %7s\n", "time [s]", "arrived", "r < 10 m", "overlap",
+              "arrived", "r < 10 m", "overlap");
+  for (long k = 1; k <= ticks; ++k) {
+    if (ours.arrived < n) {
+      ours.arrived += sim.step().arrived;
+      if (ours.arrived == n) ours_last = static_cast<double>(k) * 0.1;
+    }
+    if (theirs.arrived < n) {
+      for (std::size_t i = 0; i < n; ++i) {
+        const RVO::Vector2 d = goal[i] - rvo.getAgentPosition(i);
+        const float l = RVO::abs(d);
+        const float a = angle(rng), s = small(rng);
+        rvo.setAgentPrefVelocity(i, (l > 0 ? d / l * std::min(1.34f, l / 0.1f) : RVO::Vector2()) +
+                                        s * RVO::Vector2(std::cos(a), std::sin(a)));
+      }
+      rvo.doStep();
+      for (std::size_t i = 0; i < n; ++i)
+        if (!rvo_home[i] && RVO::absSq(goal[i] - rvo.getAgentPosition(i)) < 0.3f * 0.3f) {
+          rvo_home[i] = 1;
+          if (++theirs.arrived == n) theirs_last = static_cast<double>(k) * 0.1;
+        }
+    }
+    if (k % every != 0 && k != ticks) continue;
+    const AgentTable& t = sim.world().agents();
+    x.assign(t.x.begin(), t.x.end());
+    y.assign(t.y.begin(), t.y.end());
+    count_overlaps(x, y, 0.25, ours);
+    ours.centre = near_centre(x, y);
+    for (std::size_t i = 0; i < n; ++i) {
+      x[i] = rvo.getAgentPosition(i).x();
+      y[i] = rvo.getAgentPosition(i).y();
+    }
+    count_overlaps(x, y, 0.25, theirs);
+    theirs.centre = near_centre(x, y);
+    for (auto [now, most] : {std::pair{&ours, &ours_max}, std::pair{&theirs, &theirs_max}}) {
+      most->overlaps = std::max(most->overlaps, now->overlaps);
+      most->deepest = std::max(most->deepest, now->deepest);
+    }
+    if (k % std::max<long>(every, 300) == 0 || k == ticks)
+      std::printf("%8.0f | %8zu %8zu %7zu | %8zu %8zu %7zu\n", static_cast<double>(k) * 0.1,
+                  ours.arrived, ours.centre, ours.overlaps, theirs.arrived, theirs.centre,
+                  theirs.overlaps);
+    if (ours.arrived == n && theirs.arrived == n) break;
+  }
+  std::printf("%d people on a circle of radius %g m (free walk %.1f s):\n", agents, radius,
+              2 * radius / 1.34);
+  const auto line = [&](const char* who, const Tally& now, const Tally& most, double last) {
+    char when[32] = "never";
+    if (last >= 0) std::snprintf(when, sizeof when, "%.1f s", last);
+    std::printf(
+        "  %-13s %zu of %zu home, the last at %s; overlapping pairs at most %zu (sampled "
+        "every %g s), deepest %.3f m\n",
+        who, now.arrived, n, when, most.overlaps, static_cast<double>(every) * 0.1, most.deepest);
+  };
+  line("crowddb orca:", ours, ours_max, ours_last);
+  line("RVO2:", theirs, theirs_max, theirs_last);
+  return 0;
+}
