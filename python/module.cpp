@@ -54,7 +54,7 @@ py::dict metrics_dict(const TickMetrics& m) {
       "freeze_iterations"_a = m.freeze_iterations, "overlapping_pairs"_a = m.overlapping_pairs,
       "obstacle_overlaps"_a = m.obstacle_overlaps, "gridlocked"_a = m.gridlocked,
       "stalled"_a = m.stalled, "queueing"_a = m.queueing, "nudged"_a = m.nudged,
-      "yielding"_a = m.yielding, "sidestepping"_a = m.sidestepping,
+      "yielding"_a = m.yielding, "sidestepping"_a = m.sidestepping, "making_way"_a = m.making_way,
       "longest_stall"_a = m.longest_stall, "seconds"_a = m.seconds, "state_hash"_a = m.state_hash);
 }
 

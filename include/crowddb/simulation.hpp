@@ -221,6 +221,7 @@ struct TickMetrics {
   std::size_t longest_stall = 0;      // longest current stretch without progress [ticks]
   std::size_t yielding = 0;           // stalled agents yielding in this tick
   std::size_t sidestepping = 0;       // stalled agents sidestepping in this tick
+  std::size_t making_way = 0;         // standing agents asked to step out of a stalled walker's way
   double seconds = 0;                 // wall time of the tick
   uint64_t state_hash = 0;  // hash of the committed state (ids, positions, velocities, states)
 };

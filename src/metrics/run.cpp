@@ -56,7 +56,7 @@ struct Progress {
          {&s->agents_at_start, &s->max_overlapping_pairs, &s->max_obstacle_overlaps,
           &s->frozen_agent_ticks, &s->freeze_iterations_total, &s->freeze_iterations_max,
           &s->gridlocked_max, &s->gridlock_streaks, &s->nudged, &s->stall_streaks, &s->stalled_max,
-          &s->yields, &s->sidesteps, longest_frozen, longest_stall})
+          &s->yields, &s->sidesteps, &s->make_ways, longest_frozen, longest_stall})
       f(*v);
   }
   std::string save(double wall_now) const {
@@ -144,6 +144,7 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
       longest_stall = std::max(longest_stall, m.longest_stall);
       s.yields += m.yielding;
       s.sidesteps += m.sidestepping;
+      s.make_ways += m.making_way;
       if (m.arrived) last_arrival = m.tick;
       s.ticks = t;
       if (w) {
@@ -252,6 +253,7 @@ std::string RunSummary::json() const {
   j["max_stalled_s"] = ns(max_stalled_s);
   j["yields"] = yields;
   j["sidesteps"] = sidesteps;
+  j["make_ways"] = make_ways;
   j["wall_seconds"] = wall_seconds;
   j["ms_per_tick_median"] = ms_per_tick_median;
   j["ms_per_tick_mean"] = ms_per_tick_mean;
@@ -316,7 +318,8 @@ std::string RunSummary::text(const SimConfig& cfg) const {
      << " times, at most " << stalled_max << " agents at once, " << stalled_at_end
      << " at the end; longest " << secs(max_stalled_s) << " without progress";
   if (cfg.stall.resolve)
-    os << "; resolved by " << yields << " yields and " << sidesteps << " sidesteps";
+    os << "; resolved by " << yields << " yields, " << sidesteps << " sidesteps and " << make_ways
+       << " make-ways";
   else
     os << "; resolution off";
   os << "\n  nudge: ";

@@ -40,7 +40,7 @@ struct RunSummary {
   double longest_frozen_s = 0;
   std::size_t stall_streaks = 0, stalled_max = 0, stalled_at_end = 0;
   double max_stalled_s = 0;
-  std::size_t yields = 0, sidesteps = 0, nudged = 0;
+  std::size_t yields = 0, sidesteps = 0, make_ways = 0, nudged = 0;
   double wall_seconds = 0, ms_per_tick_median = 0, ms_per_tick_mean = 0;
   uint64_t state_hash = 0;
   SteerBenchTotals steerbench;

@@ -329,7 +329,7 @@ constexpr std::string_view kCheckpointMagic = "crowddb-checkpoint";
 // goal each agent left last (the left_goal column); 5: congestion costs of the path searches in
 // flight; 6: the navigation's routes that fall short; 7: door cuts in the searches in flight;
 // 8: the state hash in blocks and lanes (sim::state_hash).
-constexpr uint32_t kCheckpointVersion = 8;
+constexpr uint32_t kCheckpointVersion = 9;
 
 // What a checkpoint must agree on with the simulation it is restored into: the static tables
 // and the settings that change what a tick computes (not the thread count).
@@ -367,7 +367,7 @@ void metrics_fields(Io&& io, M& m) {
   for (auto* v : {&m.agents, &m.active, &m.entered, &m.arrived, &m.frozen, &m.freeze_iterations,
                   &m.overlapping_pairs, &m.obstacle_overlaps, &m.gridlocked, &m.gridlock_started,
                   &m.longest_frozen, &m.nudged, &m.stalled, &m.queueing, &m.stall_started,
-                  &m.longest_stall, &m.yielding, &m.sidestepping})
+                  &m.longest_stall, &m.yielding, &m.sidestepping, &m.making_way})
     io(*v);
   io(m.seconds);
   io(m.state_hash);
@@ -652,6 +652,7 @@ const TickMetrics& Simulation::step() {
     m.queueing = sc.queueing;
     m.yielding = sc.yielding;
     m.sidestepping = sc.sidestepping;
+    m.making_way = sc.making_way;
     head_on = std::move(sc.head_on);
   });
 
@@ -843,9 +844,9 @@ std::string Simulation::explain_analyze() const {
   }
   std::snprintf(line, sizeof line,
                 "  stalemates now: %zu stalled (longest %.1f s without progress), %zu yielding, "
-                "%zu sidestepping\n",
+                "%zu sidestepping, %zu making way\n",
                 last_.stalled, static_cast<double>(last_.longest_stall) * config_.dt,
-                last_.yielding, last_.sidestepping);
+                last_.yielding, last_.sidestepping, last_.making_way);
   os << line;
   os << "  access paths used (ticks):";
   for (const auto& [k, v] : e.log.methods()) os << " " << k << " x" << v;

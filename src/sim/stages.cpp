@@ -167,6 +167,12 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
       double px = 0, py = 0;  // preferred velocity
       if (idle(t, i)) {
         const Goal& g = goals[t.goal[i]];
+        if (t.stall_action[i] == StallAction::make_way && tick < t.stall_until[i]) {
+          // Out of a stalled walker's way (sim/stalemate.hpp), at half its preferred speed.
+          pref.vx[i] = 0.5 * t.pref_speed[i] * t.stall_dir_x[i];
+          pref.vy[i] = 0.5 * t.pref_speed[i] * t.stall_dir_y[i];
+          continue;
+        }
         if (!demand.empty() && demand[t.goal[i]] > 0 && g.is_polygon()) {
           // An area others still head for: walk on into it, towards its inner point (where the
           // disc fits nearest to it), so that its edge stays free for those coming. Stepping off

@@ -163,7 +163,9 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
       rm = std::max(rm, t.radius[i]);
       if (standing(t.state[i])) {
         t.stall_ticks[i] = 0;
-        t.stall_action[i] = StallAction::none;
+        // (Making way for a walker lasts its time: standing is what it is done from.)
+        if (!(t.stall_action[i] == StallAction::make_way && tick < t.stall_until[i]))
+          t.stall_action[i] = StallAction::none;
         continue;
       }
       const double d = path_left(t, goals, i, aim);
@@ -264,6 +266,9 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   // 3. actions for the stalled ones that have none running: each row's own columns only, read
   // from the others what this loop does not write (in chunks, on every thread; counts summed in
   // chunk order).
+  // Per looked-at row: a standing blocker asked to make way (applied after the parallel loop, in
+  // row order: the blocker's columns are not the row's own).
+  std::vector<int64_t> make_way(looked_at.size(), -1);
   auto act = [&](std::size_t q, std::size_t& yields, std::size_t& sidesteps) {
     const uint32_t i = looked_at[q];
     if (queueing[q] || t.stall_action[i] != StallAction::none) return;
@@ -318,6 +323,8 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
     } else if (blocker_stalled) {
       return;  // the blocker yields to this one
     } else {
+      if (blocker[q] >= 0 && t.state[j] == AgentState::arrived && t.goal[j] != t.goal[i])
+        make_way[q] = blocker[q];
       Rng rng = Rng::stream(cfg.seed ^ (tick * 0xbf58476d1ce4e5b9ull), t.id[i]);
       const double turn =
           rng.uniform(std::numbers::pi / 4, std::numbers::pi / 2) * (rng.below(2) ? 1 : -1);
@@ -337,6 +344,22 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   for (std::size_t k = 0; k < chunks; ++k) {
     c.yielding += yields[k];
     c.sidestepping += sidesteps[k];
+  }
+  // Standing blockers step aside, off the walker's line to the side they stand on, for
+  // yield_time (the first walker to ask, in row order, sets the direction).
+  for (std::size_t q = 0; q < looked_at.size(); ++q) {
+    if (make_way[q] < 0) continue;
+    const auto j = static_cast<std::size_t>(make_way[q]);
+    if (t.stall_action[j] == StallAction::make_way && tick < t.stall_until[j]) continue;
+    const uint32_t i = looked_at[q];
+    const double dx = dir[q].x, dy = dir[q].y;
+    const double side = dx * (t.y[j] - t.y[i]) - dy * (t.x[j] - t.x[i]);
+    const bool left = side > 0 || (side == 0 && (t.id[j] & 1));
+    t.stall_action[j] = StallAction::make_way;
+    t.stall_dir_x[j] = left ? -dy : dy;
+    t.stall_dir_y[j] = left ? dx : -dx;
+    t.stall_until[j] = tick + cfg.ticks_for(cfg.stall.yield_time);
+    ++c.making_way;
   }
   return c;
 }

@@ -42,7 +42,11 @@
 //   - otherwise: sidestep, i.e. walk at a seeded angle of 45-90 degrees off the target direction
 //     for sidestep_time, then head for the target again for `after` before the next action (a
 //     sidestep moves the agent off its best distance; acting again at once chained sidesteps
-//     into a random walk).
+//     into a random walk). When the blocker has arrived (idle) and is bound for another goal,
+//     it is also asked to make way (make_way): it steps off the agent's line, to the side it
+//     stands on, at half its preferred speed for yield_time. Idle people do not move by
+//     themselves, and one enclosed by the idle visitors of another booth (Menge's tradeshow)
+//     stood there for 200 s of 300. Waiting agents (a goal's wait) are not asked.
 // After the action the agent heads for its target again; with navigation, one that stays stalled
 // also re-plans its path (NavigationParams::replan_after), and the rows stalled head-on
 // (StallCounts::head_on) make the tick's path searches plan round them
@@ -63,6 +67,7 @@ class AimMemo;  // stages.hpp
 
 struct StallCounts {
   std::size_t stalled = 0, started = 0, longest = 0, queueing = 0, yielding = 0, sidestepping = 0;
+  std::size_t making_way = 0;  // standing blockers asked to step aside this tick
   // Rows (in row order) stalled where streams meet head-on: the chain of stalled blockers in
   // front ends in someone heading at them, or is a cycle with two such (not an arch at a door,
   // where all walk one way). Path searches plan round them (NavigationParams::congestion_cost).

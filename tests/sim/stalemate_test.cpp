@@ -104,6 +104,56 @@ TEST(Stalemates, StandingBehindIdleArrivalsAtItsOwnGoalIsQueueing) {
   EXPECT_EQ(s.action(), StallAction::none);
 }
 
+// Someone standing in a stalled walker's way who is not at the walker's goal (idle at another
+// booth: Menge's tradeshow) is asked to make way: it steps off the walker's line, to the side it
+// stands on, for yield_time; the walker still sidesteps.
+TEST(Stalemates, AStandingBlockerBoundElsewhereStepsOffTheWalkersLine) {
+  for (const double side : {0.1, -0.1}) {  // north, then south of the walker's line
+    PushedBack s(0.0, true, true, 1);
+    s.w.agents_for_tick().y[1] = 5 + side;
+    const StallCounts c = s.run();
+    EXPECT_EQ(c.making_way, 1u);
+    EXPECT_EQ(c.sidestepping, 1u);
+    const AgentTable& t = s.w.agents();
+    EXPECT_EQ(t.stall_action[0], StallAction::sidestep);
+    EXPECT_EQ(t.stall_action[1], StallAction::make_way);
+    // The walker heads west: off its line is north or south, the blocker's side.
+    EXPECT_EQ(t.stall_dir_x[1], 0.0);
+    EXPECT_EQ(t.stall_dir_y[1], side > 0 ? 1.0 : -1.0);
+    EXPECT_EQ(t.stall_until[1], 100 + s.cfg.ticks_for(s.cfg.stall.yield_time));
+  }
+}
+
+TEST(Stalemates, AStandingBlockerAtTheWalkersOwnGoalStays) {
+  PushedBack s(0.0, true, true, 0);  // a queue at its own goal (above)
+  EXPECT_EQ(s.run().making_way, 0u);
+  EXPECT_EQ(s.w.agents().stall_action[1], StallAction::none);
+}
+
+TEST(Stalemates, MakingWayLastsItsTimeAndMovesTheStandingAgent) {
+  PushedBack s(0.0, true, true, 1);
+  s.w.agents_for_tick().y[1] = 5.1;
+  ASSERT_EQ(s.run().making_way, 1u);
+  const uint64_t until = 100 + s.cfg.ticks_for(s.cfg.stall.yield_time);
+  // The goal stage walks it north at half its preferred speed while the action lasts.
+  Preferred pref;
+  pref.reset(s.w.agents().size());
+  goal_stage(s.w.agents(), s.w.goals(), s.cfg, until - 1, {}, pref, s.ex);
+  EXPECT_EQ(pref.vx[1], 0.0);
+  EXPECT_EQ(pref.vy[1], 0.5 * 1.3);
+  goal_stage(s.w.agents(), s.w.goals(), s.cfg, until, {}, pref, s.ex);
+  EXPECT_EQ(pref.vx[1], 0.0);
+  EXPECT_EQ(pref.vy[1], 0.0);
+  // The progress watch keeps a standing agent's action until then, and ends it after.
+  AgentTable& t = s.w.agents_for_tick();
+  t.stall_ticks[0] = 0;  // the walker out of the picture
+  t.progress_best[0] = 0;
+  EXPECT_EQ(stalemates(s.w, s.cfg, until - 1, *s.path, s.ex, s.stats).making_way, 0u);
+  EXPECT_EQ(t.stall_action[1], StallAction::make_way);
+  stalemates(s.w, s.cfg, until, *s.path, s.ex, s.stats);
+  EXPECT_EQ(t.stall_action[1], StallAction::none);
+}
+
 // Two stalled agents touching (0.05 m apart): a at (ax, ay) heading for goal ga, b at (bx, by)
 // heading for goal gb; goals W (0, 5) and E (39, 5) far west and east, S (5, -20) far south. Both
 // have made no progress for 6 s.
