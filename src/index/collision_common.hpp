@@ -41,7 +41,9 @@ struct Frame {
     if (d.n == 0) return f;
     double xmin = INFINITY, ymin = INFINITY, xmax = -INFINITY, ymax = -INFINITY;
     double rlo = INFINITY, rhi = -INFINITY;
+    bool nan = false;  // min and max pass over NaN: it is looked for on its own
     for (std::size_t i = 0; i < d.n; ++i) {
+      nan |= std::isnan(d.x[i]) | std::isnan(d.y[i]) | std::isnan(d.radius[i]);
       xmin = std::min(xmin, d.x[i]);
       xmax = std::max(xmax, d.x[i]);
       ymin = std::min(ymin, d.y[i]);
@@ -56,7 +58,7 @@ struct Frame {
     f.extent = std::max(f.width, f.height);
     f.rmin = rlo;
     f.rmax = rhi;
-    f.finite = std::isfinite(f.extent) && std::isfinite(rhi) && rlo > 0;
+    f.finite = !nan && std::isfinite(f.extent) && std::isfinite(rhi) && rlo > 0;
     return f;
   }
 

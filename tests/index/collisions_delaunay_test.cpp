@@ -100,5 +100,10 @@ TEST(CollisionDelaunay, DuplicatesAndCollinearCentres) {
   EXPECT_EQ(run_delaunay(one.view(), StaticScene()).agents.size(), 1u);
 }
 
+TEST(CollisionDelaunay, NanOrInfiniteRowsGiveTheNaivePairs) {
+  CollisionDelaunay path;
+  test::expect_naive_on_non_finite_rows(path);
+}
+
 }  // namespace
 }  // namespace crowddb::index

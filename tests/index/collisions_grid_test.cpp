@@ -66,5 +66,10 @@ TEST(CollisionGrid, NonFiniteInputFallsBackInsteadOfHanging) {
   EXPECT_EQ(got.agents, test::naive_pairs(t.view(), StaticScene()).agents);
 }
 
+TEST(CollisionGrid, NanOrInfiniteRowsGiveTheNaivePairs) {
+  CollisionGrid path;
+  test::expect_naive_on_non_finite_rows(path);
+}
+
 }  // namespace
 }  // namespace crowddb::index

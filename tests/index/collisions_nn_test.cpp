@@ -138,5 +138,10 @@ TEST(CollisionNn, UnequalRadiiAreAUsageError) {
   }
 }
 
+TEST(CollisionNn, NanOrInfiniteRowsGiveTheNaivePairs) {
+  CollisionNn path;
+  test::expect_naive_on_non_finite_rows(path, true);
+}
+
 }  // namespace
 }  // namespace crowddb::index

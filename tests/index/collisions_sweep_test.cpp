@@ -26,5 +26,10 @@ TEST(CollisionSweep, SameXForEveryDiscStillExact) {
   EXPECT_LT(st.pair_tests, 5000u);  // slabs keep far-apart discs out of each other's way
 }
 
+TEST(CollisionSweep, NanOrInfiniteRowsGiveTheNaivePairs) {
+  CollisionSweep path;
+  test::expect_naive_on_non_finite_rows(path);
+}
+
 }  // namespace
 }  // namespace crowddb::index
