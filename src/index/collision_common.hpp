@@ -43,7 +43,10 @@ struct Frame {
     double rlo = INFINITY, rhi = -INFINITY;
     bool nan = false;  // min and max pass over NaN: it is looked for on its own
     for (std::size_t i = 0; i < d.n; ++i) {
-      nan |= std::isnan(d.x[i]) | std::isnan(d.y[i]) | std::isnan(d.radius[i]);
+      // (As ints: | on them is meant, without a branch per row.)
+      const int bad =
+          int{std::isnan(d.x[i])} | int{std::isnan(d.y[i])} | int{std::isnan(d.radius[i])};
+      nan |= bad != 0;
       xmin = std::min(xmin, d.x[i]);
       xmax = std::max(xmax, d.x[i]);
       ymin = std::min(ymin, d.y[i]);
