@@ -147,6 +147,41 @@ TEST(NeighbourGrid, TiesCoincidentPointsAndTheRangeBoundary) {
   EXPECT_EQ(at.offset[1] - at.offset[0], 0u);
 }
 
+// A dense knot in a sparse world (a circle swap's middle, with those who arrived standing on
+// the far rim): the cells are sized by the mean density (and at most ~4 per disc), so a short
+// range (the stalemate stage's blockers) lies within a fraction of a cell, and a cell holds
+// dozens of discs. Knot centres anywhere in their cells, ranges from below the spacing to a few
+// cells, k from 1 to more than the range holds, every row (then seeded by hints) and subsets.
+TEST(NeighbourGrid, ShortRangesInADenseKnotOfASparseWorld) {
+  Rng rng(23);
+  NeighbourNaive naive;
+  NeighbourGrid grid;
+  for (int c = 0; c < 40; ++c) {
+    DiscTable t;
+    const double cx = rng.uniform(-5, 5), cy = rng.uniform(-5, 5), half = rng.uniform(1, 8);
+    const std::size_t knot = 50 + rng.below(600);
+    for (std::size_t i = 0; i < knot; ++i)
+      t.push_back(i, cx + rng.uniform(-half, half), cy + rng.uniform(-half, half), 0, 0, 0.25);
+    const std::size_t rim = 10 + rng.below(200);
+    for (std::size_t i = 0; i < rim; ++i) {
+      const double a = rng.uniform(0, 2 * 3.141592653589793);
+      t.push_back(knot + i, 100 * std::cos(a), 100 * std::sin(a), 0, 0, 0.25);
+    }
+    if (rng.below(2)) build::shuffle_ids(t, 900 + static_cast<uint64_t>(c));
+    const DiscView d = t.view();
+    const double range = rng.uniform(0.05, 6);
+    const uint32_t k = static_cast<uint32_t>(1 + rng.below(12));
+    SCOPED_TRACE("case " + std::to_string(c) + " range " + std::to_string(range) + " k " +
+                 std::to_string(k));
+    expect_same(run(grid, d, range, k), run(naive, d, range, k));
+    expect_same(run(grid, d, range, k, {}, 2), run(naive, d, range, k));  // seeded by hints
+    std::vector<uint32_t> q;
+    for (std::size_t i = 0; i < t.size(); i += 1 + rng.below(3))
+      q.push_back(static_cast<uint32_t>(i));
+    expect_same(run(grid, d, range, k, q, 2), run(naive, d, range, k, q));
+  }
+}
+
 TEST(NeighbourGrid, HugeAndSparseWorlds) {
   NeighbourNaive naive;
   NeighbourGrid grid;
