@@ -2,6 +2,7 @@
 #pragma once
 
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 
@@ -13,6 +14,10 @@ namespace crowddb::io {
 // of the original file it was made from ("case.xml:57: <agent>"). An error in a field names the
 // nearest origin at or above its pointer.
 using Origins = std::map<std::string, std::string>;
+
+// A scenario file's JSON, read strictly: a syntax error names its line and column, a duplicate
+// key is an error (nlohmann keeps the last one silently). Error(input) naming `source`.
+nlohmann::json parse_json_strict(std::string_view text, const std::string& source);
 
 // parse_scenario, with errors pointing into the original file when `origins` is given.
 Scenario parse_document(std::string_view json_text, const std::string& source,

@@ -921,15 +921,11 @@ void read_steering(Node& root, SimConfig& cfg) {
 
 namespace io {
 
-Scenario parse_document(std::string_view text, const std::string& source, const Origins* origins) {
-  Scenario sc;
-  sc.source = source;
-  sc.text = std::string(text);
-  json doc;
+json parse_json_strict(std::string_view text, const std::string& source) {
   try {
     // Reject duplicate keys: nlohmann keeps the last one silently.
     std::vector<std::set<std::string>> keys;
-    doc = json::parse(text, [&](int, json::parse_event_t event, json& parsed) {
+    return json::parse(text, [&](int, json::parse_event_t event, json& parsed) {
       if (event == json::parse_event_t::object_start) keys.emplace_back();
       if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
       if (event == json::parse_event_t::key && !keys.empty() &&
@@ -947,6 +943,13 @@ Scenario parse_document(std::string_view text, const std::string& source, const 
   } catch (const json::exception& e) {
     throw Error(Error::Kind::input, source + ": malformed JSON: " + e.what());
   }
+}
+
+Scenario parse_document(std::string_view text, const std::string& source, const Origins* origins) {
+  Scenario sc;
+  sc.source = source;
+  sc.text = std::string(text);
+  const json doc = parse_json_strict(text, source);
 
   const DocSource src{source, origins};
   Node root(doc, "", &src);

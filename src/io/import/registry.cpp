@@ -58,13 +58,15 @@ void reject_unknown_xml(const std::filesystem::path& path, std::string_view text
                   "<Project>, <Experiment> or <BFSM>; docs/importers.md)");
 }
 
-// A crowddb file's text with the options' overrides applied (the file is checked as it stands
-// first, so its own errors keep their line numbers).
+// A crowddb file's text with the options' overrides applied. The file's own JSON is read
+// strictly first (a syntax error keeps its line and column, a duplicate key is caught: the
+// re-written document has neither); the rest is checked after the overrides, by whoever loads
+// the result, so that --set can mend a value the file has wrong (a group too large for its
+// region) as docs/scenario-format.md says.
 std::string with_overrides(const std::filesystem::path& path, const std::string& text,
                            const LoadOptions& options) {
-  parse_scenario(text, path.string());
   if (options.overrides.empty()) return text;
-  nlohmann::json doc = nlohmann::json::parse(text);
+  nlohmann::json doc = io::parse_json_strict(text, path.string());
   apply_overrides(doc, options.overrides);
   return doc.dump(2) + "\n";
 }
@@ -149,7 +151,7 @@ Converted convert_scenario(const std::filesystem::path& path, const LoadOptions&
     io::reject_unknown_xml(path, text);
     // A crowddb file converts to itself (with the overrides), if it is valid.
     const std::string json = io::with_overrides(path, text, options);
-    if (!options.overrides.empty()) parse_scenario(json, path.string());
+    parse_scenario(json, path.string());
     return {json, "crowddb", {}};
   }
   io::Imported im = imp->read(path, text, options);
