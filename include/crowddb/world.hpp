@@ -144,7 +144,7 @@ enum class StallAction : uint8_t {
   sidestep = 2,     // walks off at an angle, no neighbour to yield to (or it has priority)
   yield_ahead = 3,  // yields in a jam of people going its way (src/sim/stalemate.hpp): steps
                     // back as `yield` does, and goes first in orca so the people behind make room
-  make_way = 4,     // standing (arrived or waiting) in the way of a stalled walker: steps aside
+  make_way = 4,     // arrived and standing in the way of a stalled walker: steps aside
 };
 
 // The agents table: structure-of-arrays columns, one entry per dense row. Columns are public

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "path/navigation.hpp"
+#include "sim/stalemate.hpp"
 #include "util/hash.hpp"
 #include "util/rng.hpp"
 #include "world/geometry.hpp"
@@ -167,7 +168,7 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
       double px = 0, py = 0;  // preferred velocity
       if (idle(t, i)) {
         const Goal& g = goals[t.goal[i]];
-        if (t.stall_action[i] == StallAction::make_way && tick < t.stall_until[i]) {
+        if (making_way(t, i, tick)) {
           // Out of a stalled walker's way (sim/stalemate.hpp), at half its preferred speed.
           pref.vx[i] = 0.5 * t.pref_speed[i] * t.stall_dir_x[i];
           pref.vy[i] = 0.5 * t.pref_speed[i] * t.stall_dir_y[i];

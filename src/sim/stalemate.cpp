@@ -164,8 +164,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
       if (standing(t.state[i])) {
         t.stall_ticks[i] = 0;
         // (Making way for a walker lasts its time: standing is what it is done from.)
-        if (!(t.stall_action[i] == StallAction::make_way && tick < t.stall_until[i]))
-          t.stall_action[i] = StallAction::none;
+        if (!making_way(t, i, tick)) t.stall_action[i] = StallAction::none;
         continue;
       }
       const double d = path_left(t, goals, i, aim);
@@ -350,7 +349,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   for (std::size_t q = 0; q < looked_at.size(); ++q) {
     if (make_way[q] < 0) continue;
     const auto j = static_cast<std::size_t>(make_way[q]);
-    if (t.stall_action[j] == StallAction::make_way && tick < t.stall_until[j]) continue;
+    if (making_way(t, j, tick)) continue;
     const uint32_t i = looked_at[q];
     const double dx = dir[q].x, dy = dir[q].y;
     const double side = dx * (t.y[j] - t.y[i]) - dy * (t.x[j] - t.x[i]);

@@ -88,6 +88,12 @@ std::vector<uint8_t> queue_members_naive(std::span<const uint8_t> same_way,
                                          std::span<const uint8_t> moves,
                                          std::span<const int64_t> next);
 
+// Is row i, standing, stepping out of a stalled walker's way at `tick` (StallAction::make_way,
+// not yet over)?
+inline bool making_way(const AgentTable& t, std::size_t i, uint64_t tick) {
+  return t.stall_action[i] == StallAction::make_way && tick < t.stall_until[i];
+}
+
 // The progress watch, the queueing test and (with cfg.stall.resolve) the actions, for the tick
 // `tick` just committed.
 // `aim`: the rows' aim points, shared with the goal stage (stages.hpp).
