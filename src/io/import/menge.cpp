@@ -9,16 +9,20 @@
 // condition already holds there fires at once (`auto`, or `goal_reached` when the agent is within
 // the distance); otherwise the agent walks to the goal, and the first `goal_reached` transition
 // of the state (in declaration order) moves it on: the goal's area is Menge's reach region for
-// that distance. A final state ends the sequence (the agent stands, arrival policy "idle"); so
-// does a state nothing moves the agent out of, and a state the chain has visited before (a
-// cycle). Everything else in a state machine (timers, spatial conditions, and/or/not, prob and
-// return targets, actions, velocity modifiers, tasks, events) cannot be evaluated before the run:
-// each kind is one warning line, and the chain follows the goal_reached path.
+// that distance. Where the agent stands, the state's first timer moves it on: the timer becomes
+// the wait of the goal it stands on. Prob targets are drawn per agent and visit. A final state
+// ends the sequence (the agent stands, arrival policy "idle"); so does a state nothing moves the
+// agent out of. A loop back to a state the agent has been in is followed round until the
+// project's duration has surely passed. Everything else in a state machine (spatial conditions,
+// and/or/not, return targets, timers where the agent walks, actions, velocity modifiers, tasks,
+// events) cannot be evaluated before the run: each kind is one warning line, and the chain
+// follows the goal_reached path.
 //
 // Random draws (profile selectors, property distributions, generator noise, random goals) come
 // from crowddb's Rng, one stream per agent (the project's `random` seed, the agent's index), in
 // that order; they do not reproduce Menge's numbers. The work is bounded by the input: at most
-// `max_agents` agents, each compiled in O(states x (transitions + goals)).
+// `max_agents` agents, each sequence at most kMaxVisits goals (kMaxVisitsInAll in all), each
+// goal found in O(transitions + goals of a set).
 #include "io/import/menge.hpp"
 
 #include <algorithm>
@@ -46,6 +50,16 @@ constexpr double kMargin = 2;       // [m] around everything, for the bounds
 constexpr double kTimeStep = 0.1;   // Menge's default <Common time_step>
 constexpr double kBigWhole = 9e15;  // whole numbers above this are not read exactly
 constexpr uint64_t kAllGoals = std::numeric_limits<uint64_t>::max();
+// The streams of the timers drawn once at load (per_agent="0"), counted down from here, clear of
+// the agents' streams (one per agent index).
+constexpr uint64_t kTimerStream = std::numeric_limits<uint64_t>::max();
+// A state machine that loops is followed round until the project's duration has surely passed,
+// with at most this many goals in an agent's sequence, and this many in all the sequences.
+// Each pick from a goal set costs the set's size: the rounds stop after this many in all, so that
+// a project of many agents and goals cannot make the import hang.
+constexpr std::size_t kMaxVisits = 1000;
+constexpr std::size_t kMaxVisitsInAll = 1 << 20;
+constexpr std::size_t kMaxPickWork = std::size_t{1} << 27;
 
 const char* const kModels[] = {"orca",       "pedvo",    "helbing", "johannson",
                                "karamouzas", "zanlungo", "gcf",     "dummy"};
@@ -240,17 +254,28 @@ struct SelectorDef {
   Dist off_x, off_y;  // offset: a 2-D distribution, x then y
   std::string shared_name;
   std::size_t shared_state = 0;
+  // The agent keeps the goal it got on its first entry (persistent="1", or a state whose
+  // selector another state shares).
+  bool persistent = false;
 };
 
 enum class Motion { walk, navigate, stand };
 
 struct TransitionDef {
   xml_node node;
-  enum class Cond { goal_reached, always, other };
+  enum class Cond { goal_reached, always, timer, other };
   Cond cond = Cond::other;
   xml_node cond_node;
   double distance = 0;
-  std::ptrdiff_t target = -1;  // a state, or -1: a target a static sequence cannot follow
+  // timer: the wait, as a crowddb goal's `wait` (null: none), and its least value [s]
+  nlohmann::json wait;
+  double least_wait = 0;
+  // A state; kProb: a prob target (`prob`, states and weights, drawn per agent and visit); -1:
+  // a target a static sequence cannot follow (return).
+  static constexpr std::ptrdiff_t kProb = -2;
+  std::ptrdiff_t target = -1;
+  std::vector<std::pair<std::size_t, double>> prob;
+  bool followable() const { return target >= 0 || target == kProb; }
 };
 
 struct StateDef {
@@ -889,7 +914,7 @@ class MengeReader {
     SelectorDef d;
     d.node = c;
     const std::string t = type_of(bfsm_, c);
-    flag(bfsm_, b_, c, "persistent", false);  // no state is entered twice in a sequence
+    d.persistent = flag(bfsm_, b_, c, "persistent", false);
     auto set_id = [&] { d.set_id = whole(bfsm_, c, "goal_set"); };
     if (t == "identity") {
       d.type = T::identity;
@@ -971,6 +996,7 @@ class MengeReader {
         bfsm_.fail(d.node, "shares the goal of state '" + clip(d.shared_name) +
                                "', which shares another's (Menge requires a full selector there)");
       d.shared_state = it->second;
+      states_[it->second].sel.persistent = true;  // Menge makes a shared selector persistent
       return;
     }
     const auto it = set_index_.find(d.set_id);
@@ -998,6 +1024,65 @@ class MengeReader {
     return it->second;
   }
 
+  // Menge's TimerCondition: the agent leaves its state once a duration drawn on entry has
+  // passed (per_agent="1": drawn per agent and entry; "0": one value drawn at load for all). It
+  // becomes the wait of a goal where the agent stands (docs/importers/menge.md, "Behaviour").
+  void timer(TransitionDef& t, const xml_node& cond) {
+    const pugi::xml_attribute per = cond.attribute("per_agent");
+    if (!per) bfsm_.fail(cond, "missing attribute 'per_agent' (Menge requires it on a timer)");
+    const bool per_agent = flag(bfsm_, b_, cond, "per_agent", true);
+    if (cond.attribute("seed"))
+      b_.warn("seed", bfsm_.where(cond) +
+                          ": seed attributes are ignored: every draw comes from the "
+                          "project's random seed");
+    const std::string kind = bfsm_.attr_string(cond, "dist");
+    auto num = [&](const char* key) {
+      const double v = bfsm_.attr_number(cond, key);
+      if (!std::isfinite(v)) bfsm_.fail(cond, std::string("attribute '") + key + "': not finite");
+      return v;
+    };
+    Dist d;
+    d.node = cond;
+    if (kind == "c") {
+      d.a = num("value");
+    } else if (kind == "u") {
+      d.kind = Dist::Kind::u;
+      d.a = num("min");
+      d.b = num("max");
+      if (d.a > d.b) std::swap(d.a, d.b);
+    } else if (kind == "n") {
+      d.kind = Dist::Kind::n;
+      d.a = num("mean");
+      d.b = num("stddev");
+      if (d.b < 0) bfsm_.fail(cond, "attribute 'stddev': must be >= 0");
+    } else {
+      bfsm_.fail(cond, "attribute 'dist': unknown distribution '" + clip(kind) + "' (c, u or n)");
+    }
+    if (!per_agent) {  // one value for everyone, as Menge's loader draws it
+      Rng once = Rng::stream(seed(), kTimerStream - timers_++);
+      d = Dist::constant(d.sample(once, false), cond);
+    }
+    double lo = d.a, hi = d.a;
+    if (d.kind == Dist::Kind::u) {
+      hi = d.b;
+    } else if (d.kind == Dist::Kind::n) {
+      // crowddb's waits are uniform or exponential: the uniform of the same mean and spread.
+      lo = d.a - std::sqrt(3.0) * d.b;
+      hi = d.a + std::sqrt(3.0) * d.b;
+      b_.warn("timer-normal",
+              bfsm_.where(cond) + ": a normal timer (mean " + fmt(d.a) + " s, stddev " + fmt(d.b) +
+                  " s) becomes a wait drawn uniformly in [" + fmt(std::max(lo, 0.0)) + ", " +
+                  fmt(std::max(hi, 0.0)) + "] s (the same mean and spread)");
+    }
+    if (hi > Goal::kMaxWait)
+      b_.warn("timer-cap", bfsm_.where(cond) + ": a timer longer than " + fmt(Goal::kMaxWait) +
+                               " s is cut to that");
+    lo = std::clamp(lo, 0.0, Goal::kMaxWait);  // a negative duration fires at once
+    hi = std::clamp(hi, 0.0, Goal::kMaxWait);
+    t.least_wait = lo;
+    if (hi > 0) t.wait = lo == hi ? nlohmann::json(lo) : nlohmann::json::array({lo, hi});
+  }
+
   void transition(const xml_node& n) {
     TransitionDef t;
     t.node = n;
@@ -1021,12 +1106,34 @@ class MengeReader {
         const std::string tt = type_of(bfsm_, c);
         if (tt != "prob" && tt != "return")
           bfsm_.fail(c, "unknown target type '" + clip(tt) + "' (prob, return)");
-        b_.warn("target:" + tt,
-                bfsm_.where(c) + ": a '" + tt +
-                    "' target cannot be compiled into a goal sequence: the transition is not "
-                    "followed");
-        t.target = -1;
         target = true;
+        t.target = -1;
+        t.prob.clear();
+        if (tt == "return") {
+          b_.warn("target:return",
+                  bfsm_.where(c) +
+                      ": a 'return' target cannot be compiled into a goal sequence: the "
+                      "transition is not followed");
+          continue;
+        }
+        // Menge's ProbTarget: each <State name weight> (weight default 1), drawn in proportion.
+        double total = 0;
+        for (xml_node e = c.first_child(); e; e = e.next_sibling()) {
+          if (e.type() != pugi::node_element) continue;
+          if (XmlFile::local(e) != "State")
+            bfsm_.fail(e, "unknown element in a prob <Target> (Menge reads <State>)");
+          const std::size_t st =
+              state_named(bfsm_, e, bfsm_.attr_string(e, "name"), "attribute 'name'");
+          const double w = bfsm_.attr_number_opt(e, "weight").value_or(1);
+          if (!(w >= 0) || !std::isfinite(w)) bfsm_.fail(e, "attribute 'weight': must be >= 0");
+          total += w;
+          t.prob.emplace_back(st, w);
+        }
+        if (!(total > 0))
+          bfsm_.fail(c,
+                     "a prob target needs a <State> with a weight > 0 (Menge's would have "
+                     "nowhere to go)");
+        t.target = TransitionDef::kProb;
       } else {
         bfsm_.fail(c, "unknown element in a <Transition> (Menge rejects it: Condition, Target)");
       }
@@ -1041,8 +1148,11 @@ class MengeReader {
       if (t.distance < 0) bfsm_.fail(cond, "attribute 'distance': must be >= 0");
     } else if (ct == "auto") {
       t.cond = TransitionDef::Cond::always;
-    } else if (ct == "timer" || ct == "AABB" || ct == "circle" || ct == "OBB" || ct == "and" ||
-               ct == "or" || ct == "not" || ct == "clear_AABB") {
+    } else if (ct == "timer") {
+      t.cond = TransitionDef::Cond::timer;
+      timer(t, cond);
+    } else if (ct == "AABB" || ct == "circle" || ct == "OBB" || ct == "and" || ct == "or" ||
+               ct == "not" || ct == "clear_AABB") {
       b_.warn("cond:" + ct, bfsm_.where(cond) + ": condition '" + ct +
                                 "' cannot be evaluated before the run: the transition is not "
                                 "followed (the chain takes the goal_reached path, if any)");
@@ -1356,7 +1466,7 @@ class MengeReader {
       const xml_node& origin =
           gen.type == Generator::Type::explicit_ ? gen.points[i].second : gen.node;
       const std::string where = scene_.where(origin);
-      const nlohmann::json goals = compile(g.state, pos, rng, where, !frozen);
+      const nlohmann::json goals = compile(g.state, pos, rng, where, !frozen, max_speed);
       nlohmann::json row = {{"x", pos.x},
                             {"y", pos.y},
                             {"radius", radius},
@@ -1394,7 +1504,11 @@ class MengeReader {
   }
 
   // The goal the state's selector gives an agent at `pos`.
-  Picked pick(std::size_t si, Vec2 pos, Rng& rng, std::map<std::size_t, Picked>& chosen) {
+  // `again`: the agent has gone round a loop of the state machine. Capacities are counted at
+  // start-up only (every first assignment held for the whole run); who holds a goal on a later
+  // round depends on the run, so those picks ignore them.
+  Picked pick(std::size_t si, Vec2 pos, Rng& rng, std::map<std::size_t, Picked>& chosen,
+              bool again) {
     using T = SelectorDef::Type;
     StateDef& s = states_[si];
     SelectorDef& d = s.sel;
@@ -1402,7 +1516,7 @@ class MengeReader {
       // Menge shares the selector object and makes it persistent: the agent keeps the goal it
       // got in that state, or gets one from that state's selector now.
       if (const auto it = chosen.find(d.shared_state); it != chosen.end()) return it->second;
-      Picked p = pick(d.shared_state, pos, rng, chosen);
+      Picked p = pick(d.shared_state, pos, rng, chosen, again);
       chosen[d.shared_state] = p;
       return p;
     }
@@ -1423,10 +1537,11 @@ class MengeReader {
         break;
     }
     GoalSetDef& set = sets_[d.set];
+    pick_work_ += set.goals.size();
     GoalDef* chosen_goal = nullptr;
     if (d.type == T::explicit_) {
       chosen_goal = &set.goals[d.goal];
-      if (chosen_goal->assigned >= chosen_goal->capacity)
+      if (!again && chosen_goal->assigned >= chosen_goal->capacity)
         b_.warn("capacity", bfsm_.where(chosen_goal->node) +
                                 ": more agents are sent to this goal than its capacity " +
                                 std::to_string(chosen_goal->capacity) +
@@ -1435,7 +1550,7 @@ class MengeReader {
     } else {
       std::vector<GoalDef*> avail;
       for (GoalDef& g : set.goals)
-        if (g.assigned < g.capacity) avail.push_back(&g);
+        if (again || g.assigned < g.capacity) avail.push_back(&g);
       if (avail.empty()) {
         if (set.goals.empty())
           bfsm_.fail(d.node, "goal set " + std::to_string(set.id) + " has no goals");
@@ -1469,7 +1584,7 @@ class MengeReader {
         }
       }
     }
-    ++chosen_goal->assigned;
+    if (!again) ++chosen_goal->assigned;
     p.shape = chosen_goal->shape;
     p.origin = bfsm_.where(chosen_goal->node);
     return p;
@@ -1478,7 +1593,9 @@ class MengeReader {
   static double sq(Vec2 a, Vec2 b) { return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y); }
 
   // Menge's goal_reached region for distance d, as a crowddb goal.
-  std::string reach_goal(const Picked& g, double d, const xml_node& cond) {
+  // `wait`: the goal's wait (a timer of the state the agent stands in once there).
+  std::string reach_goal(const Picked& g, double d, const xml_node& cond,
+                         const nlohmann::json& wait = nullptr) {
     const Shape& s = g.shape;
     switch (s.kind) {
       case Shape::Kind::point:
@@ -1490,12 +1607,12 @@ class MengeReader {
                       ": the goal is a disc of " + fmt(kMinReach) + " m");
           d = kMinReach;
         }
-        return b_.disc_goal(s.p, d, g.origin);
+        return b_.disc_goal(s.p, d, g.origin, wait);
       case Shape::Kind::circle:
-        return b_.disc_goal(s.p, s.r + d, g.origin);  // Menge measures to the perimeter
+        return b_.disc_goal(s.p, s.r + d, g.origin, wait);  // Menge measures to the perimeter
       case Shape::Kind::aabb:
       case Shape::Kind::obb:
-        return b_.area_goal(s.box(d), g.origin);
+        return b_.area_goal(s.box(d), g.origin, wait);
     }
     return {};
   }
@@ -1509,27 +1626,107 @@ class MengeReader {
   }
 
   // The agent's goal sequence; `agent` names it (a goal where it stands is named by it).
-  // `walks`: false for an agent with pref_speed 0 (it stands in every state).
+  // `walks`: false for an agent with pref_speed 0 (it stands in every state). `max_speed` bounds
+  // how soon it can get anywhere: a machine that loops is followed round until the project's
+  // duration has passed even at that speed, with every timer at its shortest.
   nlohmann::json compile(std::size_t start, Vec2 pos, Rng& rng, const std::string& agent,
-                         bool walks) {
+                         bool walks, double max_speed) {
     nlohmann::json seq = nlohmann::json::array();
     std::vector<char> visited(states_.size(), 0);
     std::map<std::size_t, Picked> chosen;
     bool final = false;
     std::size_t si = start;
+    double least_time = 0;  // [s] the least time the sequence so far can take
+    std::size_t idle = 0;   // transitions since the sequence last grew
+    bool again = false;     // gone round a loop
+    // The goal reached last and its reach distance (a timer's wait is spent there); `pending`:
+    // reached, but not yet in `seq`, so that the wait of a timer right after joins it.
+    struct Reach {
+      Picked g;
+      double d;
+      xml_node cond;
+    };
+    std::optional<Reach> here, pending;
+    auto put = [&](nlohmann::json goal) {
+      seq.push_back(std::move(goal));
+      ++visits_;
+      idle = 0;
+    };
+    auto flush = [&] {
+      if (pending) put(reach_goal(pending->g, pending->d, pending->cond));
+      pending.reset();
+    };
+    // Room for another goal? The first round is bounded by the states; the rounds of a loop
+    // by the caps.
+    auto room = [&] {
+      if (!again ||
+          (seq.size() < kMaxVisits && visits_ < kMaxVisitsInAll && pick_work_ < kMaxPickWork))
+        return true;
+      b_.warn("visits", bfsm_.where(states_[si].node) + ": a loop's goal sequence is cut at " +
+                            std::to_string(kMaxVisits) + " goals (in all the sequences at " +
+                            std::to_string(kMaxVisitsInAll) + " goals, or " +
+                            std::to_string(kMaxPickWork) +
+                            " goals looked at by the selectors): the agent stands after its "
+                            "last one");
+      return false;
+    };
     auto stand = [&] {
+      flush();
       if (seq.empty()) seq.push_back(b_.disc_goal(pos, kMinReach, agent));
     };
-    auto cycle = [&](const TransitionDef& t) {
-      b_.warn("cycle", bfsm_.where(t.node) +
-                           ": the state machine loops back to a state the agent has been in: the "
-                           "goal sequence ends before the loop");
+    // Moves the agent on along `t` (its target drawn if it is a prob target); false: the
+    // sequence ends here.
+    auto follow = [&](const TransitionDef& t) {
+      std::size_t to = 0;
+      if (t.target >= 0) {
+        to = static_cast<std::size_t>(t.target);
+      } else {  // Menge's ProbTarget: the first state whose running weight exceeds the draw
+        double total = 0;
+        for (const auto& [st, w] : t.prob) total += w;
+        const double draw = total * rng.uniform();
+        double acc = 0;
+        for (const auto& [st, w] : t.prob) {
+          to = st;
+          acc += w;
+          if (acc > draw) break;
+        }
+      }
+      if (visited[to]) {
+        if (!(set_.duration > 0)) {
+          b_.warn("cycle", bfsm_.where(t.node) +
+                               ": the state machine loops back to a state the agent has been "
+                               "in, and the project has no duration: the goal sequence ends "
+                               "before the loop");
+          return false;
+        }
+        if (!unrolled_said_) {
+          unrolled_said_ = true;
+          b_.warn("cycle-unrolled",
+                  bfsm_.where(t.node) +
+                      ": the state machine loops back to a state the agent has been in: each "
+                      "agent's goal sequence follows it round (random goals and prob targets "
+                      "drawn again on every round) until the project's duration (" +
+                      fmt(set_.duration) + " s) has passed at the least");
+        }
+        if (least_time > set_.duration) return false;
+        again = true;
+      }
+      if (++idle > 2 * states_.size() + 2) {  // round and round without walking or waiting
+        b_.warn("cycle", bfsm_.where(t.node) +
+                             ": the state machine loops without a walk or a wait: the goal "
+                             "sequence ends there");
+        return false;
+      }
+      si = to;
+      return true;
     };
     while (true) {
       visited[si] = 1;
       const StateDef& s = states_[si];
       const Motion motion = walks ? s.motion : Motion::stand;
-      const Picked g = pick(si, pos, rng, chosen);
+      const auto kept = chosen.find(si);
+      const Picked g = s.sel.persistent && kept != chosen.end() ? kept->second
+                                                                : pick(si, pos, rng, chosen, again);
       chosen[si] = g;
       if (s.final) {
         if (motion != Motion::stand && g.shape.sqdist(pos) > 0)
@@ -1544,7 +1741,7 @@ class MengeReader {
       // A transition that holds on entry fires at once (Menge tests them before moving).
       const TransitionDef* now = nullptr;
       for (const TransitionDef& t : s.out) {
-        if (t.target < 0) continue;
+        if (!t.followable()) continue;
         if (t.cond == TransitionDef::Cond::always ||
             (t.cond == TransitionDef::Cond::goal_reached &&
              g.shape.sqdist(pos) <= t.distance * t.distance)) {
@@ -1553,37 +1750,69 @@ class MengeReader {
         }
       }
       if (now) {
-        if (visited[static_cast<std::size_t>(now->target)]) {
-          cycle(*now);
+        if (!follow(*now)) {
           stand();
           break;
         }
-        si = static_cast<std::size_t>(now->target);
         continue;
       }
+      const TransitionDef* timer = nullptr;
+      for (const TransitionDef& t : s.out)
+        if (t.followable() && t.cond == TransitionDef::Cond::timer) {
+          timer = &t;
+          break;
+        }
       if (motion == Motion::stand || !(g.shape.sqdist(pos) > 0)) {
-        stand();  // nothing moves the agent: it stays in this state
-        break;
+        // Nothing moves the agent: it stands in this state until a timer takes it on.
+        if (!timer) {
+          stand();
+          break;
+        }
+        if (!timer->wait.is_null()) {
+          // The wait is spent where the agent stands: the goal it has just reached (the wait
+          // joins it), the one it reached before, or its spot.
+          if (pending) {
+            put(reach_goal(pending->g, pending->d, pending->cond, timer->wait));
+            pending.reset();
+          } else if (!room()) {
+            break;
+          } else {
+            put(here ? reach_goal(here->g, here->d, here->cond, timer->wait)
+                     : b_.disc_goal(pos, kMinReach, agent, timer->wait));
+          }
+          least_time += timer->least_wait;
+        }
+        if (!follow(*timer)) {
+          stand();
+          break;
+        }
+        continue;
       }
       if (motion == Motion::navigate) navigate_ = true;
+      if (timer)
+        b_.warn("timer-walk", bfsm_.where(timer->cond_node) +
+                                  ": a timer in a state whose agents walk cannot be compiled (it "
+                                  "may fire before the goal is reached): the chain takes the "
+                                  "goal_reached path, if any");
       const TransitionDef* next = nullptr;
       for (const TransitionDef& t : s.out)
-        if (t.target >= 0 && t.cond == TransitionDef::Cond::goal_reached) {
+        if (t.followable() && t.cond == TransitionDef::Cond::goal_reached) {
           next = &t;
           break;
         }
+      flush();
+      if (!room()) break;
       if (!next) {
-        seq.push_back(end_goal(g));
+        put(end_goal(g));
         break;
       }
-      seq.push_back(reach_goal(g, next->distance, next->cond_node));
+      pending = here = Reach{g, next->distance, next->cond_node};
+      idle = 0;
+      least_time += std::max(0.0, std::sqrt(g.shape.sqdist(pos)) - next->distance) / max_speed;
       pos = g.shape.centroid();
-      if (visited[static_cast<std::size_t>(next->target)]) {
-        cycle(*next);
-        break;
-      }
-      si = static_cast<std::size_t>(next->target);
+      if (!follow(*next)) break;
     }
+    stand();
     all_final_ &= final;
     return seq;
   }
@@ -1715,6 +1944,10 @@ class MengeReader {
   std::optional<OrcaValues> orca_values_;
   bool navigate_ = false;
   bool all_final_ = true;
+  uint64_t timers_ = 0;         // timers drawn once at load so far
+  std::size_t visits_ = 0;      // goals in the sequences compiled so far
+  std::size_t pick_work_ = 0;   // goals looked at by the picks so far
+  bool unrolled_said_ = false;  // the warning that a loop is followed round was given
 };
 
 }  // namespace

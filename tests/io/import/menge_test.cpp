@@ -710,15 +710,244 @@ TEST(MengeWarnings, UnsupportedElementsOneLineEach) {
   const auto& w = im.warnings;
   EXPECT_TRUE(has_warning(w, "b.xml:6: <Action>", "set_property"));
   EXPECT_TRUE(has_warning(w, "b.xml:7: <VelModifier>", "scale"));
-  EXPECT_TRUE(has_warning(w, "b.xml:11: <Condition>", "(and 1 more like it)"));  // two timers
-  EXPECT_TRUE(has_warning(w, "b.xml:14: <Target>", "prob"));
+  // A timer where the agent walks may fire on the way: not compiled.
+  EXPECT_TRUE(has_warning(w, "b.xml:11: <Condition>", "a timer in a state whose agents walk"));
   EXPECT_TRUE(has_warning(w, "b.xml:16: <Task>", "whatever"));
   EXPECT_TRUE(has_warning(w, "b.xml:17: <EventSystem>", "not supported"));
   for (const std::string& line : w) EXPECT_EQ(line.find('\n'), std::string::npos);
-  // The goal_reached path is followed: the one with a plain target.
+  // The first goal_reached transition is followed, its prob target drawn (one state).
   const auto seq = sequence(im.doc, 0);
   ASSERT_EQ(seq.size(), 1u);
-  expect_disc(seq[0], 6, 0, 0.4);
+  expect_disc(seq[0], 6, 0, 0.3);
+  EXPECT_EQ(im.doc["stop_when_all_arrived"], true);
+}
+
+// -- timers, prob targets and loops (Menge's tradeshow) -------------------------------------
+
+// Walk to a random booth; stand there 2-4 s (Arrive); then, drawn 1:1, 4-6 s (Happy) or 1-2 s
+// (Angry); then walk to another booth, round and round.
+const std::string kBooths = R"(<BFSM>
+  <GoalSet id="0">
+    <Goal type="AABB" id="0" min_x="10" min_y="0" max_x="11" max_y="1" />
+    <Goal type="AABB" id="1" min_x="-11" min_y="0" max_x="-10" max_y="1" />
+  </GoalSet>
+  <State name="Walk" final="0">
+    <GoalSelector type="random" goal_set="0" per_agent="1" />
+    <VelComponent type="goal" />
+  </State>
+  <State name="Arrive" final="0"><VelComponent type="zero" /></State>
+  <State name="Decide" final="0"><VelComponent type="zero" /></State>
+  <State name="Happy" final="0"><VelComponent type="zero" /></State>
+  <State name="Angry" final="0"><VelComponent type="zero" /></State>
+  <Transition from="Walk" to="Arrive"><Condition type="goal_reached" distance="0.4" /></Transition>
+  <Transition from="Arrive" to="Decide">
+    <Condition type="timer" dist="u" min="4" max="2" seed="5" per_agent="1" /></Transition>
+  <Transition from="Decide"><Condition type="auto" />
+    <Target type="prob"><State name="Happy" weight="1.0" /><State name="Angry" weight="1.0" /></Target>
+  </Transition>
+  <Transition from="Happy" to="Walk"><Condition type="timer" dist="u" min="4" max="6" per_agent="1" /></Transition>
+  <Transition from="Angry" to="Walk"><Condition type="timer" dist="c" value="1.5" per_agent="1" /></Transition>
+</BFSM>
+)";
+
+TEST(MengeBehaviour, TimersBecomeWaitsAndLoopsAreFollowedRound) {
+  io::ProjectSettings set;
+  set.duration = 120;
+  const io::Imported im = pair(scene(group(agents({{0, 0}, {0, 3}}))), kBooths, set);
+  EXPECT_EQ(im.doc["stop_when_all_arrived"], false);
+  EXPECT_TRUE(has_warning(im.warnings, "b.xml:", "follows it round"));
+  EXPECT_TRUE(has_warning(im.warnings, "b.xml:16: <Condition>", "seed attributes"));
+  for (std::size_t a = 0; a < 2; ++a) {
+    const auto seq = sequence(im.doc, a);
+    // Each visit: the booth reached, with Arrive's wait (min and max in either order), then
+    // the booth again with Happy's or Angry's; the sequence may end anywhere in a visit, and
+    // the last booth reached without its wait.
+    int happy = 0, angry = 0;
+    for (std::size_t k = 0; k < seq.size(); ++k) {
+      if (!seq[k].contains("wait")) {
+        EXPECT_EQ(k + 1, seq.size()) << "only the last goal has no wait";
+        continue;
+      }
+      if (seq[k]["wait"] == json({2.0, 4.0})) {
+        if (k + 1 < seq.size() && seq[k + 1].contains("wait")) {
+          EXPECT_EQ(seq[k]["area"], seq[k + 1]["area"]) << k;
+        }
+      } else if (seq[k]["wait"] == json({4.0, 6.0})) {
+        ++happy;
+      } else {
+        EXPECT_EQ(seq[k]["wait"], json(1.5)) << k;
+        ++angry;
+      }
+      if (seq[k]["wait"] != json({2.0, 4.0})) {
+        ASSERT_GT(k, 0u);
+        EXPECT_EQ(seq[k - 1]["wait"], json({2.0, 4.0})) << k;
+      }
+    }
+    EXPECT_GT(happy, 0);
+    EXPECT_GT(angry, 0);
+    // Booths 21 m apart at most (max_speed 2 m/s), or the same booth again; every round waits
+    // 3.5 s at the least: the sequence lasts past the duration, and not many rounds more.
+    EXPECT_GT(seq.size(), 2 * 120 / 16.5);
+    EXPECT_LT(seq.size(), 2 * (120 / 3.5 + 2));
+  }
+  // Drawn from the project's seed: the same again, and not the same agent twice.
+  EXPECT_EQ(pair(scene(group(agents({{0, 0}, {0, 3}}))), kBooths, set).doc, im.doc);
+  EXPECT_NE(im.doc["agents"][0]["goal"], im.doc["agents"][1]["goal"]);
+}
+
+TEST(MengeBehaviour, WithoutADurationTheSequenceEndsBeforeTheLoop) {
+  io::ProjectSettings set;
+  set.duration = 0;
+  const io::Imported im = pair(scene(group(agents({{0, 0}}))), kBooths, set);
+  const auto seq = sequence(im.doc, 0);
+  ASSERT_EQ(seq.size(), 2u);  // the first booth and its two waits
+  EXPECT_EQ(seq[0]["wait"], json({2.0, 4.0}));
+  EXPECT_TRUE(has_warning(im.warnings, "b.xml:", "no duration"));
+}
+
+TEST(MengeBehaviour, SharedTimerDrawnOnceAndZeroTimeLoopsEnd) {
+  // per_agent="0": one duration for everyone. Stand 0-10 s at the start (no goal reached: the
+  // agent's spot), then Ping and Pong hand over at once for ever.
+  const std::string b = R"(<BFSM>
+  <State name="Start" final="0"><VelComponent type="zero" /></State>
+  <State name="Ping" final="0"><VelComponent type="zero" /></State>
+  <State name="Pong" final="0"><VelComponent type="zero" /></State>
+  <Transition from="Start" to="Ping"><Condition type="timer" dist="u" min="0" max="10" per_agent="0" /></Transition>
+  <Transition from="Ping" to="Pong"><Condition type="auto" /></Transition>
+  <Transition from="Pong" to="Ping"><Condition type="auto" /></Transition>
+</BFSM>
+)";
+  const io::Imported im = pair(scene(group(agents({{0, 0}, {3, 0}, {6, 0}}), "Start")), b);
+  double wait = -1;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const auto seq = sequence(im.doc, a);
+    ASSERT_EQ(seq.size(), 1u);
+    expect_disc(seq[0], 3.0 * static_cast<double>(a), 0, 0.05);
+    ASSERT_TRUE(seq[0]["wait"].is_number()) << seq[0];
+    if (a == 0) wait = seq[0]["wait"].get<double>();
+    EXPECT_EQ(seq[0]["wait"].get<double>(), wait);
+  }
+  EXPECT_GT(wait, 0);
+  EXPECT_LT(wait, 10);
+  EXPECT_TRUE(has_warning(im.warnings, "b.xml:", "loops without a walk or a wait"));
+}
+
+TEST(MengeBehaviour, NormalTimersAndBadTimers) {
+  const std::string b = R"(<BFSM>
+  <State name="Start" final="0"><VelComponent type="zero" /></State>
+  <State name="Stop" final="1" />
+  <Transition from="Start" to="Stop"><Condition type="timer" dist="n" mean="5" stddev="1" per_agent="1" /></Transition>
+</BFSM>
+)";
+  const io::Imported im = pair(scene(group(agents({{0, 0}}), "Start")), b);
+  const auto seq = sequence(im.doc, 0);
+  ASSERT_EQ(seq.size(), 1u);
+  EXPECT_NEAR(seq[0]["wait"][0].get<double>(), 5 - std::sqrt(3.0), 1e-12);
+  EXPECT_NEAR(seq[0]["wait"][1].get<double>(), 5 + std::sqrt(3.0), 1e-12);
+  EXPECT_TRUE(has_warning(im.warnings, "b.xml:4: <Condition>", "same mean and spread"));
+  EXPECT_EQ(im.doc["stop_when_all_arrived"], true);
+  std::string bad = b;
+  bad.replace(bad.find(" per_agent=\"1\""), 14, "");
+  EXPECT_NE(error_of(scene(group(agents({{0, 0}}), "Start")), bad).find("'per_agent'"),
+            std::string::npos);
+  bad = b;
+  bad.replace(bad.find("dist=\"n\""), 8, "dist=\"w\"");
+  EXPECT_NE(error_of(scene(group(agents({{0, 0}}), "Start")), bad).find("unknown distribution"),
+            std::string::npos);
+  const std::string prob = R"(<BFSM>
+  <State name="Start" final="0"><VelComponent type="zero" /></State>
+  <State name="Stop" final="1" />
+  <Transition from="Start"><Condition type="auto" />
+    <Target type="prob"><State name="Stop" weight="0" /></Target></Transition>
+</BFSM>
+)";
+  EXPECT_NE(error_of(scene(group(agents({{0, 0}}), "Start")), prob).find("weight > 0"),
+            std::string::npos);
+}
+
+// A loop whose walks take hardly any time (0.05 m beyond the reach each) is cut at 1,000 goals.
+TEST(MengeBehaviour, LoopsWithoutTimeAreCut) {
+  const std::string b = R"(<BFSM>
+  <GoalSet id="0">
+    <Goal type="point" id="0" x="1" y="0" />
+    <Goal type="point" id="1" x="1" y="0.15" />
+  </GoalSet>
+  <State name="A" final="0">
+    <GoalSelector type="explicit" goal_set="0" goal="0" />
+    <VelComponent type="goal" />
+  </State>
+  <State name="B" final="0">
+    <GoalSelector type="explicit" goal_set="0" goal="1" />
+    <VelComponent type="goal" />
+  </State>
+  <Transition from="A" to="B"><Condition type="goal_reached" distance="0.1" /></Transition>
+  <Transition from="B" to="A"><Condition type="goal_reached" distance="0.1" /></Transition>
+</BFSM>
+)";
+  const io::Imported im = pair(scene(group(agents({{0, 0}}), "A")), b);
+  EXPECT_EQ(im.doc["agents"][0]["goal"].size(), 1000u);
+  EXPECT_TRUE(has_warning(im.warnings, "b.xml:", "cut at 1000 goals"));
+  EXPECT_NO_THROW(parse_scenario(im.doc.dump(), "loop.json"));
+}
+
+// Capacities are counted at start-up; on later rounds of a loop every goal may be picked.
+TEST(MengeBehaviour, CapacitiesHoldAtStartUpOnly) {
+  const std::string b = R"(<BFSM>
+  <GoalSet id="0">
+    <Goal type="point" id="0" x="1" y="0" capacity="1" />
+    <Goal type="point" id="1" x="2" y="0" capacity="1" />
+  </GoalSet>
+  <GoalSet id="1"><Goal type="point" id="0" x="0" y="5" /></GoalSet>
+  <State name="Box" final="0">
+    <GoalSelector type="nearest" goal_set="0" />
+    <VelComponent type="goal" />
+  </State>
+  <State name="Out" final="0">
+    <GoalSelector type="explicit" goal_set="1" goal="0" />
+    <VelComponent type="goal" />
+  </State>
+  <Transition from="Box" to="Out"><Condition type="goal_reached" distance="0.1" /></Transition>
+  <Transition from="Out" to="Box"><Condition type="goal_reached" distance="0.1" /></Transition>
+</BFSM>
+)";
+  io::ProjectSettings set;
+  set.duration = 30;
+  const io::Imported im = pair(scene(group(agents({{0, 0}, {0, 1}}), "Box")), b, set);
+  const auto first = sequence(im.doc, 0), second = sequence(im.doc, 1);
+  ASSERT_GT(first.size(), 4u);
+  ASSERT_GT(second.size(), 4u);
+  expect_disc(first[0], 1, 0, 0.1);
+  expect_disc(second[0], 2, 0, 0.1);  // the nearest is taken at start-up
+  expect_disc(second[1], 0, 5, 0.1);
+  expect_disc(second[2], 1, 0, 0.1);  // later, the nearest to (0, 5)
+  expect_disc(first[2], 1, 0, 0.1);
+  EXPECT_FALSE(has_warning(im.warnings, "b.xml:", "capacity")) << im.warnings[0];
+}
+
+// A converted tradeshow-like project runs: visitors go from booth to booth and wait there.
+TEST(MengeBehaviour, VisitorsGoRoundTheBooths) {
+  io::ProjectSettings set;
+  set.duration = 60;
+  const io::Imported im = pair(scene(group(agents({{0, 0}, {0, 3}, {0, -3}}))), kBooths, set);
+  Scenario sc = parse_scenario(im.doc.dump(), "booths.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  int waiting_ticks = 0, walking_after_a_wait = 0;
+  bool waited = false;
+  for (int k = 0; k < 600; ++k) {
+    sim.step();
+    const AgentTable& t = sim.world().agents();
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (t.state[i] == AgentState::waiting) {
+        ++waiting_ticks;
+        waited = true;
+      } else if (waited && t.state[i] == AgentState::active) {
+        ++walking_after_a_wait;
+      }
+    }
+  }
+  EXPECT_GT(waiting_ticks, 3 * 20);  // each at least one 2-4 s wait
+  EXPECT_GT(walking_after_a_wait, 0);
+  EXPECT_EQ(sim.world().agents().size(), 3u);
 }
 
 TEST(MengeWarnings, BooleansReadAsIntegers) {
