@@ -1024,6 +1024,35 @@ class MengeReader {
     return it->second;
   }
 
+  // A float distribution given by attributes with `prefix`: dist="c" value, "u" min max, "n"
+  // mean stddev (Menge's FloatGenerator; generator noise uses "displace_", timers none).
+  Dist read_dist(const XmlFile& f, const xml_node& n, const std::string& prefix) {
+    const auto key = [&](const char* name) { return prefix + name; };
+    if (n.attribute(key("seed").c_str()))
+      b_.warn("seed", f.where(n) +
+                          ": seed attributes are ignored: every draw comes from the "
+                          "project's random seed");
+    const std::string t = f.attr_string(n, key("dist").c_str());
+    Dist d;
+    d.node = n;
+    if (t == "c") {
+      d.a = f.attr_number(n, key("value").c_str());
+    } else if (t == "u") {
+      d.kind = Dist::Kind::u;
+      d.a = f.attr_number(n, key("min").c_str());
+      d.b = f.attr_number(n, key("max").c_str());
+    } else if (t == "n") {
+      d.kind = Dist::Kind::n;
+      d.a = f.attr_number(n, key("mean").c_str());
+      d.b = f.attr_number(n, key("stddev").c_str());
+      if (d.b < 0) f.fail(n, "attribute '" + key("stddev") + "': must be >= 0");
+    } else {
+      f.fail(n,
+             "attribute '" + key("dist") + "': unknown distribution '" + clip(t) + "' (c, u or n)");
+    }
+    return d;
+  }
+
   // Menge's TimerCondition: the agent leaves its state once a duration drawn on entry has
   // passed (per_agent="1": drawn per agent and entry; "0": one value drawn at load for all). It
   // becomes the wait of a goal where the agent stands (docs/importers/menge.md, "Behaviour").
@@ -1031,33 +1060,8 @@ class MengeReader {
     const pugi::xml_attribute per = cond.attribute("per_agent");
     if (!per) bfsm_.fail(cond, "missing attribute 'per_agent' (Menge requires it on a timer)");
     const bool per_agent = flag(bfsm_, b_, cond, "per_agent", true);
-    if (cond.attribute("seed"))
-      b_.warn("seed", bfsm_.where(cond) +
-                          ": seed attributes are ignored: every draw comes from the "
-                          "project's random seed");
-    const std::string kind = bfsm_.attr_string(cond, "dist");
-    auto num = [&](const char* key) {
-      const double v = bfsm_.attr_number(cond, key);
-      if (!std::isfinite(v)) bfsm_.fail(cond, std::string("attribute '") + key + "': not finite");
-      return v;
-    };
-    Dist d;
-    d.node = cond;
-    if (kind == "c") {
-      d.a = num("value");
-    } else if (kind == "u") {
-      d.kind = Dist::Kind::u;
-      d.a = num("min");
-      d.b = num("max");
-      if (d.a > d.b) std::swap(d.a, d.b);
-    } else if (kind == "n") {
-      d.kind = Dist::Kind::n;
-      d.a = num("mean");
-      d.b = num("stddev");
-      if (d.b < 0) bfsm_.fail(cond, "attribute 'stddev': must be >= 0");
-    } else {
-      bfsm_.fail(cond, "attribute 'dist': unknown distribution '" + clip(kind) + "' (c, u or n)");
-    }
+    Dist d = read_dist(bfsm_, cond, "");
+    if (d.kind == Dist::Kind::u && d.a > d.b) std::swap(d.a, d.b);
     if (!per_agent) {  // one value for everyone, as Menge's loader draws it
       Rng once = Rng::stream(seed(), kTimerStream - timers_++);
       d = Dist::constant(d.sample(once, false), cond);
@@ -1357,31 +1361,7 @@ class MengeReader {
     g.anchor = {anchor.x - g.c * actual_width * k, anchor.y - g.s * actual_width * k};
   }
 
-  Dist noise(const xml_node& n) {
-    const std::string t = scene_.attr_string(n, "displace_dist");
-    if (n.attribute("displace_seed"))
-      b_.warn("seed", scene_.where(n) +
-                          ": seed attributes are ignored: every draw comes from the "
-                          "project's random seed");
-    Dist d;
-    d.node = n;
-    if (t == "c") {
-      d.a = scene_.attr_number(n, "displace_value");
-    } else if (t == "u") {
-      d.kind = Dist::Kind::u;
-      d.a = scene_.attr_number(n, "displace_min");
-      d.b = scene_.attr_number(n, "displace_max");
-    } else if (t == "n") {
-      d.kind = Dist::Kind::n;
-      d.a = scene_.attr_number(n, "displace_mean");
-      d.b = scene_.attr_number(n, "displace_stddev");
-      if (d.b < 0) scene_.fail(n, "attribute 'displace_stddev': must be >= 0");
-    } else {
-      scene_.fail(n,
-                  "attribute 'displace_dist': unknown distribution '" + clip(t) + "' (c, u or n)");
-    }
-    return d;
-  }
+  Dist noise(const xml_node& n) { return read_dist(scene_, n, "displace_"); }
 
   // A sampled value that crowddb requires > 0, named by where it was given.
   double positive(const Dist& d, Rng& rng, const Profile& p, const char* what) {
