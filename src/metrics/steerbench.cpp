@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
+#include "crowddb/error.hpp"
 #include "util/byte_codec.hpp"
 #include "world/geometry.hpp"
 
@@ -17,8 +19,53 @@ uint64_t cell_key(int64_t cx, int64_t cy) {
 
 }  // namespace
 
-uint32_t SteerBench::open_track(uint64_t id, Track tr) {
-  tr.id = id;
+std::size_t SteerBench::IdIndex::home(uint64_t id) const {
+  uint64_t z = id * 0x9e3779b97f4a7c15ull;  // Fibonacci hashing: ids are often consecutive
+  z ^= z >> 29;
+  return static_cast<std::size_t>(z) & (keys_.size() - 1);
+}
+
+uint32_t SteerBench::IdIndex::find(uint64_t id) const {
+  if (keys_.empty()) return kNone;
+  for (std::size_t s = home(id);; s = (s + 1) & (keys_.size() - 1)) {
+    if (values_[s] == kNone) return kNone;
+    if (keys_[s] == id) return values_[s];
+  }
+}
+
+void SteerBench::IdIndex::insert(uint64_t id, uint32_t value) {
+  if (2 * (size_ + 1) > keys_.size()) {  // at most half full
+    std::vector<uint64_t> keys = std::move(keys_);
+    std::vector<uint32_t> values = std::move(values_);
+    const std::size_t cap = std::max<std::size_t>(64, 2 * keys.size());
+    keys_.assign(cap, 0);
+    values_.assign(cap, kNone);
+    size_ = 0;
+    for (std::size_t s = 0; s < keys.size(); ++s)
+      if (values[s] != kNone) insert(keys[s], values[s]);
+  }
+  std::size_t s = home(id);
+  while (values_[s] != kNone) s = (s + 1) & (keys_.size() - 1);
+  keys_[s] = id;
+  values_[s] = value;
+  ++size_;
+}
+
+void SteerBench::IdIndex::clear() {
+  keys_.clear();
+  values_.clear();
+  size_ = 0;
+}
+
+void SteerBench::open_score(uint64_t id) {
+  if (scores_.size() >= IdIndex::kNone - 1)
+    throw Error(Error::Kind::input, "steerbench: more than 2^32 - 2 agents measured in one run");
+  known_.insert(id, static_cast<uint32_t>(scores_.size()));
+  scores_.push_back({.id = id});
+  score_slot_.push_back(kNoSlot);
+}
+
+uint32_t SteerBench::open_track(Track tr) {
   tr.live = true;
   uint32_t slot;
   if (!free_slots_.empty()) {
@@ -29,8 +76,13 @@ uint32_t SteerBench::open_track(uint64_t id, Track tr) {
     slot = static_cast<uint32_t>(tracks_.size());
     tracks_.push_back(tr);
   }
-  active_.emplace(id, slot);
+  score_slot_[tr.score] = slot;
   return slot;
+}
+
+uint32_t SteerBench::slot_of(uint64_t id) const {
+  const uint32_t score = known_.find(id);
+  return score == IdIndex::kNone ? kNoSlot : score_slot_[score];
 }
 
 void SteerBench::store_sums(const Track& tr) const {
@@ -45,7 +97,7 @@ void SteerBench::close_track(uint32_t slot) {
   Track& tr = tracks_[slot];
   store_sums(tr);
   scores_[tr.score].arrived = true;
-  active_.erase(tr.id);
+  score_slot_[tr.score] = kNoSlot;
   tr.live = false;
   free_slots_.push_back(slot);
 }
@@ -53,11 +105,17 @@ void SteerBench::close_track(uint32_t slot) {
 void SteerBench::start(const World& world) {
   tick_ = 0;
   const AgentTable& t = world.agents();
+  // Exactly, and without the copies of a doubling vector.
+  scores_.reserve(scores_.size() + t.size());
+  score_slot_.reserve(score_slot_.size() + t.size());
+  tracks_.reserve(tracks_.size() + t.size());
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (t.state[i] == AgentState::arrived) continue;
-    scores_.push_back({.id = t.id[i]});
-    known_.insert(t.id[i]);
-    open_track(t.id[i], Track{scores_.size() - 1, t.x[i], t.y[i]});
+    open_score(t.id[i]);
+    Track tr{t.x[i], t.y[i]};
+    tr.id = t.id[i];
+    tr.score = static_cast<uint32_t>(scores_.size() - 1);
+    open_track(tr);
   }
 }
 
@@ -71,16 +129,19 @@ void SteerBench::tick(const World& world, const TickMetrics& m) {
     uint32_t slot = row_slot_[i];
     if (slot == kNoSlot || !tracks_[slot].live || tracks_[slot].id != id) {
       ++moved;
-      const auto it = active_.find(id);
-      slot = it == active_.end() ? kNoSlot : it->second;
+      slot = slot_of(id);
       row_slot_[i] = slot;
     }
     if (slot == kNoSlot) {
       // New in the table (a source, an insert): measured from here on. An agent measured before
       // and closed on arrival stays closed.
-      if (t.state[i] == AgentState::arrived || !known_.insert(id).second) continue;
-      scores_.push_back({.id = id});
-      row_slot_[i] = open_track(id, Track{scores_.size() - 1, t.x[i], t.y[i], 0, 0, false, tick_});
+      if (t.state[i] == AgentState::arrived || known_.find(id) != IdIndex::kNone) continue;
+      open_score(id);
+      Track tr{t.x[i], t.y[i]};
+      tr.id = id;
+      tr.seen = tick_;
+      tr.score = static_cast<uint32_t>(scores_.size() - 1);
+      row_slot_[i] = open_track(tr);
       continue;
     }
     Track& tr = tracks_[slot];
@@ -120,21 +181,34 @@ void SteerBench::flush() const {
 }
 
 void SteerBench::lay_out_in_row_order(const AgentTable& t) {
-  std::vector<Track> laid;
-  laid.reserve(active_.size());
+  // Each live track's new slot: its row's place among the rows holding live tracks; then the
+  // free slots. (After the tick's loop every live track is held by exactly one row.)
+  constexpr uint32_t kUnset = UINT32_MAX;
+  std::vector<uint32_t> dest(tracks_.size(), kUnset);
+  uint32_t next = 0;
   for (std::size_t i = 0; i < t.size(); ++i) {
     uint32_t& slot = row_slot_[i];
     if (slot == kNoSlot) continue;
     const Track& tr = tracks_[slot];
-    if (!tr.live || tr.id != t.id[i]) {  // closed this tick (arrived)
+    if (!tr.live || tr.id != t.id[i] || dest[slot] != kUnset) {  // closed this tick (arrived)
       slot = kNoSlot;
       continue;
     }
-    slot = static_cast<uint32_t>(laid.size());
-    active_[tr.id] = slot;
-    laid.push_back(tr);
+    dest[slot] = next;
+    slot = next++;
   }
-  tracks_ = std::move(laid);
+  const uint32_t live = next;
+  for (uint32_t& d : dest)
+    if (d == kUnset) d = next++;
+  // Cycle by cycle: each track swapped straight into its place.
+  for (uint32_t s = 0; s < tracks_.size(); ++s)
+    while (dest[s] != s) {
+      const uint32_t d = dest[s];
+      std::swap(tracks_[s], tracks_[d]);
+      std::swap(dest[s], dest[d]);
+    }
+  tracks_.resize(live);
+  for (uint32_t s = 0; s < live; ++s) score_slot_[tracks_[s].score] = s;
   free_slots_.clear();
 }
 
@@ -190,8 +264,8 @@ void SteerBench::collisions(const World& world) {
     }
   }
   auto count = [&](uint64_t id) {
-    const auto it = active_.find(id);
-    if (it != active_.end()) ++scores_[tracks_[it->second].score].collisions;
+    const uint32_t score = known_.find(id);
+    if (score != IdIndex::kNone && score_slot_[score] != kNoSlot) ++scores_[score].collisions;
   };
   for (const auto& p : pairs)
     if (!open_pairs_.count(p)) {
@@ -239,20 +313,23 @@ void SteerBench::save(ByteWriter& out) const {
     for (double v : {a.time, a.path_length, a.energy, a.acceleration}) out.f64(v);
     out.u8(a.arrived);
   }
-  // Hash containers in key order, so equal states save equal bytes.
-  std::vector<uint64_t> ids;
-  for (const auto& [id, tr] : active_) ids.push_back(id);
-  std::sort(ids.begin(), ids.end());
-  out.u64(ids.size());
-  for (uint64_t id : ids) {
-    const Track& tr = tracks_[active_.at(id)];
+  // In id order, so equal states save equal bytes (the layout of the slots does not show).
+  std::vector<std::pair<uint64_t, uint32_t>> live;  // id, slot
+  for (uint32_t slot = 0; slot < tracks_.size(); ++slot)
+    if (tracks_[slot].live) live.push_back({tracks_[slot].id, slot});
+  std::sort(live.begin(), live.end());
+  out.u64(live.size());
+  for (const auto& [id, slot] : live) {
+    const Track& tr = tracks_[slot];
     out.u64(id);
     out.u64(tr.score);
     for (double v : {tr.x, tr.y, tr.vx, tr.vy}) out.f64(v);
     out.u8(tr.has_v);
     out.u64(tr.seen);
   }
-  std::vector<uint64_t> known(known_.begin(), known_.end());
+  std::vector<uint64_t> known;
+  known.reserve(scores_.size());
+  for (const AgentScore& a : scores_) known.push_back(a.id);
   std::sort(known.begin(), known.end());
   out.vec(known);
   out.u64(open_pairs_.size());
@@ -269,22 +346,31 @@ void SteerBench::save(ByteWriter& out) const {
 
 void SteerBench::restore(ByteReader& in) {
   tick_ = in.u64();
-  scores_.resize(in.count(49));
-  for (AgentScore& a : scores_) {
+  const uint64_t count = in.count(49);
+  if (count >= IdIndex::kNone - 1) in.fail("steerbench: too many scores");
+  scores_.resize(count);
+  known_.clear();
+  score_slot_.assign(count, kNoSlot);
+  for (std::size_t k = 0; k < scores_.size(); ++k) {
+    AgentScore& a = scores_[k];
     a.id = in.u64();
     a.collisions = in.u64();
     for (double* v : {&a.time, &a.path_length, &a.energy, &a.acceleration}) *v = in.f64();
     a.arrived = in.u8() != 0;
+    if (known_.find(a.id) != IdIndex::kNone) in.fail("steerbench: an agent scored twice");
+    known_.insert(a.id, static_cast<uint32_t>(k));
   }
-  active_.clear();
   tracks_.clear();
   free_slots_.clear();
   row_slot_.clear();
   for (uint64_t k = 0, n = in.count(57); k < n; ++k) {
     const uint64_t id = in.u64();
     Track tr{};
-    tr.score = in.u64();
-    if (tr.score >= scores_.size()) in.fail("steerbench: a track without its score");
+    tr.id = id;
+    const uint64_t score = in.u64();
+    if (score >= scores_.size() || scores_[score].id != id)
+      in.fail("steerbench: a track without its score");
+    tr.score = static_cast<uint32_t>(score);
     for (double* v : {&tr.x, &tr.y, &tr.vx, &tr.vy}) *v = in.f64();
     tr.has_v = in.u8() != 0;
     tr.seen = in.u64();
@@ -293,12 +379,17 @@ void SteerBench::restore(ByteReader& in) {
     tr.path_length = s.path_length;
     tr.energy = s.energy;
     tr.acceleration = s.acceleration;
-    if (active_.count(id)) in.fail("steerbench: a track twice");
-    open_track(id, tr);
+    if (score_slot_[tr.score] != kNoSlot) in.fail("steerbench: a track twice");
+    open_track(tr);
   }
+  // The ids measured so far: those of the scores (the index above), written for the record.
   std::vector<uint64_t> known;
   in.vec(known);
-  known_ = {known.begin(), known.end()};
+  std::vector<uint64_t> ids;
+  ids.reserve(scores_.size());
+  for (const AgentScore& a : scores_) ids.push_back(a.id);
+  std::sort(ids.begin(), ids.end());
+  if (known != ids) in.fail("steerbench: the ids measured are not those scored");
   open_pairs_.clear();
   for (uint64_t k = 0, n = in.count(16); k < n; ++k) {
     const uint64_t a = in.u64();

@@ -19,8 +19,6 @@
 
 #include <cstdint>
 #include <set>
-#include <unordered_map>
-#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -68,42 +66,62 @@ class SteerBench {
   void restore(ByteReader& in);
 
  private:
+  // 88 bytes: at 10^6 agents every byte a track holds is a megabyte.
   struct Track {
-    std::size_t score;  // index in scores_
     double x, y, vx = 0, vy = 0;
-    bool has_v = false;
-    uint64_t seen = 0;  // tick it was last in the table
-    uint64_t id = 0;
-    bool live = true;  // false: the slot is free
     // The running sums, copied into scores_[score] when read (flush) and on close: scores_ is
     // in order of appearance, the rows are not, and a write there per row and tick was a cache
     // miss each.
     double time = 0, path_length = 0, energy = 0, acceleration = 0;
+    uint64_t id = 0;
+    uint64_t seen = 0;   // tick it was last in the table
+    uint32_t score = 0;  // index in scores_
+    bool has_v = false;
+    bool live = true;  // false: the slot is free
+  };
+  // Every id measured so far -> its index in scores_: open addressing with linear probing,
+  // never erased (an agent closed on arrival stays known). 12 bytes a slot at most half full,
+  // where a node-based map and set cost about 80 bytes an agent.
+  class IdIndex {
+   public:
+    static constexpr uint32_t kNone = UINT32_MAX;
+    uint32_t find(uint64_t id) const;
+    void insert(uint64_t id, uint32_t value);  // id not present
+    void clear();
+
+   private:
+    std::size_t home(uint64_t id) const;
+    std::vector<uint64_t> keys_;
+    std::vector<uint32_t> values_;  // kNone: empty slot
+    std::size_t size_ = 0;
   };
   static constexpr uint32_t kNoSlot = UINT32_MAX;
-  uint32_t open_track(uint64_t id, Track tr);
+  void open_score(uint64_t id);  // a new entry in scores_ and the index
+  uint32_t open_track(Track tr);
   void close_track(uint32_t slot);
+  uint32_t slot_of(uint64_t id) const;  // kNoSlot: not measured now
   void collisions(const World& world);
   void store_sums(const Track& tr) const;  // its sums into scores_[tr.score]
   void flush() const;                      // the live tracks' sums into scores_
-  // Puts the live tracks in the order of the rows that hold them (slot = place in that order).
+  // Puts the live tracks in the order of the rows that hold them (slot = place in that order),
+  // in place: a copy of them all is 88 MB at 10^6 agents, at the moment the run's memory peaks.
   void lay_out_in_row_order(const AgentTable& t);
 
   double dt_;
   bool walls_;
   uint64_t tick_ = 0;
   mutable std::vector<AgentScore> scores_;  // a live agent's sums are in its track (flush)
-  // The agents measured now: their tracks in slots (reused once closed), found by id. Each tick
-  // visits every row, so a row remembers the id it held and its slot: rows change only when the
+  IdIndex known_;                           // every id in scores_ -> its index there
+  // The agents measured now: their tracks in slots (reused once closed), found through their
+  // score. Each tick visits every row, so a row remembers its slot: rows change only when the
   // table reorders them or agents leave or enter (then the slot's track is closed or another
-  // agent's), and the hash lookup (a cache miss per agent at 10^5 agents and more) is left for
+  // agent's), and the id lookup (a cache miss per agent at 10^5 agents and more) is left for
   // those. After a tick in which many rows changed (the table put its rows in curve order), the
   // tracks are laid out again in row order, so that the next ticks walk them in memory order.
   std::vector<Track> tracks_;
   std::vector<uint32_t> free_slots_;
-  std::unordered_map<uint64_t, uint32_t> active_;  // agent id -> slot in tracks_
+  std::vector<uint32_t> score_slot_;  // per score: its track's slot, kNoSlot once closed
   std::vector<uint32_t> row_slot_;
-  std::unordered_set<uint64_t> known_;                     // every id measured so far
   std::set<std::pair<uint64_t, uint64_t>> open_pairs_;     // agent ids, smaller first
   std::set<std::pair<uint64_t, int64_t>> open_obstacles_;  // id, obstacle (-1..-4: walls)
 };

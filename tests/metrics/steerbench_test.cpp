@@ -6,9 +6,15 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <memory>
 #include <numeric>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include "crowddb/error.hpp"
 #include "crowddb/simulation.hpp"
+#include "util/byte_codec.hpp"
 #include "util/rng.hpp"
 
 namespace crowddb::metrics {
@@ -151,6 +157,122 @@ TEST(SteerBench, ScoresDoNotDependOnTheRowOrder) {
   EXPECT_GT(closed, 20u);  // agents did leave
   EXPECT_LT(closed, a.scores().size());
   EXPECT_GT(a.totals().avg_path, 1.0);  // the walks were measured
+}
+
+// A run saved halfway and restored into a fresh SteerBench ends with the same scores, bit for bit,
+// and the same saved bytes as the run that went on (agents leave, enter and are reordered on the
+// way); checkpoints whose parts disagree are refused with the input error.
+TEST(SteerBench, ARestoredRunEndsAsTheUninterruptedOneAndBadCheckpointsAreRefused) {
+  World w(Bounds{0, 0, 100, 100});
+  w.add_goal({"g", 50, 50, 0.5, 1, {}});
+  Rng rng(11);
+  auto add = [&](int count) {
+    for (int k = 0; k < count; ++k) {
+      AgentSpec a;
+      a.x = rng.uniform(5, 95);
+      a.y = rng.uniform(5, 95);
+      a.radius = 0.1;
+      a.goal = 0;
+      w.insert(a);
+    }
+    w.apply_pending();
+  };
+  add(200);
+  SteerBench a(0.1, false);
+  a.start(w);
+  std::unique_ptr<SteerBench> b;
+  TickMetrics m;
+  for (int tick = 1; tick <= 40; ++tick) {
+    AgentTable& t = w.agents_for_tick();
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      Rng walk = Rng::stream(static_cast<uint64_t>(tick), t.id[i]);
+      t.x[i] += walk.uniform(-0.1, 0.1);
+    }
+    if (tick % 6 == 0) {  // some leave, some enter
+      std::vector<std::size_t> rows;
+      for (std::size_t i = 0; i < t.size(); ++i)
+        if ((t.id[i] ^ static_cast<uint64_t>(tick)) % 9 == 0) rows.push_back(i);
+      w.remove_rows(rows);
+      add(7);
+    }
+    if (tick % 5 == 0) {
+      std::vector<uint32_t> order(w.agents().size());
+      std::iota(order.begin(), order.end(), 0u);
+      std::reverse(order.begin(), order.end());
+      w.permute_rows(order);
+    }
+    a.tick(w, m);
+    if (b) b->tick(w, m);
+    if (tick == 17) {
+      ByteWriter out;
+      a.save(out);
+      const std::string bytes = out.take();
+      b = std::make_unique<SteerBench>(0.1, false);
+      ByteReader in(bytes, "test");
+      b->restore(in);
+      EXPECT_TRUE(in.at_end());
+    }
+  }
+  ASSERT_EQ(a.scores().size(), b->scores().size());
+  EXPECT_GT(a.scores().size(), 220u);  // agents did enter
+  auto bits = [](double v) { return std::bit_cast<uint64_t>(v); };
+  for (std::size_t k = 0; k < a.scores().size(); ++k) {
+    const AgentScore &x = a.scores()[k], &y = b->scores()[k];
+    EXPECT_EQ(x.id, y.id);
+    EXPECT_EQ(bits(x.time), bits(y.time)) << k;
+    EXPECT_EQ(bits(x.path_length), bits(y.path_length)) << k;
+    EXPECT_EQ(bits(x.energy), bits(y.energy)) << k;
+    EXPECT_EQ(bits(x.acceleration), bits(y.acceleration)) << k;
+    EXPECT_EQ(x.arrived, y.arrived);
+  }
+  ByteWriter sa, sb;
+  a.save(sa);
+  b->save(sb);
+  EXPECT_EQ(sa.take(), sb.take());
+
+  // Hand-made checkpoints: scores (ids), tracks (id, score index), the ids measured.
+  auto checkpoint = [](std::vector<uint64_t> scores,
+                       std::vector<std::pair<uint64_t, uint64_t>> tracks,
+                       std::vector<uint64_t> known) {
+    ByteWriter out;
+    out.u64(3);
+    out.u64(scores.size());
+    for (uint64_t id : scores) {
+      out.u64(id);
+      out.u64(0);
+      for (int v = 0; v < 4; ++v) out.f64(0);
+      out.u8(0);
+    }
+    out.u64(tracks.size());
+    for (const auto& [id, score] : tracks) {
+      out.u64(id);
+      out.u64(score);
+      for (int v = 0; v < 4; ++v) out.f64(0);
+      out.u8(0);
+      out.u64(3);
+    }
+    out.vec(known);
+    out.u64(0);
+    out.u64(0);
+    return out.take();
+  };
+  auto refused = [](const std::string& bytes) {
+    SteerBench s(0.1, false);
+    ByteReader in(bytes, "test");
+    try {
+      s.restore(in);
+    } catch (const Error& e) {
+      return e.kind() == Error::Kind::input;
+    }
+    return false;
+  };
+  EXPECT_FALSE(refused(checkpoint({5, 6}, {{6, 1}}, {5, 6})));  // the well-formed one
+  EXPECT_TRUE(refused(checkpoint({5, 6}, {{6, 0}}, {5, 6})));   // a track under another's score
+  EXPECT_TRUE(refused(checkpoint({5, 6}, {{6, 2}}, {5, 6})));   // a score that is not there
+  EXPECT_TRUE(refused(checkpoint({5, 6}, {{6, 1}, {6, 1}}, {5, 6})));  // a track twice
+  EXPECT_TRUE(refused(checkpoint({5, 5}, {}, {5, 5})));                // an agent scored twice
+  EXPECT_TRUE(refused(checkpoint({5, 6}, {}, {5, 7})));                // other ids measured
+  EXPECT_TRUE(refused(checkpoint({5, 6}, {}, {5})));
 }
 
 }  // namespace
