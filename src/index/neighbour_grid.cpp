@@ -162,6 +162,75 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
   ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
     const std::size_t c = b / kGrain;
     NearestK best;
+    // Every disc other than `self` within `bound` (and the range) of (px, py), from the bound's
+    // chords of cells, ranked by (distance, id): the best k are the answer when at least k were
+    // found, as the selection would give them (the same squared distances). The rank of each is
+    // the number of those that precede it, counted without branches (which of two is nearer is a
+    // coin toss to the predictor, and inserting them one by one mispredicted most of it); ids
+    // settle equal distances. False (nothing written) when more were found than kCollect or
+    // fewer than k, or the ranks do not fill 0..k-1 (ids not distinct): then the row's search
+    // goes the usual way.
+    const auto ranked = [&](std::size_t self, double px, double py, double bound, double slack,
+                            uint64_t& tested) {
+      constexpr uint32_t kCollect = 64;
+      uint32_t at[kCollect];
+      double dist[kCollect];
+      uint32_t m = 0;
+      const double reach = std::sqrt(bound) + slack;
+      const int64_t cy0 = row(py - reach), cy1 = row(py + reach);
+      for (int64_t cy = cy0; cy <= cy1; ++cy) {
+        const double ly = y0_ + static_cast<double>(cy) * cell_;
+        const double ddy = std::max({ly - py - slack, py - (ly + cell_) - slack, 0.0});
+        const double room = bound - ddy * ddy;
+        if (room < 0) continue;
+        const double w = std::sqrt(room) + slack;
+        const auto base = static_cast<std::size_t>(cy * W_);
+        const uint32_t lo = S[base + static_cast<std::size_t>(col(px - w))];
+        const uint32_t hi = S[base + static_cast<std::size_t>(col(px + w)) + 1];
+        if (hi - lo > kCollect - m) return false;
+        tested += hi - lo;
+        for (uint32_t a = lo; a < hi; ++a) {
+          const double dx = X[a] - px, dy = Y[a] - py;
+          const double d2 = dx * dx + dy * dy;
+          at[m] = a;
+          dist[m] = d2;
+          m += static_cast<uint32_t>((d2 <= bound) & (d2 < r2) & (R[a] != self));
+        }
+      }
+      if (m < k) return false;
+      // Ranks by distance alone, each written to its place (past k: a spare slot); equal
+      // distances share a rank, so among the first k they show as a place written twice or
+      // left empty, and then the ids rank them.
+      uint32_t place_row[NearestK::kInline + 1];
+      double place_d2[NearestK::kInline + 1];
+      const auto place = [&](bool by_id) {
+        uint64_t filled = 0;
+        uint32_t writes = 0;
+        for (uint32_t u = 0; u < m; ++u) {
+          const double du = dist[u];
+          uint32_t before = 0;
+          if (!by_id) {
+            for (uint32_t f = 0; f < m; ++f) before += static_cast<uint32_t>(dist[f] < du);
+          } else {
+            const uint64_t id = I[at[u]];
+            for (uint32_t f = 0; f < m; ++f)
+              before += static_cast<uint32_t>((dist[f] < du) | ((dist[f] == du) & (I[at[f]] < id)));
+          }
+          const uint32_t slot = std::min(before, k);
+          filled |= uint64_t{1} << slot;
+          writes += static_cast<uint32_t>(before < k);
+          place_row[slot] = R[at[u]];
+          place_d2[slot] = du;
+        }
+        return writes == k &&
+               (filled & ((uint64_t{2} << (k - 1)) - 1)) == (uint64_t{2} << (k - 1)) - 1;
+      };
+      if (!place(false) && !place(true)) return false;
+      std::copy_n(place_row, k, slot_row_.data() + self * k);
+      if (out.with_dist2) std::copy_n(place_d2, k, out.dist2.data() + self * k);
+      slot_count_[self] = k;
+      return true;
+    };
     for (std::size_t qi = b; qi < e; ++qi) {
       const std::size_t i = spatial ? R[qi] : queries.empty() ? qi : queries[qi];
       const double px = d.x[i], py = d.y[i];
@@ -173,19 +242,32 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
       // skip the hinted rows, so that no candidate is offered twice.
       uint32_t hint[NearestK::kInline + 3];  // padded to whole vectors of 4 with kNoRow
       uint32_t nh = 0;
+      const double slack = slack_ + 1e-9 * (std::abs(px) + std::abs(py));
       if (hints) {
         const uint32_t* const last = slot_row_.data() + i * k;
         const uint32_t count = slot_count_[i];
+        double hint_d2[NearestK::kInline];
+        double hint_bound = 0;
         for (uint32_t u = 0; u < count; ++u) {
           const uint32_t j = last[u];
           if (j >= d.n || j == i) continue;
           const double dx = d.x[j] - px, dy = d.y[j] - py;
           const double d2 = dx * dx + dy * dy;
           if (!(d2 < r2)) continue;  // the scans' range test
-          hint[nh++] = j;
-          best.offer(j, d.id[j], d2);
+          hint[nh] = j;
+          hint_d2[nh++] = d2;
+          hint_bound = std::max(hint_bound, d2);
         }
         tests[c] += count;
+        // k hints within range bound the answer: its k-th distance is at most theirs. Every
+        // disc within that bound (the hints among them) is gathered from the bound's chords
+        // and ranked at once (below); otherwise the hints are offered to the selection first.
+        if (nh == k && hint_bound < kChordReach * kChordReach * cell_ * cell_ &&
+            ranked(i, px, py, hint_bound, slack, tests[c])) {
+          ++rings[c];
+          continue;
+        }
+        for (uint32_t u = 0; u < nh; ++u) best.offer(hint[u], d.id[hint[u]], hint_d2[u]);
         for (uint32_t u = nh; u < ((nh + 3) & ~3u); ++u) hint[u] = kNoRow;
       }
       auto scan = [&](int64_t cy, int64_t cx0, int64_t cx1) {
@@ -248,7 +330,6 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
       // scanned row by row, each row's chord of it as one run, and nothing else: no ring needs
       // visiting. col() and row() are monotone, so an entry within the chord (widened by
       // `slack` against rounding) lies in a cell of the run.
-      const double slack = slack_ + 1e-9 * (std::abs(px) + std::abs(py));
       if (k > 0 && best.full() && best.bound() < kChordReach * kChordReach * cell_ * cell_) {
         const double reach = std::sqrt(best.bound()) + slack;
         const int64_t cy0 = row(py - reach), cy1 = row(py + reach);

@@ -10,11 +10,15 @@
 // rows_permuted refuses anything but a permutation); the scans skip the hinted rows, so no
 // candidate is offered twice (test: NeighbourGrid.ListsOfTheCallBeforeChangeNothing).
 //
-// Search: with a full list whose k-th distance is within 1.5 cells (the usual case with hints),
-// the cells meeting the disc of that radius are scanned row by row, each row's chord of the
-// disc as one run of adjacent cells, and nothing beyond. Otherwise the 3 x 3 block around the
-// query's cell is scanned first, as three runs; when the k-th best so far (or the range) is
-// strictly nearer than the block's nearest outside edge, nothing beyond can contribute. Else the
+// Search: when the hints are k rows within range and the farthest of them within 1.5 cells (the
+// usual case), every disc within that distance is gathered from the cells meeting its disc, row
+// by row, each row's chord as one run of adjacent cells, and nothing beyond; the gathered ones
+// (the hints among them) are ranked by (distance, id), each rank counted without branches, and
+// the first k are the answer. Otherwise (too few hints, more than 64 gathered, ids not distinct)
+// the hints are offered to the selection first, and with a full list whose k-th distance is
+// within 1.5 cells the same chords are scanned for anything better. Otherwise the 3 x 3 block
+// around the query's cell is scanned first, as three runs; when the k-th best so far (or the range)
+// is strictly nearer than the block's nearest outside edge, nothing beyond can contribute. Else the
 // rings beyond are visited outwards: every disc in ring rho (Chebyshev cell distance rho) is at
 // least (rho - 1) * cell away from the query, so once the list holds k entries whose worst
 // distance is below that bound, or the bound reaches the range, no further ring can contribute;

@@ -226,7 +226,7 @@ TEST(NeighbourGrid, ListsOfTheCallBeforeChangeNothing) {
         t.x[i] += rng.uniform(-0.13, 0.13);
         t.y[i] += rng.uniform(-0.13, 0.13);
       }
-      switch (rng.below(12)) {
+      switch (rng.below(13)) {
         case 0:  // a few jump anywhere
           for (int j = 0; j < 10; ++j) {
             const std::size_t i = rng.below(n);
@@ -280,6 +280,15 @@ TEST(NeighbourGrid, ListsOfTheCallBeforeChangeNothing) {
           for (std::size_t i = 0; i < order.size(); ++i)
             order[i] = static_cast<uint32_t>((i + 1) % order.size());
           grid.rows_permuted(order);
+          break;
+        }
+        case 11: {  // a crowd packs into a 1.5 m square: rows near it find more discs within
+                    // their hints' bound than are ranked at once (64), and search the usual way
+          const double cx = rng.uniform(5, 35), cy = rng.uniform(5, 35);
+          for (std::size_t i = 0; i < n; i += 2) {
+            t.x[i] = cx + rng.uniform(0, 1.5);
+            t.y[i] = cy + rng.uniform(0, 1.5);
+          }
           break;
         }
         case 5:  // another k: the slots no longer hold lists of this k (40: too long for hints)
