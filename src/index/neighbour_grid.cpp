@@ -24,6 +24,9 @@ constexpr double kChordReach = 1.5;  // hinted bounds up to this many cells scan
 constexpr uint32_t kNoRow = ~0u;     // pads the hints (no table has 2^32 rows)
 // Four rows and their comparison masks (GCC's and clang's vector extensions; SSE2 on x86-64).
 typedef uint32_t V4u __attribute__((vector_size(16)));
+// Two distances and their comparison masks (SSE2).
+typedef double V2d __attribute__((vector_size(16)));
+typedef int64_t V2l __attribute__((vector_size(16)));
 constexpr std::size_t kCopyGrain = 4096;   // rows per chunk of the lists' compaction
 constexpr std::size_t kBuildGrain = 8192;  // rows per chunk of the grid's build
 
@@ -174,7 +177,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
                             uint64_t& tested) {
       constexpr uint32_t kCollect = 64;
       uint32_t at[kCollect];
-      double dist[kCollect];
+      double dist[kCollect + 1];
       uint32_t m = 0;
       const double reach = std::sqrt(bound) + slack;
       const int64_t cy0 = row(py - reach), cy1 = row(py + reach);
@@ -198,6 +201,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         }
       }
       if (m < k) return false;
+      if (m % 2) dist[m] = INFINITY;  // whole vectors; never nearer
       // Ranks by distance alone, each written to its place (past k: a spare slot); equal
       // distances share a rank, so among the first k they show as a place written twice or
       // left empty, and then the ids rank them.
@@ -210,7 +214,14 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
           const double du = dist[u];
           uint32_t before = 0;
           if (!by_id) {
-            for (uint32_t f = 0; f < m; ++f) before += static_cast<uint32_t>(dist[f] < du);
+            V2l nearer = {0, 0};  // -1 per lane for each one nearer
+            const V2d dv = {du, du};
+            for (uint32_t f = 0; f < m; f += 2) {
+              V2d v;
+              __builtin_memcpy(&v, dist + f, sizeof v);
+              nearer += v < dv;
+            }
+            before = static_cast<uint32_t>(-(nearer[0] + nearer[1]));
           } else {
             const uint64_t id = I[at[u]];
             for (uint32_t f = 0; f < m; ++f)
