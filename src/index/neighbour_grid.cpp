@@ -165,7 +165,8 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
   ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
     const std::size_t c = b / kGrain;
     NearestK best;
-    // Every disc other than `self` within `bound` (and the range) of (px, py), from the bound's
+    // Every disc other than `self` (at `self_at` in the grid) within `bound` (< the range) of
+    // (px, py), from the bound's
     // chords of cells, ranked by (distance, id): the best k are the answer when at least k were
     // found, as the selection would give them (the same squared distances). The rank of each is
     // the number of those that precede it, counted without branches (which of two is nearer is a
@@ -173,8 +174,8 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
     // settle equal distances. False (nothing written) when more were found than kCollect or
     // fewer than k, or the ranks do not fill 0..k-1 (ids not distinct): then the row's search
     // goes the usual way.
-    const auto ranked = [&](std::size_t self, double px, double py, double bound, double slack,
-                            uint64_t& tested) {
+    const auto ranked = [&](std::size_t self, uint32_t self_at, double px, double py, double bound,
+                            double slack, uint64_t& tested) {
       constexpr uint32_t kCollect = 64;
       uint32_t at[kCollect];
       double dist[kCollect + 1];
@@ -192,12 +193,13 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         const uint32_t hi = S[base + static_cast<std::size_t>(col(px + w)) + 1];
         if (hi - lo > kCollect - m) return false;
         tested += hi - lo;
+        // (Within the range: the bound is a hint's distance, which is.)
         for (uint32_t a = lo; a < hi; ++a) {
           const double dx = X[a] - px, dy = Y[a] - py;
           const double d2 = dx * dx + dy * dy;
           at[m] = a;
           dist[m] = d2;
-          m += static_cast<uint32_t>((d2 <= bound) & (d2 < r2) & (R[a] != self));
+          m += static_cast<uint32_t>((d2 <= bound) & (a != self_at));
         }
       }
       if (m < k) return false;
@@ -274,7 +276,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         // disc within that bound (the hints among them) is gathered from the bound's chords
         // and ranked at once (below); otherwise the hints are offered to the selection first.
         if (nh == k && hint_bound < kChordReach * kChordReach * cell_ * cell_ &&
-            ranked(i, px, py, hint_bound, slack, tests[c])) {
+            ranked(i, static_cast<uint32_t>(qi), px, py, hint_bound, slack, tests[c])) {
           ++rings[c];
           continue;
         }
