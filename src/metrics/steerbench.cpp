@@ -19,48 +19,10 @@ uint64_t cell_key(int64_t cx, int64_t cy) {
 
 }  // namespace
 
-std::size_t SteerBench::IdIndex::home(uint64_t id) const {
-  uint64_t z = id * 0x9e3779b97f4a7c15ull;  // Fibonacci hashing: ids are often consecutive
-  z ^= z >> 29;
-  return static_cast<std::size_t>(z) & (keys_.size() - 1);
-}
-
-uint32_t SteerBench::IdIndex::find(uint64_t id) const {
-  if (keys_.empty()) return kNone;
-  for (std::size_t s = home(id);; s = (s + 1) & (keys_.size() - 1)) {
-    if (values_[s] == kNone) return kNone;
-    if (keys_[s] == id) return values_[s];
-  }
-}
-
-void SteerBench::IdIndex::insert(uint64_t id, uint32_t value) {
-  if (2 * (size_ + 1) > keys_.size()) {  // at most half full
-    std::vector<uint64_t> keys = std::move(keys_);
-    std::vector<uint32_t> values = std::move(values_);
-    const std::size_t cap = std::max<std::size_t>(64, 2 * keys.size());
-    keys_.assign(cap, 0);
-    values_.assign(cap, kNone);
-    size_ = 0;
-    for (std::size_t s = 0; s < keys.size(); ++s)
-      if (values[s] != kNone) insert(keys[s], values[s]);
-  }
-  std::size_t s = home(id);
-  while (values_[s] != kNone) s = (s + 1) & (keys_.size() - 1);
-  keys_[s] = id;
-  values_[s] = value;
-  ++size_;
-}
-
-void SteerBench::IdIndex::clear() {
-  keys_.clear();
-  values_.clear();
-  size_ = 0;
-}
-
 void SteerBench::open_score(uint64_t id) {
-  if (scores_.size() >= IdIndex::kNone - 1)
+  if (scores_.size() >= kUnknown - 1)
     throw Error(Error::Kind::input, "steerbench: more than 2^32 - 2 agents measured in one run");
-  known_.insert(id, static_cast<uint32_t>(scores_.size()));
+  known_.at(id) = static_cast<uint32_t>(scores_.size());
   scores_.push_back({.id = id});
   score_slot_.push_back(kNoSlot);
 }
@@ -82,7 +44,7 @@ uint32_t SteerBench::open_track(Track tr) {
 
 uint32_t SteerBench::slot_of(uint64_t id) const {
   const uint32_t score = known_.find(id);
-  return score == IdIndex::kNone ? kNoSlot : score_slot_[score];
+  return score == kUnknown ? kNoSlot : score_slot_[score];
 }
 
 void SteerBench::store_sums(const Track& tr) const {
@@ -135,7 +97,7 @@ void SteerBench::tick(const World& world, const TickMetrics& m) {
     if (slot == kNoSlot) {
       // New in the table (a source, an insert): measured from here on. An agent measured before
       // and closed on arrival stays closed.
-      if (t.state[i] == AgentState::arrived || known_.find(id) != IdIndex::kNone) continue;
+      if (t.state[i] == AgentState::arrived || known_.find(id) != kUnknown) continue;
       open_score(id);
       Track tr{t.x[i], t.y[i]};
       tr.id = id;
@@ -265,7 +227,7 @@ void SteerBench::collisions(const World& world) {
   }
   auto count = [&](uint64_t id) {
     const uint32_t score = known_.find(id);
-    if (score != IdIndex::kNone && score_slot_[score] != kNoSlot) ++scores_[score].collisions;
+    if (score != kUnknown && score_slot_[score] != kNoSlot) ++scores_[score].collisions;
   };
   for (const auto& p : pairs)
     if (!open_pairs_.count(p)) {
@@ -347,7 +309,7 @@ void SteerBench::save(ByteWriter& out) const {
 void SteerBench::restore(ByteReader& in) {
   tick_ = in.u64();
   const uint64_t count = in.count(49);
-  if (count >= IdIndex::kNone - 1) in.fail("steerbench: too many scores");
+  if (count >= kUnknown - 1) in.fail("steerbench: too many scores");
   scores_.resize(count);
   known_.clear();
   score_slot_.assign(count, kNoSlot);
@@ -357,8 +319,8 @@ void SteerBench::restore(ByteReader& in) {
     a.collisions = in.u64();
     for (double* v : {&a.time, &a.path_length, &a.energy, &a.acceleration}) *v = in.f64();
     a.arrived = in.u8() != 0;
-    if (known_.find(a.id) != IdIndex::kNone) in.fail("steerbench: an agent scored twice");
-    known_.insert(a.id, static_cast<uint32_t>(k));
+    if (known_.find(a.id) != kUnknown) in.fail("steerbench: an agent scored twice");
+    known_.at(a.id) = static_cast<uint32_t>(k);
   }
   tracks_.clear();
   free_slots_.clear();

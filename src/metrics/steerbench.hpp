@@ -24,6 +24,7 @@
 
 #include "crowddb/simulation.hpp"
 #include "crowddb/world.hpp"
+#include "util/flat_map.hpp"
 
 namespace crowddb::metrics {
 
@@ -79,22 +80,6 @@ class SteerBench {
     bool has_v = false;
     bool live = true;  // false: the slot is free
   };
-  // Every id measured so far -> its index in scores_: open addressing with linear probing,
-  // never erased (an agent closed on arrival stays known). 12 bytes a slot at most half full,
-  // where a node-based map and set cost about 80 bytes an agent.
-  class IdIndex {
-   public:
-    static constexpr uint32_t kNone = UINT32_MAX;
-    uint32_t find(uint64_t id) const;
-    void insert(uint64_t id, uint32_t value);  // id not present
-    void clear();
-
-   private:
-    std::size_t home(uint64_t id) const;
-    std::vector<uint64_t> keys_;
-    std::vector<uint32_t> values_;  // kNone: empty slot
-    std::size_t size_ = 0;
-  };
   static constexpr uint32_t kNoSlot = UINT32_MAX;
   void open_score(uint64_t id);  // a new entry in scores_ and the index
   uint32_t open_track(Track tr);
@@ -111,7 +96,10 @@ class SteerBench {
   bool walls_;
   uint64_t tick_ = 0;
   mutable std::vector<AgentScore> scores_;  // a live agent's sums are in its track (flush)
-  IdIndex known_;                           // every id in scores_ -> its index there
+  // Every id measured so far -> its index in scores_ (never erased: an agent closed on arrival
+  // stays known).
+  static constexpr uint32_t kUnknown = UINT32_MAX;
+  FlatMap<uint32_t, kUnknown> known_;
   // The agents measured now: their tracks in slots (reused once closed), found through their
   // score. Each tick visits every row, so a row remembers its slot: rows change only when the
   // table reorders them or agents leave or enter (then the slot's track is closed or another
