@@ -20,6 +20,34 @@
 namespace crowddb::metrics {
 namespace {
 
+// `count` agents of radius 0.1 m bound for goal 0, uniform in [5, 95]^2.
+void add_walkers(World& w, Rng& rng, int count) {
+  for (int k = 0; k < count; ++k) {
+    AgentSpec a;
+    a.x = rng.uniform(5, 95);
+    a.y = rng.uniform(5, 95);
+    a.radius = 0.1;
+    a.goal = 0;
+    w.insert(a);
+  }
+  w.apply_pending();
+}
+
+// The same scores in the same order, bit for bit.
+void expect_same_scores(const SteerBench& a, const SteerBench& b) {
+  ASSERT_EQ(a.scores().size(), b.scores().size());
+  auto bits = [](double v) { return std::bit_cast<uint64_t>(v); };
+  for (std::size_t k = 0; k < a.scores().size(); ++k) {
+    const AgentScore &x = a.scores()[k], &y = b.scores()[k];
+    EXPECT_EQ(x.id, y.id);
+    EXPECT_EQ(bits(x.time), bits(y.time)) << k;
+    EXPECT_EQ(bits(x.path_length), bits(y.path_length)) << k;
+    EXPECT_EQ(bits(x.energy), bits(y.energy)) << k;
+    EXPECT_EQ(bits(x.acceleration), bits(y.acceleration)) << k;
+    EXPECT_EQ(x.arrived, y.arrived);
+  }
+}
+
 TEST(SteerBench, ConstantWalkGivesTimePathAndEnergyByHand) {
   World w(Bounds{0, 0, 100, 10});
   w.add_goal({"g", 90, 5, 0.5, 1, {}});
@@ -93,15 +121,7 @@ TEST(SteerBench, ScoresDoNotDependOnTheRowOrder) {
     World w(Bounds{0, 0, 100, 100});
     w.add_goal({"g", 90, 50, 0.5, 1, {}});
     Rng rng(5);
-    for (int k = 0; k < 300; ++k) {
-      AgentSpec a;
-      a.x = rng.uniform(5, 95);
-      a.y = rng.uniform(5, 95);
-      a.radius = 0.1;
-      a.goal = 0;
-      w.insert(a);
-    }
-    w.apply_pending();
+    add_walkers(w, rng, 300);
     return w;
   };
   World still = make(), shuffled = make();
@@ -142,17 +162,10 @@ TEST(SteerBench, ScoresDoNotDependOnTheRowOrder) {
     }
   }
   ASSERT_EQ(a.scores().size(), b.scores().size());
-  auto bits = [](double v) { return std::bit_cast<uint64_t>(v); };
+  expect_same_scores(a, b);
   std::size_t closed = 0;
   for (std::size_t k = 0; k < a.scores().size(); ++k) {
-    const AgentScore &x = a.scores()[k], &y = b.scores()[k];
-    EXPECT_EQ(x.id, y.id);
-    EXPECT_EQ(bits(x.time), bits(y.time)) << k;
-    EXPECT_EQ(bits(x.path_length), bits(y.path_length)) << k;
-    EXPECT_EQ(bits(x.energy), bits(y.energy)) << k;
-    EXPECT_EQ(bits(x.acceleration), bits(y.acceleration)) << k;
-    EXPECT_EQ(x.arrived, y.arrived);
-    closed += x.arrived;
+    closed += a.scores()[k].arrived;
   }
   EXPECT_GT(closed, 20u);  // agents did leave
   EXPECT_LT(closed, a.scores().size());
@@ -166,18 +179,7 @@ TEST(SteerBench, ARestoredRunEndsAsTheUninterruptedOneAndBadCheckpointsAreRefuse
   World w(Bounds{0, 0, 100, 100});
   w.add_goal({"g", 50, 50, 0.5, 1, {}});
   Rng rng(11);
-  auto add = [&](int count) {
-    for (int k = 0; k < count; ++k) {
-      AgentSpec a;
-      a.x = rng.uniform(5, 95);
-      a.y = rng.uniform(5, 95);
-      a.radius = 0.1;
-      a.goal = 0;
-      w.insert(a);
-    }
-    w.apply_pending();
-  };
-  add(200);
+  add_walkers(w, rng, 200);
   SteerBench a(0.1, false);
   a.start(w);
   std::unique_ptr<SteerBench> b;
@@ -193,7 +195,7 @@ TEST(SteerBench, ARestoredRunEndsAsTheUninterruptedOneAndBadCheckpointsAreRefuse
       for (std::size_t i = 0; i < t.size(); ++i)
         if ((t.id[i] ^ static_cast<uint64_t>(tick)) % 9 == 0) rows.push_back(i);
       w.remove_rows(rows);
-      add(7);
+      add_walkers(w, rng, 7);
     }
     if (tick % 5 == 0) {
       std::vector<uint32_t> order(w.agents().size());
@@ -215,16 +217,7 @@ TEST(SteerBench, ARestoredRunEndsAsTheUninterruptedOneAndBadCheckpointsAreRefuse
   }
   ASSERT_EQ(a.scores().size(), b->scores().size());
   EXPECT_GT(a.scores().size(), 220u);  // agents did enter
-  auto bits = [](double v) { return std::bit_cast<uint64_t>(v); };
-  for (std::size_t k = 0; k < a.scores().size(); ++k) {
-    const AgentScore &x = a.scores()[k], &y = b->scores()[k];
-    EXPECT_EQ(x.id, y.id);
-    EXPECT_EQ(bits(x.time), bits(y.time)) << k;
-    EXPECT_EQ(bits(x.path_length), bits(y.path_length)) << k;
-    EXPECT_EQ(bits(x.energy), bits(y.energy)) << k;
-    EXPECT_EQ(bits(x.acceleration), bits(y.acceleration)) << k;
-    EXPECT_EQ(x.arrived, y.arrived);
-  }
+  expect_same_scores(a, *b);
   ByteWriter sa, sb;
   a.save(sa);
   b->save(sb);
