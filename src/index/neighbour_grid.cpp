@@ -45,6 +45,20 @@ inline int64_t NeighbourGrid::row(double y) const {
   return c < 0 ? 0 : (c >= static_cast<double>(H_) ? H_ - 1 : static_cast<int64_t>(c));
 }
 
+// Row cy's cells [cx0, cx1] meeting the disc of squared radius `bound` round (px, py), widened
+// by `slack` against rounding; false when the row's band misses the disc.
+inline bool NeighbourGrid::chord_cells(double px, double py, double bound, double slack, int64_t cy,
+                                       int64_t& cx0, int64_t& cx1) const {
+  const double ly = y0_ + static_cast<double>(cy) * cell_;
+  const double ddy = std::max({ly - py - slack, py - (ly + cell_) - slack, 0.0});
+  const double room = bound - ddy * ddy;
+  if (room < 0) return false;
+  const double w = std::sqrt(room) + slack;
+  cx0 = col(px - w);
+  cx1 = col(px + w);
+  return true;
+}
+
 // A counting sort (index/row_buckets.hpp): the bounding box, each row's cell and the copies in
 // cell order in chunks on every thread, the placement in one pass (the layout of one thread).
 void NeighbourGrid::build(const DiscView& d, double range, uint32_t k, Executor& ex) {
@@ -166,14 +180,13 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
     const std::size_t c = b / kGrain;
     NearestK best;
     // Every disc other than `self` (at `self_at` in the grid) within `bound` (< the range) of
-    // (px, py), from the bound's
-    // chords of cells, ranked by (distance, id): the best k are the answer when at least k were
-    // found, as the selection would give them (the same squared distances). The rank of each is
-    // the number of those that precede it, counted without branches (which of two is nearer is a
-    // coin toss to the predictor, and inserting them one by one mispredicted most of it); ids
-    // settle equal distances. False (nothing written) when more were found than kCollect or
-    // fewer than k, or the ranks do not fill 0..k-1 (ids not distinct): then the row's search
-    // goes the usual way.
+    // (px, py), from the bound's chords of cells, ranked by (distance, id): the best k are the
+    // answer when at least k were found, as the selection would give them (the same squared
+    // distances). The rank of each is the number of those that precede it, counted without branches
+    // (which of two is nearer is a coin toss to the predictor, and inserting them one by one
+    // mispredicted most of it); ids settle equal distances. False (nothing written) when more were
+    // found than kCollect or fewer than k, or the ranks do not fill 0..k-1 (ids not distinct): then
+    // the row's search goes the usual way.
     const auto ranked = [&](std::size_t self, uint32_t self_at, double px, double py, double bound,
                             double slack, uint64_t& tested) {
       constexpr uint32_t kCollect = 64;
@@ -183,14 +196,11 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
       const double reach = std::sqrt(bound) + slack;
       const int64_t cy0 = row(py - reach), cy1 = row(py + reach);
       for (int64_t cy = cy0; cy <= cy1; ++cy) {
-        const double ly = y0_ + static_cast<double>(cy) * cell_;
-        const double ddy = std::max({ly - py - slack, py - (ly + cell_) - slack, 0.0});
-        const double room = bound - ddy * ddy;
-        if (room < 0) continue;
-        const double w = std::sqrt(room) + slack;
+        int64_t cx0, cx1;
+        if (!chord_cells(px, py, bound, slack, cy, cx0, cx1)) continue;
         const auto base = static_cast<std::size_t>(cy * W_);
-        const uint32_t lo = S[base + static_cast<std::size_t>(col(px - w))];
-        const uint32_t hi = S[base + static_cast<std::size_t>(col(px + w)) + 1];
+        const uint32_t lo = S[base + static_cast<std::size_t>(cx0)];
+        const uint32_t hi = S[base + static_cast<std::size_t>(cx1) + 1];
         if (hi - lo > kCollect - m) return false;
         tested += hi - lo;
         // (Within the range: the bound is a hint's distance, which is.)
@@ -347,12 +357,8 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         const double reach = std::sqrt(best.bound()) + slack;
         const int64_t cy0 = row(py - reach), cy1 = row(py + reach);
         auto chord = [&](int64_t cy) {
-          const double ly = y0_ + static_cast<double>(cy) * cell_;
-          const double ddy = std::max({ly - py - slack, py - (ly + cell_) - slack, 0.0});
-          const double room = best.bound() - ddy * ddy;
-          if (room < 0) return;
-          const double w = std::sqrt(room) + slack;
-          scan(cy, col(px - w), col(px + w));
+          int64_t cx0, cx1;
+          if (chord_cells(px, py, best.bound(), slack, cy, cx0, cx1)) scan(cy, cx0, cx1);
         };
         chord(qy);  // the query's own row first: the likeliest nearest
         for (int64_t cy = cy0; cy <= cy1; ++cy)

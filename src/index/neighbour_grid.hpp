@@ -53,6 +53,8 @@ class NeighbourGrid final : public NeighbourPath {
   void build(const DiscView& d, double range, uint32_t k, Executor& ex);
   int64_t col(double x) const;
   int64_t row(double y) const;
+  bool chord_cells(double px, double py, double bound, double slack, int64_t cy, int64_t& cx0,
+                   int64_t& cx1) const;
 
   double x0_ = 0, y0_ = 0, cell_ = 1, inv_cell_ = 1;  // (a product, not a division, per probe)
   double slack_ = 0;                                  // rounding of cell coordinates (see build)

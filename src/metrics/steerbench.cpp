@@ -42,9 +42,13 @@ uint32_t SteerBench::open_track(Track tr) {
   return slot;
 }
 
-uint32_t SteerBench::slot_of(uint64_t id) const {
-  const uint32_t score = known_.find(id);
-  return score == kUnknown ? kNoSlot : score_slot_[score];
+uint32_t SteerBench::open_agent(uint64_t id, double x, double y) {
+  open_score(id);
+  Track tr{x, y};
+  tr.id = id;
+  tr.seen = tick_;
+  tr.score = static_cast<uint32_t>(scores_.size() - 1);
+  return open_track(tr);
 }
 
 void SteerBench::store_sums(const Track& tr) const {
@@ -73,11 +77,7 @@ void SteerBench::start(const World& world) {
   tracks_.reserve(tracks_.size() + t.size());
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (t.state[i] == AgentState::arrived) continue;
-    open_score(t.id[i]);
-    Track tr{t.x[i], t.y[i]};
-    tr.id = t.id[i];
-    tr.score = static_cast<uint32_t>(scores_.size() - 1);
-    open_track(tr);
+    open_agent(t.id[i], t.x[i], t.y[i]);
   }
 }
 
@@ -91,21 +91,16 @@ void SteerBench::tick(const World& world, const TickMetrics& m) {
     uint32_t slot = row_slot_[i];
     if (slot == kNoSlot || !tracks_[slot].live || tracks_[slot].id != id) {
       ++moved;
-      slot = slot_of(id);
+      const uint32_t score = known_.find(id);
+      if (score == kUnknown) {
+        // New in the table (a source, an insert): measured from here on.
+        row_slot_[i] = t.state[i] == AgentState::arrived ? kNoSlot : open_agent(id, t.x[i], t.y[i]);
+        continue;
+      }
+      slot = score_slot_[score];
       row_slot_[i] = slot;
     }
-    if (slot == kNoSlot) {
-      // New in the table (a source, an insert): measured from here on. An agent measured before
-      // and closed on arrival stays closed.
-      if (t.state[i] == AgentState::arrived || known_.find(id) != kUnknown) continue;
-      open_score(id);
-      Track tr{t.x[i], t.y[i]};
-      tr.id = id;
-      tr.seen = tick_;
-      tr.score = static_cast<uint32_t>(scores_.size() - 1);
-      row_slot_[i] = open_track(tr);
-      continue;
-    }
+    if (slot == kNoSlot) continue;  // measured before and closed on arrival: stays closed
     Track& tr = tracks_[slot];
     if (t.state[i] == AgentState::arrived) {  // arrived in this tick: the tick is not counted
       close_track(slot);

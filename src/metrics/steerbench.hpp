@@ -84,7 +84,7 @@ class SteerBench {
   void open_score(uint64_t id);  // a new entry in scores_ and the index
   uint32_t open_track(Track tr);
   void close_track(uint32_t slot);
-  uint32_t slot_of(uint64_t id) const;  // kNoSlot: not measured now
+  uint32_t open_agent(uint64_t id, double x, double y);  // its score and track; the slot
   void collisions(const World& world);
   void store_sums(const Track& tr) const;  // its sums into scores_[tr.score]
   void flush() const;                      // the live tracks' sums into scores_
