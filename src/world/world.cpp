@@ -15,6 +15,8 @@
 namespace crowddb {
 namespace {
 
+constexpr std::size_t kKeptPending = 4096;  // changes whose room a batch keeps for the next
+
 std::string fmt(double v) {
   std::ostringstream os;
   os.precision(17);
@@ -487,7 +489,12 @@ std::size_t World::apply_pending() {
       }
     }
   }
-  pending_.clear();
+  // A big batch (a scenario's agents, loaded at once: 128 bytes each, 134 MB at 10^6) gives its
+  // memory back; the tick's own small batches keep theirs.
+  if (pending_.capacity() > kKeptPending)
+    std::vector<Change>().swap(pending_);
+  else
+    pending_.clear();
   return applied;
 }
 
