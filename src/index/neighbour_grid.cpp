@@ -159,10 +159,12 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
   const uint32_t* const R = rows_.data();
   const uint64_t* const I = id_.data();
   const uint32_t* const S = start_.data();
-  // Every row with a bounded k: walk the queries in the grid's cell order (neighbouring queries
-  // read the same cells, which stay in cache) and write each list into its row's own slot of k;
-  // the slots are compacted into the CSR in row order afterwards. Otherwise: query order, lists
-  // gathered per chunk.
+  // Every row with a bounded k: walk the rows in order and write each list into its row's own
+  // slot of k; the slots are compacted into the CSR afterwards. The table keeps its rows in
+  // space-filling-curve order, so neighbouring queries still read the same cells, and the row's
+  // own columns and hints are read in memory order (walking in the grid's cell order instead,
+  // row-major, jumped through them: the stage 376 -> 369 ms per 100 ticks at 2 * 10^4 agents,
+  // one thread, A B B A). Otherwise: query order, lists gathered per chunk.
   const bool spatial = queries.empty() && k > 0;
   // Last call's lists seed this call's (see the header): only when they were made the same way.
   const bool hintable = spatial && k <= NearestK::kInline;
@@ -176,6 +178,14 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
     if (out.with_dist2) out.dist2.resize(d.n * k);
   }
   hint_k_ = hintable ? k : 0;
+  if (spatial) {  // each row's place in the grid (the ranked search skips the query's own)
+    at_.resize(d.n);
+    uint32_t* const at = at_.data();
+    ex.for_each_chunk(d.n, kCopyGrain, [&](std::size_t b, std::size_t e) {
+      for (std::size_t a = b; a < e; ++a) at[R[a]] = static_cast<uint32_t>(a);
+    });
+  }
+  const uint32_t* const At = at_.data();
   ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
     const std::size_t c = b / kGrain;
     NearestK best;
@@ -255,7 +265,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
       return true;
     };
     for (std::size_t qi = b; qi < e; ++qi) {
-      const std::size_t i = spatial ? R[qi] : queries.empty() ? qi : queries[qi];
+      const std::size_t i = queries.empty() ? qi : queries[qi];
       const double px = d.x[i], py = d.y[i];
       best.reset(k);
       // The hints: this row's list of the last call, offered first and in their old order (the
@@ -286,7 +296,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         // disc within that bound (the hints among them) is gathered from the bound's chords
         // and ranked at once (below); otherwise the hints are offered to the selection first.
         if (nh == k && hint_bound < kChordReach * kChordReach * cell_ * cell_ &&
-            ranked(i, static_cast<uint32_t>(qi), px, py, hint_bound, slack, tests[c])) {
+            ranked(i, At[i], px, py, hint_bound, slack, tests[c])) {
           ++rings[c];
           continue;
         }

@@ -64,6 +64,7 @@ class NeighbourGrid final : public NeighbourPath {
   std::vector<double> x_, y_;    // their positions, copied in cell order
   std::vector<uint64_t> id_;
   std::vector<int64_t> cell_of_;  // scratch: cell per row
+  std::vector<uint32_t> at_;      // per row: its place in the cell-ordered arrays
   // Per-row lists of k (spatial order): the rows, kept as the next call's hints; their distances
   // are written into the output's slots.
   std::vector<uint32_t> slot_count_, slot_row_;
