@@ -28,7 +28,9 @@
 // an adjacent wedge's gradient. L1 classification is always exact: sign(x_p - x_q) is exact.)
 //
 // SWEEP. Per combo the tile's entries are sorted by (a, b) and b is ranked (for the L1 combos
-// both come from the tile's (x, y, id) order and y ranks, without sorting again). The forward
+// both come from the tile's (x, y, id) order and y ranks, without sorting again; that order and
+// the y ranks come from radix sorts of the coordinates' bits, the rare runs of equal x then
+// sorted by (y, id)). The forward
 // sweep visits runs of equal a in increasing a; probes of a run query a Fenwick tree over
 // b-ranks (prefix: sources with smaller a and smaller b: the wedge interior), an array of
 // per-rank sums (smaller a, equal b: one ray) and a running sum inside the run (equal a,
@@ -73,11 +75,16 @@
 // tiles.
 //
 // DETERMINISM. Entries are ordered by (x, id) and inside swept tiles by (x, y, id); tiles are cut
-// by a deterministic greedy rule; each probe is computed in exactly one tile by one thread, and
-// slabs are independent: the output does not depend on the thread count.
+// by a deterministic greedy rule; each probe is computed in exactly one tile, and slabs are
+// independent, one thread each. A world that fits one tile (2 * 10^4 agents on 200 m at the
+// thesis's k) would leave every thread but one idle: its combos run on every thread instead, each
+// sweep's sums kept apart and added in the order one thread adds them. The output does not depend
+// on the thread count (tests: FieldIndex.ThreadCountDoesNotChangeBits, OneLargeTileOnEveryThread).
 #include "index/field_index.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -85,6 +92,7 @@
 
 #include "crowddb/error.hpp"
 #include "query/field_kernels.hpp"
+#include "util/executor.hpp"
 #include "util/stopwatch.hpp"
 
 namespace crowddb {
@@ -94,6 +102,9 @@ constexpr double kExponentBudget = 650;  // max |exponent| of a stored weight (e
 constexpr double kHaloMargin = 36;       // e^{-36} = 2.3e-16: per-table budget for dropped terms
 // A tile with at most this many probe x source pairs per entry is summed pair by pair.
 constexpr std::size_t kDirectPairsPerEntry = 16;
+// From this many entries a tile runs its combos on every thread (a one-tile world: the slabs
+// of a tiled one already run on every thread).
+constexpr std::size_t kParallelCombos = 4096;
 
 // A linear form cx x + cy y with cx, cy in {-1, 0, 1}.
 struct Form {
@@ -174,6 +185,48 @@ Separable separable_of(const PotentialSpec& s) {
   return sep;
 }
 
+// The order of finite doubles as unsigned words (-0 and +0 as one: they compare equal).
+inline uint64_t order_bits(double v) {
+  const auto b = std::bit_cast<uint64_t>(v + 0.0);  // -0 + 0 = +0
+  return b >> 63 ? ~b : b | (uint64_t{1} << 63);
+}
+
+struct KeyedIndex {
+  uint64_t key;
+  uint32_t at;
+};
+
+// Sorts v by key, stably: least significant digit first, 11 bits at a time, skipping the digits
+// on which every key agrees (the coordinates of one region share their sign, exponent and top
+// bits). Six passes for 2 * 10^4 positions: a fifth of std::sort's time on (x, y, id).
+void radix_by_key(std::vector<KeyedIndex>& v, std::vector<KeyedIndex>& tmp) {
+  constexpr int kDigit = 11;
+  constexpr std::size_t kBuckets = std::size_t{1} << kDigit;
+  const std::size_t n = v.size();
+  if (n < 2) return;
+  uint64_t any = 0, all = ~uint64_t{0};
+  for (const KeyedIndex& e : v) {
+    any |= e.key;
+    all &= e.key;
+  }
+  const uint64_t varying = any ^ all;
+  tmp.resize(n);
+  std::array<uint32_t, kBuckets> place;
+  for (int shift = 0; shift < 64; shift += kDigit) {
+    if (((varying >> shift) & (kBuckets - 1)) == 0) continue;
+    place.fill(0);
+    for (const KeyedIndex& e : v) ++place[(e.key >> shift) & (kBuckets - 1)];
+    uint32_t sum = 0;
+    for (uint32_t& c : place) {
+      const uint32_t k = c;
+      c = sum;
+      sum += k;
+    }
+    for (const KeyedIndex& e : v) tmp[place[(e.key >> shift) & (kBuckets - 1)]++] = e;
+    v.swap(tmp);
+  }
+}
+
 // Sum over [0, i) of a Fenwick tree stored 1-based in t.
 inline double fen_prefix(const std::vector<double>& t, std::size_t i) {
   double s = 0;
@@ -184,19 +237,29 @@ inline void fen_add(std::vector<double>& t, std::size_t i, double v) {
   for (++i; i < t.size(); i += i & (~i + 1)) t[i] += v;
 }
 
+// One combo's working storage.
+struct ComboScratch {
+  std::vector<Key> ka, kb;
+  std::vector<double> ea, iea, eb, ieb, fen, eq;
+  std::vector<uint32_t> order, rank;
+  std::vector<std::pair<Key, uint32_t>> bsort;
+  // When the combos run on several threads: each probe's sums over the two wedges, added to
+  // the tile's sums afterwards in the order one thread adds them.
+  std::vector<double> fwd, bwd;
+};
+
 // Per-thread working storage, reused across tiles.
 struct Scratch {
   uint64_t pairs = 0;  // direct pair evaluations (QueryStats::pair_tests)
   // Tile entries in (x, y, id) order.
   std::vector<double> x, y, lx, ly, w, pot, gx, gy;
   std::vector<uint32_t> slot;
-  // Per combo.
-  std::vector<Key> ka, kb;
-  std::vector<double> ea, iea, eb, ieb, fen, eq;
-  std::vector<uint32_t> order, rank, yrank;
+  std::vector<uint32_t> yrank;
   std::size_t yrank_count = 0;
-  std::vector<std::pair<Key, uint32_t>> bsort;
-  std::vector<std::pair<double, uint32_t>> ysort;
+  ComboScratch combo;                        // the combos one after the other
+  std::vector<ComboScratch> combo_tasks;     // or one per combo, on several threads
+  std::vector<KeyedIndex> keyed, keyed_tmp;  // radix_by_key
+  std::vector<uint64_t> sorted_items;
   // Slab and tile cutting.
   struct SlabItem {
     double y;
@@ -211,31 +274,34 @@ struct Outputs {
   std::span<double> pot, gx, gy;
 };
 
-void run_combo(Scratch& s, const Combo& c) {
+// One combo's forward and backward sweeps over the tile's entries (read only). Each probe's sum
+// over the forward wedge goes to fwd(e, res), over the backward wedge to bwd(e, res), once each.
+template <class Fwd, class Bwd>
+void run_combo(const Scratch& s, ComboScratch& cs, const Combo& c, Fwd&& fwd, Bwd&& bwd) {
   const std::size_t m = s.x.size();
-  s.ka.resize(m);
-  s.kb.resize(m);
-  s.ea.resize(m);
-  s.iea.resize(m);
-  s.eb.resize(m);
-  s.ieb.resize(m);
+  cs.ka.resize(m);
+  cs.kb.resize(m);
+  cs.ea.resize(m);
+  cs.iea.resize(m);
+  cs.eb.resize(m);
+  cs.ieb.resize(m);
   for (std::size_t i = 0; i < m; ++i) {
-    s.ka[i] = key_of(c.a, s.x[i], s.y[i]);
-    s.kb[i] = key_of(c.b, s.x[i], s.y[i]);
-    s.ea[i] = std::exp(c.alpha * value_of(c.a, s.lx[i], s.ly[i]));
-    s.eb[i] = std::exp(c.beta * value_of(c.b, s.lx[i], s.ly[i]));
-    s.iea[i] = 1 / s.ea[i];
-    s.ieb[i] = 1 / s.eb[i];
+    cs.ka[i] = key_of(c.a, s.x[i], s.y[i]);
+    cs.kb[i] = key_of(c.b, s.x[i], s.y[i]);
+    cs.ea[i] = std::exp(c.alpha * value_of(c.a, s.lx[i], s.ly[i]));
+    cs.eb[i] = std::exp(c.beta * value_of(c.b, s.lx[i], s.ly[i]));
+    cs.iea[i] = 1 / cs.ea[i];
+    cs.ieb[i] = 1 / cs.eb[i];
   }
-  s.order.resize(m);
-  s.rank.resize(m);
+  cs.order.resize(m);
+  cs.rank.resize(m);
   std::size_t r = 0;
   if (c.a.cx == 1 && c.a.cy == 0 && c.b.cx == 0) {
     // L1 combos: entries are stored in (x, y, id) order with y ranked (process_tile).
     r = s.yrank_count;
     if (c.b.cy > 0) {
-      std::iota(s.order.begin(), s.order.end(), 0u);
-      std::copy(s.yrank.begin(), s.yrank.begin() + static_cast<std::ptrdiff_t>(m), s.rank.begin());
+      std::iota(cs.order.begin(), cs.order.end(), 0u);
+      std::copy(s.yrank.begin(), s.yrank.begin() + static_cast<std::ptrdiff_t>(m), cs.rank.begin());
     } else {
       // (x, -y, id) order: inside each run of equal x, the groups of equal y reversed.
       std::size_t out = 0;
@@ -245,93 +311,89 @@ void run_combo(Scratch& s, const Combo& c) {
         for (std::size_t g_end = run_end; g_end > run;) {
           std::size_t g = g_end - 1;
           while (g > run && s.y[g - 1] == s.y[g]) --g;
-          for (std::size_t i = g; i < g_end; ++i) s.order[out++] = static_cast<uint32_t>(i);
+          for (std::size_t i = g; i < g_end; ++i) cs.order[out++] = static_cast<uint32_t>(i);
           g_end = g;
         }
         run = run_end;
       }
-      for (std::size_t i = 0; i < m; ++i) s.rank[i] = static_cast<uint32_t>(r - 1 - s.yrank[i]);
+      for (std::size_t i = 0; i < m; ++i) cs.rank[i] = static_cast<uint32_t>(r - 1 - s.yrank[i]);
     }
   } else {
-    std::iota(s.order.begin(), s.order.end(), 0u);
-    std::sort(s.order.begin(), s.order.end(), [&](uint32_t i, uint32_t j) {
-      if (s.ka[i] < s.ka[j]) return true;
-      if (s.ka[j] < s.ka[i]) return false;
-      if (s.kb[i] < s.kb[j]) return true;
-      if (s.kb[j] < s.kb[i]) return false;
+    std::iota(cs.order.begin(), cs.order.end(), 0u);
+    std::sort(cs.order.begin(), cs.order.end(), [&](uint32_t i, uint32_t j) {
+      if (cs.ka[i] < cs.ka[j]) return true;
+      if (cs.ka[j] < cs.ka[i]) return false;
+      if (cs.kb[i] < cs.kb[j]) return true;
+      if (cs.kb[j] < cs.kb[i]) return false;
       return i < j;
     });
-    s.bsort.resize(m);
-    for (uint32_t i = 0; i < m; ++i) s.bsort[i] = {s.kb[i], i};
-    std::sort(s.bsort.begin(), s.bsort.end(),
+    cs.bsort.resize(m);
+    for (uint32_t i = 0; i < m; ++i) cs.bsort[i] = {cs.kb[i], i};
+    std::sort(cs.bsort.begin(), cs.bsort.end(),
               [](const auto& p, const auto& q) { return p.first < q.first; });
     for (std::size_t i = 0; i < m; ++i) {
-      if (i > 0 && !(s.bsort[i].first == s.bsort[i - 1].first)) ++r;
-      s.rank[s.bsort[i].second] = static_cast<uint32_t>(r);
+      if (i > 0 && !(cs.bsort[i].first == cs.bsort[i - 1].first)) ++r;
+      cs.rank[cs.bsort[i].second] = static_cast<uint32_t>(r);
     }
     r = m ? r + 1 : 0;
   }
 
   // Forward: wedge Δa > 0, Δb > 0 and its rays.
-  s.fen.assign(r + 1, 0.0);
-  s.eq.assign(r, 0.0);
+  cs.fen.assign(r + 1, 0.0);
+  cs.eq.assign(r, 0.0);
   for (std::size_t pos = 0; pos < m;) {
     std::size_t run_end = pos + 1;
-    while (run_end < m && s.ka[s.order[run_end]] == s.ka[s.order[pos]]) ++run_end;
+    while (run_end < m && cs.ka[cs.order[run_end]] == cs.ka[cs.order[pos]]) ++run_end;
     double pre = 0;  // same a, smaller b: sum of w e^{β b}
     for (std::size_t g = pos; g < run_end;) {
       std::size_t g_end = g + 1;
-      while (g_end < run_end && s.kb[s.order[g_end]] == s.kb[s.order[g]]) ++g_end;
+      while (g_end < run_end && cs.kb[cs.order[g_end]] == cs.kb[cs.order[g]]) ++g_end;
       for (std::size_t i = g; i < g_end; ++i) {
-        const uint32_t e = s.order[i];
+        const uint32_t e = cs.order[i];
         if (s.slot[e] == FieldEntry::kNoSlot) continue;
-        const uint32_t rk = s.rank[e];
-        const double inter = fen_prefix(s.fen, rk) * s.iea[e] * s.ieb[e];
-        const double res = inter + 0.5 * (s.eq[rk] * s.iea[e] + pre * s.ieb[e]);
-        s.pot[e] += res;
-        s.gx[e] += c.gpp_x * res;
-        s.gy[e] += c.gpp_y * res;
+        const uint32_t rk = cs.rank[e];
+        const double inter = fen_prefix(cs.fen, rk) * cs.iea[e] * cs.ieb[e];
+        const double res = inter + 0.5 * (cs.eq[rk] * cs.iea[e] + pre * cs.ieb[e]);
+        fwd(e, res);
       }
-      for (std::size_t i = g; i < g_end; ++i) pre += s.w[s.order[i]] * s.eb[s.order[i]];
+      for (std::size_t i = g; i < g_end; ++i) pre += s.w[cs.order[i]] * cs.eb[cs.order[i]];
       g = g_end;
     }
     for (std::size_t i = pos; i < run_end; ++i) {
-      const uint32_t e = s.order[i];
+      const uint32_t e = cs.order[i];
       if (s.w[e] == 0) continue;
-      fen_add(s.fen, s.rank[e], s.w[e] * s.ea[e] * s.eb[e]);
-      s.eq[s.rank[e]] += s.w[e] * s.ea[e];
+      fen_add(cs.fen, cs.rank[e], s.w[e] * cs.ea[e] * cs.eb[e]);
+      cs.eq[cs.rank[e]] += s.w[e] * cs.ea[e];
     }
     pos = run_end;
   }
 
   // Backward: wedge Δa < 0, Δb < 0; the tree is indexed by reversed rank (prefix = larger b).
-  s.fen.assign(r + 1, 0.0);
-  s.eq.assign(r, 0.0);
+  cs.fen.assign(r + 1, 0.0);
+  cs.eq.assign(r, 0.0);
   for (std::size_t end = m; end > 0;) {
     std::size_t run_begin = end - 1;
-    while (run_begin > 0 && s.ka[s.order[run_begin - 1]] == s.ka[s.order[end - 1]]) --run_begin;
+    while (run_begin > 0 && cs.ka[cs.order[run_begin - 1]] == cs.ka[cs.order[end - 1]]) --run_begin;
     double suf = 0;  // same a, larger b: sum of w e^{-β b}
     for (std::size_t g_end = end; g_end > run_begin;) {
       std::size_t g = g_end - 1;
-      while (g > run_begin && s.kb[s.order[g - 1]] == s.kb[s.order[g_end - 1]]) --g;
+      while (g > run_begin && cs.kb[cs.order[g - 1]] == cs.kb[cs.order[g_end - 1]]) --g;
       for (std::size_t i = g; i < g_end; ++i) {
-        const uint32_t e = s.order[i];
+        const uint32_t e = cs.order[i];
         if (s.slot[e] == FieldEntry::kNoSlot) continue;
-        const uint32_t rk = s.rank[e];
-        const double inter = fen_prefix(s.fen, r - 1 - rk) * s.ea[e] * s.eb[e];
-        const double res = inter + 0.5 * (s.eq[rk] * s.ea[e] + suf * s.eb[e]);
-        s.pot[e] += res;
-        s.gx[e] += c.gmm_x * res;
-        s.gy[e] += c.gmm_y * res;
+        const uint32_t rk = cs.rank[e];
+        const double inter = fen_prefix(cs.fen, r - 1 - rk) * cs.ea[e] * cs.eb[e];
+        const double res = inter + 0.5 * (cs.eq[rk] * cs.ea[e] + suf * cs.eb[e]);
+        bwd(e, res);
       }
-      for (std::size_t i = g; i < g_end; ++i) suf += s.w[s.order[i]] * s.ieb[s.order[i]];
+      for (std::size_t i = g; i < g_end; ++i) suf += s.w[cs.order[i]] * cs.ieb[cs.order[i]];
       g_end = g;
     }
     for (std::size_t i = run_begin; i < end; ++i) {
-      const uint32_t e = s.order[i];
+      const uint32_t e = cs.order[i];
       if (s.w[e] == 0) continue;
-      fen_add(s.fen, r - 1 - s.rank[e], s.w[e] * s.iea[e] * s.ieb[e]);
-      s.eq[s.rank[e]] += s.w[e] * s.iea[e];
+      fen_add(cs.fen, r - 1 - cs.rank[e], s.w[e] * cs.iea[e] * cs.ieb[e]);
+      cs.eq[cs.rank[e]] += s.w[e] * cs.iea[e];
     }
     end = run_begin;
   }
@@ -342,7 +404,7 @@ void run_combo(Scratch& s, const Combo& c) {
 // source pairs) are summed pair by pair with the naive path's own kernel; the others by sweeps.
 void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, double ox, double oy,
                   double half, double halo, bool direct_only, const Separable& sep,
-                  const PairKernel& kernel, Scratch& s, const Outputs& out) {
+                  const PairKernel& kernel, Scratch& s, const Outputs& out, Executor* ex) {
   const std::size_t m = items.size();
   std::size_t probes = 0, sources = 0;
   for (uint64_t it : items) {
@@ -370,19 +432,32 @@ void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, d
     return;
   }
 
-  // Sweeps: entries in (x, y, id) order.
-  std::sort(items.begin(), items.end(), [&](uint64_t a, uint64_t b) {
-    const FieldEntry &p = E[a >> 1], &q = E[b >> 1];
-    if (p.x != q.x) return p.x < q.x;
-    if (p.y != q.y) return p.y < q.y;
-    return p.id < q.id;
-  });
+  // Sweeps: entries in (x, y, id) order (ids are unique: one order, whatever the items' order):
+  // by x with a radix sort, then the runs of equal x (rare) by (y, id).
+  s.keyed.resize(m);
+  for (std::size_t i = 0; i < m; ++i)
+    s.keyed[i] = {order_bits(E[items[i] >> 1].x), static_cast<uint32_t>(i)};
+  radix_by_key(s.keyed, s.keyed_tmp);
+  s.sorted_items.resize(m);
+  for (std::size_t i = 0; i < m; ++i) s.sorted_items[i] = items[s.keyed[i].at];
+  for (std::size_t g = 0; g < m;) {
+    std::size_t g_end = g + 1;
+    while (g_end < m && s.keyed[g_end].key == s.keyed[g].key) ++g_end;
+    if (g_end - g > 1)
+      std::sort(s.sorted_items.begin() + static_cast<std::ptrdiff_t>(g),
+                s.sorted_items.begin() + static_cast<std::ptrdiff_t>(g_end),
+                [&](uint64_t a, uint64_t b) {
+                  const FieldEntry &p = E[a >> 1], &q = E[b >> 1];
+                  return p.y < q.y || (p.y == q.y && p.id < q.id);
+                });
+    g = g_end;
+  }
+  std::copy(s.sorted_items.begin(), s.sorted_items.end(), items.begin());
   for (auto* v : {&s.x, &s.y, &s.lx, &s.ly, &s.w}) v->resize(m);
   s.slot.resize(m);
   s.pot.assign(m, 0.0);
   s.gx.assign(m, 0.0);
   s.gy.assign(m, 0.0);
-  s.ysort.resize(m);
   for (std::size_t i = 0; i < m; ++i) {
     const FieldEntry& e = E[items[i] >> 1];
     s.x[i] = e.x;
@@ -391,15 +466,15 @@ void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, d
     s.ly[i] = (e.y - oy) - half;
     s.w[i] = e.w;
     s.slot[i] = (items[i] & 1) ? e.slot : FieldEntry::kNoSlot;
-    s.ysort[i] = {e.y, static_cast<uint32_t>(i)};
+    s.keyed[i] = {order_bits(e.y), static_cast<uint32_t>(i)};
   }
-  std::sort(s.ysort.begin(), s.ysort.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
+  // y ranks: equal y, equal rank.
+  radix_by_key(s.keyed, s.keyed_tmp);
   s.yrank.resize(m);
   std::size_t r = 0;
   for (std::size_t i = 0; i < m; ++i) {
-    if (i > 0 && s.ysort[i].first != s.ysort[i - 1].first) ++r;
-    s.yrank[s.ysort[i].second] = static_cast<uint32_t>(r);
+    if (i > 0 && s.keyed[i].key != s.keyed[i - 1].key) ++r;
+    s.yrank[s.keyed[i].at] = static_cast<uint32_t>(r);
   }
   s.yrank_count = r + 1;
 
@@ -421,7 +496,50 @@ void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, d
     }
     g = g_end;
   }
-  for (int c = 0; c < sep.combos; ++c) run_combo(s, sep.c[c]);
+  if (ex && ex->threads() > 1 && m >= kParallelCombos) {
+    // The combos on every thread, each with its own storage; their sums are added in the order
+    // one thread adds them (forward, backward, combo by combo), so the same bits.
+    s.combo_tasks.resize(static_cast<std::size_t>(sep.combos));
+    ex->for_each_chunk(s.combo_tasks.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t c = b; c < e; ++c) {
+        ComboScratch& cs = s.combo_tasks[c];
+        cs.fwd.resize(m);
+        cs.bwd.resize(m);
+        run_combo(
+            s, cs, sep.c[c], [&](uint32_t i, double res) { cs.fwd[i] = res; },
+            [&](uint32_t i, double res) { cs.bwd[i] = res; });
+      }
+    });
+    for (int c = 0; c < sep.combos; ++c) {
+      const Combo& q = sep.c[c];
+      const ComboScratch& cs = s.combo_tasks[static_cast<std::size_t>(c)];
+      for (std::size_t i = 0; i < m; ++i) {
+        if (s.slot[i] == FieldEntry::kNoSlot) continue;
+        s.pot[i] += cs.fwd[i];
+        s.gx[i] += q.gpp_x * cs.fwd[i];
+        s.gy[i] += q.gpp_y * cs.fwd[i];
+        s.pot[i] += cs.bwd[i];
+        s.gx[i] += q.gmm_x * cs.bwd[i];
+        s.gy[i] += q.gmm_y * cs.bwd[i];
+      }
+    }
+  } else {
+    for (int c = 0; c < sep.combos; ++c) {
+      const Combo& q = sep.c[c];
+      run_combo(
+          s, s.combo, q,
+          [&](uint32_t i, double res) {
+            s.pot[i] += res;
+            s.gx[i] += q.gpp_x * res;
+            s.gy[i] += q.gpp_y * res;
+          },
+          [&](uint32_t i, double res) {
+            s.pot[i] += res;
+            s.gx[i] += q.gmm_x * res;
+            s.gy[i] += q.gmm_y * res;
+          });
+    }
+  }
   for (std::size_t i = 0; i < m; ++i) {
     if (s.slot[i] == FieldEntry::kNoSlot) continue;
     out.pot[s.slot[i]] = s.pot[i];
@@ -475,6 +593,26 @@ void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, boo
     ymax = std::max(ymax, e.y);
   }
   Stopwatch clock;
+  const double hx = (xmax - xmin) / 2, hy = (ymax - ymin) / 2;
+  const double halo = (std::log(static_cast<double>(sources) + 1) + kHaloMargin) / sep.decay;
+  // Tile side T: swept tiles are as large as the exponent budget allows; direct tiles 2H, so a
+  // window of (T + 2H)^2 = 16 H^2 serves a tile of 4 H^2.
+  const double side = cutoff ? 2 * halo : 2 * (kExponentBudget / sep.bound(1, 1) - halo);
+  const bool one_tile =
+      cutoff ? !(2 * std::max(hx, hy) > side) : sep.bound(hx, hy) <= kExponentBudget;
+  if (one_tile) {
+    // One tile, origin at the centre of the bounding box, nothing dropped. The tile puts its
+    // entries in its own order: the entries' order does not matter.
+    Scratch s;
+    s.items.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      s.items[i] = (uint64_t{i} << 1) | (E[i].slot != FieldEntry::kNoSlot);
+    process_tile(E, s.items, xmin + hx, ymin + hy, 0.0, INFINITY, cutoff, sep, kernel, s, out, &ex);
+    stats.pair_tests += s.pairs;
+    stats.nodes_visited += 1;
+    stats.query_seconds += clock.seconds();
+    return;
+  }
   {
     // By x only (ties by id): slabs need x order; tiles that sweep sort their own entries.
     std::vector<std::pair<double, uint32_t>> order(n);
@@ -488,26 +626,6 @@ void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, boo
   }
   stats.build_seconds += clock.seconds();
   clock.restart();
-
-  const double hx = (xmax - xmin) / 2, hy = (ymax - ymin) / 2;
-  const double halo = (std::log(static_cast<double>(sources) + 1) + kHaloMargin) / sep.decay;
-  // Tile side T: swept tiles are as large as the exponent budget allows; direct tiles 2H, so a
-  // window of (T + 2H)^2 = 16 H^2 serves a tile of 4 H^2.
-  const double side = cutoff ? 2 * halo : 2 * (kExponentBudget / sep.bound(1, 1) - halo);
-  const bool one_tile =
-      cutoff ? !(2 * std::max(hx, hy) > side) : sep.bound(hx, hy) <= kExponentBudget;
-  if (one_tile) {
-    // One tile, origin at the centre of the bounding box, nothing dropped.
-    Scratch s;
-    s.items.resize(n);
-    for (std::size_t i = 0; i < n; ++i)
-      s.items[i] = (uint64_t{i} << 1) | (E[i].slot != FieldEntry::kNoSlot);
-    process_tile(E, s.items, xmin + hx, ymin + hy, 0.0, INFINITY, cutoff, sep, kernel, s, out);
-    stats.pair_tests += s.pairs;
-    stats.nodes_visited += 1;
-    stats.query_seconds += clock.seconds();
-    return;
-  }
 
   if (!(side > 0) || !std::isfinite(side))
     throw Error(Error::Kind::input, "field index: kernel rate out of range for tiling");
@@ -566,7 +684,7 @@ void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, boo
             s.items.push_back((uint64_t{it.gpos} << 1) | (probe ? 1u : 0u));
         }
         std::sort(s.items.begin(), s.items.end());
-        process_tile(E, s.items, sl.s0, t0, half, halo, cutoff, sep, kernel, s, out);
+        process_tile(E, s.items, sl.s0, t0, half, halo, cutoff, sep, kernel, s, out, nullptr);
         ++tiles_per_slab[si];
         pairs_per_slab[si] += s.pairs;
         s.pairs = 0;

@@ -304,6 +304,41 @@ TEST(FieldIndex, ThreadCountDoesNotChangeBits) {
   }
 }
 
+// Worlds that fit one tile and are large enough for the tile to run its combos on every thread
+// (field_index.cpp, kParallelCombos), and to sort its entries by radix: against the naive loop,
+// and the same bits on 1, 2 and 3 threads. A uniform crowd; a lattice (ties in x, in y and on the
+// diagonals) with a few duplicate positions and -0 beside +0 (one key for the radix sort, as
+// they compare equal); mixed-sign charges.
+TEST(FieldIndex, OneLargeTileOnEveryThread) {
+  DiscTable uniform = build::uniform(6000, {0, 0, 90, 90}, 1, 0.2, 0.3, 21);
+  random_charges(uniform, 21, true);
+  DiscTable lattice = build::lattice(4900, 1.0, 1, 0.4, 5);
+  random_charges(lattice, 5);
+  for (std::size_t i = 0; i < lattice.size(); i += 97) {  // duplicates of the row before
+    lattice.x[i] = lattice.x[i - (i > 0)];
+    lattice.y[i] = lattice.y[i - (i > 0)];
+  }
+  std::size_t zeros = 0;  // every other x of 0 made -0
+  for (std::size_t i = 0; i < lattice.size(); ++i)
+    if (lattice.x[i] == 0 && zeros++ % 2) lattice.x[i] = -0.0;
+  ASSERT_GT(zeros, 20u);
+  for (const DiscTable* t : {&uniform, &lattice}) {
+    const std::string what = t == &uniform ? "one tile, uniform" : "one tile, lattice";
+    check_all_metrics(*t, StaticScene{}, what);
+    for (const PotentialSpec& s : {exp_spec(Metric::l1), exp_spec(Metric::radial)}) {
+      QueryStats stats;
+      const FieldColumns a = potential_field(t->view(), StaticScene{}, s, "index", 1, &stats);
+      EXPECT_EQ(stats.nodes_visited, 1u) << what << ": not one tile";
+      for (int threads : {2, 3}) {
+        const FieldColumns b = potential_field(t->view(), StaticScene{}, s, "index", threads);
+        EXPECT_EQ(a.potential, b.potential) << what << " " << metric_name(s) << " " << threads;
+        EXPECT_EQ(a.grad_x, b.grad_x) << what << " " << metric_name(s) << " " << threads;
+        EXPECT_EQ(a.grad_y, b.grad_y) << what << " " << metric_name(s) << " " << threads;
+      }
+    }
+  }
+}
+
 TEST(FieldIndex, FiniteDifferenceModeMatchesNaive) {
   for (uint64_t seed = 1; seed <= 3; ++seed) {
     DiscTable t = build::uniform(300, {0, 0, 80, 80}, 5, 1, 3, seed);
