@@ -30,8 +30,8 @@
 // SWEEP. Per combo the tile's entries are sorted by (a, b) and b is ranked (for the L1 combos
 // both come from the tile's (x, y, id) order and y ranks, without sorting again; that order and
 // the y ranks come from radix sorts of the coordinates' bits, the rare runs of equal x then
-// sorted by (y, id)). The forward
-// sweep visits runs of equal a in increasing a; probes of a run query a Fenwick tree over
+// sorted by (y, id)). The forward sweep visits runs of equal a in increasing a; probes of a run
+// query a Fenwick tree over
 // b-ranks (prefix: sources with smaller a and smaller b: the wedge interior), an array of
 // per-rank sums (smaller a, equal b: one ray) and a running sum inside the run (equal a,
 // smaller b: the other ray); then the run's sources are inserted. The backward sweep mirrors it.
@@ -68,13 +68,16 @@
 // components are sums of the same terms times wedge coefficients of size <= k: the same bound
 // times k. Measured (tests, E5): |S_idx - S_naive| <= ~1e-4 of the tolerance.
 //
-// COMPLEXITY. One global sort by x, O(n log n); every source lies in at most 4 tiles
-// (2H < T); per swept tile of m entries: a sort by (x, y, id) and, per combo, at most two
-// sorts and two sweeps, O(m log m); a direct tile costs O(pairs) <= 16 m. Total O(n log n)
-// time, O(n) memory. Exponentials: 2 per entry per combo in swept tiles, 1 per pair in direct
+// COMPLEXITY. One global sort by x, O(n log n) (not for a world of one swept tile, which needs
+// no order but its own); every source lies in at most 4 tiles (2H < T); per swept tile of m
+// entries: a radix sort by x (O(m) passes of 11 bits over the varying bits) and, per combo, at
+// most two sorts and two sweeps, O(m log m); a direct tile costs O(pairs) <= 16 m. Total
+// O(n log n) time, O(n) memory (a world of one tile on T threads: min(T, combos) sweeps'
+// scratch at once). Exponentials: 2 per entry per combo in swept tiles, 1 per pair in direct
 // tiles.
 //
-// DETERMINISM. Entries are ordered by (x, id) and inside swept tiles by (x, y, id); tiles are cut
+// DETERMINISM. Entries are ordered by (x, id) (direct tiles add their terms in that order) and
+// inside swept tiles by (x, y, id); tiles are cut
 // by a deterministic greedy rule; each probe is computed in exactly one tile, and slabs are
 // independent, one thread each. A world that fits one tile (2 * 10^4 agents on 200 m at the
 // thesis's k) would leave every thread but one idle: its combos run on every thread instead, each
@@ -197,8 +200,9 @@ struct KeyedIndex {
 };
 
 // Sorts v by key, stably: least significant digit first, 11 bits at a time, skipping the digits
-// on which every key agrees (the coordinates of one region share their sign, exponent and top
-// bits). Six passes for 2 * 10^4 positions: a fifth of std::sort's time on (x, y, id).
+// on which every key agrees (coordinates of one sign within a few powers of two share their top
+// bits; a region around 0 shares none). Six passes for 2 * 10^4 positions on 200 m: a fifth of
+// std::sort's time on (x, y, id).
 void radix_by_key(std::vector<KeyedIndex>& v, std::vector<KeyedIndex>& tmp) {
   constexpr int kDigit = 11;
   constexpr std::size_t kBuckets = std::size_t{1} << kDigit;
@@ -243,9 +247,6 @@ struct ComboScratch {
   std::vector<double> ea, iea, eb, ieb, fen, eq;
   std::vector<uint32_t> order, rank;
   std::vector<std::pair<Key, uint32_t>> bsort;
-  // When the combos run on several threads: each probe's sums over the two wedges, added to
-  // the tile's sums afterwards in the order one thread adds them.
-  std::vector<double> fwd, bwd;
 };
 
 // Per-thread working storage, reused across tiles.
@@ -256,8 +257,11 @@ struct Scratch {
   std::vector<uint32_t> slot;
   std::vector<uint32_t> yrank;
   std::size_t yrank_count = 0;
-  ComboScratch combo;                        // the combos one after the other
-  std::vector<ComboScratch> combo_tasks;     // or one per combo, on several threads
+  ComboScratch combo;  // the combos one after the other
+  // Or on several threads: a scratch per chunk of combos, and per combo each probe's sums over
+  // its two wedges, added to the tile's sums afterwards in the order one thread adds them.
+  std::vector<ComboScratch> chunk_combo;
+  std::vector<std::vector<double>> fwd, bwd;
   std::vector<KeyedIndex> keyed, keyed_tmp;  // radix_by_key
   std::vector<uint64_t> sorted_items;
   // Slab and tile cutting.
@@ -499,28 +503,36 @@ void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, d
   if (ex && ex->threads() > 1 && m >= kParallelCombos) {
     // The combos on every thread, each with its own storage; their sums are added in the order
     // one thread adds them (forward, backward, combo by combo), so the same bits.
-    s.combo_tasks.resize(static_cast<std::size_t>(sep.combos));
-    ex->for_each_chunk(s.combo_tasks.size(), 1, [&](std::size_t b, std::size_t e) {
+    const auto combos = static_cast<std::size_t>(sep.combos);
+    // As many chunks as threads, at most: a sweep's scratch is about 100 bytes an entry.
+    const auto threads = static_cast<std::size_t>(ex->threads());
+    const std::size_t grain = (combos + threads - 1) / threads;
+    s.chunk_combo.resize((combos + grain - 1) / grain);
+    s.fwd.resize(combos);
+    s.bwd.resize(combos);
+    ex->for_each_chunk(combos, grain, [&](std::size_t b, std::size_t e) {
       for (std::size_t c = b; c < e; ++c) {
-        ComboScratch& cs = s.combo_tasks[c];
-        cs.fwd.resize(m);
-        cs.bwd.resize(m);
+        std::vector<double>& fwd = s.fwd[c];
+        std::vector<double>& bwd = s.bwd[c];
+        fwd.resize(m);
+        bwd.resize(m);
         run_combo(
-            s, cs, sep.c[c], [&](uint32_t i, double res) { cs.fwd[i] = res; },
-            [&](uint32_t i, double res) { cs.bwd[i] = res; });
+            s, s.chunk_combo[b / grain], sep.c[c], [&](uint32_t i, double res) { fwd[i] = res; },
+            [&](uint32_t i, double res) { bwd[i] = res; });
       }
     });
-    for (int c = 0; c < sep.combos; ++c) {
+    for (std::size_t c = 0; c < combos; ++c) {
       const Combo& q = sep.c[c];
-      const ComboScratch& cs = s.combo_tasks[static_cast<std::size_t>(c)];
+      const std::vector<double>& fwd = s.fwd[c];
+      const std::vector<double>& bwd = s.bwd[c];
       for (std::size_t i = 0; i < m; ++i) {
         if (s.slot[i] == FieldEntry::kNoSlot) continue;
-        s.pot[i] += cs.fwd[i];
-        s.gx[i] += q.gpp_x * cs.fwd[i];
-        s.gy[i] += q.gpp_y * cs.fwd[i];
-        s.pot[i] += cs.bwd[i];
-        s.gx[i] += q.gmm_x * cs.bwd[i];
-        s.gy[i] += q.gmm_y * cs.bwd[i];
+        s.pot[i] += fwd[i];
+        s.gx[i] += q.gpp_x * fwd[i];
+        s.gy[i] += q.gpp_y * fwd[i];
+        s.pot[i] += bwd[i];
+        s.gx[i] += q.gmm_x * bwd[i];
+        s.gy[i] += q.gmm_y * bwd[i];
       }
     }
   } else {
@@ -581,12 +593,13 @@ void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, boo
   const std::size_t n = E.size();
   if (n == 0) return;
   if (n >= (std::size_t{1} << 31)) throw Error(Error::Kind::input, "field index: too many points");
-  std::size_t sources = 0;
+  std::size_t sources = 0, probes = 0;
   double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
   for (const FieldEntry& e : E) {
     if (!std::isfinite(e.x) || !std::isfinite(e.y) || !std::isfinite(e.w))
       throw Error(Error::Kind::input, "field index: a point or charge is not finite");
     sources += e.w != 0;
+    probes += e.slot != FieldEntry::kNoSlot;
     xmin = std::min(xmin, e.x);
     xmax = std::max(xmax, e.x);
     ymin = std::min(ymin, e.y);
@@ -600,9 +613,24 @@ void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, boo
   const double side = cutoff ? 2 * halo : 2 * (kExponentBudget / sep.bound(1, 1) - halo);
   const bool one_tile =
       cutoff ? !(2 * std::max(hx, hy) > side) : sep.bound(hx, hy) <= kExponentBudget;
+  // A tile summed pair by pair adds each probe's terms in the entries' order, so the entries go
+  // in (x, id) order first, as the slabs need them anyway. A swept tile sorts its own entries by
+  // (x, y, id): for a world of one such tile the order of the input does not matter.
+  const bool direct = cutoff || probes * sources <= kDirectPairsPerEntry * n;
+  if (!one_tile || direct) {
+    std::vector<std::pair<double, uint32_t>> order(n);
+    for (std::size_t i = 0; i < n; ++i) order[i] = {E[i].x, static_cast<uint32_t>(i)};
+    std::sort(order.begin(), order.end(), [&](const auto& a, const auto& b) {
+      return a.first < b.first || (a.first == b.first && E[a.second].id < E[b.second].id);
+    });
+    std::vector<FieldEntry> sorted(n);
+    for (std::size_t i = 0; i < n; ++i) sorted[i] = E[order[i].second];
+    E.swap(sorted);
+    stats.build_seconds += clock.seconds();
+    clock.restart();
+  }
   if (one_tile) {
-    // One tile, origin at the centre of the bounding box, nothing dropped. The tile puts its
-    // entries in its own order: the entries' order does not matter.
+    // One tile, origin at the centre of the bounding box, nothing dropped.
     Scratch s;
     s.items.resize(n);
     for (std::size_t i = 0; i < n; ++i)
@@ -613,19 +641,6 @@ void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, boo
     stats.query_seconds += clock.seconds();
     return;
   }
-  {
-    // By x only (ties by id): slabs need x order; tiles that sweep sort their own entries.
-    std::vector<std::pair<double, uint32_t>> order(n);
-    for (std::size_t i = 0; i < n; ++i) order[i] = {E[i].x, static_cast<uint32_t>(i)};
-    std::sort(order.begin(), order.end(), [&](const auto& a, const auto& b) {
-      return a.first < b.first || (a.first == b.first && E[a.second].id < E[b.second].id);
-    });
-    std::vector<FieldEntry> sorted(n);
-    for (std::size_t i = 0; i < n; ++i) sorted[i] = E[order[i].second];
-    E.swap(sorted);
-  }
-  stats.build_seconds += clock.seconds();
-  clock.restart();
 
   if (!(side > 0) || !std::isfinite(side))
     throw Error(Error::Kind::input, "field index: kernel rate out of range for tiling");

@@ -31,8 +31,8 @@ struct FieldEntry {
 // Exact separable sums: out_*[slot] = sum over source entries q other than the probe entry itself
 // of w_q K(d(p, q)), and its analytic gradient with respect to p, for K = e^{-k d} with d the
 // spec's l1 or radial (1-2 frames) metric; sign(0) = 0 conventions as PairKernel. The sums are
-// unscaled (no A, no probe charge). `entries` is reordered. out_* must have room for every slot;
-// slots not present are left untouched. Thread count does not change the output.
+// unscaled (no A, no probe charge). `entries` may be reordered. out_* must have room for every
+// slot; slots not present are left untouched. Thread count does not change the output.
 void separable_field_sums(std::vector<FieldEntry>& entries, const PotentialSpec& spec,
                           std::span<double> out_pot, std::span<double> out_gx,
                           std::span<double> out_gy, Executor& ex, QueryStats& stats);

@@ -314,16 +314,23 @@ TEST(FieldIndex, OneLargeTileOnEveryThread) {
   random_charges(uniform, 21, true);
   DiscTable lattice = build::lattice(4900, 1.0, 1, 0.4, 5);
   random_charges(lattice, 5);
-  for (std::size_t i = 0; i < lattice.size(); i += 97) {  // duplicates of the row before
-    lattice.x[i] = lattice.x[i - (i > 0)];
-    lattice.y[i] = lattice.y[i - (i > 0)];
+  for (std::size_t i = 97; i < lattice.size(); i += 97) {  // duplicates of the row before
+    lattice.x[i] = lattice.x[i - 1];
+    lattice.y[i] = lattice.y[i - 1];
   }
-  std::size_t zeros = 0;  // every other x of 0 made -0
-  for (std::size_t i = 0; i < lattice.size(); ++i)
+  std::size_t zeros = 0;  // every other coordinate of 0 made -0, in x and in y
+  for (std::size_t i = 0; i < lattice.size(); ++i) {
     if (lattice.x[i] == 0 && zeros++ % 2) lattice.x[i] = -0.0;
-  ASSERT_GT(zeros, 20u);
-  for (const DiscTable* t : {&uniform, &lattice}) {
-    const std::string what = t == &uniform ? "one tile, uniform" : "one tile, lattice";
+    if (lattice.y[i] == 0 && zeros++ % 2) lattice.y[i] = -0.0;
+  }
+  ASSERT_GT(zeros, 40u);
+  DiscTable negative = uniform;  // the same crowd in negative coordinates
+  for (double& x : negative.x) x -= 1e3;
+  for (double& y : negative.y) y = -y;
+  for (const DiscTable* t : {&uniform, &lattice, &negative}) {
+    const std::string what = t == &uniform   ? "one tile, uniform"
+                             : t == &lattice ? "one tile, lattice"
+                                             : "one tile, negative";
     check_all_metrics(*t, StaticScene{}, what);
     for (const PotentialSpec& s : {exp_spec(Metric::l1), exp_spec(Metric::radial)}) {
       QueryStats stats;
