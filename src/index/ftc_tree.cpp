@@ -13,6 +13,7 @@
 
 #include "crowddb/error.hpp"
 #include "query/ftc_geometry.hpp"
+#include "util/executor.hpp"
 #include "util/stopwatch.hpp"
 
 namespace crowddb {
@@ -25,6 +26,9 @@ using Kind = Collider::Kind;
 // margin of more than ten.
 constexpr double kSlack = 1e-6;
 constexpr uint32_t kNoRow = std::numeric_limits<uint32_t>::max();
+// From this many members a tree's subtrees are built on every thread (below, the threads'
+// start-up costs more than they save).
+constexpr uint32_t kParallelBuild = 4096;
 
 // The time axis every tree of one build shares.
 struct Frame {
@@ -315,7 +319,9 @@ double overlap_terms(const double* __restrict x, const double* __restrict y,
 template <class Src>
 class KineticTree {
  public:
-  void build(const Src& src, const Frame& f, std::size_t leaf_size);
+  // With `ex` (more than one thread, kParallelBuild members or more), the subtrees below the top
+  // levels are built on its threads: the same tree, node for node.
+  void build(const Src& src, const Frame& f, std::size_t leaf_size, Executor* ex = nullptr);
   using Order = FtcIndexOptions::Order;
   // Adds this tree's members to `best`. self_pos: the query's position in tree order (it is
   // skipped as a member, and its leaf is scanned first), or kNoRow.
@@ -345,7 +351,23 @@ class KineticTree {
   struct Raw {
     double lo_x, lo_y, hi_x, hi_y;
   };
-  uint32_t build_node(uint32_t b, uint32_t e, uint32_t parent, Cell cell);
+  // A median split's scratch (select_median): one per thread building.
+  struct Split;
+  // Builds the subtree of pts_[b, e) rooted at node idx, its nodes numbered in preorder from
+  // idx (the left child is idx + 1); returns the number after its last node.
+  uint32_t build_node(uint32_t idx, uint32_t b, uint32_t e, uint32_t parent, Cell cell, Split& sc);
+  // A subtree left to build_node on some thread.
+  struct Subtree {
+    uint32_t idx, b, e, parent;
+    Cell cell;
+  };
+  // The top `depth` levels of the subtree of pts_[b, e) rooted at idx, on the calling thread:
+  // the splits go to `top` (their bounds are merged once the subtrees below are built), the
+  // subtrees below them to `below`.
+  void build_top(uint32_t idx, uint32_t b, uint32_t e, uint32_t parent, Cell cell, int depth,
+                 std::vector<Subtree>& below, std::vector<uint32_t>& top);
+  // Splits pts_[b, e) at its median along the wider side of `cell`: the cut, the two cells.
+  double split(uint32_t b, uint32_t e, const Cell& cell, Split& sc, Cell& lc, Cell& rc);
   // Nodes of the tree over n members (median splits until at most leaf_size_ remain).
   std::size_t count_nodes(std::size_t n) const {
     return n <= leaf_size_ ? 1 : 1 + count_nodes(n / 2) + count_nodes(n - n / 2);
@@ -376,15 +398,19 @@ class KineticTree {
     double x, y;  // the source's values (x - ox is monotone in x: raw order is frame order)
     uint32_t row;
   };
-  std::vector<Pt> pts_, lohi_, middle_;
+  std::vector<Pt> pts_;
+  struct Split {
+    std::vector<Pt> lohi, middle;
+  };
+  std::vector<Split> splits_;  // one per subtree built at once
   // Rearranges pts_[b, e) as std::nth_element does at position k, by coordinate C.
   template <double Pt::*C>
-  void select_median(uint32_t b, uint32_t e, uint32_t k);
+  void select_median(uint32_t b, uint32_t e, uint32_t k, Split& sc);
   std::vector<Raw> raw_;  // (K + 1) per node (chord) or 2 per node (frustum: box, velocity box)
 };
 
 template <class Src>
-void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_size) {
+void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_size, Executor* ex) {
   src_ = &src;
   f_ = &f;
   leaf_size_ = std::max<std::size_t>(leaf_size, 1);
@@ -408,18 +434,39 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
     y1 = std::max(y1, pts_[i].y);
   }
   // Frame coordinates (x - ox is monotone in x, so orders by raw x are orders by frame x).
-  x0 -= f.ox;
-  x1 -= f.ox;
-  y0 -= f.oy;
-  y1 -= f.oy;
-  // Median splits leave at least leaf_size / 2 members per leaf: at most 4n / leaf + 2 nodes.
-  const std::size_t most = 4 * n / leaf_size_ + 2;
-  nodes_.reserve(most);
+  const Cell root{x0 - f.ox, y0 - f.oy, x1 - f.ox, y1 - f.oy};
+  // Every node has its place before it is built (preorder; the sizes fix the shape), so
+  // subtrees can be built at once.
   stride_ = count_nodes(n);
+  nodes_.resize(stride_);
+  cells_.resize(stride_);
   slices_.resize(stride_ * static_cast<std::size_t>(f.slices()));
-  raw_.reserve(most * (f.chord ? f.knots.size() : 2));
-  cells_.reserve(most);
-  build_node(0, n, kNoRow, {x0, y0, x1, y1});
+  raw_.resize(stride_ * (f.chord ? f.knots.size() : 2));
+  const int threads = ex ? ex->threads() : 1;
+  if (threads > 1 && n >= kParallelBuild) {
+    // The top levels here (the first split alone is a tenth of the work at 2 * 10^4), then
+    // at least two subtrees per thread.
+    int depth = 1;
+    while ((1 << depth) < 2 * threads) ++depth;
+    std::vector<Subtree> below;
+    std::vector<uint32_t> top;
+    if (splits_.empty()) splits_.resize(1);
+    build_top(0, 0, n, kNoRow, root, depth, below, top);
+    if (splits_.size() < below.size()) splits_.resize(below.size());
+    ex->for_each_chunk(below.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const Subtree& t = below[k];
+        build_node(t.idx, t.b, t.e, t.parent, t.cell, splits_[k]);
+      }
+    });
+    for (auto it = top.rbegin(); it != top.rend(); ++it) {  // children before their parents
+      merge_bounds(*it, *it + 1, nodes_[*it].right);
+      finish_bounds(*it);
+    }
+  } else {
+    if (splits_.empty()) splits_.resize(1);
+    build_node(0, 0, n, kNoRow, root, splits_[0]);
+  }
   for (uint32_t i = 0; i < n; ++i) perm_[i] = items_[i].row;
   for (uint32_t i = 0; i < n; ++i) pos_of_[perm_[i]] = i;
   for (uint32_t k = 0; k < nodes_.size(); ++k)
@@ -431,16 +478,53 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
     reach_vx_ = std::max(reach_vx_, std::fabs(src.vx(i)));
     reach_vy_ = std::max(reach_vy_, std::fabs(src.vy(i)));
   }
-  raw_.clear();
 }
 
 template <class Src>
-uint32_t KineticTree<Src>::build_node(uint32_t b, uint32_t e, uint32_t parent, Cell cell) {
-  const auto idx = static_cast<uint32_t>(nodes_.size());
-  nodes_.push_back({0, 0, b, e, 0, parent});
-  cells_.push_back(cell);
-  const std::size_t per = f_->chord ? f_->knots.size() : 2;
-  raw_.resize(raw_.size() + per);
+double KineticTree<Src>::split(uint32_t b, uint32_t e, const Cell& cell, Split& sc, Cell& lc,
+                               Cell& rc) {
+  // Split the cell's wider side at the median: balanced, depth ceil(log2(n / leaf)).
+  const bool by_x = cell.x1 - cell.x0 >= cell.y1 - cell.y0;
+  const uint32_t mid = b + (e - b) / 2;
+  if (by_x)
+    select_median<&Pt::x>(b, e, mid, sc);
+  else
+    select_median<&Pt::y>(b, e, mid, sc);
+  // Left members have coordinate <= cut, right ones >= cut (ties may fall either side).
+  // (x - ox rounds monotonically: raw order is frame order, and the cut bounds both sides.)
+  const double cut = by_x ? pts_[mid].x - f_->ox : pts_[mid].y - f_->oy;
+  lc = cell;
+  rc = cell;
+  (by_x ? lc.x1 : lc.y1) = cut;
+  (by_x ? rc.x0 : rc.y0) = cut;
+  return cut;
+}
+
+template <class Src>
+void KineticTree<Src>::build_top(uint32_t idx, uint32_t b, uint32_t e, uint32_t parent, Cell cell,
+                                 int depth, std::vector<Subtree>& below,
+                                 std::vector<uint32_t>& top) {
+  if (depth == 0 || e - b <= leaf_size_) {
+    below.push_back({idx, b, e, parent, cell});
+    return;
+  }
+  Cell lc, rc;
+  split(b, e, cell, splits_[0], lc, rc);
+  const uint32_t mid = b + (e - b) / 2;
+  const auto r = static_cast<uint32_t>(idx + 1 + count_nodes(mid - b));
+  nodes_[idx] = {0, 0, b, e, r, parent};
+  cells_[idx] = cell;
+  top.push_back(idx);
+  build_top(idx + 1, b, mid, idx, lc, depth - 1, below, top);
+  build_top(r, mid, e, idx, rc, depth - 1, below, top);
+}
+
+template <class Src>
+uint32_t KineticTree<Src>::build_node(uint32_t idx, uint32_t b, uint32_t e, uint32_t parent,
+                                      Cell cell, Split& sc) {
+  nodes_[idx] = {0, 0, b, e, 0, parent};
+  cells_[idx] = cell;
+  uint32_t next = idx + 1;
   if (e - b <= leaf_size_) {
     // The leaf's members, copied from the source, by key: a scan can stop at the first key
     // that can no longer win.
@@ -454,26 +538,16 @@ uint32_t KineticTree<Src>::build_node(uint32_t b, uint32_t e, uint32_t parent, C
     });
     leaf_bounds(idx);
   } else {
-    // Split the cell's wider side at the median: balanced, depth ceil(log2(n / leaf)).
-    const bool by_x = cell.x1 - cell.x0 >= cell.y1 - cell.y0;
+    Cell lc, rc;
+    split(b, e, cell, sc, lc, rc);
     const uint32_t mid = b + (e - b) / 2;
-    if (by_x)
-      select_median<&Pt::x>(b, e, mid);
-    else
-      select_median<&Pt::y>(b, e, mid);
-    // Left members have coordinate <= cut, right ones >= cut (ties may fall either side).
-    // (x - ox rounds monotonically: raw order is frame order, and the cut bounds both sides.)
-    const double cut = by_x ? pts_[mid].x - f_->ox : pts_[mid].y - f_->oy;
-    Cell lc = cell, rc = cell;
-    (by_x ? lc.x1 : lc.y1) = cut;
-    (by_x ? rc.x0 : rc.y0) = cut;
-    const uint32_t l = build_node(b, mid, idx, lc);
-    const uint32_t r = build_node(mid, e, idx, rc);
+    const uint32_t r = build_node(idx + 1, b, mid, idx, lc, sc);
+    next = build_node(r, mid, e, idx, rc, sc);
     nodes_[idx].right = r;
-    merge_bounds(idx, l, r);
+    merge_bounds(idx, idx + 1, r);
   }
   finish_bounds(idx);
-  return idx;
+  return next;
 }
 
 // nth_element's comparisons are unpredictable branches, a pass per level of the tree. Large
@@ -482,7 +556,7 @@ uint32_t KineticTree<Src>::build_node(uint32_t b, uint32_t e, uint32_t parent, C
 // to nth_element. If the bracket misses the median (adversarial orders), nth_element does it all.
 template <class Src>
 template <double KineticTree<Src>::Pt::*C>
-void KineticTree<Src>::select_median(uint32_t b, uint32_t e, uint32_t k) {
+void KineticTree<Src>::select_median(uint32_t b, uint32_t e, uint32_t k, Split& sc) {
   Pt* a = pts_.data() + b;
   const std::size_t n = e - b, kk = k - b;
   const auto less = [](const Pt& p, const Pt& q) { return p.*C < q.*C; };
@@ -494,12 +568,12 @@ void KineticTree<Src>::select_median(uint32_t b, uint32_t e, uint32_t k) {
   for (std::size_t i = 0; i < 31; ++i) s[i] = a[(2 * i + 1) * n / 62].*C;
   std::sort(s, s + 31);
   const double p1 = s[11], p2 = s[19];
-  if (lohi_.size() < n) {
-    lohi_.resize(n);
-    middle_.resize(n);
+  if (sc.lohi.size() < n) {
+    sc.lohi.resize(n);
+    sc.middle.resize(n);
   }
-  Pt* t = lohi_.data();  // below p1 from the front, above p2 from the back
-  Pt* m = middle_.data();
+  Pt* t = sc.lohi.data();  // below p1 from the front, above p2 from the back
+  Pt* m = sc.middle.data();
   std::size_t lo = 0, hi = 0, mi = 0;
   for (std::size_t i = 0; i < n; ++i) {
     // Every slot written to is either kept (its counter advances) or unused: the front and the
@@ -1034,7 +1108,8 @@ FtcIndex::FtcIndex(FtcIndexOptions options) : impl_(std::make_unique<Impl>()) {
 
 FtcIndex::~FtcIndex() = default;
 
-void FtcIndex::build(const DiscView& discs, const StaticScene& scene, double horizon) {
+void FtcIndex::build(const DiscView& discs, const StaticScene& scene, double horizon,
+                     Executor* ex) {
   Impl& m = *impl_;
   if (discs.n >= kNoRow) throw Error(Error::Kind::input, "first-to-collide index: too many discs");
   for (std::size_t i = 0; i < discs.n; ++i) {
@@ -1057,7 +1132,7 @@ void FtcIndex::build(const DiscView& discs, const StaticScene& scene, double hor
   m.make_frame();
   m.agents.d = &m.discs;
   m.circles.c = scene.circles();
-  m.agent_tree.build(m.agents, m.frame, m.opt.leaf_size);
+  m.agent_tree.build(m.agents, m.frame, m.opt.leaf_size, ex);
   m.circle_tree.build(m.circles, m.frame, m.opt.leaf_size);
   m.polygon_boxes.clear();
   const double d0 = m.frame.delta0, d1 = m.frame.delta1;
@@ -1109,7 +1184,7 @@ FtcHit FtcIndex::query(std::size_t row, QueryStats* stats) const {
 void FtcIndex::run(const DiscView& discs, const StaticScene& scene, double horizon,
                    std::span<FtcHit> out, Executor& ex, QueryStats& stats) {
   Stopwatch sw;
-  build(discs, scene, horizon);
+  build(discs, scene, horizon, &ex);
   stats.build_seconds += sw.seconds();
   sw.restart();
   query_all(out, ex, stats);

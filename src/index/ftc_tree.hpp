@@ -75,15 +75,18 @@
 // COMPLEXITY. Build O(n log n): a median split per level; large ranges are first cut by two
 // sample quantiles bracketing the median in one branch-free pass, and only the middle part goes to
 // nth_element (whose comparisons are unpredictable branches); plus O(n K) for the kinetic
-// bounds. Memory O(n / leaf * K) aggregates, the members' copy (56 bytes each) and three arrays
-// of n ints. The overlap join costs O(leaf) tests per agent at a fixed density. A query costs O(log
-// n) node visits when a collision is found nearby (the usual case); in the worst case (no collision
-// within the horizon and bounds that cannot prune, e.g. sparse worlds with fast random
-// velocities, whose nodes all carry the full velocity spread) it is O(n), as the naive loop.
-// Splitting velocities as well as positions (a 4-d tree) was tried and measured, and dropped:
-// on uniform worlds with radius 0.1-0.3, n = 1,000 on 640 x 480, it cut pair tests per query
-// from 524 to 332 at best, but at the E1 density (n = 15,000, radius 1-3) it raised them from
-// 18 to 53-580 (position locality is what finds the overlapping neighbours).
+// bounds. On several threads (from 4,096 members) the top levels are split on the calling thread
+// and the subtrees below them built at once: every node's number is known in advance (preorder,
+// and the shape depends only on the sizes), so the tree is the one a single thread builds
+// (test: FtcIndex.TreeBuiltOnThreadsIsTheSame). Memory O(n / leaf * K) aggregates, the members'
+// copy (56 bytes each) and three arrays of n ints. The overlap join costs O(leaf) tests per agent
+// at a fixed density. A query costs O(log n) node visits when a collision is found nearby (the
+// usual case); in the worst case (no collision within the horizon and bounds that cannot prune,
+// e.g. sparse worlds with fast random velocities, whose nodes all carry the full velocity spread)
+// it is O(n), as the naive loop. Splitting velocities as well as positions (a 4-d tree) was tried
+// and measured, and dropped: on uniform worlds with radius 0.1-0.3, n = 1,000 on 640 x 480, it cut
+// pair tests per query from 524 to 332 at best, but at the E1 density (n = 15,000, radius 1-3) it
+// raised them from 18 to 53-580 (position locality is what finds the overlapping neighbours).
 //
 // THE BIG CRUNCH (thesis §4.1: its index was worse than naive there). Every agent heads for the
 // centre c and arrives at t = A: v_b = (c - p_b) / A, so relative to a every other agent moves
@@ -158,7 +161,9 @@ class FtcIndex final : public FtcPath {
   // The two halves of run(), for tests, benchmarks and experiments. The index keeps pointers
   // into `discs` and `scene`: they must stay alive and unchanged while it is queried.
   // Throws Error(input) naming the row and column when a disc has a non-finite value.
-  void build(const DiscView& discs, const StaticScene& scene, double horizon);
+  // With `ex`, large trees are built on its threads (the same tree, node for node).
+  void build(const DiscView& discs, const StaticScene& scene, double horizon,
+             Executor* ex = nullptr);
   // out[i] for every disc i; deterministic whatever the executor's thread count.
   void query_all(std::span<FtcHit> out, Executor& ex, QueryStats& stats) const;
   // One disc's answer; adds its counters (rows, pair_tests, nodes_visited, queue pushes and

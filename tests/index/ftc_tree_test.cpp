@@ -320,6 +320,37 @@ TEST(FtcIndex, SameAnswerOnAnyThreadCount) {
   EXPECT_EQ(s1.queue_pops, s3.queue_pops);
 }
 
+// From 4,096 members the tree's subtrees are built on every thread below its top levels, into
+// node numbers fixed in advance: the tree must be the one a single thread builds, node for node.
+// So every query visits the same nodes and tests the same pairs, and the answers are the naive
+// loop's. Uniform and lattice (ties in x and y at every median) tables, of sizes whose two
+// halves hold different numbers of nodes (16 * 2^k and one more: a node more on the right).
+TEST(FtcIndex, TreeBuiltOnThreadsIsTheSame) {
+  const DiscTable uniform = build::uniform(16'385, {}, 50, 1, 3, 8);
+  const DiscTable lattice = build::lattice(8'193, 2.0, 1, 0.5, 3);
+  for (const DiscTable* t : {&uniform, &lattice}) {
+    FtcIndex one;
+    one.build(t->view(), kNoScene, 30);
+    for (int threads : {2, 3, 4}) {
+      Executor ex(threads);
+      FtcIndex many;
+      many.build(t->view(), kNoScene, 30, &ex);
+      ASSERT_EQ(many.validate(), "");
+      ASSERT_EQ(many.node_count(), one.node_count());
+      int differ = 0;
+      for (std::size_t i = 0; i < t->size(); ++i) {
+        QueryStats a, b;
+        const FtcHit ha = one.query(i, &a), hb = many.query(i, &b);
+        differ += !(ha.with == hb.with && same_bits(ha.time, hb.time) &&
+                    a.nodes_visited == b.nodes_visited && a.pair_tests == b.pair_tests &&
+                    a.queue_pushes == b.queue_pushes);
+      }
+      EXPECT_EQ(differ, 0) << t->size() << " members, " << threads << " threads";
+    }
+  }
+  EXPECT_EQ(compare(build::uniform(5'000, {}, 50, 1, 3, 9), kNoScene, 30, {}, 2), 0);
+}
+
 TEST(FtcIndex, StatisticsAddUp) {
   const DiscTable t = build::uniform(1000, {}, 50, 1, 3, 2);
   FtcIndex index;
