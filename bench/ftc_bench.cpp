@@ -92,7 +92,7 @@ void report(benchmark::State& state, const QueryStats& st, std::size_t n, uint64
   state.counters["hash"] = static_cast<double>(hash % 1000000007ull);
 }
 
-// Build only.
+// Build only, on one thread.
 void BM_Build(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
   const DiscTable& t = world(static_cast<int>(state.range(1)), n);

@@ -113,7 +113,7 @@ inline Run run_index(FtcIndex& index, const DiscTable& t, Executor& ex, std::vec
   Run r;
   RunClock clock(ex.threads());
   Stopwatch wall;
-  index.build(t.view(), no_obstacles(), kHorizon);
+  index.build(t.view(), no_obstacles(), kHorizon, &ex);
   r.build_s = clock.seconds();
   clock.restart();
   index.query_all(out, ex, r.stats);

@@ -3,6 +3,7 @@
 #include "index/ftc_tree.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -366,8 +367,9 @@ class KineticTree {
   // subtrees below them to `below`.
   void build_top(uint32_t idx, uint32_t b, uint32_t e, uint32_t parent, Cell cell, int depth,
                  std::vector<Subtree>& below, std::vector<uint32_t>& top);
-  // Splits pts_[b, e) at its median along the wider side of `cell`: the cut, the two cells.
-  double split(uint32_t b, uint32_t e, const Cell& cell, Split& sc, Cell& lc, Cell& rc);
+  // Splits pts_[b, e) at its median along the wider side of `cell`: returns the first member of
+  // the right half; the two halves' cells.
+  uint32_t split(uint32_t b, uint32_t e, const Cell& cell, Split& sc, Cell& lc, Cell& rc);
   // Nodes of the tree over n members (median splits until at most leaf_size_ remain).
   std::size_t count_nodes(std::size_t n) const {
     return n <= leaf_size_ ? 1 : 1 + count_nodes(n / 2) + count_nodes(n - n / 2);
@@ -406,7 +408,9 @@ class KineticTree {
   // Rearranges pts_[b, e) as std::nth_element does at position k, by coordinate C.
   template <double Pt::*C>
   void select_median(uint32_t b, uint32_t e, uint32_t k, Split& sc);
-  std::vector<Raw> raw_;  // (K + 1) per node (chord) or 2 per node (frustum: box, velocity box)
+  // (K + 1) per node (chord) or 2 per node (frustum: box, velocity box). Only the build reads
+  // them; kept from build to build, as splits_ is, so that its memory is not touched anew.
+  std::vector<Raw> raw_;
 };
 
 template <class Src>
@@ -456,7 +460,9 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
     ex->for_each_chunk(below.size(), 1, [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
         const Subtree& t = below[k];
-        build_node(t.idx, t.b, t.e, t.parent, t.cell, splits_[k]);
+        [[maybe_unused]] const uint32_t end =
+            build_node(t.idx, t.b, t.e, t.parent, t.cell, splits_[k]);
+        assert(end == t.idx + count_nodes(t.e - t.b));
       }
     });
     for (auto it = top.rbegin(); it != top.rend(); ++it) {  // children before their parents
@@ -465,7 +471,8 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
     }
   } else {
     if (splits_.empty()) splits_.resize(1);
-    build_node(0, 0, n, kNoRow, root, splits_[0]);
+    [[maybe_unused]] const uint32_t end = build_node(0, 0, n, kNoRow, root, splits_[0]);
+    assert(end == stride_);
   }
   for (uint32_t i = 0; i < n; ++i) perm_[i] = items_[i].row;
   for (uint32_t i = 0; i < n; ++i) pos_of_[perm_[i]] = i;
@@ -481,8 +488,8 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
 }
 
 template <class Src>
-double KineticTree<Src>::split(uint32_t b, uint32_t e, const Cell& cell, Split& sc, Cell& lc,
-                               Cell& rc) {
+uint32_t KineticTree<Src>::split(uint32_t b, uint32_t e, const Cell& cell, Split& sc, Cell& lc,
+                                 Cell& rc) {
   // Split the cell's wider side at the median: balanced, depth ceil(log2(n / leaf)).
   const bool by_x = cell.x1 - cell.x0 >= cell.y1 - cell.y0;
   const uint32_t mid = b + (e - b) / 2;
@@ -497,7 +504,7 @@ double KineticTree<Src>::split(uint32_t b, uint32_t e, const Cell& cell, Split& 
   rc = cell;
   (by_x ? lc.x1 : lc.y1) = cut;
   (by_x ? rc.x0 : rc.y0) = cut;
-  return cut;
+  return mid;
 }
 
 template <class Src>
@@ -509,8 +516,7 @@ void KineticTree<Src>::build_top(uint32_t idx, uint32_t b, uint32_t e, uint32_t 
     return;
   }
   Cell lc, rc;
-  split(b, e, cell, splits_[0], lc, rc);
-  const uint32_t mid = b + (e - b) / 2;
+  const uint32_t mid = split(b, e, cell, splits_[0], lc, rc);
   const auto r = static_cast<uint32_t>(idx + 1 + count_nodes(mid - b));
   nodes_[idx] = {0, 0, b, e, r, parent};
   cells_[idx] = cell;
@@ -539,8 +545,7 @@ uint32_t KineticTree<Src>::build_node(uint32_t idx, uint32_t b, uint32_t e, uint
     leaf_bounds(idx);
   } else {
     Cell lc, rc;
-    split(b, e, cell, sc, lc, rc);
-    const uint32_t mid = b + (e - b) / 2;
+    const uint32_t mid = split(b, e, cell, sc, lc, rc);
     const uint32_t r = build_node(idx + 1, b, mid, idx, lc, sc);
     next = build_node(r, mid, e, idx, rc, sc);
     nodes_[idx].right = r;

@@ -161,7 +161,8 @@ class FtcIndex final : public FtcPath {
   // The two halves of run(), for tests, benchmarks and experiments. The index keeps pointers
   // into `discs` and `scene`: they must stay alive and unchanged while it is queried.
   // Throws Error(input) naming the row and column when a disc has a non-finite value.
-  // With `ex`, large trees are built on its threads (the same tree, node for node).
+  // With `ex`, large trees are built on its threads (the same tree, node for node); not from
+  // inside one of that executor's loops (it is not re-entrant).
   void build(const DiscView& discs, const StaticScene& scene, double horizon,
              Executor* ex = nullptr);
   // out[i] for every disc i; deterministic whatever the executor's thread count.
