@@ -228,6 +228,11 @@ class World {
   std::size_t pending_changes() const { return pending_.size(); }
   // Applies the buffered changes in call order. Returns the number applied.
   std::size_t apply_pending();
+  // Room for `agents` agents in all (their rows and ids) and for the inserts that takes, as
+  // std::vector::reserve: a hint, never a limit, and nothing else changes. A caller about to
+  // insert many agents at once (a scenario's) saves the copies of growing tables. Throws
+  // Error(usage) beyond the most agents a world can hold.
+  void reserve(std::size_t agents);
 
   // ---- reads ----
   const AgentTable& agents() const { return agents_; }

@@ -1108,6 +1108,7 @@ Scenario parse_document(std::string_view text, const std::string& source, const 
     root.fail(e.field(), e.what());
   }
   sc.world.set_walls(sc.config.walls);  // the loader checked every agent against them already
+  sc.world.reserve(loader.agents.size());
   for (std::size_t i = 0; i < loader.agents.size(); ++i) {
     const AgentId id = sc.world.insert(loader.agents[i]);
     (void)id;

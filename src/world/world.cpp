@@ -394,6 +394,16 @@ void World::permute_rows(std::span<const uint32_t> order, Executor* ex) {
   });
 }
 
+void World::reserve(std::size_t agents) {
+  if (agents > AgentId::kNoIndex)
+    throw Error(Error::Kind::usage, "reserve: " + std::to_string(agents) +
+                                        " agents; a world holds at most " +
+                                        std::to_string(AgentId::kNoIndex));
+  each_column(agents_, [&](auto& column) { column.reserve(agents); });
+  slots_.reserve(agents);
+  pending_.reserve(agents - std::min(agents, agents_.size()));
+}
+
 void World::remove_rows(std::vector<std::size_t> rows) {
   // Descending rows: each swap-remove moves in a row that is staying (or already handled).
   std::sort(rows.begin(), rows.end(), std::greater<>());

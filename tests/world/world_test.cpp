@@ -42,6 +42,41 @@ TEST(World, InsertsAreBufferedUntilApplied) {
   w.validate();
 }
 
+// reserve() is room and nothing else: the same inserts, erases and batches give the same table
+// and ids with it as without, also when called with changes pending or below the size; an
+// impossible count is refused and changes nothing.
+TEST(World, ReserveGivesRoomAndChangesNothingElse) {
+  auto run = [](bool reserve) {
+    World w = world_with_goals();
+    if (reserve) w.reserve(1000);
+    std::vector<AgentId> ids;
+    for (int i = 0; i < 300; ++i) ids.push_back(w.insert(spec_at(1 + i % 90, 1 + i / 90)));
+    if (reserve) {
+      EXPECT_GE(w.agents().x.capacity(), 1000u);
+      w.reserve(2000);  // with 300 inserts pending
+      EXPECT_EQ(w.pending_changes(), 300u);
+    }
+    w.apply_pending();
+    for (int i = 0; i < 300; i += 7) w.erase(ids[static_cast<std::size_t>(i)]);
+    if (reserve) w.reserve(10);  // below the size: nothing
+    w.apply_pending();
+    for (int i = 0; i < 50; ++i) w.insert(spec_at(50, 1 + i, 1));
+    w.apply_pending();
+    w.validate();
+    return w;
+  };
+  const World plain = run(false), roomy = run(true);
+  EXPECT_EQ(plain.agents().id, roomy.agents().id);
+  EXPECT_EQ(plain.agents().x, roomy.agents().x);
+  EXPECT_EQ(plain.agents().y, roomy.agents().y);
+  EXPECT_EQ(plain.agents().goal, roomy.agents().goal);
+  World w = world_with_goals();
+  w.insert(spec_at(1, 1));
+  EXPECT_THROW(w.reserve(std::size_t{1} << 40), Error);
+  EXPECT_EQ(w.pending_changes(), 1u);
+  EXPECT_EQ(w.apply_pending(), 1u);
+}
+
 TEST(World, EraseSwapsLastRowInAndKeepsHandlesValid) {
   World w = world_with_goals();
   const AgentId a = w.insert(spec_at(1, 0)), b = w.insert(spec_at(2, 0)),
