@@ -105,6 +105,12 @@ constexpr double kExponentBudget = 650;  // max |exponent| of a stored weight (e
 constexpr double kHaloMargin = 36;       // e^{-36} = 2.3e-16: per-table budget for dropped terms
 // A tile with at most this many probe x source pairs per entry is summed pair by pair.
 constexpr std::size_t kDirectPairsPerEntry = 16;
+
+// Is a tile of m entries summed pair by pair (direct) rather than swept? The one-tile path asks
+// before the tile does, to put the entries in the order a direct tile adds its terms in.
+bool sums_directly(bool cutoff, std::size_t probes, std::size_t sources, std::size_t m) {
+  return cutoff || probes * sources <= kDirectPairsPerEntry * m;
+}
 // From this many entries a tile runs its combos on every thread (a one-tile world: the slabs
 // of a tiled one already run on every thread).
 constexpr std::size_t kParallelCombos = 4096;
@@ -416,7 +422,7 @@ void process_tile(const std::vector<FieldEntry>& E, std::span<uint64_t> items, d
     sources += E[it >> 1].w != 0;
   }
   if (probes == 0) return;
-  if (direct_only || probes * sources <= kDirectPairsPerEntry * m) {
+  if (sums_directly(direct_only, probes, sources, m)) {
     for (std::size_t i = 0; i < m; ++i) {
       if (!(items[i] & 1)) continue;
       const FieldEntry& p = E[items[i] >> 1];
@@ -616,8 +622,7 @@ void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, boo
   // A tile summed pair by pair adds each probe's terms in the entries' order, so the entries go
   // in (x, id) order first, as the slabs need them anyway. A swept tile sorts its own entries by
   // (x, y, id): for a world of one such tile the order of the input does not matter.
-  const bool direct = cutoff || probes * sources <= kDirectPairsPerEntry * n;
-  if (!one_tile || direct) {
+  if (!one_tile || sums_directly(cutoff, probes, sources, n)) {
     std::vector<std::pair<double, uint32_t>> order(n);
     for (std::size_t i = 0; i < n; ++i) order[i] = {E[i].x, static_cast<uint32_t>(i)};
     std::sort(order.begin(), order.end(), [&](const auto& a, const auto& b) {

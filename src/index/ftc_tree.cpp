@@ -447,6 +447,7 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
   slices_.resize(stride_ * static_cast<std::size_t>(f.slices()));
   raw_.resize(stride_ * (f.chord ? f.knots.size() : 2));
   const int threads = ex ? ex->threads() : 1;
+  if (splits_.empty()) splits_.resize(1);
   if (threads > 1 && n >= kParallelBuild) {
     // The top levels here (the first split alone is a tenth of the work at 2 * 10^4), then
     // at least two subtrees per thread.
@@ -454,7 +455,6 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
     while ((1 << depth) < 2 * threads) ++depth;
     std::vector<Subtree> below;
     std::vector<uint32_t> top;
-    if (splits_.empty()) splits_.resize(1);
     build_top(0, 0, n, kNoRow, root, depth, below, top);
     if (splits_.size() < below.size()) splits_.resize(below.size());
     ex->for_each_chunk(below.size(), 1, [&](std::size_t b, std::size_t e) {
@@ -470,7 +470,6 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
       finish_bounds(*it);
     }
   } else {
-    if (splits_.empty()) splits_.resize(1);
     [[maybe_unused]] const uint32_t end = build_node(0, 0, n, kNoRow, root, splits_[0]);
     assert(end == stride_);
   }
