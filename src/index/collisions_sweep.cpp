@@ -49,7 +49,7 @@ void CollisionSweep::run(const DiscView& d, const StaticScene& scene, CollisionP
   order_.resize(n);
   for (std::size_t i = 0; i < n; ++i)
     order_[i] = bucket(d.x[i] - frame.x0 - frame.reach(d.radius[i])) << 32 | i;
-  radix_sort(order_, scratch_, 32, 32 + kKeyBits + 1);
+  radix_sort(order_, radix_, 32, 32 + kKeyBits + 1);
 
   // Slabs: height twice the mean reach, at most max(1024, 2n) of them.
   const double span_y = yhi_max - ylo_min;

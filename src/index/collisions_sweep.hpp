@@ -42,7 +42,8 @@ class CollisionSweep final : public CollisionPath {
     uint32_t row;
     uint32_t slab0;  // its lowest slab
   };
-  std::vector<uint64_t> order_, scratch_;
+  std::vector<uint64_t> order_;
+  RadixScratch radix_;
   std::vector<Disc> packed_;
   std::vector<std::vector<Active>> slabs_;
   ObstacleIndex obstacles_;

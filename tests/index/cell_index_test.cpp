@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
+#include <vector>
+
 #include "scenario/builders.hpp"
 
 namespace crowddb::index {
@@ -14,13 +18,13 @@ TEST(CellIndex, ThreadsBuildTheSameIndex) {
   for (int shape = 0; shape < 3; ++shape) {
     DiscTable t;
     if (shape == 2) {  // a lattice: runs of equal keys, where a stable sort shows
-      for (int i = 0; i < 200; ++i)
-        for (int j = 0; j < 200; ++j)
-          t.push_back(static_cast<uint64_t>(i * 200 + j), i * 0.25, j * 0.25, 0, 0, 0.2);
+      for (int i = 0; i < 400; ++i)
+        for (int j = 0; j < 400; ++j)
+          t.push_back(static_cast<uint64_t>(i * 400 + j), i * 0.25, j * 0.25, 0, 0, 0.2);
     } else {
-      t = build::uniform(shape == 0 ? 2 * CellIndex::kParallelRadix + 99 : 34000,
-                         {0, 0, shape == 0 ? 600.0 : 300.0, shape == 0 ? 600.0 : 60.0}, 1, 0.25,
-                         0.25, 7 + static_cast<uint64_t>(shape));
+      t = build::uniform(shape == 0 ? 2 * CellIndex::kParallelRadix + 99 : 140000,
+                         {0, 0, 600.0, shape == 0 ? 600.0 : 120.0}, 1, 0.25, 0.25,
+                         7 + static_cast<uint64_t>(shape));
     }
     const DiscView d = t.view();
     const Frame frame = Frame::of(d);
@@ -38,7 +42,10 @@ TEST(CellIndex, ThreadsBuildTheSameIndex) {
         SCOPED_TRACE("shape " + std::to_string(shape) + " subset " + std::to_string(subset) +
                      " threads " + std::to_string(threads));
         ASSERT_EQ(many.size(), one.size());
-        ASSERT_GT(one.size(), 16384u);  // large enough to be built in chunks
+        // Large enough to be built in chunks (the subsets of the first shape too).
+        if (!subset || shape == 0) {
+          ASSERT_GE(one.size(), 2 * kRadixChunk);
+        }
         for (std::size_t k = 0; k < one.size(); ++k) {
           ASSERT_EQ(many.key(k), one.key(k)) << k;
           ASSERT_EQ(many.row(k), one.row(k)) << k;
@@ -47,6 +54,37 @@ TEST(CellIndex, ThreadsBuildTheSameIndex) {
           ASSERT_EQ(many.r(k), one.r(k)) << k;
         }
       }
+    }
+  }
+}
+
+// The radix sort on threads is the one-thread sort, which is std::stable_sort by the key bits:
+// keys of 1 to 40 bits (one to four passes, digits of 9 to 12 bits), with many equal keys, over
+// enough words for several chunks and a short last one.
+TEST(RadixSort, ThreadsSortAsOneThreadAndAsAStableSort) {
+  const std::size_t n = 3 * kRadixChunk + 17;
+  std::mt19937_64 rng(11);
+  for (int bits : {1, 9, 12, 13, 23, 24, 25, 32, 40}) {
+    const int lo = bits > 32 ? 24 : 32;  // the key's lowest bit (a row below it)
+    std::vector<uint64_t> words(n);
+    const uint64_t keys = std::min<uint64_t>(uint64_t{1} << bits, n / 3);  // equal keys
+    for (std::size_t k = 0; k < n; ++k) {
+      const uint64_t key = (rng() % keys) << (bits - std::min(bits, 20));  // high bits used
+      words[k] = (key & ((uint64_t{1} << bits) - 1)) << lo | (k & ((uint64_t{1} << lo) - 1));
+    }
+    std::vector<uint64_t> expect = words;
+    std::stable_sort(expect.begin(), expect.end(), [&](uint64_t a, uint64_t b) {
+      return (a >> lo) < (b >> lo);  // bits above lo + bits are zero
+    });
+    RadixScratch scratch;
+    std::vector<uint64_t> one = words;
+    radix_sort(one, scratch, lo, lo + bits);
+    EXPECT_EQ(one, expect) << bits << " bits, one thread";
+    for (int threads : {2, 3}) {
+      Executor ex(threads);
+      std::vector<uint64_t> many = words;
+      radix_sort(many, scratch, lo, lo + bits, &ex);
+      EXPECT_EQ(many, expect) << bits << " bits, " << threads << " threads";
     }
   }
 }
