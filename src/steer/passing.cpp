@@ -1,6 +1,7 @@
 #include "steer/passing.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <numbers>
 
 #include "index/row_buckets.hpp"
@@ -52,9 +53,28 @@ double diamond_angle(double x, double y) {
   return x < 0 ? 2 - y / s : 3 + x / s;
 }
 
-int heading_class(double x, double y) {
+}  // namespace
+
+int heading_class_reference(double x, double y) {
   return std::min(15, static_cast<int>(diamond_angle(x, y) * 4));
 }
+
+// heading_class without branches (which quadrant a wish points into is a coin toss to the
+// predictor, and every row asks once a tick). In each quadrant diamond_angle adds a base to a
+// numerator over s that is |y| or |x|: 1 - x / s is 1 + |x| / s exactly for x < 0, 2 - y / s is
+// 2 + |y| / s, and y / s, 3 + x / s differ from 0 + |y| / s, 3 + |x| / s only in the sign of a
+// zero numerator, which the class does not see. So the same class, from integer selects.
+int heading_class(double x, double y) {
+  const double ax = std::abs(x), ay = std::abs(y), s = ax + ay;
+  const uint64_t up = y >= 0, right = x >= 0;    // (x < 0 is !right: the heading is never NaN)
+  const uint64_t pick_y = 0 - (up ^ right ^ 1);  // all ones in the quadrants that divide |y|
+  const double q = std::bit_cast<double>((std::bit_cast<uint64_t>(ay) & pick_y) |
+                                         (std::bit_cast<uint64_t>(ax) & ~pick_y));
+  const auto base = static_cast<double>(2 * (up ^ 1) + (up ^ right));
+  return std::min(15, static_cast<int>((base + q / s) * 4));
+}
+
+namespace {
 
 // The heading classes a wish more than 120 degrees from the unit direction (ux, uy) can fall in:
 // those of the arc within 60 degrees of (-ux, -uy), widened by 2 degrees on each side against
@@ -106,8 +126,6 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
     return;
   }
   const auto [xmin, ymin, xmax, ymax] = index::bounding_box(v.x, v.y, ex);
-  rmax_ = 0;
-  for (const double r : v.radius) rmax_ = std::max(rmax_, r);
   const double w = std::max(xmax - xmin, 1e-9), h = std::max(ymax - ymin, 1e-9);
   // About kRowsPerCell rows per cell at the mean density, and at least kMinCell. Bounded by the
   // rows, however sparse, large or thin the world: with c the cell, w h / c^2 <= n / 4 and
@@ -125,8 +143,11 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
   const auto cells = static_cast<std::size_t>(W_ * H_);
   cell_of_.resize(n);
   class_of_.resize(n);
+  std::vector<double> chunk_rmax((n + kBuildGrain - 1) / kBuildGrain, 0);
   ex.for_each_chunk(n, kBuildGrain, [&](std::size_t b, std::size_t e) {
+    double rm = 0;  // the chunk's, written once at its end (the entries share cache lines)
     for (std::size_t i = b; i < e; ++i) {
+      rm = std::max(rm, v.radius[i]);
       cell_of_[i] = row(v.y[i]) * W_ + col(v.x[i]);
       // The row's heading class as a bit; standing rows pass nobody. A wish so small or so
       // large that its square leaves the doubles' range makes passing()'s angle test
@@ -137,7 +158,10 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
                          ? static_cast<uint16_t>(1u << heading_class(wx, wy))
                          : uint16_t{0xFFFF};
     }
+    chunk_rmax[b / kBuildGrain] = rm;
   });
+  rmax_ = 0;
+  for (const double r : chunk_rmax) rmax_ = std::max(rmax_, r);
   index::bucket_rows(cell_of_, cells, start_, rows_);
   copy_.resize(n);
   ex.for_each_chunk(n, kBuildGrain, [&](std::size_t b, std::size_t e) {

@@ -43,6 +43,13 @@ struct PassingView {
   std::span<const double> target_x, target_y;  // the rows' current waypoints
 };
 
+// A wish's heading class, 0..15: the sixteenth of its direction's "diamond angle" (a
+// pseudo-angle, in [0, 4) counter-clockwise from the x axis, only its order used), for (x, y)
+// finite and not both zero. Without branches; heading_class_reference is the plain quadrant by
+// quadrant form it equals (tests).
+int heading_class(double x, double y);
+int heading_class_reference(double x, double y);
+
 // Is row j passing row i, (ux, uy) being i's unit wish (see the top)? Only rows ahead within
 // `look` count (along i's wish; INFINITY: any distance).
 inline bool passing(const PassingView& v, std::size_t i, std::size_t j, double ux, double uy,

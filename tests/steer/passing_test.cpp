@@ -233,6 +233,38 @@ TEST(PassingLookahead, ConvergingBehindOrStandingIsNotPassing) {
   compare(d, kLooks);
 }
 
+// The branch-free heading class is the quadrant-by-quadrant one: on the axes and diagonals (and
+// their -0 twins), at the sixteen class boundaries and a few ulps either side, and on random
+// directions of every scale the build lets through (squares within 1e-280 .. 1e280).
+TEST(HeadingClass, EqualsTheReferenceEverywhere) {
+  std::vector<std::pair<double, double>> dirs;
+  for (double x : {-1.0, -0.0, 0.0, 1.0})
+    for (double y : {-1.0, -0.0, 0.0, 1.0})
+      if (x != 0 || y != 0) dirs.push_back({x, y});
+  for (int k = 0; k < 16; ++k) {
+    // The boundary k / 4 of the diamond angle: quadrant k / 4, numerator share (k % 4) / 4.
+    const double f = (k % 4) / 4.0, g = 1 - f;
+    const std::pair<double, double> q[4] = {{g, f}, {-f, g}, {-g, -f}, {f, -g}};
+    auto [x, y] = q[k / 4];
+    for (int u = 0; u < 4; ++u) {
+      dirs.push_back({x, y});
+      x = std::nextafter(x, -x), y = std::nextafter(y, y + 1);
+    }
+  }
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> angle(0, 2 * std::numbers::pi), scale(-130, 130);
+  for (int n = 0; n < 200000; ++n) {
+    const double a = angle(rng), m = std::pow(10.0, scale(rng));
+    dirs.push_back({m * std::cos(a), m * std::sin(a)});
+  }
+  for (auto [x, y] : dirs)
+    ASSERT_EQ(heading_class(x, y), heading_class_reference(x, y)) << x << " " << y;
+  // Every class is met.
+  std::vector<int> seen(16, 0);
+  for (auto [x, y] : dirs) seen[static_cast<std::size_t>(heading_class(x, y))] = 1;
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 16);
+}
+
 // Keeping to one side stops near a sharp bend only: a route's corners round a pillar (15-25
 // degrees each) are gentle, a corridor's mouth or a door (90 degrees) is sharp, and so is a
 // waypoint with nothing after it. The test turns a leg by every angle, at any length and in any
