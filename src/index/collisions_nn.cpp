@@ -88,7 +88,13 @@ void CollisionNn::run(const DiscView& d, const StaticScene& scene, CollisionPair
     std::vector<std::vector<std::pair<uint32_t, Collider>>> found(chunks);
     std::vector<uint64_t> found_tests(chunks, 0);
     ex.for_each_chunk(d.n, kObstacleGrain, [&](std::size_t b, std::size_t e) {
-      obstacles_.overlaps(d, b, e, found[b / kObstacleGrain], found_tests[b / kObstacleGrain]);
+      // Into the chunk's own list and count, then moved in (the per-chunk entries and vector
+      // headers share cache lines between the threads).
+      std::vector<std::pair<uint32_t, Collider>> mine;
+      uint64_t tests_c = 0;
+      obstacles_.overlaps(d, b, e, mine, tests_c);
+      found[b / kObstacleGrain] = std::move(mine);
+      found_tests[b / kObstacleGrain] = tests_c;
     });
     for (std::size_t c = 0; c < chunks; ++c) {
       out.obstacles.insert(out.obstacles.end(), found[c].begin(), found[c].end());

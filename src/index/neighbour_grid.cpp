@@ -188,6 +188,12 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
   const uint32_t* const At = at_.data();
   ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
     const std::size_t c = b / kGrain;
+    // The chunk's counters and lists are its own until the end: written per row into the
+    // per-chunk arrays, neighbouring chunks' entries (and vector headers) share cache lines, which
+    // the threads would pass back and forth on every row.
+    uint64_t tests_c = 0, rings_c = 0;
+    std::vector<uint32_t> counts = std::move(lists.counts[c]), items = std::move(lists.items[c]);
+    std::vector<double> d2s = std::move(lists.d2[c]);
     NearestK best;
     // Every disc other than `self` (at `self_at` in the grid) within `bound` (< the range) of
     // (px, py), from the bound's chords of cells, ranked by (distance, id): the best k are the
@@ -291,13 +297,13 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
           hint_d2[nh++] = d2;
           hint_bound = std::max(hint_bound, d2);
         }
-        tests[c] += count;
+        tests_c += count;
         // k hints within range bound the answer: its k-th distance is at most theirs. Every
         // disc within that bound (the hints among them) is gathered from the bound's chords
         // and ranked at once (below); otherwise the hints are offered to the selection first.
         if (nh == k && hint_bound < kChordReach * kChordReach * cell_ * cell_ &&
-            ranked(i, At[i], px, py, hint_bound, slack, tests[c])) {
-          ++rings[c];
+            ranked(i, At[i], px, py, hint_bound, slack, tests_c)) {
+          ++rings_c;
           continue;
         }
         for (uint32_t u = 0; u < nh; ++u) best.offer(hint[u], d.id[hint[u]], hint_d2[u]);
@@ -321,7 +327,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
             const double d2 = dx * dx + dy * dy;
             if (d2 < rr && rs[a] != self) best.offer(rs[a], is[a], d2);
           }
-          tests[c] += hi - lo;
+          tests_c += hi - lo;
           return;
         }
         double limit = std::min(rr, best.bound());
@@ -355,7 +361,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
             limit = std::min(rr, best.bound());
           }
         }
-        tests[c] += hi - lo;
+        tests_c += hi - lo;
       };
       const int64_t qx = col(px), qy = row(py);
       // A list filled by the hints bounds the answer: whatever can still enter lies within the
@@ -373,7 +379,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         chord(qy);  // the query's own row first: the likeliest nearest
         for (int64_t cy = cy0; cy <= cy1; ++cy)
           if (cy != qy) chord(cy);
-        ++rings[c];
+        ++rings_c;
       } else if (k == 0) {
         // Every cell the range box touches (one cell of slack against rounding).
         const int64_t cx0 = std::max<int64_t>(0, col(px - range) - 1);
@@ -404,7 +410,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         scan(qy, bx0, bx1);
         if (by0 < qy) scan(by0, bx0, bx1);
         if (by1 > qy) scan(by1, bx0, bx1);
-        rings[c] += 2;
+        rings_c += 2;
         // Every disc outside the block is at least `gap` away (a side on the grid's edge has
         // nothing beyond it); done when the k-th best, or the range, is strictly nearer.
         double gap = INFINITY;
@@ -418,7 +424,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         for (int64_t rho = 2; rho <= max_ring; ++rho) {
           const double reach = static_cast<double>(rho - 1) * cell_ * (1 - 1e-9);
           if (reach >= range || (best.full() && best.bound() < reach * reach)) break;
-          ++rings[c];
+          ++rings_c;
           const int64_t cx0 = std::max<int64_t>(0, qx - rho), cx1 = std::min(W_ - 1, qx + rho);
           for (int64_t cx = cx0; cx <= cx1; ++cx) {
             if (qy - rho >= 0) scan_cell(cx, qy - rho);  // bottom row of the ring
@@ -442,11 +448,15 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
                     out.dist2.begin() + static_cast<std::ptrdiff_t>(i * k));
         continue;
       }
-      lists.counts[c].push_back(static_cast<uint32_t>(best.size()));
-      lists.items[c].insert(lists.items[c].end(), best.rows().begin(), best.rows().end());
-      if (out.with_dist2)
-        lists.d2[c].insert(lists.d2[c].end(), best.dist2().begin(), best.dist2().end());
+      counts.push_back(static_cast<uint32_t>(best.size()));
+      items.insert(items.end(), best.rows().begin(), best.rows().end());
+      if (out.with_dist2) d2s.insert(d2s.end(), best.dist2().begin(), best.dist2().end());
     }
+    tests[c] = tests_c;
+    rings[c] = rings_c;
+    lists.counts[c] = std::move(counts);
+    lists.items[c] = std::move(items);
+    lists.d2[c] = std::move(d2s);
   });
   if (spatial) {
     out.offset.resize(d.n + 1);

@@ -158,7 +158,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   std::vector<uint8_t> look(t.size(), 0);
   std::vector<double> chunk_rmax((t.size() + kWatchGrain - 1) / kWatchGrain, 0);
   ex.for_each_chunk(t.size(), kWatchGrain, [&](std::size_t b, std::size_t e) {
-    double& rm = chunk_rmax[b / kWatchGrain];
+    double rm = 0;  // the chunk's, written once at its end (the entries share cache lines)
     for (std::size_t i = b; i < e; ++i) {
       rm = std::max(rm, t.radius[i]);
       if (standing(t.state[i])) {
@@ -189,6 +189,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
         t.stall_action[i] = StallAction::none;
       look[i] = t.stall_ticks[i] >= after;
     }
+    chunk_rmax[b / kWatchGrain] = rm;
   });
   std::vector<uint32_t> looked_at;  // in row order
   for (std::size_t i = 0; i < t.size(); ++i)
@@ -338,7 +339,10 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   const std::size_t chunks = (looked_at.size() + kLookGrain - 1) / kLookGrain;
   std::vector<std::size_t> yields(chunks, 0), sidesteps(chunks, 0);
   ex.for_each_chunk(looked_at.size(), kLookGrain, [&](std::size_t b, std::size_t e) {
-    for (std::size_t q = b; q < e; ++q) act(q, yields[b / kLookGrain], sidesteps[b / kLookGrain]);
+    std::size_t yielded = 0, sidestepped = 0;  // written once (the entries share cache lines)
+    for (std::size_t q = b; q < e; ++q) act(q, yielded, sidestepped);
+    yields[b / kLookGrain] = yielded;
+    sidesteps[b / kLookGrain] = sidestepped;
   });
   for (std::size_t k = 0; k < chunks; ++k) {
     c.yielding += yields[k];

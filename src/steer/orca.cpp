@@ -265,6 +265,7 @@ class OrcaModel final : public Model {
         }
       });
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
+        uint64_t infeasible = 0;  // the chunk's count, written once at its end (see find_passing)
         std::vector<HalfPlane> planes;
         std::vector<double> ipx, ipy, ivx, ivy, ir, itau, ishare;  // agent_planes' inputs
         for (std::size_t i = b; i < e; ++i) {
@@ -326,10 +327,11 @@ class OrcaModel final : public Model {
           if (p.time_gap > 0 || (p.stream_gap > 0 && streams_.marked[i]))
             cap_by_headway(in, i, px, py);
           const LpResult r = solve_velocity_lp(planes, hard, t.max_speed[i], px, py);
-          infeasible_[b / kGrain] += !r.feasible;
+          infeasible += !r.feasible;
           vx[i] = r.vx;
           vy[i] = r.vy;
         }
+        infeasible_[b / kGrain] = infeasible;
       });
     });
     uint64_t fallback = 0;
@@ -503,7 +505,10 @@ class OrcaModel final : public Model {
     const std::size_t chunks = (n + kGrain - 1) / kGrain;
     std::vector<uint64_t> tests(chunks, 0), near(chunks, 0), far(chunks, 0);
     ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
-      const std::size_t c = b / kGrain;
+      // The chunk's counts, written once at its end: counted per row in the per-chunk arrays,
+      // whose entries share cache lines with the neighbouring chunks', the threads passed the
+      // lines back and forth on every row.
+      uint64_t n_tests = 0, n_near = 0, n_far = 0;
       for (std::size_t i = b; i < e; ++i) {
         turn_[i] = 0;
         const double wx = in.pref_vx[i], wy = in.pref_vy[i];
@@ -517,18 +522,22 @@ class OrcaModel final : public Model {
         if (neighbours) {
           for (uint32_t a = nb_.offset[i]; a < nb_.offset[i + 1] && !seen; ++a)
             seen = passing(view, i, nb_.row[a], ux, uy);
-          tests[c] += nb_.offset[i + 1] - nb_.offset[i];
-          near[c] += seen;
+          n_tests += nb_.offset[i + 1] - nb_.offset[i];
+          n_near += seen;
         }
         if (!seen && look > 0) {
-          witness_[i] = lookahead_.find(view, i, ux, uy, look, tests[c], witness_[i]);
+          witness_[i] = lookahead_.find(view, i, ux, uy, look, n_tests, witness_[i]);
           if (witness_[i] != PassingLookahead::kNobody) {
             seen = true;
-            ++far[c];
+            ++n_far;
           }
         }
         turn_[i] = seen;
       }
+      const std::size_t c = b / kGrain;
+      tests[c] = n_tests;
+      near[c] = n_near;
+      far[c] = n_far;
     });
     passing_near_ = passing_far_ = 0;
     for (std::size_t c = 0; c < chunks; ++c) {

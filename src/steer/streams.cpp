@@ -1,5 +1,6 @@
 #include "steer/streams.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "util/executor.hpp"
@@ -50,15 +51,18 @@ void mark_meetings(const StreamView& v, StreamMarks& out, Executor& ex) {
   const NeighbourLists& nb = *v.nb;
   const std::size_t n = nb.queries();
   std::vector<uint8_t>& marked = out.marked;
-  marked.resize(n);  // every row written below
-  out.follows.assign(nb.row.size(), 0);
+  marked.resize(n);                   // every row written below
+  out.follows.resize(nb.row.size());  // every entry written below
   // Per row, in parallel (each chunk writes its own rows and list entries): the meetings, and
   // whom the others follow.
   ex.for_each_chunk(n, kStreamGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       marked[i] = at_meeting(v, i);
       double ux, uy;
-      if (marked[i] || !unit_wish(v, i, ux, uy)) continue;
+      if (marked[i] || !unit_wish(v, i, ux, uy)) {
+        std::fill(out.follows.begin() + nb.offset[i], out.follows.begin() + nb.offset[i + 1], 0);
+        continue;
+      }
       for (uint32_t a = nb.offset[i]; a < nb.offset[i + 1]; ++a)
         out.follows[a] = follows(v, i, nb.row[a], ux, uy);
     }
