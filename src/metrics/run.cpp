@@ -9,6 +9,7 @@
 #include "crowddb/error.hpp"
 #include "io/trajectory.hpp"
 #include "util/byte_codec.hpp"
+#include "util/executor.hpp"
 #include "util/stopwatch.hpp"
 
 namespace crowddb::metrics {
@@ -97,6 +98,7 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
   s.agents_at_start = sim.world().agents().size();
   const double dt = s.dt;
   SteerBench bench(dt, sim.config().walls);
+  Executor metrics_ex(sim.config().threads);  // the scores' per-row pass, between ticks
   std::vector<double> tick_seconds;
   uint64_t last_arrival = 0;
   std::size_t longest_frozen = 0, longest_stall = 0;
@@ -129,7 +131,7 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
       }
       const TickMetrics& m = sim.step();
       tick_seconds.push_back(m.seconds);
-      bench.tick(sim.world(), m);
+      bench.tick(sim.world(), m, &metrics_ex);
       s.max_overlapping_pairs = std::max(s.max_overlapping_pairs, m.overlapping_pairs);
       s.max_obstacle_overlaps = std::max(s.max_obstacle_overlaps, m.obstacle_overlaps);
       s.frozen_agent_ticks += m.frozen;

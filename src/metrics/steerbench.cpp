@@ -6,6 +6,7 @@
 
 #include "crowddb/error.hpp"
 #include "util/byte_codec.hpp"
+#include "util/executor.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb::metrics {
@@ -81,12 +82,59 @@ void SteerBench::start(const World& world) {
   }
 }
 
-void SteerBench::tick(const World& world, const TickMetrics& m) {
+void SteerBench::add_tick(Track& tr, double x, double y) const {
+  tr.seen = tick_;
+  const double dx = x - tr.x, dy = y - tr.y;
+  const double vx = dx / dt_, vy = dy / dt_;
+  tr.time += dt_;
+  tr.path_length += std::sqrt(dx * dx + dy * dy);
+  tr.energy += 0.5 * (vx * vx + vy * vy);
+  if (tr.has_v) {
+    const double ax = vx - tr.vx, ay = vy - tr.vy;
+    tr.acceleration += std::sqrt(ax * ax + ay * ay) / dt_;
+  }
+  tr.x = x;
+  tr.y = y;
+  tr.vx = vx;
+  tr.vy = vy;
+  tr.has_v = true;
+}
+
+void SteerBench::tick(const World& world, const TickMetrics& m, Executor* ex) {
   ++tick_;
   const AgentTable& t = world.agents();
-  row_slot_.resize(t.size(), kNoSlot);
+  const std::size_t n = t.size();
+  row_slot_.resize(n, kNoSlot);
+  // 1. Every row whose slot holds its own live track and that did not arrive adds the tick to
+  // that track, on every thread: a live track is one agent's, so one row's, and a row writes
+  // nothing else. The other rows are marked for 2.
+  pending_.resize(n);
+  const std::size_t chunks = (n + kTickGrain - 1) / kTickGrain;
+  std::vector<std::size_t> chunk_seen(chunks, 0);
+  const auto own_tracks = [&](std::size_t b, std::size_t e) {
+    std::size_t seen = 0;
+    for (std::size_t i = b; i < e; ++i) {
+      const uint32_t slot = row_slot_[i];
+      const bool own = slot != kNoSlot && tracks_[slot].live && tracks_[slot].id == t.id[i] &&
+                       t.state[i] != AgentState::arrived;
+      pending_[i] = !own;
+      if (!own) continue;
+      add_tick(tracks_[slot], t.x[i], t.y[i]);
+      ++seen;
+    }
+    chunk_seen[b / kTickGrain] = seen;
+  };
+  if (ex && ex->threads() > 1)
+    ex->for_each_chunk(n, kTickGrain, own_tracks);
+  else
+    for (std::size_t b = 0; b < n; b += kTickGrain) own_tracks(b, std::min(n, b + kTickGrain));
+  std::size_t seen = 0;  // live tracks seen this tick
+  for (std::size_t c : chunk_seen) seen += c;
+  // 2. The others in row order, on one thread: new agents are opened, arrivals closed, and
+  // rows whose slot changed (the table reordered its rows) find their track by id.
   std::size_t moved = 0;  // rows whose track had to be looked up
-  for (std::size_t i = 0; i < t.size(); ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!pending_[i]) continue;
     const uint64_t id = t.id[i];
     uint32_t slot = row_slot_[i];
     if (slot == kNoSlot || !tracks_[slot].live || tracks_[slot].id != id) {
@@ -94,39 +142,33 @@ void SteerBench::tick(const World& world, const TickMetrics& m) {
       const uint32_t score = known_.find(id);
       if (score == kUnknown) {
         // New in the table (a source, an insert): measured from here on.
-        row_slot_[i] = t.state[i] == AgentState::arrived ? kNoSlot : open_agent(id, t.x[i], t.y[i]);
+        if (t.state[i] == AgentState::arrived) {
+          row_slot_[i] = kNoSlot;
+        } else {
+          row_slot_[i] = open_agent(id, t.x[i], t.y[i]);
+          ++seen;
+        }
         continue;
       }
       slot = score_slot_[score];
       row_slot_[i] = slot;
     }
-    if (slot == kNoSlot) continue;  // measured before and closed on arrival: stays closed
-    Track& tr = tracks_[slot];
+    if (slot == kNoSlot) continue;            // measured before and closed on arrival: stays closed
     if (t.state[i] == AgentState::arrived) {  // arrived in this tick: the tick is not counted
       close_track(slot);
       row_slot_[i] = kNoSlot;
       continue;
     }
-    tr.seen = tick_;
-    const double dx = t.x[i] - tr.x, dy = t.y[i] - tr.y;
-    const double vx = dx / dt_, vy = dy / dt_;
-    tr.time += dt_;
-    tr.path_length += std::sqrt(dx * dx + dy * dy);
-    tr.energy += 0.5 * (vx * vx + vy * vy);
-    if (tr.has_v) {
-      const double ax = vx - tr.vx, ay = vy - tr.vy;
-      tr.acceleration += std::sqrt(ax * ax + ay * ay) / dt_;
-    }
-    tr.x = t.x[i];
-    tr.y = t.y[i];
-    tr.vx = vx;
-    tr.vy = vy;
-    tr.has_v = true;
+    add_tick(tracks_[slot], t.x[i], t.y[i]);
+    ++seen;
   }
-  // Agents no longer in the table left it on arrival (or were deleted).
-  for (uint32_t slot = 0; slot < tracks_.size(); ++slot)
-    if (tracks_[slot].live && tracks_[slot].seen != tick_) close_track(slot);
-  if (moved > t.size() / 8) lay_out_in_row_order(t);
+  // Agents no longer in the table left it on arrival (or were deleted): their tracks were not
+  // seen. (Every live track is seen at most once, so when the count says all were, no slot
+  // needs a look.)
+  if (seen != tracks_.size() - free_slots_.size())
+    for (uint32_t slot = 0; slot < tracks_.size(); ++slot)
+      if (tracks_[slot].live && tracks_[slot].seen != tick_) close_track(slot);
+  if (moved > n / 8) lay_out_in_row_order(t);
   if (m.overlapping_pairs > 0 || m.obstacle_overlaps > 0 || !open_pairs_.empty() ||
       !open_obstacles_.empty())
     collisions(world);

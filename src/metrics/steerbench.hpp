@@ -54,8 +54,10 @@ class SteerBench {
   // The agents at the start (tick 0).
   void start(const World& world);
   // After each tick. `m` tells whether anything overlaps at all (when nothing does, no collision
-  // can have started and the per-pair search is skipped).
-  void tick(const World& world, const TickMetrics& m);
+  // can have started and the per-pair search is skipped). With an executor the rows that only
+  // add the tick to their agent's track do so on its threads (the same sums: each track is one
+  // row's).
+  void tick(const World& world, const TickMetrics& m, Executor* ex = nullptr);
   // In order of first appearance.
   const std::vector<AgentScore>& scores() const {
     flush();
@@ -86,8 +88,9 @@ class SteerBench {
   void close_track(uint32_t slot);
   uint32_t open_agent(uint64_t id, double x, double y);  // its score and track; the slot
   void collisions(const World& world);
-  void store_sums(const Track& tr) const;  // its sums into scores_[tr.score]
-  void flush() const;                      // the live tracks' sums into scores_
+  void store_sums(const Track& tr) const;              // its sums into scores_[tr.score]
+  void add_tick(Track& tr, double x, double y) const;  // the tick's step, its agent now at (x, y)
+  void flush() const;                                  // the live tracks' sums into scores_
   // Puts the live tracks in the order of the rows that hold them (slot = place in that order),
   // in place: a copy of them all is 88 MB at 10^6 agents, at the moment the run's memory peaks.
   void lay_out_in_row_order(const AgentTable& t);
@@ -110,6 +113,8 @@ class SteerBench {
   std::vector<uint32_t> free_slots_;
   std::vector<uint32_t> score_slot_;  // per score: its track's slot, kNoSlot once closed
   std::vector<uint32_t> row_slot_;
+  std::vector<uint8_t> pending_;  // per row, scratch of tick(): left for its one-thread pass
+  static constexpr std::size_t kTickGrain = 8192;          // rows per chunk of tick()
   std::set<std::pair<uint64_t, uint64_t>> open_pairs_;     // agent ids, smaller first
   std::set<std::pair<uint64_t, int64_t>> open_obstacles_;  // id, obstacle (-1..-4: walls)
 };

@@ -15,6 +15,7 @@
 #include "crowddb/error.hpp"
 #include "crowddb/simulation.hpp"
 #include "util/byte_codec.hpp"
+#include "util/executor.hpp"
 #include "util/rng.hpp"
 
 namespace crowddb::metrics {
@@ -35,10 +36,11 @@ void add_walkers(World& w, Rng& rng, int count) {
 
 // The same scores in the same order, bit for bit.
 void expect_same_scores(const SteerBench& a, const SteerBench& b) {
-  ASSERT_EQ(a.scores().size(), b.scores().size());
+  const std::vector<AgentScore>&sa = a.scores(), &sb = b.scores();  // (each call flushes)
+  ASSERT_EQ(sa.size(), sb.size());
   auto bits = [](double v) { return std::bit_cast<uint64_t>(v); };
-  for (std::size_t k = 0; k < a.scores().size(); ++k) {
-    const AgentScore &x = a.scores()[k], &y = b.scores()[k];
+  for (std::size_t k = 0; k < sa.size(); ++k) {
+    const AgentScore &x = sa[k], &y = sb[k];
     EXPECT_EQ(x.id, y.id);
     EXPECT_EQ(bits(x.time), bits(y.time)) << k;
     EXPECT_EQ(bits(x.path_length), bits(y.path_length)) << k;
@@ -79,6 +81,41 @@ TEST(SteerBench, ConstantWalkGivesTimePathAndEnergyByHand) {
   const SteerBenchTotals tot = sb.totals();
   EXPECT_NEAR(tot.composite01, s.time + s.energy, 1e-9);
   EXPECT_NEAR(tot.composite02, s.time + s.energy + s.acceleration, 1e-9);
+}
+
+// An agent that arrives in a tick is closed in it, and that tick is not counted: by hand, on one
+// thread and on two (the row that arrives goes to the one-thread pass; the others stay open).
+TEST(SteerBench, AnArrivalIsClosedInItsTickWithoutCountingIt) {
+  for (int threads : {1, 2}) {
+    World w(Bounds{0, 0, 100, 10});
+    w.add_goal({"g", 90, 5, 0.5, 1, {}});
+    for (double y : {3.0, 7.0}) {
+      AgentSpec a;
+      a.x = 10;
+      a.y = y;
+      a.goal = 0;
+      w.insert(a);
+    }
+    w.apply_pending();
+    SteerBench sb(0.1, false);
+    sb.start(w);
+    Executor ex(threads);
+    AgentTable& t = w.agents_for_tick();
+    TickMetrics m;
+    for (int k = 1; k <= 5; ++k) {
+      t.x[0] += 0.1;
+      t.x[1] += 0.1;
+      if (k == 3) t.state[0] = AgentState::arrived;
+      sb.tick(w, m, &ex);
+    }
+    const std::vector<AgentScore>& s = sb.scores();
+    ASSERT_EQ(s.size(), 2u);
+    EXPECT_TRUE(s[0].arrived);
+    EXPECT_NEAR(s[0].time, 0.2, 1e-12);  // ticks 1 and 2
+    EXPECT_NEAR(s[0].path_length, 0.2, 1e-12);
+    EXPECT_FALSE(s[1].arrived);
+    EXPECT_NEAR(s[1].time, 0.5, 1e-12);
+  }
 }
 
 TEST(SteerBench, CollisionEpisodesCountOncePerAgentAndEpisode) {
@@ -170,6 +207,59 @@ TEST(SteerBench, ScoresDoNotDependOnTheRowOrder) {
   EXPECT_GT(closed, 20u);  // agents did leave
   EXPECT_LT(closed, a.scores().size());
   EXPECT_GT(a.totals().avg_path, 1.0);  // the walks were measured
+}
+
+// The per-row pass on threads gives the scores of one thread, bit for bit, and the same saved
+// state, through ticks in which agents walk, arrive (closed in their tick), leave, enter and are
+// reordered, on enough rows for several chunks.
+TEST(SteerBench, ThreadsScoreAsOneThread) {
+  World w(Bounds{0, 0, 100, 100});
+  w.add_goal({"g", 50, 50, 0.5, 1, {}});
+  Rng rng(13);
+  add_walkers(w, rng, 20000);
+  SteerBench one(0.1, false), two(0.1, false), three(0.1, false);
+  Executor ex2(2), ex3(3);
+  for (SteerBench* s : {&one, &two, &three}) s->start(w);
+  Rng order_rng(17);
+  TickMetrics m;
+  for (int tick = 1; tick <= 30; ++tick) {
+    AgentTable& t = w.agents_for_tick();
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      Rng walk = Rng::stream(static_cast<uint64_t>(tick), t.id[i]);
+      t.x[i] += walk.uniform(-0.1, 0.1);
+      t.y[i] += walk.uniform(-0.1, 0.1);
+      if (walk.below(400) == 0) t.state[i] = AgentState::arrived;  // arrives in this tick
+    }
+    if (tick % 4 == 0) {  // the arrived leave, a few others too; some enter
+      std::vector<std::size_t> rows;
+      for (std::size_t i = 0; i < t.size(); ++i)
+        if (t.state[i] == AgentState::arrived || (t.id[i] ^ static_cast<uint64_t>(tick)) % 97 == 0)
+          rows.push_back(i);
+      w.remove_rows(rows);
+      add_walkers(w, rng, 300);
+    }
+    if (tick % 5 == 0) {  // a reorder: every row's slot goes stale at once
+      std::vector<uint32_t> order(w.agents().size());
+      std::iota(order.begin(), order.end(), 0u);
+      for (std::size_t i = order.size(); i > 1; --i)
+        std::swap(order[i - 1], order[order_rng.below(i)]);
+      w.permute_rows(order);
+    }
+    one.tick(w, m);
+    two.tick(w, m, &ex2);
+    three.tick(w, m, &ex3);
+  }
+  EXPECT_GT(one.scores().size(), 22000u);  // agents did enter
+  std::size_t closed = 0;
+  for (const AgentScore& a : one.scores()) closed += a.arrived;
+  EXPECT_GT(closed, 1000u);  // and arrive
+  for (const SteerBench* s : {&two, &three}) {
+    expect_same_scores(one, *s);
+    ByteWriter a, b;
+    one.save(a);
+    s->save(b);
+    EXPECT_EQ(a.take(), b.take());
+  }
 }
 
 // A run saved halfway and restored into a fresh SteerBench ends with the same scores, bit for bit,
