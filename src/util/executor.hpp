@@ -4,7 +4,9 @@
 // worker (RVO2's step ran 24x slower at 2 threads with one core taken). So: the calling thread
 // works too, chunks are handed out on demand (oneTBB's work stealing), and idle workers sleep
 // rather than spin. Results never depend on how chunks land on threads: every body writes only
-// the rows of its own chunk, and reductions are done afterwards in row order.
+// the rows of its own chunk, and reductions are done afterwards in row order. A body keeps its
+// counters and appends in locals and stores them into its per-chunk slot once, at its end:
+// neighbouring chunks' slots share a cache line, and the threads work on neighbouring chunks.
 #pragma once
 
 #include <cstddef>
