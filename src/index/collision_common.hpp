@@ -92,7 +92,6 @@ inline void radix_sort(std::vector<uint64_t>& a, RadixScratch& s, int lo_bit, in
   const int passes = (bits + kMaxDigit - 1) / kMaxDigit;
   const int digit = (bits + passes - 1) / passes;
   const std::size_t buckets = std::size_t{1} << digit;
-  const uint64_t mask = buckets - 1;
   const std::size_t n = a.size();
   const std::size_t chunk = ex ? kRadixChunk : std::max<std::size_t>(n, 1);
   const std::size_t chunks = std::max<std::size_t>((n + chunk - 1) / chunk, 1);
@@ -106,6 +105,8 @@ inline void radix_sort(std::vector<uint64_t>& a, RadixScratch& s, int lo_bit, in
   s.place.resize(chunks * buckets);
   s.digits.resize(buckets);
   for (int shift = lo_bit; shift < hi_bit; shift += digit) {
+    // The last pass may be narrower: bits at and above hi_bit are not read.
+    const uint64_t mask = (uint64_t{1} << std::min(digit, hi_bit - shift)) - 1;
     each([&](std::size_t b, std::size_t e) {
       uint32_t* count = s.place.data() + b / chunk * buckets;
       std::fill(count, count + buckets, 0u);

@@ -58,23 +58,22 @@ TEST(CellIndex, ThreadsBuildTheSameIndex) {
   }
 }
 
-// The radix sort on threads is the one-thread sort, which is std::stable_sort by the key bits:
-// keys of 1 to 40 bits (one to four passes, digits of 9 to 12 bits), with many equal keys, over
-// enough words for several chunks and a short last one.
-TEST(RadixSort, ThreadsSortAsOneThreadAndAsAStableSort) {
-  const std::size_t n = 3 * kRadixChunk + 17;
+// Sorts n random words whose key is bits [lo, lo + bits) on 1, 2 and 3 threads (see below).
+void sort_and_compare(std::size_t n) {
   std::mt19937_64 rng(11);
-  for (int bits : {1, 9, 12, 13, 23, 24, 25, 32, 40}) {
-    const int lo = bits > 32 ? 24 : 32;  // the key's lowest bit (a row below it)
+  for (int bits : {0, 1, 9, 12, 13, 23, 24, 25, 27, 32, 40}) {
+    const int lo = bits > 32 ? 20 : 28;  // the key's lowest bit (a row below it)
+    const uint64_t key_mask = (uint64_t{1} << bits) - 1;
     std::vector<uint64_t> words(n);
-    const uint64_t keys = std::min<uint64_t>(uint64_t{1} << bits, n / 3);  // equal keys
+    const uint64_t keys = std::max<uint64_t>(1, std::min<uint64_t>(key_mask + 1, n / 3));
     for (std::size_t k = 0; k < n; ++k) {
-      const uint64_t key = (rng() % keys) << (bits - std::min(bits, 20));  // high bits used
-      words[k] = (key & ((uint64_t{1} << bits) - 1)) << lo | (k & ((uint64_t{1} << lo) - 1));
+      const uint64_t key = ((rng() % keys) << (bits - std::min(bits, 20))) & key_mask;
+      const uint64_t above = rng() >> (lo + bits);  // bits above the key: not part of it
+      words[k] = (above << (lo + bits)) | key << lo | (k & ((uint64_t{1} << lo) - 1));
     }
     std::vector<uint64_t> expect = words;
     std::stable_sort(expect.begin(), expect.end(), [&](uint64_t a, uint64_t b) {
-      return (a >> lo) < (b >> lo);  // bits above lo + bits are zero
+      return (a >> lo & key_mask) < (b >> lo & key_mask);
     });
     RadixScratch scratch;
     std::vector<uint64_t> one = words;
@@ -86,6 +85,17 @@ TEST(RadixSort, ThreadsSortAsOneThreadAndAsAStableSort) {
       radix_sort(many, scratch, lo, lo + bits, &ex);
       EXPECT_EQ(many, expect) << bits << " bits, " << threads << " threads";
     }
+  }
+}
+
+// The radix sort on threads is the one-thread sort, which is std::stable_sort by the key bits:
+// keys of 0 to 40 bits (no pass up to four passes, digits of 9 to 12 bits, a narrower last one),
+// with many equal keys and bits set above the key that must not count, over enough words for
+// several chunks and a short last one, over fewer than a chunk, and over none.
+TEST(RadixSort, ThreadsSortAsOneThreadAndAsAStableSort) {
+  for (std::size_t n : {3 * kRadixChunk + 17, std::size_t{1000}, std::size_t{0}}) {
+    SCOPED_TRACE(n);
+    sort_and_compare(n);
   }
 }
 
