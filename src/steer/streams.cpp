@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "index/collision_common.hpp"
 #include "util/executor.hpp"
 
 namespace crowddb::steer {
 namespace {
 
 constexpr std::size_t kStreamGrain = 1024;  // rows per chunk of the marking
+constexpr std::size_t kRadixEdges = 256;    // fewer edges are sorted by comparisons
 
 }  // namespace
 
@@ -53,58 +55,67 @@ void mark_meetings(const StreamView& v, StreamMarks& out, Executor& ex) {
   std::vector<uint8_t>& marked = out.marked;
   marked.resize(n);                   // every row written below
   out.follows.resize(nb.row.size());  // every entry written below
-  // Per row, in parallel (each chunk writes its own rows and list entries): the meetings, and
-  // whom the others follow.
+  // Per row, in parallel (each chunk writes its own rows and list entries): the meetings, whom
+  // the others follow, and per chunk the "follows" edges (followed << 32 | follower, in row
+  // order) and the meetings counted.
+  const std::size_t chunks = (n + kStreamGrain - 1) / kStreamGrain;
+  out.chunk_edges.resize(chunks);
+  out.chunk_meetings.resize(chunks);  // every chunk writes its own
   ex.for_each_chunk(n, kStreamGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<uint64_t> edges = std::move(out.chunk_edges[b / kStreamGrain]);
+    edges.clear();
+    std::size_t meetings = 0;
     for (std::size_t i = b; i < e; ++i) {
       marked[i] = at_meeting(v, i);
+      meetings += marked[i];
       double ux, uy;
       if (marked[i] || !unit_wish(v, i, ux, uy)) {
         std::fill(out.follows.begin() + nb.offset[i], out.follows.begin() + nb.offset[i + 1], 0);
         continue;
       }
-      for (uint32_t a = nb.offset[i]; a < nb.offset[i + 1]; ++a)
+      for (uint32_t a = nb.offset[i]; a < nb.offset[i + 1]; ++a) {
         out.follows[a] = follows(v, i, nb.row[a], ux, uy);
+        if (out.follows[a]) edges.push_back(uint64_t{nb.row[a]} << 32 | i);
+      }
     }
+    out.chunk_edges[b / kStreamGrain] = std::move(edges);
+    out.chunk_meetings[b / kStreamGrain] = meetings;
   });
-  // The followers of each row (the "follows" edges reversed), by counting. Rows at a meeting
-  // have no edges (their follows stay 0), and where nearly everyone is at one, as in an
-  // airport, skipping them saves most of the pass.
-  std::vector<uint32_t>& offset = out.follower_offset;
-  offset.assign(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    if (!marked[i])
-      for (uint32_t a = nb.offset[i]; a < nb.offset[i + 1]; ++a)
-        offset[nb.row[a] + 1] += out.follows[a];
-  for (std::size_t j = 0; j < n; ++j) offset[j + 1] += offset[j];
-  out.follower.resize(offset[n]);
-  out.cursor.assign(offset.begin(), offset.end() - 1);
-  for (std::size_t i = 0; i < n; ++i)
-    if (!marked[i])
-      for (uint32_t a = nb.offset[i]; a < nb.offset[i + 1]; ++a)
-        if (out.follows[a]) out.follower[out.cursor[nb.row[a]]++] = static_cast<uint32_t>(i);
-  // Breadth first from the meetings: the set reached does not depend on the order. Meetings
-  // nobody follows are counted, not queued (where nearly everyone is at a meeting, queueing
-  // them all was most of this pass).
+  std::size_t meetings = 0;
+  for (std::size_t m : out.chunk_meetings) meetings += m;
+  out.edges.clear();
+  for (const std::vector<uint64_t>& c : out.chunk_edges)
+    out.edges.insert(out.edges.end(), c.begin(), c.end());
+  // Breadth first from the meetings, over the edges reversed: the set reached does not depend on
+  // the order. The edges sorted by the row followed (a radix sort: O(E)) give each row's
+  // followers as a run. Where nearly everyone is at a meeting, as in an airport, there are few
+  // edges, and nothing here reads a per-row array.
+  std::vector<uint64_t>& edges = out.edges;
   out.queue.clear();
-  std::size_t idle_meetings = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!marked[i]) continue;
-    if (offset[i] < offset[i + 1])
-      out.queue.push_back(static_cast<uint32_t>(i));
-    else
-      ++idle_meetings;
-  }
-  for (std::size_t q = 0; q < out.queue.size(); ++q) {
-    const uint32_t j = out.queue[q];
-    for (uint32_t f = offset[j]; f < offset[j + 1]; ++f) {
-      const uint32_t i = out.follower[f];
-      if (marked[i]) continue;
-      marked[i] = 1;
-      out.queue.push_back(i);
+  if (meetings > 0 && !edges.empty()) {
+    index::radix_sort(edges, out.radix, 32, 32 + index::bits_for(n));
+    const auto followers = [&](uint32_t j) {
+      const auto lo = std::lower_bound(edges.begin(), edges.end(), uint64_t{j} << 32);
+      const auto hi = std::lower_bound(lo, edges.end(), (uint64_t{j} + 1) << 32);
+      return std::pair{lo, hi};
+    };
+    for (std::size_t k = 0; k < edges.size();) {  // the meetings somebody follows
+      const auto j = static_cast<uint32_t>(edges[k] >> 32);
+      if (marked[j]) out.queue.push_back(j);
+      while (k < edges.size() && edges[k] >> 32 == j) ++k;
+    }
+    for (std::size_t q = 0; q < out.queue.size(); ++q) {
+      const auto [lo, hi] = followers(out.queue[q]);
+      for (auto it = lo; it != hi; ++it) {
+        const auto i = static_cast<uint32_t>(*it & 0xffffffffu);
+        if (marked[i]) continue;
+        marked[i] = 1;
+        out.queue.push_back(i);
+        ++meetings;  // now counts every row marked
+      }
     }
   }
-  out.count = idle_meetings + out.queue.size();
+  out.count = meetings;
 }
 
 void mark_meetings_naive(const StreamView& v, std::vector<uint8_t>& marked) {

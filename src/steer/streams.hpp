@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "crowddb/query.hpp"
+#include "index/collision_common.hpp"
 
 namespace crowddb {
 class Executor;
@@ -72,12 +73,19 @@ struct StreamMarks {
   // (0 for the others): the search needs no more, and where nearly everyone is at a meeting
   // (an airport's crossing travellers) the headway finds whom they follow as it goes.
   std::vector<uint8_t> follows;
-  uint64_t count = 0;                                              // rows marked
-  std::vector<uint32_t> follower_offset, follower, cursor, queue;  // scratch
+  uint64_t count = 0;  // rows marked
+  // Scratch: the "follows" edges (followed << 32 | follower) and the meetings per chunk, the
+  // edges all together, and the search's queue.
+  std::vector<std::vector<uint64_t>> chunk_edges;
+  std::vector<std::size_t> chunk_meetings;
+  std::vector<uint64_t> edges;
+  index::RadixScratch radix;
+  std::vector<uint32_t> queue;
 };
 
 // Marks every row at or behind a meeting. Rows with no wish are never marked (they follow no
-// one). Work O(rows + list entries); the result does not depend on the thread count.
+// one). Work O(rows + list entries) on every thread, then O(E log E) on one for the E "follows"
+// edges; the result does not depend on the thread count.
 void mark_meetings(const StreamView& v, StreamMarks& out, Executor& ex);
 
 // The naive twin for tests: the meetings, then sweeps over every row marking those that follow

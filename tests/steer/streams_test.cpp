@@ -90,7 +90,9 @@ TEST(Streams, RandomCrowdsMarkAsTheNaiveSweeps) {
   std::size_t marked_total = 0, unmarked_total = 0;
   for (int round = 0; round < 60; ++round) {
     StreamCrowd c;
-    const int n = 20 + static_cast<int>(rng() % 400);
+    // Every tenth crowd large enough for several chunks of the parallel marking.
+    const int n = round % 10 == 9 ? 2500 + static_cast<int>(rng() % 2000)
+                                  : 20 + static_cast<int>(rng() % 400);
     const double side =
         std::sqrt(n / (0.2 + static_cast<double>(rng() % 30) / 10.0));  // 0.2 to 3.1 per m^2
     const uint32_t goals = 1 + rng() % 4;
