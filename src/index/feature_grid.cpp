@@ -125,10 +125,8 @@ void FeatureGrid::run(const DiscView& p, std::span<const double> reach, const St
   std::vector<uint64_t> tests(chunks, 0);
   ex.for_each_chunk(p.n, kFeatureGrain, [&](std::size_t b, std::size_t e) {
     const std::size_t c = b / kFeatureGrain;
-    // The chunk's lists and count are its own until the end (written per row in the per-chunk
-    // arrays, neighbouring chunks' vector headers share cache lines between the threads).
-    std::vector<uint32_t> counts = std::move(lists.counts[c]), items = std::move(lists.items[c]);
-    std::vector<double> d2s = std::move(lists.d2[c]);
+    // The chunk's lists and count are its own until the end (util/executor.hpp).
+    ListChunks::Chunk mine;
     uint64_t tests_c = 0;
     std::vector<uint32_t> cand;
     for (std::size_t i = b; i < e; ++i) {
@@ -150,7 +148,7 @@ void FeatureGrid::run(const DiscView& p, std::span<const double> reach, const St
         const uint16_t m = clear_[static_cast<std::size_t>(clamp_row(py) * W_ + clamp_col(px))];
         const double slack = 1e-9 * (cell_ + std::abs(px) + std::abs(py) + r);
         if (m >= 3 && static_cast<double>(m - 3) * cell_ > r + slack) {
-          counts.push_back(0);
+          mine.counts.push_back(0);
           continue;
         }
         // One cell of slack on each side against rounding of the box.
@@ -170,19 +168,17 @@ void FeatureGrid::run(const DiscView& p, std::span<const double> reach, const St
         for (uint32_t f : cand) {
           const double d2 = feature_dist2(scene, f, px, py);
           if (d2 < r2) {
-            items.push_back(f);
-            d2s.push_back(d2);
+            mine.items.push_back(f);
+            mine.d2.push_back(d2);
             ++count;
           }
         }
         tests_c += cand.size();
       }
-      counts.push_back(count);
+      mine.counts.push_back(count);
     }
     tests[c] = tests_c;
-    lists.counts[c] = std::move(counts);
-    lists.items[c] = std::move(items);
-    lists.d2[c] = std::move(d2s);
+    lists.put(c, std::move(mine));
   });
   lists.gather(out, &FeatureLists::feature, &ex);
   stats.rows += p.n;

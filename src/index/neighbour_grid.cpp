@@ -188,12 +188,9 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
   const uint32_t* const At = at_.data();
   ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
     const std::size_t c = b / kGrain;
-    // The chunk's counters and lists are its own until the end: written per row into the
-    // per-chunk arrays, neighbouring chunks' entries (and vector headers) share cache lines, which
-    // the threads would pass back and forth on every row.
+    // The chunk's counters and lists are its own until the end (util/executor.hpp).
     uint64_t tests_c = 0, rings_c = 0;
-    std::vector<uint32_t> counts = std::move(lists.counts[c]), items = std::move(lists.items[c]);
-    std::vector<double> d2s = std::move(lists.d2[c]);
+    ListChunks::Chunk mine;
     NearestK best;
     // Every disc other than `self` (at `self_at` in the grid) within `bound` (< the range) of
     // (px, py), from the bound's chords of cells, ranked by (distance, id): the best k are the
@@ -448,15 +445,13 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
                     out.dist2.begin() + static_cast<std::ptrdiff_t>(i * k));
         continue;
       }
-      counts.push_back(static_cast<uint32_t>(best.size()));
-      items.insert(items.end(), best.rows().begin(), best.rows().end());
-      if (out.with_dist2) d2s.insert(d2s.end(), best.dist2().begin(), best.dist2().end());
+      mine.counts.push_back(static_cast<uint32_t>(best.size()));
+      mine.items.insert(mine.items.end(), best.rows().begin(), best.rows().end());
+      if (out.with_dist2) mine.d2.insert(mine.d2.end(), best.dist2().begin(), best.dist2().end());
     }
     tests[c] = tests_c;
     rings[c] = rings_c;
-    lists.counts[c] = std::move(counts);
-    lists.items[c] = std::move(items);
-    lists.d2[c] = std::move(d2s);
+    lists.put(c, std::move(mine));
   });
   if (spatial) {
     out.offset.resize(d.n + 1);

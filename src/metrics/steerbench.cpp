@@ -115,8 +115,7 @@ void SteerBench::tick(const World& world, const TickMetrics& m, Executor* ex) {
     std::size_t seen = 0;
     for (std::size_t i = b; i < e; ++i) {
       const uint32_t slot = row_slot_[i];
-      const bool own = slot != kNoSlot && tracks_[slot].live && tracks_[slot].id == t.id[i] &&
-                       t.state[i] != AgentState::arrived;
+      const bool own = holds(slot, t.id[i]) && t.state[i] != AgentState::arrived;
       pending_[i] = !own;
       if (!own) continue;
       add_tick(tracks_[slot], t.x[i], t.y[i]);
@@ -137,7 +136,7 @@ void SteerBench::tick(const World& world, const TickMetrics& m, Executor* ex) {
     if (!pending_[i]) continue;
     const uint64_t id = t.id[i];
     uint32_t slot = row_slot_[i];
-    if (slot == kNoSlot || !tracks_[slot].live || tracks_[slot].id != id) {
+    if (!holds(slot, id)) {
       ++moved;
       const uint32_t score = known_.find(id);
       if (score == kUnknown) {

@@ -90,7 +90,11 @@ class SteerBench {
   void collisions(const World& world);
   void store_sums(const Track& tr) const;              // its sums into scores_[tr.score]
   void add_tick(Track& tr, double x, double y) const;  // the tick's step, its agent now at (x, y)
-  void flush() const;                                  // the live tracks' sums into scores_
+  // Does the slot a row remembers still hold agent id's live track?
+  bool holds(uint32_t slot, uint64_t id) const {
+    return slot != kNoSlot && tracks_[slot].live && tracks_[slot].id == id;
+  }
+  void flush() const;  // the live tracks' sums into scores_
   // Puts the live tracks in the order of the rows that hold them (slot = place in that order),
   // in place: a copy of them all is 88 MB at 10^6 agents, at the moment the run's memory peaks.
   void lay_out_in_row_order(const AgentTable& t);

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <algorithm>
+#include <utility>
+#include <vector>
 
 #include "plan/access_path.hpp"
 #include "util/executor.hpp"
@@ -152,6 +154,17 @@ struct ListChunks {
     counts.assign(chunks, {});
     items.assign(chunks, {});
     d2.assign(chunks, {});
+  }
+  // One chunk's lists, built by its body in a local and put in place once at its end: appended
+  // to per row in place, neighbouring chunks' vector headers share cache lines between threads.
+  struct Chunk {
+    std::vector<uint32_t> counts, items;
+    std::vector<double> d2;
+  };
+  void put(std::size_t c, Chunk&& chunk) {
+    counts[c] = std::move(chunk.counts);
+    items[c] = std::move(chunk.items);
+    d2[c] = std::move(chunk.d2);
   }
   // Concatenates the chunks' lists into out's CSR in chunk order. With an executor, and from
   // kParallelGather rows, the chunks are copied on its threads (each into its own place; the same
