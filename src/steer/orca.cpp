@@ -648,7 +648,9 @@ class OrcaModel final : public Model {
     bool by_place;
     const bool decides = int{std::isfinite(remaining_[i])} & int{std::isfinite(remaining_[j])} &
                          int{sim::ahead(heading_[i], heading_[j], by_place)};
-    return decides ? by_place : by_path;
+    // (As a mask: g++ made the ?: a jump on `decides`, a coin toss too.)
+    const unsigned take = 0u - unsigned{decides};
+    return ((take & unsigned{by_place}) | (~take & unsigned{by_path})) != 0;
   }
 
   NeighbourLists nb_;
