@@ -240,7 +240,7 @@ class OrcaModel final : public Model {
       if (p.pass_look > 0) sop.count("someone passing within pass_look", passing_far_);
     }
     infeasible_.assign(chunks, 0);
-    const double hi_share = p.first_share;
+    const double hi_share = p.first_share, lo_share = 1 - hi_share;
     log.timed("ORCA linear programs", n, [&] {
       // Priority: agents yielding to a stalemate first, then the one with less of its path left;
       // idle agents come last.
@@ -308,7 +308,7 @@ class OrcaModel final : public Model {
             if (!(clear || gap >= reach || d == 0)) {
               const double nx = (t.x[j] - t.x[i]) / d, ny = (t.y[j] - t.y[i]) / d;
               // v . n <= g  <=>  v . (-n) >= -g: the plane through -n g with normal -n.
-              const double share = i_first ? 1 - hi_share : hi_share;
+              const double share = pick(i_first, lo_share, hi_share);
               const double g = std::max(0.0, gap) * share / in.cfg.dt;
               planes.push_back({nx * g, ny * g, -nx, -ny});
             }
@@ -324,7 +324,7 @@ class OrcaModel final : public Model {
             ir[a] = t.radius[i] + t.radius[j];
             // The pair's horizon: no longer than until one of them arrives (see the top).
             itau[a] = std::clamp(std::min(arrive_[i], arrive_[j]), in.cfg.dt, p.time_horizon);
-            ishare[a] = i_first ? hi_share : 1 - hi_share;
+            ishare[a] = pick(i_first, hi_share, lo_share);
           }
           retreat_plane(in, i, planes);
           const std::size_t hard = planes.size();
