@@ -296,7 +296,10 @@ class OrcaModel final : public Model {
           // 1e-9 is beyond reach in the exact test below whatever its rounding (an error of a few
           // ulps of d): most are, and they need no square root.
           const double beyond = reach + kSkin + t.radius[i];
-          for (auto* col : {&ipx, &ipy, &ivx, &ivy, &ir, &itau, &ishare}) col->resize(m);
+          // Grown, never shrunk: a resize per row and column (zero-filling what it adds) cost
+          // more than the columns' fill.
+          if (ipx.size() < m)
+            for (auto* col : {&ipx, &ipy, &ivx, &ivy, &ir, &itau, &ishare}) col->resize(m);
           for (std::size_t a = 0; a < m; ++a) {
             const uint32_t j = nb_.row[lo + a];
             const bool i_first = first(in, i, j);
