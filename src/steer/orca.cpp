@@ -275,7 +275,7 @@ class OrcaModel final : public Model {
       });
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
         uint64_t infeasible = 0;  // the chunk's count, written once at its end (see find_passing)
-        std::vector<HalfPlane> planes;
+        std::vector<HalfPlane> planes, soft;
         std::vector<double> ipx, ipy, ivx, ivy, ir, itau, ishare;  // agent_planes' inputs
         for (std::size_t i = b; i < e; ++i) {
           planes.clear();
@@ -331,10 +331,13 @@ class OrcaModel final : public Model {
           }
           retreat_plane(in, i, planes);
           const std::size_t hard = planes.size();
-          planes.resize(hard + m);
+          // Built in a buffer of their own and appended: resizing `planes` would zero-fill them
+          // first, row by row.
+          if (soft.size() < m) soft.resize(m);
           agent_planes({ipx.data(), ipy.data(), ivx.data(), ivy.data(), ir.data(), itau.data(),
                         ishare.data()},
-                       m, in.cfg.dt, vix, viy, planes.data() + hard);
+                       m, in.cfg.dt, vix, viy, soft.data());
+          planes.insert(planes.end(), soft.begin(), soft.begin() + static_cast<std::ptrdiff_t>(m));
           double px = in.pref_vx[i], py = in.pref_vy[i];
           if (p.pass_side != OrcaParams::PassSide::none) keep_to_side(in, i, px, py);
           if (p.time_gap > 0 || (p.stream_gap > 0 && streams_.marked[i]))
