@@ -3,11 +3,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <tuple>
+#include <vector>
 
 #include "query/ftc_geometry.hpp"
 #include "scenario/builders.hpp"
+#include "util/rng.hpp"
 
 namespace crowddb {
 namespace {
@@ -200,6 +204,47 @@ TEST(NaivePaths, OutputDoesNotDependOnThreadCount) {
   CollisionNaive().run(t.view(), scene, c2, two_threads, st);
   EXPECT_EQ(c1.agents, c2.agents);
   EXPECT_EQ(c1.obstacles.size(), c2.obstacles.size());
+}
+
+// An unbounded list (k = 0) comes out in (dist2, id) order: up to kRankSort entries it is
+// sorted by counting ranks, beyond by std::sort; both against std::sort of the same candidates.
+// Distances drawn from a few values tie often (the ids settle them), and equal (dist2, id) keys
+// (which the rank count cannot place) fall back to std::sort.
+TEST(NearestK, UnboundedListsComeOutSortedByDistanceThenId) {
+  Rng rng(42);
+  for (int round = 0; round < 400; ++round) {
+    const std::size_t m = 1 + rng.below(round % 4 == 0 ? 100 : 66);
+    const bool ties = round % 3 == 0, twins = round % 17 == 0;
+    std::vector<std::tuple<double, uint64_t, uint32_t>> want;
+    NearestK best;
+    best.reset(0);
+    for (std::size_t a = 0; a < m; ++a) {
+      const double d2 = ties ? static_cast<double>(rng.below(4)) : rng.uniform(0, 9);
+      uint64_t id = rng.below(1u << 30);
+      if (twins && a > 0 && a % 5 == 0) id = std::get<1>(want[a - 1]);
+      const double key = twins && a > 0 && a % 5 == 0 ? std::get<0>(want[a - 1]) : d2;
+      want.emplace_back(key, id, static_cast<uint32_t>(a));
+      best.offer(static_cast<uint32_t>(a), id, key);
+    }
+    best.finish();
+    std::sort(want.begin(), want.end(), [](const auto& p, const auto& q) {
+      return std::get<0>(p) < std::get<0>(q) ||
+             (std::get<0>(p) == std::get<0>(q) && std::get<1>(p) < std::get<1>(q));
+    });
+    ASSERT_EQ(best.size(), m);
+    for (std::size_t a = 0; a < m; ++a) {
+      EXPECT_EQ(best.dist2()[a], std::get<0>(want[a])) << "round " << round << " entry " << a;
+      // Equal keys may come in either order (std::sort is not stable): then only the key counts.
+      const auto same = [&](std::size_t b) {
+        return std::get<0>(want[b]) == std::get<0>(want[a]) &&
+               std::get<1>(want[b]) == std::get<1>(want[a]);
+      };
+      const bool twin = (a > 0 && same(a - 1)) || (a + 1 < m && same(a + 1));
+      if (!twin) {
+        EXPECT_EQ(best.rows()[a], std::get<2>(want[a])) << "round " << round << " entry " << a;
+      }
+    }
+  }
 }
 
 TEST(Registry, UnknownMethodIsAUsageErrorListingTheChoices) {
