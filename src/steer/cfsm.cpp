@@ -26,6 +26,8 @@
 namespace crowddb::steer {
 namespace {
 
+constexpr uint32_t kBatch = 32;  // neighbours filtered at once for the corridor ahead
+
 // Do segments [a, b] and [c, d] intersect (touching counts)?
 bool segments_cross(double ax, double ay, double bx, double by, const Vec2& c, const Vec2& d) {
   auto orient = [](double px, double py, double qx, double qy, double rx, double ry) {
@@ -175,15 +177,26 @@ class CfsmModel final : public Model {
     dx /= len;
     dy /= len;
     // Spacing to the nearest neighbour ahead in the corridor of width 2 l along e.
+    // In batches: first the neighbours in the corridor ahead, without branches (whether one is
+    // behind is a coin toss to the predictor), then their spacings in list order. (The tests as
+    // ints: & on them is meant.)
     double spacing = INFINITY;
-    for (uint32_t a = lo; a < hi; ++a) {
-      const uint32_t j = nb_.row[a];
-      const double rx = t.x[j] - x, ry = t.y[j] - y;
-      if (rx * dx + ry * dy < 0) continue;  // behind
-      const double l = r + t.radius[j];
-      if (std::abs(ry * dx - rx * dy) > l) continue;  // beside the corridor
-      if (hidden(in, i, j)) continue;
-      spacing = std::min(spacing, std::sqrt(dist2_of(t, i, j)) - l);
+    for (uint32_t a0 = lo; a0 < hi; a0 += kBatch) {
+      const uint32_t a1 = std::min(hi, a0 + kBatch);
+      uint32_t pick[kBatch];
+      uint32_t m = 0;
+      for (uint32_t a = a0; a < a1; ++a) {
+        const uint32_t j = nb_.row[a];
+        const double rx = t.x[j] - x, ry = t.y[j] - y;
+        pick[m] = j;
+        m += static_cast<uint32_t>(int{!(rx * dx + ry * dy < 0)} &                          // ahead
+                                   int{!(std::abs(ry * dx - rx * dy) > r + t.radius[j])});  // in it
+      }
+      for (uint32_t u = 0; u < m; ++u) {
+        const uint32_t j = pick[u];
+        if (hidden(in, i, j)) continue;
+        spacing = std::min(spacing, std::sqrt(dist2_of(t, i, j)) - (r + t.radius[j]));
+      }
     }
     double speed = std::min(std::max(spacing / p.time_gap, 0.0), v0);
     // Contact clipping: at most half the gap to a neighbour, all of it to an obstacle, per tick.
@@ -193,9 +206,9 @@ class CfsmModel final : public Model {
       const double d = std::sqrt(dist2_of(t, i, j));
       if (d == 0) continue;
       const double along = ((t.x[j] - x) * dx + (t.y[j] - y) * dy) / d;  // e . n_ij
-      if (along <= 0) continue;
+      // Only towards j (along > 0); picked by mask, not by a jump (a coin toss, as above).
       const double gap = std::max(0.0, d - r - t.radius[j] - kSkin);
-      speed = std::min(speed, 0.5 * gap / (dt * along));
+      speed = std::min(speed, pick(!(along <= 0), 0.5 * gap / (dt * along), INFINITY));
     }
     for (uint32_t a = features_.offset[i]; a < features_.offset[i + 1] && speed > 0; ++a) {
       const Vec2 c = feature_closest(in.scene, features_.feature[a], x, y);

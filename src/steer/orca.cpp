@@ -153,7 +153,6 @@
 // area), so they make room. The backoff stays on as the safety net; with orca it rarely fires
 // (EXPLAIN ANALYZE counts it).
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -179,14 +178,6 @@ constexpr double kSideTurn = 30 * std::numbers::pi / 180;
 constexpr double kTurnNearWaypoint = 2;  // [m]
 constexpr double kStanding = 1e-100;     // [m/s] a wish below this does not look for anyone
 constexpr uint32_t kCapBatch = 32;       // neighbours filtered at once for the headway caps
-
-// `c ? a : b` from the bits of both, without a branch: g++ turns the ?: on loaded doubles into
-// a jump, which mispredicts where c is a coin toss.
-inline double pick(bool c, double a, double b) {
-  const uint64_t mask = uint64_t{0} - uint64_t{c};
-  return std::bit_cast<double>((std::bit_cast<uint64_t>(a) & mask) |
-                               (std::bit_cast<uint64_t>(b) & ~mask));
-}
 
 class OrcaModel final : public Model {
  public:
