@@ -11,8 +11,6 @@
 // in registry.cpp only.
 #pragma once
 
-#include <bit>
-#include <cstdint>
 #include <functional>
 #include <memory>
 #include <ostream>
@@ -24,6 +22,7 @@
 #include "crowddb/simulation.hpp"
 #include "sim/oplog.hpp"
 #include "util/executor.hpp"
+#include "util/pick.hpp"
 
 namespace crowddb::steer {
 
@@ -32,15 +31,6 @@ inline constexpr std::size_t kGrain = 128;
 // [m] Contact planes and headways keep this much more than touching distance, so that rounding of
 // the new positions cannot turn an exact touch into an overlap the backoff would freeze.
 inline constexpr double kSkin = 1e-6;
-
-// `c ? a : b` from the bits of both, without a branch. g++ turns a ?: on two loaded doubles
-// into a jump, which mispredicts where c is a coin toss (who goes first, whether a neighbour is
-// ahead), once per neighbour of every row.
-inline double pick(bool c, double a, double b) {
-  const uint64_t mask = uint64_t{0} - uint64_t{c};
-  return std::bit_cast<double>((std::bit_cast<uint64_t>(a) & mask) |
-                               (std::bit_cast<uint64_t>(b) & ~mask));
-}
 
 // The squared distance of rows i and j as the neighbour lists compute it (same operands, same
 // order: the same double), so that a model's lists need not store it (NeighbourLists::with_dist2:

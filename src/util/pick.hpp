@@ -1,0 +1,18 @@
+// `c ? a : b` for doubles without a branch. g++ turns a ?: on two loaded doubles into a jump,
+// which mispredicts about every other time where c is a coin toss: who of two goes first,
+// whether a neighbour is ahead, whether a tree node's box is within reach. Those run once per
+// neighbour or node of every row, every tick (docs/benchmarks.md, 2026-12-02 evening).
+#pragma once
+
+#include <bit>
+#include <cstdint>
+
+namespace crowddb {
+
+inline double pick(bool c, double a, double b) {
+  const uint64_t mask = uint64_t{0} - uint64_t{c};
+  return std::bit_cast<double>((std::bit_cast<uint64_t>(a) & mask) |
+                               (std::bit_cast<uint64_t>(b) & ~mask));
+}
+
+}  // namespace crowddb
