@@ -2,7 +2,6 @@
 #pragma once
 
 #include <algorithm>
-#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -93,19 +92,7 @@ class NearestK {
   // Sorts an unbounded (k = 0) list; a bounded one is kept sorted already.
   void finish() {
     if (k_ != 0 || rows_.size() < 2) return;
-    if (rows_.size() <= kRankSort && rank_sort()) return;
-    order_.resize(rows_.size());
-    for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<uint32_t>(i);
-    std::sort(order_.begin(), order_.end(),
-              [&](uint32_t a, uint32_t b) { return better(d2_[a], ids_[a], d2_[b], ids_[b]); });
-    scratch_rows_.resize(order_.size());
-    scratch_d2_.resize(order_.size());
-    for (std::size_t i = 0; i < order_.size(); ++i) {
-      scratch_rows_[i] = rows_[order_[i]];
-      scratch_d2_[i] = d2_[order_[i]];
-    }
-    rows_.swap(scratch_rows_);
-    d2_.swap(scratch_d2_);
+    sort_unbounded();
   }
   std::span<const uint32_t> rows() const {
     return small_ ? std::span<const uint32_t>(srows_, n_) : std::span<const uint32_t>(rows_);
@@ -115,6 +102,9 @@ class NearestK {
   }
 
  private:
+  // Out of line (query/neighbours_naive.cpp): the bounded queries' hot loops inline finish()
+  // and never come here.
+  void sort_unbounded();
   // Unbounded lists up to this long are sorted by counting each entry's rank.
   static constexpr std::size_t kRankSort = 64;
 
@@ -127,48 +117,7 @@ class NearestK {
   // mispredicted jump each (the cfsm model's range query sorts every row's list, every tick).
   // The same order as std::sort's when the keys (dist2, id) are distinct; false (nothing moved)
   // when two are not, and the caller sorts the usual way.
-  bool rank_sort() {
-    typedef double V2d __attribute__((vector_size(16)));
-    typedef int64_t V2l __attribute__((vector_size(16)));
-    const std::size_t m = rows_.size();
-    alignas(16) double dist[kRankSort];
-    std::copy_n(d2_.data(), m, dist);
-    if (m % 2) dist[m] = INFINITY;  // whole vectors; never nearer
-    uint32_t rows[kRankSort];
-    double d2s[kRankSort];
-    const uint64_t all = m == 64 ? ~uint64_t{0} : (uint64_t{1} << m) - 1;
-    for (const bool by_id : {false, true}) {
-      uint64_t filled = 0;
-      for (std::size_t a = 0; a < m; ++a) {
-        const double da = dist[a];
-        std::size_t rank = 0;
-        if (!by_id) {
-          V2l nearer = {0, 0};  // -1 per lane for each one nearer
-          const V2d dv = {da, da};
-          for (std::size_t b = 0; b < m; b += 2) {
-            V2d v;
-            __builtin_memcpy(&v, dist + b, sizeof v);
-            nearer += v < dv;
-          }
-          rank = static_cast<std::size_t>(-(nearer[0] + nearer[1]));
-        } else {  // equal distances share a rank above: the ids settle them
-          const uint64_t ia = ids_[a];
-          for (std::size_t b = 0; b < m; ++b)
-            rank += static_cast<std::size_t>(int{dist[b] < da} |
-                                             (int{dist[b] == da} & int{ids_[b] < ia}));
-        }
-        rows[rank] = rows_[a];
-        d2s[rank] = da;
-        filled |= uint64_t{1} << rank;
-      }
-      if (filled == all) {
-        std::copy_n(rows, m, rows_.data());
-        std::copy_n(d2s, m, d2_.data());
-        return true;
-      }
-    }
-    return false;
-  }
+  bool rank_sort();
   // Inserts into the sorted arrays holding n entries (capacity k_), dropping the worst when full.
   void offer_into(uint32_t* rows, double* d2s, uint64_t* ids, std::size_t& n, uint32_t row,
                   uint64_t id, double d2) const {

@@ -1,6 +1,8 @@
 // The naive neighbour and obstacle-feature queries: a scan of every row (every feature) per
 // query. The oracles of the indexed methods in src/index/neighbour_grid.cpp and feature_grid.cpp.
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 
 #include "query/naive_paths.hpp"
 
@@ -69,6 +71,67 @@ void FeatureNaive::run(const DiscView& p, std::span<const double> reach, const S
   lists.gather(out, &FeatureLists::feature, &ex);
   stats.rows += p.n;
   stats.pair_tests += p.n * features;
+}
+
+// ---------------------------------------------------------- NearestK, unbounded lists
+
+void NearestK::sort_unbounded() {
+  if (rows_.size() <= kRankSort && rank_sort()) return;
+  order_.resize(rows_.size());
+  for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<uint32_t>(i);
+  std::sort(order_.begin(), order_.end(),
+            [&](uint32_t a, uint32_t b) { return better(d2_[a], ids_[a], d2_[b], ids_[b]); });
+  scratch_rows_.resize(order_.size());
+  scratch_d2_.resize(order_.size());
+  for (std::size_t i = 0; i < order_.size(); ++i) {
+    scratch_rows_[i] = rows_[order_[i]];
+    scratch_d2_[i] = d2_[order_[i]];
+  }
+  rows_.swap(scratch_rows_);
+  d2_.swap(scratch_d2_);
+}
+
+bool NearestK::rank_sort() {
+  typedef double V2d __attribute__((vector_size(16)));
+  typedef int64_t V2l __attribute__((vector_size(16)));
+  const std::size_t m = rows_.size();
+  alignas(16) double dist[kRankSort];
+  std::copy_n(d2_.data(), m, dist);
+  if (m % 2) dist[m] = INFINITY;  // whole vectors; never nearer
+  uint32_t rows[kRankSort];
+  double d2s[kRankSort];
+  const uint64_t all = m == 64 ? ~uint64_t{0} : (uint64_t{1} << m) - 1;
+  for (const bool by_id : {false, true}) {
+    uint64_t filled = 0;
+    for (std::size_t a = 0; a < m; ++a) {
+      const double da = dist[a];
+      std::size_t rank = 0;
+      if (!by_id) {
+        V2l nearer = {0, 0};  // -1 per lane for each one nearer
+        const V2d dv = {da, da};
+        for (std::size_t b = 0; b < m; b += 2) {
+          V2d v;
+          __builtin_memcpy(&v, dist + b, sizeof v);
+          nearer += v < dv;
+        }
+        rank = static_cast<std::size_t>(-(nearer[0] + nearer[1]));
+      } else {  // equal distances share a rank above: the ids settle them
+        const uint64_t ia = ids_[a];
+        for (std::size_t b = 0; b < m; ++b)
+          rank += static_cast<std::size_t>(int{dist[b] < da} |
+                                           (int{dist[b] == da} & int{ids_[b] < ia}));
+      }
+      rows[rank] = rows_[a];
+      d2s[rank] = da;
+      filled |= uint64_t{1} << rank;
+    }
+    if (filled == all) {
+      std::copy_n(rows, m, rows_.data());
+      std::copy_n(d2s, m, d2_.data());
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace crowddb
