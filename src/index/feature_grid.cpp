@@ -10,7 +10,7 @@
 namespace crowddb::index {
 namespace {
 
-constexpr std::size_t kFeatureGrain = 64;
+constexpr std::size_t kFeatureGrain = 256;
 
 // A feature's bounding box (Box of index/row_buckets.hpp).
 Box feature_box(const StaticScene& scene, std::size_t f) {
@@ -127,6 +127,7 @@ void FeatureGrid::run(const DiscView& p, std::span<const double> reach, const St
     const std::size_t c = b / kFeatureGrain;
     // The chunk's lists and count are its own until the end (util/executor.hpp).
     ListChunks::Chunk mine;
+    mine.counts.reserve(e - b);  // one allocation, not one per doubling
     uint64_t tests_c = 0;
     std::vector<uint32_t> cand;
     for (std::size_t i = b; i < e; ++i) {
