@@ -1,7 +1,8 @@
 #include "steer/orca_planes.hpp"
 
 #include <cmath>
-#include <xsimd/xsimd.hpp>
+
+#include "steer/orca_planes_lanes.hpp"
 
 namespace crowddb::steer {
 
@@ -60,50 +61,24 @@ HalfPlane agent_plane(double px, double py, double vx, double vy, double r, doub
   return {vix + share * ux, viy + share * uy, nx, ny};
 }
 
+#if CROWDDB_PLANES_AVX2
+// orca_planes_avx2.cpp: the lanes of AVX2, for a build whose own instruction set is narrower.
+std::size_t agent_planes_avx2(const PlaneInputs& in, std::size_t m, double dt, double vix,
+                              double viy, HalfPlane* out);
+#endif
+
 void agent_planes(const PlaneInputs& in, std::size_t m, double dt, double vix, double viy,
-                  HalfPlane* out) {
-  using B = xsimd::batch<double>;
-  constexpr std::size_t L = B::size;
-  const B zero(0.0), one(1.0), bdt(dt), bvix(vix), bviy(viy);
-  std::size_t a = 0;
-  for (; a + L <= m; a += L) {
-    const B px = B::load_unaligned(in.px + a), py = B::load_unaligned(in.py + a);
-    const B vx = B::load_unaligned(in.vx + a), vy = B::load_unaligned(in.vy + a);
-    const B r = B::load_unaligned(in.r + a), tau = B::load_unaligned(in.tau + a);
-    const B share = B::load_unaligned(in.share + a);
-    const B d2 = px * px + py * py, r2 = r * r;
-    const auto overlap = !(d2 > r2);
-    // The cut-off arc, and the overlapping case: the same formula with horizon dt, and when the
-    // relative velocity points nowhere, the normal (1, 0).
-    const B te = xsimd::select(overlap, bdt, tau);
-    const B wx = vx - px / te, wy = vy - py / te;
-    const B w2 = wx * wx + wy * wy;
-    const B wp = wx * px + wy * py;
-    const auto arc = overlap | ((wp < zero) & (wp * wp > r2 * w2));
-    const B wl = xsimd::sqrt(w2);
-    const auto nowhere = overlap & !(wl > zero);
-    const B anx = xsimd::select(nowhere, one, wx / wl);
-    const B any = xsimd::select(nowhere, zero, wy / wl);
-    const B s = r / te - wl;
-    const B aux = s * anx, auy = s * any;
-    // The legs: the right leg is the left one with -r for r (negating a product is exact).
-    const B leg = xsimd::sqrt(d2 - r2);
-    const auto left = px * wy - py * wx > zero;
-    const B sr = xsimd::select(left, r, -r);
-    const B lx = (px * leg - py * sr) / d2;
-    const B ly = (px * sr + py * leg) / d2;
-    const B lnx = xsimd::select(left, -ly, ly);
-    const B lny = xsimd::select(left, lx, -lx);
-    const B along = vx * lx + vy * ly;
-    const B lux = along * lx - vx, luy = along * ly - vy;
-    const B ux = xsimd::select(arc, aux, lux), uy = xsimd::select(arc, auy, luy);
-    alignas(64) double opx[L], opy[L], onx[L], ony[L];
-    (bvix + share * ux).store_aligned(opx);
-    (bviy + share * uy).store_aligned(opy);
-    xsimd::select(arc, anx, lnx).store_aligned(onx);
-    xsimd::select(arc, any, lny).store_aligned(ony);
-    for (std::size_t l = 0; l < L; ++l) out[a + l] = {opx[l], opy[l], onx[l], ony[l]};
-  }
+                  HalfPlane* out, PlaneLanes lanes) {
+#if CROWDDB_PLANES_AVX2
+  // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  std::size_t a = avx2 && lanes == PlaneLanes::widest
+                      ? agent_planes_avx2(in, m, dt, vix, viy, out)
+                      : agent_planes_lanes<xsimd::default_arch>(in, m, dt, vix, viy, out);
+#else
+  (void)lanes;  // the build's lanes are the widest there are
+  std::size_t a = agent_planes_lanes<xsimd::default_arch>(in, m, dt, vix, viy, out);
+#endif
   for (; a < m; ++a)  // the tail, one at a time
     out[a] = agent_plane(in.px[a], in.py[a], in.vx[a], in.vy[a], in.r[a], in.tau[a], dt, vix, viy,
                          in.share[a]);

@@ -3,11 +3,12 @@
 //
 // Two ways to build them, with the same answers bit for bit: `agent_plane`, one neighbour at a
 // time (the reference, as the paper reads), and `agent_planes`, a row's neighbours at once,
-// several per instruction (xsimd: SSE2 lanes of two by default, four with CROWDDB_NATIVE on an
-// AVX machine). The batch computes every case (cut-off arc, left leg, right leg, overlapping) in
-// every lane and selects, where the reference branches: which leg a neighbour's plane follows is
-// a coin toss to the branch predictor. Both use the same operations in the same order, and the
-// build keeps a*b+c unfused (-ffp-contract=off), so their answers agree to the bit; the test
+// several per instruction (xsimd: the build's lanes, two of SSE2 by default, and where the CPU
+// has AVX2 its four, chosen at run time; CROWDDB_NATIVE builds for the machine's own). The batch
+// computes every case (cut-off arc, left leg, right leg, overlapping) in every lane and selects,
+// where the reference branches: which leg a neighbour's plane follows is a coin toss to the branch
+// predictor. Both use the same operations in the same order, and the build keeps a*b+c unfused
+// (-ffp-contract=off), so their answers agree to the bit; the test
 // (tests/steer/orca_planes_test.cpp) compares them on random and degenerate neighbours.
 #pragma once
 
@@ -28,8 +29,12 @@ struct PlaneInputs {
   const double *px, *py, *vx, *vy, *r, *tau, *share;
 };
 
+// Which lanes agent_planes uses: the widest the CPU has (AVX2 where the build's own set is
+// narrower: chosen at run time), or the build's own instruction set (tests compare both).
+enum class PlaneLanes { widest, build };
+
 // out[a] = agent_plane(in.px[a], ..., dt, vix, viy, in.share[a]) for a < m.
 void agent_planes(const PlaneInputs& in, std::size_t m, double dt, double vix, double viy,
-                  HalfPlane* out);
+                  HalfPlane* out, PlaneLanes lanes = PlaneLanes::widest);
 
 }  // namespace crowddb::steer

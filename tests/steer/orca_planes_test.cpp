@@ -1,7 +1,8 @@
 // ORCA's agent planes built several at a time (agent_planes, xsimd) against the reference built
 // one at a time (agent_plane): the same planes to the bit, on random neighbours in every case the
 // construction distinguishes (the cut-off arc, either leg, overlapping, coincident), for every
-// count of neighbours (so that whole batches and the tail both run).
+// count of neighbours (so that whole batches and the tail both run), in the build's own lanes and
+// in the widest the CPU has (AVX2's, chosen at run time in a default build).
 #include "steer/orca_planes.hpp"
 
 #include <gtest/gtest.h>
@@ -80,8 +81,16 @@ TEST(OrcaPlanes, BatchMatchesTheReferenceBitForBit) {
       c.share.push_back(rng.below(2) ? 0.5 : rng.uniform(0, 1));
     }
     const double vix = rng.uniform(-2, 2), viy = rng.uniform(-2, 2);
-    std::vector<HalfPlane> batch(m);
-    agent_planes(c.view(), m, dt, vix, viy, batch.data());
+    std::vector<HalfPlane> batch(m), build(m);
+    agent_planes(c.view(), m, dt, vix, viy, batch.data());  // the widest lanes there are
+    agent_planes(c.view(), m, dt, vix, viy, build.data(), PlaneLanes::build);
+    for (std::size_t a = 0; a < m; ++a) {
+      const HalfPlane& own = build[a];
+      const HalfPlane& wide = batch[a];
+      ASSERT_TRUE(same_bits(own.px, wide.px) && same_bits(own.py, wide.py) &&
+                  same_bits(own.nx, wide.nx) && same_bits(own.ny, wide.ny))
+          << "trial " << trial << " neighbour " << a << ": the build's lanes and the widest differ";
+    }
     for (std::size_t a = 0; a < m; ++a) {
       ++seen[case_of(c.px[a], c.py[a], c.vx[a], c.vy[a], c.r[a], c.tau[a], dt)];
       const HalfPlane ref = agent_plane(c.px[a], c.py[a], c.vx[a], c.vy[a], c.r[a], c.tau[a], dt,
