@@ -112,11 +112,11 @@ class NearestK {
     return d2 < d2b || (d2 == d2b && id < idb);
   }
   // Sorts rows_ and d2_ (m <= kRankSort) by rank: the number of entries nearer than each,
-  // counted two at a time with SSE2 compares, and the ids where distances tie. Which of two is
-  // nearer is a coin toss to the branch predictor, and std::sort's comparisons took a
-  // mispredicted jump each (the cfsm model's range query sorts every row's list, every tick).
-  // The same order as std::sort's when the keys (dist2, id) are distinct; false (nothing moved)
-  // when two are not, and the caller sorts the usual way.
+  // counted two at a time in a 16-byte vector (SSE2 on x86-64), and the ids where distances tie.
+  // Which of two is nearer is a coin toss to the branch predictor, and std::sort's comparisons took
+  // a mispredicted jump each (the cfsm model's range query sorts every row's list, every tick). The
+  // same order as std::sort's when the keys (dist2, id) are distinct; false (nothing moved) when
+  // two are not, and the caller sorts the usual way.
   bool rank_sort();
   // Inserts into the sorted arrays holding n entries (capacity k_), dropping the worst when full.
   void offer_into(uint32_t* rows, double* d2s, uint64_t* ids, std::size_t& n, uint32_t row,

@@ -182,18 +182,18 @@ class CfsmModel final : public Model {
     // ints: & on them is meant.)
     double spacing = INFINITY;
     for (uint32_t a0 = lo; a0 < hi; a0 += kBatch) {
-      const uint32_t a1 = std::min(hi, a0 + kBatch);
-      uint32_t pick[kBatch];
+      const uint32_t a1 = a0 + std::min(kBatch, hi - a0);
+      uint32_t ahead[kBatch];
       uint32_t m = 0;
       for (uint32_t a = a0; a < a1; ++a) {
         const uint32_t j = nb_.row[a];
         const double rx = t.x[j] - x, ry = t.y[j] - y;
-        pick[m] = j;
+        ahead[m] = j;
         m += static_cast<uint32_t>(int{!(rx * dx + ry * dy < 0)} &                          // ahead
                                    int{!(std::abs(ry * dx - rx * dy) > r + t.radius[j])});  // in it
       }
       for (uint32_t u = 0; u < m; ++u) {
-        const uint32_t j = pick[u];
+        const uint32_t j = ahead[u];
         if (hidden(in, i, j)) continue;
         spacing = std::min(spacing, std::sqrt(dist2_of(t, i, j)) - (r + t.radius[j]));
       }

@@ -61,18 +61,27 @@ HalfPlane agent_plane(double px, double py, double vx, double vy, double r, doub
   return {vix + share * ux, viy + share * uy, nx, ny};
 }
 
-#if CROWDDB_PLANES_AVX2
+#if CROWDDB_PLANES_AVX2 && !XSIMD_WITH_AVX2
+#define CROWDDB_PLANES_DISPATCH 1
 // orca_planes_avx2.cpp: the lanes of AVX2, for a build whose own instruction set is narrower.
 std::size_t agent_planes_avx2(const PlaneInputs& in, std::size_t m, double dt, double vix,
                               double viy, HalfPlane* out);
 #endif
 
-void agent_planes(const PlaneInputs& in, std::size_t m, double dt, double vix, double viy,
-                  HalfPlane* out, PlaneLanes lanes) {
-#if CROWDDB_PLANES_AVX2
+bool wider_plane_lanes() {
+#if CROWDDB_PLANES_DISPATCH
   // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
   static const bool avx2 = __builtin_cpu_supports("avx2");
-  std::size_t a = avx2 && lanes == PlaneLanes::widest
+  return avx2;
+#else
+  return false;
+#endif
+}
+
+void agent_planes(const PlaneInputs& in, std::size_t m, double dt, double vix, double viy,
+                  HalfPlane* out, PlaneLanes lanes) {
+#if CROWDDB_PLANES_DISPATCH
+  std::size_t a = wider_plane_lanes() && lanes == PlaneLanes::widest
                       ? agent_planes_avx2(in, m, dt, vix, viy, out)
                       : agent_planes_lanes<xsimd::default_arch>(in, m, dt, vix, viy, out);
 #else

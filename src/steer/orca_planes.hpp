@@ -33,6 +33,10 @@ struct PlaneInputs {
 // narrower: chosen at run time), or the build's own instruction set (tests compare both).
 enum class PlaneLanes { widest, build };
 
+// Are the widest lanes wider than the build's here (AVX2 chosen at run time)? When not, the two
+// choices of PlaneLanes are the same code.
+bool wider_plane_lanes();
+
 // out[a] = agent_plane(in.px[a], ..., dt, vix, viy, in.share[a]) for a < m.
 void agent_planes(const PlaneInputs& in, std::size_t m, double dt, double vix, double viy,
                   HalfPlane* out, PlaneLanes lanes = PlaneLanes::widest);

@@ -2,7 +2,8 @@
 // a row's neighbours in the lanes of xsimd's batch for Arch. Included by orca_planes.cpp (the
 // build's own instruction set) and orca_planes_avx2.cpp (compiled with -mavx2, called only when
 // the CPU has it): the same operations on the same operands in every lane, and no fused
-// multiply-adds (-ffp-contract=off, and -mfma is never given), so both give the reference's bits.
+// multiply-adds (-ffp-contract=off everywhere; the AVX2 file is not given -mfma either), so both
+// give the reference's bits.
 // Nothing but xsimd's templates on Arch and this function may be used here: an inline function
 // of another header compiled with -mavx2 could be the copy the linker keeps for everyone.
 #pragma once

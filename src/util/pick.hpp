@@ -1,7 +1,8 @@
 // `c ? a : b` for doubles without a branch. g++ turns a ?: on two loaded doubles into a jump,
-// which mispredicts about every other time where c is a coin toss: who of two goes first,
-// whether a neighbour is ahead, whether a tree node's box is within reach. Those run once per
-// neighbour or node of every row, every tick (docs/benchmarks.md, 2026-12-02 evening).
+// which mispredicts about every other time where c is a coin toss: orca's velocity and share
+// of a neighbour by who of the two goes first, cfsm's clipping by whether a neighbour lies
+// towards the heading. Those run once per neighbour of every row, every tick
+// (docs/benchmarks.md, 2026-12-02 evening).
 #pragma once
 
 #include <bit>

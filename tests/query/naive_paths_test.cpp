@@ -212,14 +212,29 @@ TEST(NaivePaths, OutputDoesNotDependOnThreadCount) {
 // (which the rank count cannot place) fall back to std::sort.
 TEST(NearestK, UnboundedListsComeOutSortedByDistanceThenId) {
   Rng rng(42);
-  for (int round = 0; round < 400; ++round) {
-    const std::size_t m = 1 + rng.below(round % 4 == 0 ? 100 : 66);
-    const bool ties = round % 3 == 0, twins = round % 17 == 0;
+  // The sizes at the rank sort's edges first (one, two, odd, 63-65), then random ones.
+  const std::size_t edges[] = {1, 2, 3, 63, 64, 65, 1, 2, 3, 63, 64, 65};
+  for (int round = 0; round < 412; ++round) {
+    const std::size_t m = round < 12 ? edges[round] : 1 + rng.below(round % 4 == 0 ? 100 : 66);
+    const bool ties = round % 3 == 0 || (round >= 6 && round < 12), twins = round % 17 == 0;
+    // Zeros of both signs and infinite distances now and then (they tie as std::sort ties them).
+    const auto special = [&](double d2) {
+      switch (rng.below(16)) {
+        case 0:
+          return 0.0;
+        case 1:
+          return -0.0;
+        case 2:
+          return static_cast<double>(INFINITY);
+        default:
+          return d2;
+      }
+    };
     std::vector<std::tuple<double, uint64_t, uint32_t>> want;
     NearestK best;
     best.reset(0);
     for (std::size_t a = 0; a < m; ++a) {
-      const double d2 = ties ? static_cast<double>(rng.below(4)) : rng.uniform(0, 9);
+      const double d2 = special(ties ? static_cast<double>(rng.below(4)) : rng.uniform(0, 9));
       uint64_t id = rng.below(1u << 30);
       if (twins && a > 0 && a % 5 == 0) id = std::get<1>(want[a - 1]);
       const double key = twins && a > 0 && a % 5 == 0 ? std::get<0>(want[a - 1]) : d2;
