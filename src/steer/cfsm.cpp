@@ -26,7 +26,7 @@
 namespace crowddb::steer {
 namespace {
 
-constexpr uint32_t kBatch = 32;  // neighbours filtered at once for the corridor ahead
+constexpr uint32_t kCorridorBatch = 32;  // neighbours filtered at once for the corridor ahead
 
 // Do segments [a, b] and [c, d] intersect (touching counts)?
 bool segments_cross(double ax, double ay, double bx, double by, const Vec2& c, const Vec2& d) {
@@ -181,9 +181,9 @@ class CfsmModel final : public Model {
     // behind is a coin toss to the predictor), then their spacings in list order. (The tests as
     // ints: & on them is meant.)
     double spacing = INFINITY;
-    for (uint32_t a0 = lo; a0 < hi; a0 += kBatch) {
-      const uint32_t a1 = a0 + std::min(kBatch, hi - a0);
-      uint32_t ahead[kBatch];
+    for (uint32_t a0 = lo; a0 < hi; a0 += kCorridorBatch) {
+      const uint32_t a1 = a0 + std::min(kCorridorBatch, hi - a0);
+      uint32_t ahead[kCorridorBatch];
       uint32_t m = 0;
       for (uint32_t a = a0; a < a1; ++a) {
         const uint32_t j = nb_.row[a];
