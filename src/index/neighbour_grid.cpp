@@ -24,9 +24,6 @@ constexpr double kChordReach = 1.5;  // hinted bounds up to this many cells scan
 constexpr uint32_t kNoRow = ~0u;     // pads the hints (no table has 2^32 rows)
 // Four rows and their comparison masks (GCC's and clang's vector extensions; SSE2 on x86-64).
 typedef uint32_t V4u __attribute__((vector_size(16)));
-// Two distances and their comparison masks (SSE2).
-typedef double V2d __attribute__((vector_size(16)));
-typedef int64_t V2l __attribute__((vector_size(16)));
 constexpr std::size_t kCopyGrain = 4096;   // rows per chunk of the lists' compaction
 constexpr std::size_t kBuildGrain = 8192;  // rows per chunk of the grid's build
 
@@ -239,14 +236,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
           const double du = dist[u];
           uint32_t before = 0;
           if (!by_id) {
-            V2l nearer = {0, 0};  // -1 per lane for each one nearer
-            const V2d dv = {du, du};
-            for (uint32_t f = 0; f < m; f += 2) {
-              V2d v;
-              __builtin_memcpy(&v, dist + f, sizeof v);
-              nearer += v < dv;
-            }
-            before = static_cast<uint32_t>(-(nearer[0] + nearer[1]));
+            before = count_nearer(dist, m, du);
           } else {
             const uint64_t id = I[at[u]];
             for (uint32_t f = 0; f < m; ++f)

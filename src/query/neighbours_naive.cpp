@@ -92,8 +92,6 @@ void NearestK::sort_unbounded() {
 }
 
 bool NearestK::rank_sort() {
-  typedef double V2d __attribute__((vector_size(16)));
-  typedef int64_t V2l __attribute__((vector_size(16)));
   const std::size_t m = rows_.size();
   alignas(16) double dist[kRankSort];
   std::copy_n(d2_.data(), m, dist);
@@ -107,14 +105,7 @@ bool NearestK::rank_sort() {
       const double da = dist[a];
       std::size_t rank = 0;
       if (!by_id) {
-        V2l nearer = {0, 0};  // -1 per lane for each one nearer
-        const V2d dv = {da, da};
-        for (std::size_t b = 0; b < m; b += 2) {
-          V2d v;
-          __builtin_memcpy(&v, dist + b, sizeof v);
-          nearer += v < dv;
-        }
-        rank = static_cast<std::size_t>(-(nearer[0] + nearer[1]));
+        rank = count_nearer(dist, static_cast<uint32_t>(m), da);
       } else {  // equal distances share a rank above: the ids settle them
         const uint64_t ia = ids_[a];
         for (std::size_t b = 0; b < m; ++b)
