@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "index/row_buckets.hpp"
 #include "query/naive_paths.hpp"
@@ -17,8 +18,8 @@ constexpr uint32_t kBatch = 32;  // candidates filtered at once before any is of
 // ms per tick, min of 5 interleaved runs): 2 -> 9.5, 4 -> 9.0, 6 -> 8.8, 8 -> 8.6 (2 without
 // the hints: 11.3). With the hints most queries scan chords, and fewer, longer runs of cells
 // beat fewer candidates: the filter is branch-free, each run is not. 6 rather than 8: the two
-// are within the host's noise, and the larger cells also serve the queries that never have
-// hints (a subset of rows: the stalemate stage's, idle groups'; the first tick), unmeasured.
+// are within the host's noise, and the larger cells also serve the queries without hints (the
+// first tick, rows new to a query, a k above NearestK::kInline), unmeasured.
 constexpr double kBlockFill = 6;
 constexpr double kChordReach = 1.5;  // hinted bounds up to this many cells scan chords
 constexpr uint32_t kNoRow = ~0u;     // pads the hints (no table has 2^32 rows)
@@ -163,19 +164,29 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
   // row-major, jumped through them: the stage 376 -> 369 ms per 100 ticks at 2 * 10^4 agents,
   // one thread, A B B A). Otherwise: query order, lists gathered per chunk.
   const bool spatial = queries.empty() && k > 0;
-  // Last call's lists seed this call's (see the header): only when they were made the same way.
-  const bool hintable = spatial && k <= NearestK::kInline;
+  // Last call's lists seed this call's (see the header): only when they were made with the same
+  // k. A call for a subset of rows (the stalemate stage's: mostly the same rows tick after tick)
+  // keeps its rows' lists in the slots too; the other rows' slots keep older lists, which are
+  // still distinct rows.
+  // The subset must name each row once (ascending, as the callers give it): two queries of one
+  // row would write its slot while reading it.
+  const bool hintable = k > 0 && k <= NearestK::kInline &&
+                        std::adjacent_find(queries.begin(), queries.end(),
+                                           std::greater_equal<uint32_t>()) == queries.end();
   const bool hints = hintable && k == hint_k_;
-  if (spatial) {
+  // Each row's list in its slot of k: every row's (spatial, compacted into the output after), or
+  // the asked rows' kept as hints.
+  const bool slots = spatial || hintable;
+  if (slots) {
     if (!hints) slot_count_.assign(d.n, 0);
     slot_count_.resize(d.n, 0);  // rows new since the last call have no hints
     slot_row_.resize(d.n * k);
-    // The distances go straight into the output's slots (a second array of n k doubles was the
-    // largest item of memory at 10^6 agents), compacted in place afterwards.
-    if (out.with_dist2) out.dist2.resize(d.n * k);
   }
+  // The distances go straight into the output's slots (a second array of n k doubles was the
+  // largest item of memory at 10^6 agents), compacted in place afterwards.
+  if (spatial && out.with_dist2) out.dist2.resize(d.n * k);
   hint_k_ = hintable ? k : 0;
-  if (spatial) {  // each row's place in the grid (the ranked search skips the query's own)
+  if (hintable) {  // each row's place in the grid (the ranked search skips the query's own)
     at_.resize(d.n);
     uint32_t* const at = at_.data();
     ex.for_each_chunk(d.n, kCopyGrain, [&](std::size_t b, std::size_t e) {
@@ -253,8 +264,14 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
       };
       if (!place(false) && !place(true)) return false;
       std::copy_n(place_row, k, slot_row_.data() + self * k);
-      if (out.with_dist2) std::copy_n(place_d2, k, out.dist2.data() + self * k);
       slot_count_[self] = k;
+      if (spatial) {
+        if (out.with_dist2) std::copy_n(place_d2, k, out.dist2.data() + self * k);
+      } else {
+        mine.counts.push_back(k);
+        mine.items.insert(mine.items.end(), place_row, place_row + k);
+        if (out.with_dist2) mine.d2.insert(mine.d2.end(), place_d2, place_d2 + k);
+      }
       return true;
     };
     for (std::size_t qi = b; qi < e; ++qi) {
@@ -426,10 +443,12 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         }
       }
       best.finish();
-      if (spatial) {
+      if (slots) {
         slot_count_[i] = static_cast<uint32_t>(best.size());
         std::copy(best.rows().begin(), best.rows().end(),
                   slot_row_.begin() + static_cast<std::ptrdiff_t>(i * k));
+      }
+      if (spatial) {
         if (out.with_dist2)
           std::copy(best.dist2().begin(), best.dist2().end(),
                     out.dist2.begin() + static_cast<std::ptrdiff_t>(i * k));

@@ -1,13 +1,14 @@
 // The indexed neighbour query: a uniform grid over disc centres, rebuilt each tick (counting
 // sort, O(n)), with a ring-by-ring k-nearest search seeded by the lists of the call before.
 //
-// Hints (k nearest of every row, the steering models' query, asked once per tick): each row's
-// list of the last such call is kept and offered first, in its old order. Between two ticks a
-// list hardly changes, so the hints arrive nearly sorted (cheap insertions) and fill the list
-// with a tight bound on the k-th distance at once. Any rows would do as hints: the answer is the
-// best k of all candidates in whatever order they come, so stale hints (rows reordered, removed,
-// or another table) cost time, never exactness, as long as they are distinct rows (a list is;
-// rows_permuted refuses anything but a permutation); the scans skip the hinted rows, so no
+// Hints (k nearest, asked once per tick: the steering models' query of every row, the stalemate
+// stage's of the rows it looks at): each row's list of the last call with the same k is kept and
+// offered first, in its old order (a row left out of a call keeps its older list). Between two
+// ticks a list hardly changes, so the hints arrive nearly sorted (cheap insertions) and fill the
+// list with a tight bound on the k-th distance at once. Any rows would do as hints: the answer is
+// the best k of all candidates in whatever order they come, so stale hints (rows reordered,
+// removed, or another table) cost time, never exactness, as long as they are distinct rows (a list
+// is; rows_permuted refuses anything but a permutation); the scans skip the hinted rows, so no
 // candidate is offered twice (test: NeighbourGrid.ListsOfTheCallBeforeChangeNothing).
 //
 // Search: when the hints are k rows within range and the farthest of them within 1.5 cells (the

@@ -473,6 +473,7 @@ const TickMetrics& Simulation::step() {
       const std::vector<uint32_t> order = sim::curve_order(world_.agents(), ex);
       world_.permute_rows(order, ex);
       e.model->rows_permuted(order, ex);
+      if (e.stall_path) e.stall_path->rows_permuted(order, ex);
     });
   e.refresh_scene(world_, cfg);
   const TickPlan plan = e.plan(world_, cfg);
