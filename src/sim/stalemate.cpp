@@ -16,6 +16,7 @@ constexpr double kFreeWalk = 0.5;  // walking at half the preferred speed toward
 constexpr double kOpposed = -0.5;  // cos 120 degrees: directions further apart head at each other
 constexpr std::size_t kWatchGrain = 256;  // rows per chunk of the progress watch
 constexpr std::size_t kLookGrain = 64;    // looked-at rows per chunk of blockers and actions
+constexpr std::size_t kPlaceTable = 16;   // a table of places from 1 looked-at row in 16 on
 
 uint64_t priority(uint64_t seed, uint64_t id) {
   uint64_t s = seed ^ (id * 0x9e3779b97f4a7c15ull);
@@ -204,8 +205,17 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   std::vector<Vec2> dir(looked_at.size());
   std::vector<uint8_t> same_way(looked_at.size(), 0), queueing(looked_at.size(), 0);
   std::vector<int64_t> bpos(looked_at.size(), -1);  // the blocker's place in looked_at, or -1
-  // Where a row is in looked_at (sorted), -1 if not looked at: a search, not a table of every row.
+  // Where a row is in looked_at (sorted), -1 if not looked at: a table of every row when many
+  // are looked at (a dense jam: the searches were a tenth of the stage), else a search (a few
+  // among 10^6 rows need no table of 10^6 entries).
+  std::vector<int32_t> place;
+  if (looked_at.size() >= t.size() / kPlaceTable) {
+    place.assign(t.size(), -1);
+    for (std::size_t q = 0; q < looked_at.size(); ++q)
+      place[looked_at[q]] = static_cast<int32_t>(q);
+  }
   auto pos = [&](std::size_t j) -> int64_t {
+    if (!place.empty()) return place[j];
     const auto it = std::lower_bound(looked_at.begin(), looked_at.end(), j);
     return it != looked_at.end() && *it == j ? it - looked_at.begin() : -1;
   };
