@@ -23,6 +23,8 @@ struct OperatorStats {
   // the most in one loop.
   std::string events_name;
   uint64_t events = 0, events_max = 0;
+  // The operator this one ran beside, on the same threads (Executor::both): their times overlap.
+  std::string beside;
   void count(const char* name, uint64_t k) {
     events_name = name;
     events += k;
@@ -43,11 +45,23 @@ class OpLog {
   void timed(const std::string& name, std::size_t rows, F&& body) {
     Stopwatch sw;
     body();
+    book(name, rows, sw.seconds());
+  }
+  // Books one loop over `rows` rows that took `seconds` under `name` (timed by the caller: work
+  // run beside other work, Executor::both).
+  OperatorStats& book(const std::string& name, std::size_t rows, double seconds) {
     OperatorStats& s = at(name);
     s.loops += 1;
     s.rows += rows;
-    s.seconds += sw.seconds();
+    s.seconds += seconds;
+    return s;
   }
+  // Operators run side by side took `seconds` of wall time together (their own times are booked
+  // as usual): the report's total counts the overlap once.
+  void side_by_side(double booked_seconds, double wall_seconds) {
+    overlap_ += std::max(0.0, booked_seconds - wall_seconds);
+  }
+  double overlap_seconds() const { return overlap_; }
   // Counts a tick on which an access path was used ("neighbours=grid").
   void used(const std::string& method) { ++methods_[method]; }
 
@@ -57,6 +71,7 @@ class OpLog {
  private:
   std::vector<std::pair<std::string, OperatorStats>> ops_;
   std::map<std::string, uint64_t> methods_;
+  double overlap_ = 0;
 };
 
 }  // namespace crowddb::sim

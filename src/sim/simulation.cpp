@@ -783,7 +783,7 @@ std::string Simulation::explain_analyze() const {
   std::snprintf(line, sizeof line, "  %-22s %8s %12s %12s %12s\n", "operator", "loops", "rows",
                 "total ms", "ms/loop");
   os << line;
-  double total = 0;
+  double total = -e.log.overlap_seconds();
   for (const auto& [name, s] : e.log.entries()) total += s.seconds;
   for (const auto& [name, s] : e.log.entries()) {
     if (!s.loops) continue;
@@ -791,6 +791,11 @@ std::string Simulation::explain_analyze() const {
                   static_cast<unsigned long long>(s.loops), static_cast<unsigned long long>(s.rows),
                   s.seconds * 1e3, s.seconds * 1e3 / static_cast<double>(s.loops));
     os << line;
+    if (!s.beside.empty()) {
+      std::snprintf(line, sizeof line, "  %-22s beside %s, on the same threads (times overlap)\n",
+                    "", s.beside.c_str());
+      os << line;
+    }
     const QueryStats& q = s.query;
     if (q.pair_tests || q.nodes_visited || q.queue_pops) {
       std::snprintf(line, sizeof line,
@@ -816,6 +821,12 @@ std::string Simulation::explain_analyze() const {
   }
   std::snprintf(line, sizeof line, "  %-22s %8s %12s %12.3f\n", "total", "", "", total * 1e3);
   os << line;
+  if (e.log.overlap_seconds() > 0) {
+    std::snprintf(line, sizeof line,
+                  "  (operators side by side overlapped by %.3f ms: counted once in the total)\n",
+                  e.log.overlap_seconds() * 1e3);
+    os << line;
+  }
   if (e.nav) {
     const path::NavigationStats ns = e.nav->stats();
     const path::PathService::Stats ss = e.nav->service_stats();

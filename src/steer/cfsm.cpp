@@ -22,6 +22,7 @@
 
 #include "plan/access_path.hpp"
 #include "steer/model.hpp"
+#include "util/stopwatch.hpp"
 
 namespace crowddb::steer {
 namespace {
@@ -55,28 +56,44 @@ class CfsmModel final : public Model {
     const DiscView view = DiscView::of(t);
     const NeighbourMethod& nm = neighbour_method(in.cfg.access.neighbours, n);
     log.used("neighbours=" + nm.info.name);
-    sim::OperatorStats& nop = log.at("CFSM neighbours");
-    log.timed("CFSM neighbours", n, [&] {
-      auto& path = neighbour_paths_[nm.info.name];
-      if (!path) path = nm.make();
-      nb_.with_dist2 = false;  // recomputed where needed (dist2_of)
-      path->run(view, {}, p.cutoff, 0, nb_, ex, nop.query);
-    });
+    auto& neighbours = neighbour_paths_[nm.info.name];
+    if (!neighbours) neighbours = nm.make();
     const bool obstacles = in.scene.feature_count() > 0;
+    const FeatureMethod* fm =
+        obstacles ? &feature_method(in.cfg.access.edges, in.scene.feature_count()) : nullptr;
+    if (fm) log.used("edges=" + fm->info.name);
+    // The two queries do not read each other's answers: side by side on the same threads
+    // (Executor::both), so that neither's one-thread parts leave the other thread idle. Each is
+    // timed on its own (EXPLAIN ANALYZE); their times overlap.
+    sim::OperatorStats neighbour_op, obstacle_op;
+    Stopwatch side_by_side;
+    ex.both(
+        [&] {
+          Stopwatch sw;
+          nb_.with_dist2 = false;  // recomputed where needed (dist2_of)
+          neighbours->run(view, {}, p.cutoff, 0, nb_, ex, neighbour_op.query);
+          neighbour_op.seconds = sw.seconds();
+        },
+        [&] {
+          Stopwatch sw;
+          if (obstacles) {
+            reach_.assign(n, p.cutoff);
+            auto& path = feature_paths_[fm->info.name];
+            if (!path) path = fm->make();
+            path->run(view, reach_, in.scene, features_, ex, obstacle_op.query);
+          } else {
+            features_.offset.assign(n + 1, 0);
+            features_.feature.clear();
+            features_.dist2.clear();
+          }
+          obstacle_op.seconds = sw.seconds();
+        });
+    log.side_by_side(neighbour_op.seconds + obstacle_op.seconds, side_by_side.seconds());
+    log.book("CFSM neighbours", n, neighbour_op.seconds).query += neighbour_op.query;
     if (obstacles) {
-      const FeatureMethod& fm = feature_method(in.cfg.access.edges, in.scene.feature_count());
-      log.used("edges=" + fm.info.name);
-      sim::OperatorStats& fop = log.at("CFSM obstacles");
-      log.timed("CFSM obstacles", n, [&] {
-        reach_.assign(n, p.cutoff);
-        auto& path = feature_paths_[fm.info.name];
-        if (!path) path = fm.make();
-        path->run(view, reach_, in.scene, features_, ex, fop.query);
-      });
-    } else {
-      features_.offset.assign(n + 1, 0);
-      features_.feature.clear();
-      features_.dist2.clear();
+      sim::OperatorStats& op = log.book("CFSM obstacles", n, obstacle_op.seconds);
+      op.query += obstacle_op.query;
+      op.beside = "CFSM neighbours";
     }
     log.timed("CFSM rule", n, [&] {
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {

@@ -2,6 +2,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -41,6 +42,15 @@ void Executor::for_each_chunk(std::size_t n, std::size_t grain,
         },
         tbb::simple_partitioner());
   });
+}
+
+void Executor::both(const std::function<void()>& f, const std::function<void()>& g) {
+  if (!arena_) {
+    g();
+    f();
+    return;
+  }
+  arena_->arena.execute([&] { tbb::parallel_invoke(f, g); });
 }
 
 }  // namespace crowddb

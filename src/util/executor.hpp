@@ -28,9 +28,17 @@ class Executor {
   // Calls body(begin, end) for the chunks [k*grain, min(n, (k+1)*grain)) covering [0, n), in any
   // order and on any thread; the boundaries are fixed, so per-chunk buffers may be indexed by
   // begin / grain.
-  // Not re-entrant: one call at a time per Executor. An exception thrown by a body is rethrown.
+  // A body may itself call for_each_chunk (nested loops share the threads); so may the two
+  // tasks of both(). An exception thrown by a body is rethrown.
   void for_each_chunk(std::size_t n, std::size_t grain,
                       const std::function<void(std::size_t, std::size_t)>& body);
+
+  // Runs f and g, which must not depend on each other, at once: each may run its own loops
+  // (for_each_chunk), and a thread done with one helps with the other's. For a step that one
+  // thread does alone (an index's placement pass) beside a parallel stage it need not wait for:
+  // the second thread does not idle through it. With one thread, g then f. An exception thrown
+  // by either is rethrown once both are done.
+  void both(const std::function<void()>& f, const std::function<void()>& g);
 
  private:
   struct Arena;

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <sstream>
 
 #include "crowddb/scenario.hpp"
 #include "sim/stages.hpp"
@@ -285,6 +287,44 @@ TEST(Simulation, ExplainNamesEveryOperatorAndAccessPath) {
   const std::string analyze = sim.explain_analyze();
   EXPECT_NE(analyze.find("EXPLAIN ANALYZE  3 ticks"), std::string::npos) << analyze;
   EXPECT_NE(analyze.find("pair tests"), std::string::npos) << analyze;
+}
+
+// ORCA's and CFSM's obstacle queries (and ORCA's look ahead for people passing) run beside the
+// neighbour query on the same threads: EXPLAIN ANALYZE says so, and its total counts the
+// overlap once: it is the operators' times less the overlap it reports.
+TEST(Simulation, ExplainAnalyzeCountsOperatorsSideBySideOnce) {
+  for (const char* model : {"orca", "cfsm"}) {
+    std::string text = small_airport(1, 2);
+    const std::string thesis = R"("model": "thesis")";
+    text.replace(text.find(thesis), thesis.size(), std::string(R"("model": ")") + model + "\"");
+    Scenario sc = parse_scenario(text, "t.json");
+    Simulation sim(std::move(sc.world), sc.config);
+    for (int t = 0; t < 5; ++t) sim.step();
+    const std::string a = sim.explain_analyze();
+    SCOPED_TRACE(a);
+    const std::string neighbours = model == std::string("orca") ? "ORCA" : "CFSM";
+    EXPECT_NE(a.find("beside " + neighbours + " neighbours, on the same threads"),
+              std::string::npos);
+    // Sum the operators' "total ms" column and compare with the total line.
+    double sum = 0, total = -1, overlap = 0;
+    std::istringstream in(a);
+    for (std::string line; std::getline(in, line);) {
+      unsigned long long loops = 0, rows = 0;
+      double ms = 0, per = 0;
+      char name[64];
+      if (std::sscanf(line.c_str(), "  total %lf", &total) == 1) continue;
+      if (std::sscanf(line.c_str(), "  (operators side by side overlapped by %lf", &overlap) == 1)
+        continue;
+      // "  name words  loops rows total ms/loop": the four numbers at the end.
+      const auto at = line.find_last_not_of(" 0123456789.");
+      if (at == std::string::npos || line.rfind("  ", 0) != 0) continue;
+      if (std::sscanf(line.c_str() + at + 1, "%llu %llu %lf %lf", &loops, &rows, &ms, &per) == 4 &&
+          std::sscanf(line.c_str(), "  %63s", name) == 1)
+        sum += ms;
+    }
+    ASSERT_GT(total, 0);
+    EXPECT_NEAR(total, sum - overlap, 0.01 + 1e-6 * sum);
+  }
 }
 
 TEST(Simulation, UnknownAccessPathIsRejectedBeforeTheRun) {

@@ -7,6 +7,7 @@
 #include <set>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
 namespace crowddb {
 namespace {
@@ -45,6 +46,66 @@ TEST(Executor, ABodyExceptionReachesTheCaller) {
                                  }),
                std::runtime_error);
   EXPECT_THROW(Executor(0), std::invalid_argument);
+}
+
+// both(): each task once, the loops each runs whole (nested, on the shared threads), and on one
+// thread g before f.
+TEST(Executor, BothRunsEachTaskOnceWithItsOwnLoops) {
+  for (int threads : {1, 2, 4}) {
+    Executor ex(threads);
+    for (int round = 0; round < 20; ++round) {
+      std::vector<int> a(5000, 0), b(3001, 0);
+      std::atomic<int> f_runs{0}, g_runs{0};
+      std::vector<char> order;
+      std::mutex m;
+      ex.both(
+          [&] {
+            ++f_runs;
+            {
+              std::lock_guard lock(m);
+              order.push_back('f');
+            }
+            ex.for_each_chunk(a.size(), 64, [&](std::size_t lo, std::size_t hi) {
+              for (std::size_t i = lo; i < hi; ++i) a[i] += static_cast<int>(i);
+            });
+          },
+          [&] {
+            ++g_runs;
+            {
+              std::lock_guard lock(m);
+              order.push_back('g');
+            }
+            ex.for_each_chunk(b.size(), 7, [&](std::size_t lo, std::size_t hi) {
+              for (std::size_t i = lo; i < hi; ++i) b[i] += 2 * static_cast<int>(i);
+            });
+          });
+      EXPECT_EQ(f_runs.load(), 1);
+      EXPECT_EQ(g_runs.load(), 1);
+      for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], static_cast<int>(i));
+      for (std::size_t i = 0; i < b.size(); ++i) ASSERT_EQ(b[i], 2 * static_cast<int>(i));
+      if (threads == 1) {
+        EXPECT_EQ(order, (std::vector<char>{'g', 'f'}));
+      }
+    }
+  }
+}
+
+TEST(Executor, BothRethrowsEitherTasksException) {
+  for (int threads : {1, 2}) {
+    Executor ex(threads);
+    const auto throws = [] { throw std::runtime_error("f"); };
+    const auto loop_throws = [&] {
+      ex.for_each_chunk(100, 10, [](std::size_t b, std::size_t) {
+        if (b == 50) throw std::logic_error("g");
+      });
+    };
+    EXPECT_THROW(ex.both(throws, [] {}), std::runtime_error);
+    EXPECT_THROW(ex.both([] {}, loop_throws), std::logic_error);
+    // Still usable afterwards.
+    int ran = 0;
+    ex.both([&] { ++ran; }, [&] { ++ran; });
+    EXPECT_EQ(ran, 2);
+  }
 }
 
 }  // namespace
