@@ -186,7 +186,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
   // largest item of memory at 10^6 agents), compacted in place afterwards.
   if (spatial && out.with_dist2) out.dist2.resize(d.n * k);
   hint_k_ = hintable ? k : 0;
-  if (hintable) {  // each row's place in the grid (the ranked search skips the query's own)
+  if (spatial) {  // each row's place in the grid (the ranked search skips the query's own)
     at_.resize(d.n);
     uint32_t* const at = at_.data();
     ex.for_each_chunk(d.n, kCopyGrain, [&](std::size_t b, std::size_t e) {
@@ -233,6 +233,13 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
           m += static_cast<uint32_t>((d2 <= bound) & (a != self_at));
         }
       }
+      if (self_at == kNoRow)  // (a subset's query: its place was not looked up) drop its own
+        for (uint32_t u = 0; u < m; ++u)
+          if (R[at[u]] == self) {
+            at[u] = at[--m];
+            dist[u] = dist[m];
+            break;
+          }
       if (m < k) return false;
       if (m % 2) dist[m] = INFINITY;  // whole vectors; never nearer
       // Ranks by distance alone, each written to its place (past k: a spare slot); equal
@@ -286,9 +293,11 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
       uint32_t hint[NearestK::kInline + 3];  // padded to whole vectors of 4 with kNoRow
       uint32_t nh = 0;
       const double slack = slack_ + 1e-9 * (std::abs(px) + std::abs(py));
-      if (hints) {
+      // (A list of fewer than k last time: too few within range to bound anything, and the
+      // scans then look at every cell within range anyway. So no hints, and nothing to skip.)
+      if (hints && slot_count_[i] == k) {
         const uint32_t* const last = slot_row_.data() + i * k;
-        const uint32_t count = slot_count_[i];
+        const uint32_t count = k;
         double hint_d2[NearestK::kInline];
         double hint_bound = 0;
         for (uint32_t u = 0; u < count; ++u) {
@@ -306,7 +315,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         // disc within that bound (the hints among them) is gathered from the bound's chords
         // and ranked at once (below); otherwise the hints are offered to the selection first.
         if (nh == k && hint_bound < kChordReach * kChordReach * cell_ * cell_ &&
-            ranked(i, At[i], px, py, hint_bound, slack, tests_c)) {
+            ranked(i, spatial ? At[i] : kNoRow, px, py, hint_bound, slack, tests_c)) {
           ++rings_c;
           continue;
         }

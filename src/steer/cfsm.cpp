@@ -93,7 +93,7 @@ class CfsmModel final : public Model {
     if (obstacles) {
       sim::OperatorStats& op = log.book("CFSM obstacles", n, obstacle_op.seconds);
       op.query += obstacle_op.query;
-      op.beside = "CFSM neighbours";
+      if (ex.threads() > 1) op.beside = "CFSM neighbours";
     }
     log.timed("CFSM rule", n, [&] {
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {

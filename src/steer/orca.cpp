@@ -241,7 +241,7 @@ class OrcaModel final : public Model {
     if (obstacles) {
       sim::OperatorStats& op = log.book("ORCA obstacles", n, obstacle_op.seconds);
       op.query += obstacle_op.query;
-      op.beside = "ORCA neighbours";
+      if (ex.threads() > 1) op.beside = "ORCA neighbours";
     }
     if (p.stream_gap > 0) {
       sim::OperatorStats& sop = log.at("ORCA stream meetings");
@@ -257,7 +257,7 @@ class OrcaModel final : public Model {
       }
       sim::OperatorStats& sop = log.book("ORCA keeping to a side", n, passing_op.seconds);
       sop.query += passing_op.query;
-      if (passing_beside) sop.beside = "ORCA neighbours";
+      if (passing_beside && ex.threads() > 1) sop.beside = "ORCA neighbours";
       if (!(p.pass_look >= p.neighbor_dist))
         sop.count("someone passing among the neighbours", passing_near_);
       if (p.pass_look > 0) sop.count("someone passing within pass_look", passing_far_);
