@@ -8,7 +8,6 @@ namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr std::size_t kParallelEntries = 4096;  // below, one pass: the merge would not pay
-constexpr std::size_t kObstacleGrain = 2048;    // rows per chunk of the obstacle half
 
 }  // namespace
 
@@ -82,24 +81,8 @@ void CollisionNn::run(const DiscView& d, const StaticScene& scene, CollisionPair
     if (best_row[k] != kNone) out.agents.push_back(ordered(cells_.row(k), best_row[k]));
   finish_pairs(out.agents);
   if (!scene.empty()) {
-    // Rows in chunks on every thread, each chunk's overlaps appended in row order.
     obstacles_.build(scene, frame);
-    const std::size_t chunks = (d.n + kObstacleGrain - 1) / kObstacleGrain;
-    std::vector<std::vector<std::pair<uint32_t, Collider>>> found(chunks);
-    std::vector<uint64_t> found_tests(chunks, 0);
-    ex.for_each_chunk(d.n, kObstacleGrain, [&](std::size_t b, std::size_t e) {
-      // Into the chunk's own list and count, then moved in (the per-chunk entries and vector
-      // headers share cache lines between the threads).
-      std::vector<std::pair<uint32_t, Collider>> mine;
-      uint64_t tests_c = 0;
-      obstacles_.overlaps(d, b, e, mine, tests_c);
-      found[b / kObstacleGrain] = std::move(mine);
-      found_tests[b / kObstacleGrain] = tests_c;
-    });
-    for (std::size_t c = 0; c < chunks; ++c) {
-      out.obstacles.insert(out.obstacles.end(), found[c].begin(), found[c].end());
-      tests += found_tests[c];
-    }
+    obstacles_.overlaps(d, out.obstacles, tests, ex);
   }
   stats.pair_tests += tests;
   stats.rows += d.n;

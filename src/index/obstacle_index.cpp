@@ -111,6 +111,27 @@ void ObstacleIndex::overlaps(const DiscView& d, std::size_t begin, std::size_t e
   }
 }
 
+void ObstacleIndex::overlaps(const DiscView& d, std::vector<std::pair<uint32_t, Collider>>& out,
+                             uint64_t& tests, Executor& ex) const {
+  constexpr std::size_t kGrain = 2048;  // rows per chunk
+  const std::size_t chunks = (d.n + kGrain - 1) / kGrain;
+  std::vector<std::vector<std::pair<uint32_t, Collider>>> found(chunks);
+  std::vector<uint64_t> found_tests(chunks, 0);
+  ex.for_each_chunk(d.n, kGrain, [&](std::size_t b, std::size_t e) {
+    // Into the chunk's own list and count, then moved in (the per-chunk entries and vector
+    // headers share cache lines between the threads).
+    std::vector<std::pair<uint32_t, Collider>> mine;
+    uint64_t tests_c = 0;
+    overlaps(d, b, e, mine, tests_c);
+    found[b / kGrain] = std::move(mine);
+    found_tests[b / kGrain] = tests_c;
+  });
+  for (std::size_t c = 0; c < chunks; ++c) {
+    out.insert(out.end(), found[c].begin(), found[c].end());
+    tests += found_tests[c];
+  }
+}
+
 void obstacle_overlaps(const DiscView& d, const StaticScene& scene, const Frame& frame,
                        std::vector<std::pair<uint32_t, Collider>>& out, QueryStats& stats) {
   if (scene.empty() || d.n == 0) return;

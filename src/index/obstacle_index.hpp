@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "index/collision_common.hpp"
+#include "util/executor.hpp"
 
 namespace crowddb::index {
 
@@ -24,6 +25,10 @@ class ObstacleIndex {
   // Appends (row, obstacle) for rows [begin, end), in the order disc_obstacle_overlaps uses.
   void overlaps(const DiscView& d, std::size_t begin, std::size_t end,
                 std::vector<std::pair<uint32_t, Collider>>& out, uint64_t& tests) const;
+  // The same for every row, in chunks on `ex`'s threads, appended in row order (the same output
+  // on any thread count).
+  void overlaps(const DiscView& d, std::vector<std::pair<uint32_t, Collider>>& out, uint64_t& tests,
+                Executor& ex) const;
 
  private:
   const StaticScene* scene_ = nullptr;

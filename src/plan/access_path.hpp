@@ -61,6 +61,18 @@ class NeighbourPath {
   virtual void rows_permuted(std::span<const uint32_t> /*order*/, Executor* /*ex*/ = nullptr) {}
 };
 
+// Lists a NeighbourPath returned, with what it was asked: for every row of the table it ran over,
+// the `k` nearest other rows (all when k = 0) whose centres lie strictly closer than `range`,
+// nearest first. So a row's list holds every row strictly closer than its bound: `range` when
+// the list is shorter than k (or k = 0), else the distance of its k-th. A steering model offers
+// its tick's lists (steer::Model::near_lists) to the backoff, which can rule overlaps out from
+// them without a collision query (sim/backoff.cpp).
+struct NearLists {
+  const NeighbourLists* lists = nullptr;  // null: none this tick
+  double range = 0;
+  uint32_t k = 0;
+};
+
 class FeaturePath {
  public:
   virtual ~FeaturePath() = default;

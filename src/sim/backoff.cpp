@@ -1,11 +1,14 @@
 // The backoff stage: classification of overlaps, the incremental freeze loop, and the plain loop
 // it is tested against. See stages.hpp for the contract.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "index/collisions_grid.hpp"
+#include "index/obstacle_index.hpp"
 #include "query/naive_paths.hpp"
 #include "sim/stages.hpp"
+#include "util/stopwatch.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb::sim {
@@ -150,14 +153,117 @@ OverlapReport backoff_reference(const AgentTable& t, NextState& next, const Stat
   }
 }
 
+// Rows whose lists fall short, at most (their pairs among each other are tested one by one).
+constexpr std::size_t kShortMost = 256;
+
+bool lists_rule_out_overlaps(const AgentTable& t, const NextState& next, const NearLists& near,
+                             Executor& ex) {
+  const std::size_t n = t.size();
+  if (!near.lists || near.lists->queries() != n || n == 0) return false;
+  // Raw columns: through the captured vectors every load re-read their data pointers.
+  const double *x = t.x.data(), *y = t.y.data(), *r = t.radius.data();
+  const double *nx = next.x.data(), *ny = next.y.data();
+  const uint32_t *offset = near.lists->offset.data(), *row = near.lists->row.data();
+  // The largest move and radius, per chunk, then folded (a maximum: the same in any order).
+  // Every row is given the largest move as its own (D_i <= D_max): no square root per row, and
+  // a bound hardly looser where everyone walks.
+  constexpr std::size_t kGrain = 4096;
+  const std::size_t chunks = (n + kGrain - 1) / kGrain;
+  std::vector<double> part_move2(chunks, 0), part_radius(chunks, 0);
+  std::vector<uint8_t> shown(chunks, 1);
+  ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
+    double m2 = 0, rm = 0;
+    bool finite = true;
+    for (std::size_t i = b; i < e; ++i) {
+      const double dx = nx[i] - x[i], dy = ny[i] - y[i], d2 = dx * dx + dy * dy;
+      finite &= std::isfinite(d2) & std::isfinite(r[i]);
+      m2 = std::max(m2, d2);
+      rm = std::max(rm, r[i]);
+    }
+    part_move2[b / kGrain] = m2;
+    part_radius[b / kGrain] = rm;
+    shown[b / kGrain] = finite;
+  });
+  double move2_max = 0, radius_max = 0;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    if (!shown[c]) return false;  // a position or radius that is not finite
+    move2_max = std::max(move2_max, part_move2[c]);
+    radius_max = std::max(radius_max, part_radius[c]);
+  }
+  // Distances come from differences of doubles, each within a few ulps of the true one: a
+  // relative 1e-9 on the bound keeps it conservative.
+  const double skin = radius_max + 2 * std::sqrt(move2_max);
+  const double range2 = near.range * near.range;
+  const uint32_t k = near.k;
+  // Once a chunk fails the answer is no, whichever: the chunks not yet begun are skipped.
+  std::atomic<bool> failed{false};
+  std::vector<std::vector<uint32_t>> part_short(chunks);
+  ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
+    bool ok = !failed.load(std::memory_order_relaxed);
+    std::vector<uint32_t>& short_rows = part_short[b / kGrain];
+    for (std::size_t i = b; i < e && ok; ++i) {
+      const double need = (r[i] + skin) * (1 + 1e-9);
+      const double need2 = need * need;
+      const uint32_t lo = offset[i], hi = offset[i + 1];
+      const double xi = x[i], yi = y[i];
+      auto dist2 = [&](uint32_t j) {  // as the lists rank them (steer::dist2_of)
+        const double dx = x[j] - xi, dy = y[j] - yi;
+        return dx * dx + dy * dy;
+      };
+      // Everyone strictly closer than the list's bound is in it (NearLists).
+      const double bound2 = k > 0 && hi - lo >= k ? dist2(row[hi - 1]) : range2;
+      if (!(bound2 >= need2)) {
+        short_rows.push_back(static_cast<uint32_t>(i));
+        ok = short_rows.size() <= kShortMost;
+        continue;
+      }
+      // Nearest first: the pairs near enough to overlap come first. Tested from both sides: a
+      // row whose list falls short has its pairs tested from the other side only.
+      for (uint32_t a = lo; a < hi && ok; ++a) {
+        const uint32_t j = row[a];
+        if (!(dist2(j) < need2)) break;
+        ok = !discs_overlap(nx[j] - nx[i], ny[j] - ny[i], r[i] + r[j]);
+      }
+    }
+    if (!ok) failed.store(true, std::memory_order_relaxed);
+  });
+  if (failed.load()) return false;
+  // A pair of two short-listed rows may be in neither list: every such pair is tested.
+  std::vector<uint32_t> short_rows;
+  for (const auto& part : part_short) short_rows.insert(short_rows.end(), part.begin(), part.end());
+  if (short_rows.size() > kShortMost) return false;
+  for (std::size_t a = 0; a < short_rows.size(); ++a)
+    for (std::size_t b = a + 1; b < short_rows.size(); ++b) {
+      const uint32_t i = short_rows[a], j = short_rows[b];
+      if (discs_overlap(nx[j] - nx[i], ny[j] - ny[i], r[i] + r[j])) return false;
+    }
+  return true;
+}
+
 OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& scene,
-                      CollisionPath& path, Executor& ex, QueryStats& stats,
-                      std::size_t& iterations) {
+                      CollisionPath& path, Executor& ex, QueryStats& stats, std::size_t& iterations,
+                      const NearLists& near) {
   const DiscView view = next_view(t, next);
   CollisionPairs first;
-  path.run(view, scene, first, ex, stats);
+  const bool by_lists = lists_rule_out_overlaps(t, next, near, ex);
+  if (by_lists) {
+    // No agent pair: only the obstacle half of the query is left.
+    if (!scene.empty()) {
+      Stopwatch sw;
+      index::ObstacleIndex obstacles;
+      obstacles.build(scene, index::Frame::of(view));
+      stats.build_seconds += sw.seconds();
+      sw.restart();
+      obstacles.overlaps(view, first.obstacles, stats.pair_tests, ex);
+      stats.query_seconds += sw.seconds();
+    }
+    stats.rows += view.n;
+  } else {
+    path.run(view, scene, first, ex, stats);
+  }
   iterations = 1;
   OverlapReport report = classify(t, next, scene, first);
+  report.agents_by_lists = by_lists;
   if (report.violators.empty()) return report;
 
   // stamp[i]: the iteration that froze i (0: never). Agents already frozen on entry keep 0 and
@@ -206,6 +312,7 @@ OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& s
   // Final overlaps: pairs of the first query whose agents both stayed, plus the probe pairs that
   // still hold; obstacle hits of agents that stayed, plus those of the moved agents where they are.
   report = {};
+  report.agents_by_lists = by_lists;
   for (auto [i, j] : first.agents) report.agent_pairs += stamp[i] == 0 && stamp[j] == 0;
   for (const Found& f : found) report.agent_pairs += stamp[f.b] == 0 || stamp[f.b] <= f.k;
   for (const auto& hit : first.obstacles) report.obstacle_hits += stamp[hit.first] == 0;

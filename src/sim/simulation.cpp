@@ -171,6 +171,12 @@ struct Simulation::Engine {
   // then is a method that finds the collision set but not every pair (nn) exact for the
   // backoff: every overlap is new, so the set is all the freeze loop needs.
   bool start_clean = false;
+  // The backoff's check on the model's neighbour lists (sim::lists_rule_out_overlaps) costs a
+  // pass over the rows. Where it keeps failing (a dense queue: lists shorter than the tick's
+  // moves) it waits 1, 2, 4, ... up to kListsWaitMost ticks before the next try. Which ticks try
+  // changes the cost only, never a result.
+  static constexpr uint32_t kListsWaitMost = 16;
+  uint32_t lists_wait = 0, lists_left = 0;  // the current wait, and the ticks left of it
 
   // The collision access path for the next tick. A method forced by name that does not apply to
   // this tick (nn while agents still overlap from before, or radii that stopped being equal
@@ -506,8 +512,9 @@ const TickMetrics& Simulation::step() {
   log.timed("integrate", n, [&] { sim::integrate(t, e.next, cfg.dt, e.ex); });
 
   // 4. backoff (or, without it, just measure the overlaps)
-  log.used("collisions=" + plan.collisions->info.name +
-           (plan.collisions_fallback ? " (instead of " + cfg.access.collisions + ")" : ""));
+  const std::string collisions_used =
+      "collisions=" + plan.collisions->info.name +
+      (plan.collisions_fallback ? " (instead of " + cfg.access.collisions + ")" : "");
   CollisionPath& cpath = [&]() -> CollisionPath& {
     auto& slot = e.collision_paths[plan.collisions->info.name];
     if (!slot) slot = plan.collisions->make();
@@ -518,12 +525,24 @@ const TickMetrics& Simulation::step() {
   sim::OperatorStats& bop = log.at(backoff_name);
   log.timed(backoff_name, n, [&] {
     if (cfg.backoff) {
-      overlaps = sim::backoff(t, e.next, e.scene, cpath, e.ex, bop.query, m.freeze_iterations);
+      const NearLists near = e.lists_left == 0 ? e.model->near_lists() : NearLists{};
+      e.lists_left -= e.lists_left > 0;
+      overlaps =
+          sim::backoff(t, e.next, e.scene, cpath, e.ex, bop.query, m.freeze_iterations, near);
+      if (near.lists) {
+        e.lists_wait = overlaps.agents_by_lists
+                           ? 0
+                           : std::min<uint32_t>(std::max<uint32_t>(2 * e.lists_wait, 1),
+                                                Simulation::Engine::kListsWaitMost);
+        e.lists_left = e.lists_wait;
+      }
       bop.count("rounds (1: nothing to undo)", m.freeze_iterations);
     } else {
       overlaps = sim::find_overlaps(t, e.next, e.scene, cpath, e.ex, bop.query);
     }
   });
+  log.used(overlaps.agents_by_lists ? std::string("collisions=model's neighbour lists")
+                                    : collisions_used);
   m.overlapping_pairs = overlaps.agent_pairs;
   m.obstacle_overlaps = overlaps.obstacle_hits;
   e.start_clean = cfg.backoff && overlaps.agent_pairs == 0;
@@ -728,7 +747,8 @@ std::string Simulation::explain() const {
   os << "  " << step++ << " "
      << (cfg.backoff
              ? "backoff            freeze the collision set until empty; one full query, then"
-               " probes of the agents frozen last"
+               " probes of the agents frozen last; the query's agent half skipped on a tick the"
+               " steering model's neighbour lists reach far enough to show no pair overlaps"
              : "overlap count      backoff off: overlaps are only counted")
      << "\n       access path: " << p.collisions->info.name << " ("
      << p.collisions->info.description << ")";

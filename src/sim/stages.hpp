@@ -152,6 +152,7 @@ struct OverlapReport {
   std::size_t agent_pairs = 0;      // all overlapping agent pairs
   std::size_t obstacle_hits = 0;    // all agent-obstacle overlaps (walls are obstacles)
   std::vector<uint32_t> violators;  // rows in a new or deepened overlap, sorted, unique
+  bool agents_by_lists = false;     // the model's neighbour lists ruled agent overlaps out
 };
 
 // Is the overlapping pair (i, j) (next-state positions) a violation: new, or deeper than at the
@@ -165,6 +166,18 @@ bool obstacle_violates(const AgentTable& t, const NextState& next, const StaticS
 OverlapReport find_overlaps(const AgentTable& t, const NextState& next, const StaticScene& scene,
                             CollisionPath& path, Executor& ex, QueryStats& stats);
 
+// Do a steering model's neighbour lists of this tick (`near`, over the start-of-tick rows) show
+// that no two agents overlap at their next positions? A row that moves D_i this tick can only
+// come to overlap a row whose start lies within r_i + r_j + D_i + D_j of its own (triangle
+// inequality), so within need_i = r_i + r_max + 2 D_max (plus a relative 1e-9 for rounding).
+// A row whose list bound (NearLists) reaches need_i holds all of them; its listed pairs that near
+// are tested. A pair of which one row's list falls short is then tested from the other's side;
+// pairs of two such rows (at most 256 of them, else no) are tested one by one. Verlet lists,
+// with the tick's moves as the skin. False when not shown: no lists, too many short lists (a
+// dense crowd, a fast agent), an overlap, or a position or radius that is not finite.
+bool lists_rule_out_overlaps(const AgentTable& t, const NextState& next, const NearLists& near,
+                             Executor& ex);
+
 // Backoff (DESIGN.md §3.2): freeze the violators (back to the start position, zero velocity)
 // until none is left. Returns the overlaps of the final state (exact counts, and no violators)
 // and the number of iterations in `iterations` (1 when nothing had to be frozen).
@@ -174,9 +187,11 @@ OverlapReport find_overlaps(const AgentTable& t, const NextState& next, const St
 // k+1 asks just for the overlaps of the agents frozen in iteration k (through a DiscGrid over the
 // current positions). The frozen sets, iterations and final counts are those of the plain loop
 // that re-runs the full query every iteration (backoff_reference; tested equal).
+// With `near` lists that rule agent overlaps out (lists_rule_out_overlaps), the full query is
+// just its obstacle half: the path would have found no agent pair either.
 OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& scene,
-                      CollisionPath& path, Executor& ex, QueryStats& stats,
-                      std::size_t& iterations);
+                      CollisionPath& path, Executor& ex, QueryStats& stats, std::size_t& iterations,
+                      const NearLists& near = {});
 
 // The plain loop of DESIGN.md §3.2: find the violators with a full query, freeze them, repeat.
 // The oracle for backoff() (tests), and the thesis's algorithm as written.

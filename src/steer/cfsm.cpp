@@ -54,6 +54,7 @@ class CfsmModel final : public Model {
     const CfsmParams& p = in.cfg.steering.cfsm;
     const std::size_t n = t.size();
     const DiscView view = DiscView::of(t);
+    near_ = {};  // until this call's lists are in
     const NeighbourMethod& nm = neighbour_method(in.cfg.access.neighbours, n);
     log.used("neighbours=" + nm.info.name);
     auto& neighbours = neighbour_paths_[nm.info.name];
@@ -72,6 +73,7 @@ class CfsmModel final : public Model {
           Stopwatch sw;
           nb_.with_dist2 = false;  // recomputed where needed (dist2_of)
           neighbours->run(view, {}, p.cutoff, 0, nb_, ex, neighbour_op.query);
+          near_ = {&nb_, p.cutoff, 0};
           neighbour_op.seconds = sw.seconds();
         },
         [&] {
@@ -121,6 +123,8 @@ class CfsmModel final : public Model {
        << ", D=" << explain_number(p.range_geometry)
        << " m); speed min(max(s/T, 0), v0), T=" << explain_number(p.time_gap) << " s\n";
   }
+
+  NearLists near_lists() const override { return near_; }
 
  private:
   // Is the segment from agent i to agent j blocked by one of i's nearby obstacle edges?
@@ -243,6 +247,7 @@ class CfsmModel final : public Model {
   }
 
   NeighbourLists nb_;
+  NearLists near_;  // nb_ with what it was asked, once this tick's query ran
   FeatureLists features_;
   std::vector<double> reach_;
   std::map<std::string, std::unique_ptr<NeighbourPath>> neighbour_paths_;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "crowddb/simulation.hpp"
+#include "plan/access_path.hpp"
 #include "sim/oplog.hpp"
 #include "util/executor.hpp"
 #include "util/pick.hpp"
@@ -69,6 +70,9 @@ class Model {
   // access paths that keep per-row state across ticks (on `ex`'s threads when given). Never
   // changes a result.
   virtual void rows_permuted(std::span<const uint32_t> /*order*/, Executor* /*ex*/ = nullptr) {}
+  // The neighbour lists of the last velocities() call, over every row of its table, for the
+  // backoff to rule overlaps out with (sim::lists_rule_out_overlaps); none by default.
+  virtual NearLists near_lists() const { return {}; }
 };
 
 struct ModelInfo {

@@ -187,6 +187,7 @@ class OrcaModel final : public Model {
     const OrcaParams& p = in.cfg.steering.orca;
     const std::size_t n = t.size();
     const DiscView view = DiscView::of(t);
+    near_ = {};  // until this call's lists are in
 
     const NeighbourMethod& nm = neighbour_method(in.cfg.access.neighbours, n);
     log.used("neighbours=" + nm.info.name);
@@ -210,6 +211,7 @@ class OrcaModel final : public Model {
           Stopwatch sw;
           nb_.with_dist2 = false;  // recomputed where needed (dist2_of): 80 MB fewer at 10^6
           neighbours->run(view, {}, p.neighbor_dist, p.max_neighbors, nb_, ex, neighbour_op.query);
+          near_ = {&nb_, p.neighbor_dist, p.max_neighbors};
           neighbour_op.seconds = sw.seconds();
         },
         [&] {
@@ -430,6 +432,8 @@ class OrcaModel final : public Model {
     os << ", backwards at most " << explain_number(p.max_retreat) << " x pref_speed";
     os << ", 3-D fallback when infeasible\n";
   }
+
+  NearLists near_lists() const override { return near_; }
 
   void rows_permuted(std::span<const uint32_t> order, Executor* ex = nullptr) override {
     for (auto& [name, path] : neighbour_paths_) path->rows_permuted(order, ex);
@@ -683,6 +687,7 @@ class OrcaModel final : public Model {
   }
 
   NeighbourLists nb_;
+  NearLists near_;  // nb_ with what it was asked, once this tick's query ran
   PassingLookahead lookahead_;
   std::vector<uint8_t> turn_;  // per row: turns aside for someone passing (find_passing)
   // Per row: the last row the grid found passing it (a hint for find, maybe many ticks old or

@@ -147,6 +147,141 @@ TEST(Backoff, ChainOfFreezesTakesOneIterationPerLink) {
   }
 }
 
+// Agents at (x, y) of radius r, stepping dx along the x axis this tick.
+struct Step {
+  double x, y, r, dx;
+};
+Tentative steps(const std::vector<Step>& all) {
+  Tentative k;
+  uint64_t id = 0;
+  for (const Step& a : all) {
+    k.t.x.push_back(a.x);
+    k.t.y.push_back(a.y);
+    k.t.vx.push_back(0);
+    k.t.vy.push_back(0);
+    k.t.radius.push_back(a.r);
+    k.t.charge.push_back(1);
+    k.t.id.push_back(id++);
+    k.next.x.push_back(a.x + a.dx);
+    k.next.y.push_back(a.y);
+    k.next.vx.push_back(a.dx);
+    k.next.vy.push_back(0);
+    k.next.frozen.push_back(0);
+  }
+  return k;
+}
+// The same on a line, radius 0.25.
+Tentative line_tick(std::initializer_list<std::pair<double, double>> x_dx) {
+  std::vector<Step> all;
+  for (auto [x, dx] : x_dx) all.push_back({x, 0, 0.25, dx});
+  return steps(all);
+}
+
+bool by_lists(const Tentative& k, double range, uint32_t k_nearest) {
+  Executor ex(1);
+  const NeighbourLists lists = neighbours(DiscView::of(k.t), range, k_nearest, {}, "naive");
+  return lists_rule_out_overlaps(k.t, k.next, {&lists, range, k_nearest}, ex);
+}
+
+TEST(Backoff, NeighbourListsMustReachAsFarAsBothAgentsMove) {
+  // A and B (1 m apart) step 0.3 m towards each other and overlap. Each one's single nearest
+  // neighbour is someone else 0.9 m off (C, D), who stays: neither list holds the pair. A bound
+  // of r + r_max + one's own move (0.8 m) would pass both lists; the other's move must count.
+  const Tentative k = line_tick({{0, 0.3}, {1, -0.3}, {-0.9, 0}, {1.9, 0}});
+  Executor ex(1);
+  QueryStats st;
+  EXPECT_GT(find_overlaps(k.t, k.next, k.scene, *make_path("naive"), ex, st).agent_pairs, 0u);
+  EXPECT_FALSE(by_lists(k, 5, 1));
+  EXPECT_FALSE(by_lists(k, 5, 0));  // every row within 5 m listed: the pair is, and overlaps
+  // Stepping apart by 0.1 m: nobody within 0.7 m (r + r_max + both moves) of anyone, so the
+  // single nearest (0.9 m) is enough, and so are empty lists complete to 0.75 m; those complete
+  // to 0.65 m fall short, and the four rows' pairs are tested one by one.
+  const Tentative apart = line_tick({{0, -0.1}, {1, 0.1}, {-0.9, -0.1}, {1.9, 0.1}});
+  EXPECT_TRUE(by_lists(apart, 5, 1));
+  EXPECT_TRUE(by_lists(apart, 0.75, 0));
+  EXPECT_TRUE(by_lists(apart, 0.65, 0));
+  // Radii count at their largest. A (0.25 m) and B (0.5 m), 0.9 m apart, step 0.1 m towards
+  // each other and overlap. B's two nearest are A and D (1.3 m): its list holds the pair. A's are
+  // C and E (0.8, 0.85 m), short of 0.25 + 0.5 + 0.1 + 0.1 (though not of 0.25 + 0.25 + 0.2): the
+  // pair is in one list only, and a check of each pair from one side would miss it.
+  const Tentative mixed = steps({{0, 0, 0.25, 0.1},
+                                 {0.9, 0, 0.5, -0.1},
+                                 {-0.8, 0, 0.25, 0},
+                                 {2.2, 0, 0.25, 0},
+                                 {0, 0.85, 0.25, 0}});
+  EXPECT_GT(
+      find_overlaps(mixed.t, mixed.next, mixed.scene, *make_path("naive"), ex, st).agent_pairs, 0u);
+  EXPECT_FALSE(by_lists(mixed, 5, 2));
+}
+
+TEST(Backoff, NeighbourListsFallingShortAreTestedOneByOneUpToACap) {
+  // A row of agents 0.6 m apart, all stepping 0.05 m to the right: every single-nearest list
+  // (0.6 m) falls short of 0.25 + 0.25 + 2 * 0.05. Up to 256 such rows
+  // their pairs are tested one by one; beyond, the lists show nothing.
+  for (std::size_t n : {200u, 256u, 257u, 300u}) {
+    std::vector<Step> row;
+    for (std::size_t i = 0; i < n; ++i)
+      row.push_back({0.6 * static_cast<double>(i), 0, 0.25, 0.05});
+    Tentative k = steps(row);
+    EXPECT_EQ(by_lists(k, 5, 1), n <= 256) << n;
+    // One pair stepping into each other (rows 10 and 11) is found among them.
+    k.next.x[10] = k.t.x[10] + 0.06;
+    k.next.x[11] = k.t.x[11] - 0.06;
+    EXPECT_FALSE(by_lists(k, 5, 1)) << n;
+  }
+}
+
+TEST(Backoff, NeighbourListsRuleOutOnlyTicksWithoutOverlaps) {
+  // Random ticks against the naive collision query; lists of every k and range. Whenever the
+  // lists rule overlaps out, the oracle finds none, and the backoff with them (which then skips
+  // the query's agent half) ends where the plain loop does.
+  Executor one(1), two(2);
+  std::size_t shown = 0, overlapping = 0, not_shown_clean = 0;
+  for (uint64_t seed = 1; seed <= 40; ++seed) {
+    Rng rng(seed);
+    const std::size_t n = 20 + rng.below(400);
+    const bool equal = seed % 3 == 0;
+    const double reach = seed % 4 == 0 ? 0.3 : (seed % 4 == 1 ? 0.01 : 0.05);
+    const Tentative k = make_tick(n, seed, equal, seed % 5 == 0, reach);
+    NextState plain = k.next;
+    std::size_t plain_iter = 0;
+    QueryStats st;
+    const OverlapReport want =
+        backoff_reference(k.t, plain, k.scene, *make_path("naive"), one, st, plain_iter);
+    const OverlapReport before = find_overlaps(k.t, k.next, k.scene, *make_path("naive"), one, st);
+    for (uint32_t kn : {0u, 1u, 4u, 8u, 12u, 30u})
+      for (double range : {2.0, 4.0, 6.5, 20.0}) {
+        SCOPED_TRACE("seed " + std::to_string(seed) + " k " + std::to_string(kn) + " range " +
+                     std::to_string(range));
+        const NeighbourLists lists = neighbours(DiscView::of(k.t), range, kn, {}, "naive");
+        const NearLists near{&lists, range, kn};
+        const bool ruled_out = lists_rule_out_overlaps(k.t, k.next, near, one);
+        EXPECT_EQ(lists_rule_out_overlaps(k.t, k.next, near, two), ruled_out);
+        if (ruled_out) {
+          ++shown;
+          EXPECT_EQ(before.agent_pairs, 0u);
+        } else {
+          overlapping += before.agent_pairs > 0;
+          not_shown_clean += before.agent_pairs == 0;
+        }
+        NextState got = k.next;
+        std::size_t iter = 0;
+        const OverlapReport r = backoff(k.t, got, k.scene, *make_path("grid"), two, st, iter, near);
+        EXPECT_EQ(r.agents_by_lists, ruled_out);
+        EXPECT_EQ(iter, plain_iter);
+        EXPECT_EQ(r.agent_pairs, want.agent_pairs);
+        EXPECT_EQ(r.obstacle_hits, want.obstacle_hits);
+        EXPECT_EQ(got.frozen, plain.frozen);
+        EXPECT_EQ(got.x, plain.x);
+        EXPECT_EQ(got.y, plain.y);
+      }
+  }
+  // All three kinds of tick occur: the test is not vacuous.
+  EXPECT_GT(shown, 100u);
+  EXPECT_GT(overlapping, 100u);
+  EXPECT_GT(not_shown_clean, 20u);
+}
+
 World two_agents_head_on() {
   World w(Bounds{0, 0, 100, 100});
   w.add_goal({"east", 90, 50, 1, 1, {}});
