@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <exception>
 #include <stdexcept>
 
 namespace crowddb {
@@ -45,12 +46,33 @@ void Executor::for_each_chunk(std::size_t n, std::size_t grain,
 }
 
 void Executor::both(const std::function<void()>& f, const std::function<void()>& g) {
+  // Each task's exception is caught in the task itself: one leaving a task of parallel_invoke
+  // would cancel the group, and the cancellation would cut the other task's loops short (their
+  // parallel_for returning with chunks never run) before the rethrow. Both run to the end; then
+  // f's exception is rethrown, else g's.
+  std::exception_ptr ef, eg;
+  const auto run_f = [&] {
+    try {
+      f();
+    } catch (...) {
+      ef = std::current_exception();
+    }
+  };
+  const auto run_g = [&] {
+    try {
+      g();
+    } catch (...) {
+      eg = std::current_exception();
+    }
+  };
   if (!arena_) {
-    g();
-    f();
-    return;
+    run_g();
+    run_f();
+  } else {
+    arena_->arena.execute([&] { tbb::parallel_invoke(run_f, run_g); });
   }
-  arena_->arena.execute([&] { tbb::parallel_invoke(f, g); });
+  if (ef) std::rethrow_exception(ef);
+  if (eg) std::rethrow_exception(eg);
 }
 
 }  // namespace crowddb

@@ -36,8 +36,8 @@ class Executor {
   // Runs f and g, which must not depend on each other, at once: each may run its own loops
   // (for_each_chunk), and a thread done with one helps with the other's. For a step that one
   // thread does alone (an index's placement pass) beside a parallel stage it need not wait for:
-  // the second thread does not idle through it. With one thread, g then f. An exception thrown
-  // by either is rethrown once both are done.
+  // the second thread does not idle through it. With one thread, g then f. Both run to the end
+  // whatever the other throws; then f's exception is rethrown, else g's.
   void both(const std::function<void()>& f, const std::function<void()>& g);
 
  private:

@@ -108,5 +108,31 @@ TEST(Executor, BothRethrowsEitherTasksException) {
   }
 }
 
+TEST(Executor, BothRunsTheOtherTaskToTheEndWhenOneThrows) {
+  // A task that throws at once beside one that runs a loop of many chunks: the loop is not cut
+  // short (oneTBB would cancel it with the group) and f's exception wins over g's.
+  for (int threads : {1, 2}) {
+    for (int round = 0; round < 20; ++round) {
+      Executor ex(threads);
+      std::vector<std::atomic<int>> hits(4000);
+      const auto long_loop = [&] {
+        ex.for_each_chunk(hits.size(), 1, [&](std::size_t b, std::size_t e) {
+          volatile double sink = 0;
+          for (int k = 0; k < 200; ++k) sink = sink + k;
+          for (std::size_t i = b; i < e; ++i) ++hits[i];
+        });
+      };
+      EXPECT_THROW(ex.both([] { throw std::runtime_error("f"); }, long_loop), std::runtime_error);
+      for (auto& h : hits) ASSERT_EQ(h.load(), 1) << threads;
+      for (auto& h : hits) h = 0;
+      EXPECT_THROW(ex.both(long_loop, [] { throw std::logic_error("g"); }), std::logic_error);
+      for (auto& h : hits) ASSERT_EQ(h.load(), 1) << threads;
+      EXPECT_THROW(
+          ex.both([] { throw std::runtime_error("f"); }, [] { throw std::logic_error("g"); }),
+          std::runtime_error);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace crowddb
