@@ -67,7 +67,8 @@ class NeighbourGrid final : public NeighbourPath {
   std::vector<int64_t> cell_of_;  // scratch: cell per row
   std::vector<uint32_t> at_;      // per row: its place in the cell-ordered arrays
   // Per-row lists of k (spatial order): the rows, kept as the next call's hints; their distances
-  // are written into the output's slots.
+  // are written into the output's slots. Room for every row of the table, however few a subset
+  // asks for: 4 k bytes a row (24 MB for the stalemate stage's k = 6 at 10^6 rows).
   std::vector<uint32_t> slot_count_, slot_row_;
   uint32_t hint_k_ = 0;  // k of the last call when its lists are in the slots (hints), else 0
 };

@@ -480,6 +480,7 @@ const TickMetrics& Simulation::step() {
       world_.permute_rows(order, ex);
       e.model->rows_permuted(order, ex);
       if (e.stall_path) e.stall_path->rows_permuted(order, ex);
+      if (e.join_path) e.join_path->rows_permuted(order, ex);
     });
   e.refresh_scene(world_, cfg);
   const TickPlan plan = e.plan(world_, cfg);
@@ -525,7 +526,11 @@ const TickMetrics& Simulation::step() {
   sim::OperatorStats& bop = log.at(backoff_name);
   log.timed(backoff_name, n, [&] {
     if (cfg.backoff) {
-      const NearLists near = e.lists_left == 0 ? e.model->near_lists() : NearLists{};
+      // Only with the collision method left to the planner: a method asked for by name (the
+      // naive oracle, say) answers every tick itself.
+      const NearLists near = cfg.access.collisions == "auto" && e.lists_left == 0
+                                 ? e.model->near_lists()
+                                 : NearLists{};
       e.lists_left -= e.lists_left > 0;
       overlaps =
           sim::backoff(t, e.next, e.scene, cpath, e.ex, bop.query, m.freeze_iterations, near);
@@ -744,12 +749,15 @@ std::string Simulation::explain() const {
      << steer::find_model(cfg.steering.model).description << "\n";
   e.model->explain(os, e.input(world_, cfg, last_.tick + 1), step);
   os << "  " << step++ << " integrate          p' = p + v' dt\n";
+  const bool by_lists = cfg.access.collisions == "auto";
   os << "  " << step++ << " "
-     << (cfg.backoff
+     << (!cfg.backoff ? "overlap count      backoff off: overlaps are only counted"
+         : by_lists
              ? "backoff            freeze the collision set until empty; one full query, then"
                " probes of the agents frozen last; the query's agent half skipped on a tick the"
                " steering model's neighbour lists reach far enough to show no pair overlaps"
-             : "overlap count      backoff off: overlaps are only counted")
+             : "backoff            freeze the collision set until empty; one full query, then"
+               " probes of the agents frozen last")
      << "\n       access path: " << p.collisions->info.name << " ("
      << p.collisions->info.description << ")";
   if (p.collisions_fallback)

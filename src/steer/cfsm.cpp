@@ -90,7 +90,9 @@ class CfsmModel final : public Model {
           }
           obstacle_op.seconds = sw.seconds();
         });
-    log.side_by_side(neighbour_op.seconds + obstacle_op.seconds, side_by_side.seconds());
+    // Only the times booked below count towards the overlap (no obstacles: none booked).
+    log.side_by_side(neighbour_op.seconds + (obstacles ? obstacle_op.seconds : 0),
+                     side_by_side.seconds());
     log.book("CFSM neighbours", n, neighbour_op.seconds).query += neighbour_op.query;
     if (obstacles) {
       sim::OperatorStats& op = log.book("CFSM obstacles", n, obstacle_op.seconds);

@@ -237,8 +237,10 @@ class OrcaModel final : public Model {
             passing_op.seconds = sw.seconds();
           }
         });
-    log.side_by_side(neighbour_op.seconds + obstacle_op.seconds + passing_op.seconds,
-                     side_by_side.seconds());
+    // Only the times booked below count towards the overlap (no obstacles: none booked).
+    log.side_by_side(
+        neighbour_op.seconds + (obstacles ? obstacle_op.seconds : 0) + passing_op.seconds,
+        side_by_side.seconds());
     log.book("ORCA neighbours", n, neighbour_op.seconds).query += neighbour_op.query;
     if (obstacles) {
       sim::OperatorStats& op = log.book("ORCA obstacles", n, obstacle_op.seconds);

@@ -443,7 +443,9 @@ TEST(Backoff, ShippedScenariosKeepTheInvariantAndAllExactMethodsAgree) {
     SCOPED_TRACE(run.name);
     std::vector<uint64_t> reference;
     std::size_t frozen = 0;
-    for (const std::string m : {"naive", "grid", "sweep", "nn"}) {
+    // "auto": under orca the backoff's agent half answered from orca's neighbour lists (only
+    // with the method left to the planner), against the methods asked for by name.
+    for (const std::string m : {"naive", "grid", "sweep", "nn", "auto"}) {
       Scenario sc = test::load_edited(run.name, [&](nlohmann::json& j) {
         run.edit(j);
         j["access"]["collisions"] = m;
@@ -456,6 +458,9 @@ TEST(Backoff, ShippedScenariosKeepTheInvariantAndAllExactMethodsAgree) {
       ASSERT_TRUE(test::initially_overlap_free(sc.world, sc.config));
       Simulation sim(std::move(sc.world), sc.config);
       const test::RunResult r = test::run_checked(sim, run.ticks, m == "naive" || m == "grid");
+      const bool by_lists =
+          sim.explain_analyze().find("collisions=model's neighbour lists") != std::string::npos;
+      EXPECT_EQ(by_lists, m == "auto" && !run.backoff_busy) << m;
       EXPECT_EQ(r.bad, 0u) << m;
       EXPECT_EQ(r.overlaps_at_end, 0u) << m;
       EXPECT_EQ(r.metric_mismatch, 0u) << m;
