@@ -36,6 +36,13 @@ std::string num(double v) {
   return buf;
 }
 
+// Does the backoff try the steering model's neighbour lists (sim::lists_rule_out_overlaps)? Only
+// with the collision method left to the planner: a method asked for by name (the naive oracle,
+// say) answers every tick itself.
+bool backoff_reads_model_lists(const SimConfig& cfg) {
+  return cfg.access.collisions == "auto";
+}
+
 // Does the tick put the rows in curve order (AccessChoice::row_order)?
 bool reorders(const SimConfig& cfg, std::size_t rows) {
   return cfg.access.row_order == "curve" ||
@@ -526,11 +533,8 @@ const TickMetrics& Simulation::step() {
   sim::OperatorStats& bop = log.at(backoff_name);
   log.timed(backoff_name, n, [&] {
     if (cfg.backoff) {
-      // Only with the collision method left to the planner: a method asked for by name (the
-      // naive oracle, say) answers every tick itself.
-      const NearLists near = cfg.access.collisions == "auto" && e.lists_left == 0
-                                 ? e.model->near_lists()
-                                 : NearLists{};
+      const NearLists near =
+          backoff_reads_model_lists(cfg) && e.lists_left == 0 ? e.model->near_lists() : NearLists{};
       e.lists_left -= e.lists_left > 0;
       overlaps =
           sim::backoff(t, e.next, e.scene, cpath, e.ex, bop.query, m.freeze_iterations, near);
@@ -749,16 +753,17 @@ std::string Simulation::explain() const {
      << steer::find_model(cfg.steering.model).description << "\n";
   e.model->explain(os, e.input(world_, cfg, last_.tick + 1), step);
   os << "  " << step++ << " integrate          p' = p + v' dt\n";
-  const bool by_lists = cfg.access.collisions == "auto";
-  os << "  " << step++ << " "
-     << (!cfg.backoff ? "overlap count      backoff off: overlaps are only counted"
-         : by_lists
-             ? "backoff            freeze the collision set until empty; one full query, then"
-               " probes of the agents frozen last; the query's agent half skipped on a tick the"
-               " steering model's neighbour lists reach far enough to show no pair overlaps"
-             : "backoff            freeze the collision set until empty; one full query, then"
-               " probes of the agents frozen last")
-     << "\n       access path: " << p.collisions->info.name << " ("
+  os << "  " << step++ << " ";
+  if (!cfg.backoff) {
+    os << "overlap count      backoff off: overlaps are only counted";
+  } else {
+    os << "backoff            freeze the collision set until empty; one full query, then probes"
+          " of the agents frozen last";
+    if (backoff_reads_model_lists(cfg))
+      os << "; the query's agent half skipped on a tick the steering model's neighbour lists"
+            " reach far enough to show no pair overlaps";
+  }
+  os << "\n       access path: " << p.collisions->info.name << " ("
      << p.collisions->info.description << ")";
   if (p.collisions_fallback)
     os << " instead of " << cfg.access.collisions << ": agents overlap at the start";

@@ -51,20 +51,16 @@ void Executor::both(const std::function<void()>& f, const std::function<void()>&
   // parallel_for returning with chunks never run) before the rethrow. Both run to the end; then
   // f's exception is rethrown, else g's.
   std::exception_ptr ef, eg;
-  const auto run_f = [&] {
-    try {
-      f();
-    } catch (...) {
-      ef = std::current_exception();
-    }
+  const auto guarded = [](const std::function<void()>& task, std::exception_ptr& caught) {
+    return [&task, &caught] {
+      try {
+        task();
+      } catch (...) {
+        caught = std::current_exception();
+      }
+    };
   };
-  const auto run_g = [&] {
-    try {
-      g();
-    } catch (...) {
-      eg = std::current_exception();
-    }
-  };
+  const auto run_f = guarded(f, ef), run_g = guarded(g, eg);
   if (!arena_) {
     run_g();
     run_f();
