@@ -992,6 +992,7 @@ struct FtcIndex::Impl {
   KineticTree<CircleSource> circle_tree;
   std::vector<Slice> polygon_boxes;  // one static slice per polygon (frustum form)
   mutable ProbeScratch scratch;      // for query()
+  bool no_overlaps = false;          // FtcPath::assume_no_overlaps
 
   void make_frame();
   // The answer for one row; pos: its position in the agent tree's order.
@@ -1052,7 +1053,8 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, ProbeScratch& sc, Count
   const Member& a = agent_tree.member(pos);  // the row's own values, in tree order
   Probe q{a.x, a.y, a.vx, a.vy, a.r, a.x - frame.ox, a.y - frame.oy, row};
   Best best;
-  if (opt.overlaps_first && opt.overlap_join) {
+  const bool overlaps_first = opt.overlaps_first && !no_overlaps;
+  if (overlaps_first && opt.overlap_join) {
     // An agent overlapping the query now wins outright (time 0, agents before obstacles); only
     // the smallest (id, row) is wanted, and only t = 0 checks are needed to find it. The join
     // answers the whole leaf at once (queries run in tree order, so once per leaf). Counters:
@@ -1073,7 +1075,7 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, ProbeScratch& sc, Count
       const uint32_t hit = sc.hit[pos - begin];
       if (hit != kNoRow) return {{Kind::agent, hit}, 0.0};
     }
-  } else if (opt.overlaps_first) {
+  } else if (overlaps_first) {
     // The same answer through the tree search in the chosen order, t = 0 checks only.
     agent_tree.search<true>(q, horizon, best, sc, c, opt.order, pos, opt.seed_own_leaf);
     if (best.kind != Kind::none) return {{best.kind, best.row}, best.t};
@@ -1207,6 +1209,9 @@ std::size_t FtcIndex::node_count() const {
 }
 bool FtcIndex::uses_chord_bound() const {
   return impl_->frame.chord;
+}
+void FtcIndex::assume_no_overlaps(bool yes) {
+  impl_->no_overlaps = yes;
 }
 const FtcIndexOptions& FtcIndex::options() const {
   return impl_->opt;

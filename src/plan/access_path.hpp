@@ -24,6 +24,12 @@ class FtcPath {
   // out[i] = the first collider of disc i within `horizon` (DESIGN.md §5), for every disc.
   virtual void run(const DiscView& discs, const StaticScene& scene, double horizon,
                    std::span<FtcHit> out, Executor& ex, QueryStats& stats) = 0;
+  // A hint for the runs that follow, until withdrawn: no two discs overlap at t = 0 (closer than
+  // the sum of their radii), as the engine knows at the start of a tick after one whose backoff
+  // left no overlapping pair (and no insert since). A method may then skip work that only pays
+  // where many overlap. It changes the cost only: the answers are the same with or without it,
+  // true or not. Off by default.
+  virtual void assume_no_overlaps(bool /*yes*/) {}
 };
 
 class FieldPath {

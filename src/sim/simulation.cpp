@@ -292,7 +292,7 @@ struct Simulation::Engine {
   }
 
   steer::TickInput input(const World& w, const SimConfig& cfg, uint64_t tick) const {
-    return {w.agents(), w.goals(), scene, cfg, pref.vx, pref.vy, pref.left, tick};
+    return {w.agents(), w.goals(), scene, cfg, pref.vx, pref.vy, pref.left, tick, start_clean};
   }
 };
 

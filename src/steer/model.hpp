@@ -55,6 +55,9 @@ struct TickInput {
   std::span<const double> path_left;         // [m] sim::path_left per row (goal stage); infinite
                                              // for those standing
   uint64_t tick;                             // the tick being computed
+  // No two agents overlap at the tick's start: the last tick's backoff left no overlapping pair
+  // and nothing was inserted since (the engine's own knowledge; false when unknown).
+  bool no_overlaps = false;
 };
 
 class Model {

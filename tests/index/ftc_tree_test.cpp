@@ -61,12 +61,14 @@ bool same_bits(double a, double b) {
   return std::memcmp(&a, &b, sizeof a) == 0;
 }
 
-// Index (with `opt`, on `threads` threads) == naive for every row; returns how many rows differ.
+// Index (with `opt`, on `threads` threads, told `no_overlaps`) == naive for every row; returns
+// how many rows differ.
 int compare(const DiscTable& t, const StaticScene& s, double horizon, Opt opt = {}, int threads = 1,
-            QueryStats* stats_out = nullptr) {
+            QueryStats* stats_out = nullptr, bool no_overlaps = false) {
   const DiscView d = t.view();
   const auto& want = naive_cached(d, s, horizon);
   FtcIndex index(opt);
+  index.assume_no_overlaps(no_overlaps);
   Executor ex(threads);
   QueryStats st;
   std::vector<FtcHit> got(d.n);
@@ -156,6 +158,30 @@ TEST(FtcIndex, CrowdFallsBackFromTheJoin) {
     EXPECT_EQ(compare(t, kNoScene, 30, {.overlap_join = join}, 1, &st), 0) << join;
     // The join would test every pair (n^2 = 2.25e6); the fallback prunes by smallest id.
     EXPECT_LT(st.pair_tests, 1500u * 1499u / 4) << join;
+  }
+}
+
+// The hint that nothing overlaps (the engine's, after a clean tick) skips the overlaps-first
+// pass: fewer pair tests where it holds, and the naive loop's answers whether it holds or not.
+TEST(FtcIndex, NoOverlapsHintChangesTheCostNotTheAnswers) {
+  // Apart: a jittered lattice, 8 m spacing, radii up to 3 m, random velocities.
+  Rng rng(5);
+  DiscTable apart;
+  for (uint64_t i = 0; i < 1600; ++i)
+    apart.push_back(i, 8.0 * static_cast<double>(i % 40) + rng.uniform(0, 1),
+                    8.0 * static_cast<double>(i / 40) + rng.uniform(0, 1), rng.uniform(-2, 2),
+                    rng.uniform(-2, 2), rng.uniform(1, 3));
+  const DiscTable dense = build::uniform(2000, {}, 50, 1, 3, 2);  // many overlap
+  for (const Opt& o : {Opt{}, Opt{.overlap_join = false}, Opt{.lanes = false}}) {
+    for (const DiscTable* t : std::vector<const DiscTable*>{&apart, &dense}) {
+      QueryStats told, not_told;
+      EXPECT_EQ(compare(*t, kNoScene, 30, o, 1, &told, true), 0);
+      EXPECT_EQ(compare(*t, kNoScene, 30, o, 1, &not_told, false), 0);
+      if (t == &apart) {
+        EXPECT_LT(told.pair_tests + told.nodes_visited,
+                  not_told.pair_tests + not_told.nodes_visited);
+      }
+    }
   }
 }
 

@@ -288,6 +288,9 @@ TEST(Simulation, ExplainNamesEveryOperatorAndAccessPath) {
   const std::string analyze = sim.explain_analyze();
   EXPECT_NE(analyze.find("EXPLAIN ANALYZE  3 ticks"), std::string::npos) << analyze;
   EXPECT_NE(analyze.find("pair tests"), std::string::npos) << analyze;
+  // Placed apart, the crowd starts tick 1 with overlaps unknown and ticks 2 and 3 with none
+  // (the backoff's word): the first-to-collide query is told so on those two.
+  EXPECT_NE(analyze.find("ticks started without overlaps 2 "), std::string::npos) << analyze;
 }
 
 // ORCA's and CFSM's obstacle queries (and ORCA's look ahead for people passing) run beside the
