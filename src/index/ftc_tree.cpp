@@ -1108,6 +1108,7 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, ProbeScratch& sc, Count
 
 FtcIndex::FtcIndex(FtcIndexOptions options) : impl_(std::make_unique<Impl>()) {
   if (options.leaf_size < 1) options.leaf_size = 1;
+  if (options.leaf_size_apart < 1) options.leaf_size_apart = 1;
   if (options.slices < 1) options.slices = 1;
   impl_->opt = options;
 }
@@ -1138,7 +1139,8 @@ void FtcIndex::build(const DiscView& discs, const StaticScene& scene, double hor
   m.make_frame();
   m.agents.d = &m.discs;
   m.circles.c = scene.circles();
-  m.agent_tree.build(m.agents, m.frame, m.opt.leaf_size, ex);
+  m.agent_tree.build(m.agents, m.frame, m.no_overlaps ? m.opt.leaf_size_apart : m.opt.leaf_size,
+                     ex);
   m.circle_tree.build(m.circles, m.frame, m.opt.leaf_size);
   m.polygon_boxes.clear();
   const double d0 = m.frame.delta0, d1 = m.frame.delta1;

@@ -143,6 +143,13 @@ struct FtcIndexOptions {
   // lanes of a vector; false: one by one (the reference the tests compare with: the same bounds
   // and times bit for bit, so the same search).
   bool lanes = true;
+  // Most members in an agent leaf when told that no discs overlap (assume_no_overlaps): then the
+  // overlap join, whose cost grows with the leaf, does not run, and larger leaves trade node
+  // bounds (branchy, one at a time) for pair times (in lanes, several at a time). The thesis
+  // model's first-to-collide query on ticks without overlaps, airport at 2,000 / 5,000 /
+  // 20,000 / 100,000 agents, ms per tick against leaf_size 16: 32 -12 / -15 / -18 / -13 %,
+  // 48 -11 / -18 / -21 / -11 %, 64 -5 / -13 / -19 / -11 % (docs/benchmarks.md).
+  std::size_t leaf_size_apart = 48;
 };
 
 // Thread-safety: build() and query() change the index (one caller at a time); query_all() may
@@ -157,8 +164,9 @@ class FtcIndex final : public FtcPath {
   // build() then query_all(); fills stats.build_seconds and stats.query_seconds.
   void run(const DiscView& discs, const StaticScene& scene, double horizon, std::span<FtcHit> out,
            Executor& ex, QueryStats& stats) override;
-  // With the hint (FtcPath::assume_no_overlaps), the queries skip `overlaps_first`, which would
-  // find nothing (every option is exact, so a wrong hint costs time only). The thesis model gives
+  // With the hint (FtcPath::assume_no_overlaps), the trees built from then on have agent leaves
+  // of up to leaf_size_apart members, and the queries skip `overlaps_first`, which would find
+  // nothing (every option is exact, so a wrong hint costs time only). The thesis model gives
   // it on ticks that start without overlaps (airport-20k: the overlap join was 3-4 % of the
   // query's time there).
   void assume_no_overlaps(bool yes) override;

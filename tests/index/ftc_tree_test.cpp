@@ -162,7 +162,8 @@ TEST(FtcIndex, CrowdFallsBackFromTheJoin) {
 }
 
 // The hint that nothing overlaps (the engine's, after a clean tick) skips the overlaps-first
-// pass: fewer pair tests where it holds, and the naive loop's answers whether it holds or not.
+// pass and builds larger leaves: the naive loop's answers whether it holds or not, and, with the
+// leaves kept as they are, less work where it holds.
 TEST(FtcIndex, NoOverlapsHintChangesTheCostNotTheAnswers) {
   // Apart: a jittered lattice, 8 m spacing, radii up to 3 m, random velocities.
   Rng rng(5);
@@ -172,17 +173,28 @@ TEST(FtcIndex, NoOverlapsHintChangesTheCostNotTheAnswers) {
                     8.0 * static_cast<double>(i / 40) + rng.uniform(0, 1), rng.uniform(-2, 2),
                     rng.uniform(-2, 2), rng.uniform(1, 3));
   const DiscTable dense = build::uniform(2000, {}, 50, 1, 3, 2);  // many overlap
-  for (const Opt& o : {Opt{}, Opt{.overlap_join = false}, Opt{.lanes = false}}) {
+  for (const Opt& o :
+       {Opt{}, Opt{.overlap_join = false}, Opt{.lanes = false}, Opt{.leaf_size_apart = 1},
+        Opt{.leaf_size_apart = 100}, Opt{.bound = Opt::Bound::frustum, .leaf_size_apart = 7}}) {
     for (const DiscTable* t : std::vector<const DiscTable*>{&apart, &dense}) {
-      QueryStats told, not_told;
-      EXPECT_EQ(compare(*t, kNoScene, 30, o, 1, &told, true), 0);
-      EXPECT_EQ(compare(*t, kNoScene, 30, o, 1, &not_told, false), 0);
-      if (t == &apart) {
-        EXPECT_LT(told.pair_tests + told.nodes_visited,
-                  not_told.pair_tests + not_told.nodes_visited);
-      }
+      EXPECT_EQ(compare(*t, kNoScene, 30, o, 1, nullptr, true), 0);
+      EXPECT_EQ(compare(*t, kNoScene, 30, o, 2, nullptr, true), 0);
+      EXPECT_EQ(compare(*t, kNoScene, 30, o, 1, nullptr, false), 0);
     }
   }
+  QueryStats told, not_told;
+  const Opt same_leaves{.leaf_size_apart = Opt{}.leaf_size};
+  EXPECT_EQ(compare(apart, kNoScene, 30, same_leaves, 1, &told, true), 0);
+  EXPECT_EQ(compare(apart, kNoScene, 30, same_leaves, 1, &not_told, false), 0);
+  EXPECT_LT(told.pair_tests + told.nodes_visited, not_told.pair_tests + not_told.nodes_visited);
+  // And the leaves do grow: 1,600 members in leaves of at most 48 rather than 16 (median splits).
+  FtcIndex larger, usual;
+  larger.assume_no_overlaps(true);
+  larger.build(apart.view(), kNoScene, 30);
+  usual.build(apart.view(), kNoScene, 30);
+  EXPECT_EQ(larger.validate(), "");
+  EXPECT_EQ(larger.node_count(), 127u);  // 1,600 halved 6 times: 64 leaves of 25
+  EXPECT_EQ(usual.node_count(), 255u);   // 7 times: 128 leaves of 12 or 13
 }
 
 TEST(FtcIndex, UniformE1Setup) {
