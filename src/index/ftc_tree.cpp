@@ -13,11 +13,47 @@
 #include <xsimd/xsimd.hpp>
 
 #include "crowddb/error.hpp"
+#include "index/ftc_pair_lanes.hpp"
 #include "query/ftc_geometry.hpp"
 #include "util/executor.hpp"
 #include "util/stopwatch.hpp"
 
 namespace crowddb {
+
+namespace ftc {
+#if CROWDDB_FTC_AVX2 && !XSIMD_WITH_AVX2
+#define CROWDDB_FTC_DISPATCH 1
+// ftc_pair_lanes_avx2.cpp: the lanes of AVX2, for a build whose own instruction set is narrower.
+uint32_t pair_times_lanes_avx2(const Member* m, uint32_t n, const Query& q, double horizon,
+                               double* out);
+#endif
+
+bool pair_times_avx2() {
+#if CROWDDB_FTC_DISPATCH
+  // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+#else
+  return false;
+#endif
+}
+
+void pair_times(const Member* m, uint32_t n, const Query& q, double horizon, double* out,
+                Lanes lanes) {
+#if CROWDDB_FTC_DISPATCH
+  uint32_t k = pair_times_avx2() && lanes == Lanes::widest
+                   ? pair_times_lanes_avx2(m, n, q, horizon, out)
+                   : pair_times_lanes<xsimd::default_arch>(m, n, q, horizon, out);
+#else
+  (void)lanes;  // the build's lanes are the widest there are
+  uint32_t k = pair_times_lanes<xsimd::default_arch>(m, n, q, horizon, out);
+#endif
+  for (; k < n; ++k)  // the tail, one at a time (AgentSource::time's expression)
+    out[k] = ray_disc_time(m[k].x - q.x, m[k].y - q.y, m[k].vx - q.vx, m[k].vy - q.vy, q.r + m[k].r,
+                           horizon);
+}
+}  // namespace ftc
+
 namespace {
 
 using Kind = Collider::Kind;
@@ -196,14 +232,7 @@ inline double node_bound(const Slice* s, std::size_t stride, const Frame& f, con
 
 // ------------------------------------------------------------------- member sources
 
-// A member of a tree: its columns copied from the source in tree order, so a leaf's members lie
-// together in memory (scans and queries run in tree order). The values are the source's own,
-// untouched, so pair times computed from them are bit-identical to the naive path's.
-struct Member {
-  double x, y, vx, vy, r;
-  uint64_t key;
-  uint32_t row;
-};
+using Member = ftc::Member;  // (index/ftc_pair_lanes.hpp)
 
 // An agent leaf's pair times several at a time (lanes_scan below), up to this many members;
 // larger leaves (leaf_size is an option) are scanned one by one.
@@ -242,43 +271,11 @@ struct AgentSource {
   }
 };
 
-// ray_disc_time of the query against members m[0, n), several at a time in the lanes of xsimd's
-// batches: every case computed in every lane, then selected; the same operations on the same
-// operands as AgentSource::time, lane by lane (IEEE square roots and divisions; -ffp-contract=off
-// keeps products and sums apart), so the same bits. Which case a pair falls in is a coin toss to
-// the predictor: receding, missing, hitting.
+// ray_disc_time of the query against members m[0, n), several at a time in lanes (AVX2's four
+// where the CPU has them and the build's own set is narrower, else the build's): the same bits as
+// AgentSource::time (index/ftc_pair_lanes.hpp).
 void lanes_pair_times(const Member* m, uint32_t n, const Probe& q, double horizon, double* out) {
-  using B = xsimd::batch<double>;
-  constexpr uint32_t L = B::size;
-  const B ax(q.ax), ay(q.ay), avx(q.avx), avy(q.avy), ar(q.ar), hz(horizon), zero(0.0),
-      inf(INFINITY);
-  uint32_t k = 0;
-  for (; k + L <= n; k += L) {
-    alignas(64) double x[L], y[L], vx[L], vy[L], r[L];
-    for (uint32_t l = 0; l < L; ++l) {
-      const Member& u = m[k + l];
-      x[l] = u.x;
-      y[l] = u.y;
-      vx[l] = u.vx;
-      vy[l] = u.vy;
-      r[l] = u.r;
-    }
-    const B dx = B::load_aligned(x) - ax, dy = B::load_aligned(y) - ay;
-    const B wx = B::load_aligned(vx) - avx, wy = B::load_aligned(vy) - avy;
-    const B R = ar + B::load_aligned(r);
-    const B c = dx * dx + dy * dy - R * R;
-    const B b = dx * wx + dy * wy;
-    const B a = wx * wx + wy * wy;
-    const B cross = dx * wy - dy * wx;
-    const B disc = a * (R * R) - cross * cross;
-    const B t = c / (-b + xsimd::sqrt(disc));
-    B time = xsimd::select(t <= hz, t, inf);
-    time = xsimd::select(disc > zero, time, inf);
-    time = xsimd::select(b < zero, time, inf);
-    time = xsimd::select(c < zero, zero, time);
-    time.store_unaligned(out + k);
-  }
-  for (; k < n; ++k) out[k] = AgentSource::time(q, m[k], horizon);  // the tail, one at a time
+  ftc::pair_times(m, n, {q.ax, q.ay, q.avx, q.avy, q.ar}, horizon, out);
 }
 
 struct CircleSource {

@@ -1,0 +1,79 @@
+// The first-to-collide tree's pair times several at a time (index/ftc_tree.cpp), for one
+// instruction set: ray_disc_time of one query against a leaf's members in the lanes of xsimd's
+// batch for Arch. Included by ftc_tree.cpp (the build's own instruction set) and
+// ftc_pair_lanes_avx2.cpp (compiled with -mavx2, called only when the CPU has it): every case
+// computed in every lane, then selected; the same operations on the same operands as
+// ray_disc_time, lane by lane (IEEE square roots and divisions, and no fused multiply-adds:
+// -ffp-contract=off everywhere, and the AVX2 file is not given -mfma), so the same bits.
+// Nothing but xsimd's templates on Arch and this function may be used here: an inline function
+// of another header compiled with -mavx2 could be the copy the linker keeps for everyone.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <xsimd/xsimd.hpp>
+
+namespace crowddb::ftc {
+
+// A member of a tree: its columns copied from the source in tree order, so a leaf's members lie
+// together in memory (scans and queries run in tree order). The values are the source's own,
+// untouched, so pair times computed from them are bit-identical to the naive path's.
+struct Member {
+  double x, y, vx, vy, r;
+  uint64_t key;
+  uint32_t row;
+};
+
+// The query's own columns.
+struct Query {
+  double x, y, vx, vy, r;
+};
+
+// out[k] = ray_disc_time(m[k] - q) for k < n - n % lanes; returns that count (the caller does
+// the tail).
+template <class Arch>
+uint32_t pair_times_lanes(const Member* m, uint32_t n, const Query& q, double horizon,
+                          double* out) {
+  using B = xsimd::batch<double, Arch>;
+  constexpr uint32_t L = B::size;
+  const B ax(q.x), ay(q.y), avx(q.vx), avy(q.vy), ar(q.r), hz(horizon), zero(0.0), inf(INFINITY);
+  uint32_t k = 0;
+  for (; k + L <= n; k += L) {
+    alignas(64) double x[L], y[L], vx[L], vy[L], r[L];
+    for (uint32_t l = 0; l < L; ++l) {
+      const Member& u = m[k + l];
+      x[l] = u.x;
+      y[l] = u.y;
+      vx[l] = u.vx;
+      vy[l] = u.vy;
+      r[l] = u.r;
+    }
+    const B dx = B::load_aligned(x) - ax, dy = B::load_aligned(y) - ay;
+    const B wx = B::load_aligned(vx) - avx, wy = B::load_aligned(vy) - avy;
+    const B R = ar + B::load_aligned(r);
+    const B c = dx * dx + dy * dy - R * R;
+    const B b = dx * wx + dy * wy;
+    const B a = wx * wx + wy * wy;
+    const B cross = dx * wy - dy * wx;
+    const B disc = a * (R * R) - cross * cross;
+    const B t = c / (-b + xsimd::sqrt(disc));
+    B time = xsimd::select(t <= hz, t, inf);
+    time = xsimd::select(disc > zero, time, inf);
+    time = xsimd::select(b < zero, time, inf);
+    time = xsimd::select(c < zero, zero, time);
+    time.store_unaligned(out + k);
+  }
+  return k;
+}
+
+// Does this build call the AVX2 lanes (the CPU has them and the build's own set is narrower)?
+bool pair_times_avx2();
+
+// out[k] = ray_disc_time(m[k] - q) for every k < n: the widest lanes there are (AVX2 where
+// pair_times_avx2()), or the build's own (tests compare both), and the tail one at a time.
+// Defined in ftc_tree.cpp.
+enum class Lanes { widest, build };
+void pair_times(const Member* m, uint32_t n, const Query& q, double horizon, double* out,
+                Lanes lanes = Lanes::widest);
+
+}  // namespace crowddb::ftc
