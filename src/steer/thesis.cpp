@@ -17,6 +17,7 @@
 
 #include "plan/access_path.hpp"
 #include "steer/model.hpp"
+#include "util/stopwatch.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb::steer {
@@ -49,41 +50,70 @@ class ThesisModel final : public Model {
     for (auto* c : {&ax_, &ay_, &fx_, &fy_, &ox_, &oy_, &qx_, &qy_}) c->assign(n, 0.0);
 
     log.timed("Q1 attraction", n, [&] { attraction(in, ex); });
-    if (p.w_apf > 0) {
-      const FieldMethod& m = field_method(in);
-      log.used("field=" + m.info.name);
-      sim::OperatorStats& op = log.at("Q2 inner avoidance");
-      log.timed("Q2 inner avoidance", n, [&] {
-        path(field_paths_, m).run(view, in.scene, p.potential, field_, ex, op.query);
-        ex.for_each_chunk(n, kThesisGrain, [&](std::size_t b, std::size_t e) {
-          for (std::size_t i = b; i < e; ++i) {
-            fx_[i] = -p.w_apf * field_.grad_x[i];
-            fy_[i] = -p.w_apf * field_.grad_y[i];
+    // Q2 and Q3 read the table and write columns of their own: they run beside each other on the
+    // same threads (Executor::both), so that neither's one-thread parts (the field's serial
+    // passes and its two sweeps, which occupy two threads at most; the tree's top levels) leave
+    // a thread idle. Each is timed on its own (EXPLAIN ANALYZE); side by side, their times
+    // overlap.
+    const FieldMethod* field = p.w_apf > 0 ? &field_method(in) : nullptr;
+    const FeatureMethod* edges =
+        field && p.obstacle_repulsion == ThesisParams::ObstacleRepulsion::nearest &&
+                in.scene.feature_count() > 0
+            ? &feature_method(in.cfg.access.edges, in.scene.feature_count())
+            : nullptr;
+    const FtcMethod* ftc = p.w_ftc > 0 ? &ftc_method(in) : nullptr;
+    if (field) log.used("field=" + field->info.name);
+    if (edges) log.used("edges=" + edges->info.name);
+    if (ftc) log.used("ftc=" + ftc->info.name);
+    sim::OperatorStats field_op, edges_op, ftc_op;
+    Stopwatch side_by_side;
+    ex.both(
+        [&] {
+          if (field) {
+            Stopwatch sw;
+            path(field_paths_, *field).run(view, in.scene, p.potential, field_, ex, field_op.query);
+            ex.for_each_chunk(n, kThesisGrain, [&](std::size_t b, std::size_t e) {
+              for (std::size_t i = b; i < e; ++i) {
+                fx_[i] = -p.w_apf * field_.grad_x[i];
+                fy_[i] = -p.w_apf * field_.grad_y[i];
+              }
+            });
+            field_op.seconds = sw.seconds();
           }
+          if (edges) {
+            Stopwatch sw;
+            nearest_obstacles(in, view, *edges, ex, edges_op.query);
+            edges_op.seconds = sw.seconds();
+          }
+        },
+        [&] {
+          if (!ftc) return;
+          Stopwatch sw;
+          hits_.assign(n, FtcHit{});
+          FtcPath& f = path(ftc_paths_, *ftc);
+          // On a tick that starts without overlaps the index skips its overlaps-first pass (cost
+          // only: the answers are the same).
+          f.assume_no_overlaps(in.no_overlaps);
+          f.run(view, in.scene, p.horizon, hits_, ex, ftc_op.query);
+          outer(in, ex);
+          ftc_op.seconds = sw.seconds();
         });
-      });
-      if (p.obstacle_repulsion == ThesisParams::ObstacleRepulsion::nearest &&
-          in.scene.feature_count() > 0) {
-        const FeatureMethod& fm = feature_method(in.cfg.access.edges, in.scene.feature_count());
-        log.used("edges=" + fm.info.name);
-        sim::OperatorStats& fop = log.at("Q2 obstacles");
-        log.timed("Q2 obstacles", n, [&] { nearest_obstacles(in, view, fm, ex, fop.query); });
-      }
+    log.side_by_side(field_op.seconds + edges_op.seconds + ftc_op.seconds, side_by_side.seconds());
+    const bool beside = ftc && field && ex.threads() > 1;
+    if (field) {
+      sim::OperatorStats& op = log.book("Q2 inner avoidance", n, field_op.seconds);
+      op.query += field_op.query;
+      if (beside) op.beside = "Q3 outer avoidance";
     }
-    if (p.w_ftc > 0) {
-      const FtcMethod& m = ftc_method(in);
-      log.used("ftc=" + m.info.name);
-      sim::OperatorStats& op = log.at("Q3 outer avoidance");
-      log.timed("Q3 outer avoidance", n, [&] {
-        hits_.assign(n, FtcHit{});
-        FtcPath& ftc = path(ftc_paths_, m);
-        // On a tick that starts without overlaps the index skips its overlaps-first pass (cost
-        // only: the answers are the same).
-        ftc.assume_no_overlaps(in.no_overlaps);
-        ftc.run(view, in.scene, p.horizon, hits_, ex, op.query);
-        op.count("ticks started without overlaps", in.no_overlaps ? 1 : 0);
-        outer(in, ex);
-      });
+    if (edges) {
+      sim::OperatorStats& op = log.book("Q2 obstacles", n, edges_op.seconds);
+      op.query += edges_op.query;
+      if (beside) op.beside = "Q3 outer avoidance";
+    }
+    if (ftc) {
+      sim::OperatorStats& op = log.book("Q3 outer avoidance", n, ftc_op.seconds);
+      op.query += ftc_op.query;
+      op.count("ticks started without overlaps", in.no_overlaps ? 1 : 0);
     }
     log.timed("combine", n, [&] { combine(in, vx, vy, ex); });
   }
