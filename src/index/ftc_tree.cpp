@@ -234,8 +234,8 @@ inline double node_bound(const Slice* s, std::size_t stride, const Frame& f, con
 
 using Member = ftc::Member;  // (index/ftc_pair_lanes.hpp)
 
-// An agent leaf's pair times several at a time (lanes_scan below), up to this many members;
-// larger leaves (leaf_size is an option) are scanned one by one.
+// An agent leaf's pair times several at a time (scan below), up to this many members; larger
+// leaves (leaf_size and leaf_size_apart are options) are scanned one by one.
 constexpr uint32_t kLaneLeaf = 64;
 
 struct ProbeScratch {
@@ -1209,8 +1209,9 @@ std::size_t FtcIndex::node_count() const {
 bool FtcIndex::uses_chord_bound() const {
   return impl_->frame.chord;
 }
-void FtcIndex::assume_no_overlaps(bool yes) {
+bool FtcIndex::assume_no_overlaps(bool yes) {
   impl_->no_overlaps = yes;
+  return true;
 }
 const FtcIndexOptions& FtcIndex::options() const {
   return impl_->opt;

@@ -8,7 +8,8 @@
 // naive path's inputs, and the index only decides which pairs need computing.
 //
 // STRUCTURE. A k-d tree over the positions at t = 0: median split of the wider side of the cell,
-// leaves of at most leaf_size members, members of a leaf sorted by key (id). The index reads the
+// leaves of at most leaf_size members (leaf_size_apart once told that no discs overlap,
+// assume_no_overlaps), members of a leaf sorted by key (id). The index reads the
 // rows through the DiscView and keeps a copy of each member's columns (x, y, v, r, id, row) in
 // tree order, so a leaf's members lie together in memory and queries, run in tree order, read
 // memory in order; the copies are the rows' own values, so pair times are unchanged. It also
@@ -52,21 +53,21 @@
 // when the answer STRICTLY precedes (bound, kind, min_key) of the node: a node whose bound equals
 // the best time may still hold an equal-time member with a smaller id. The queue is ordered by
 // (bound, min_key) and the search stops when its smallest entry is skipped (nothing later can
-// win). Order (leaf_queue, default): (1) overlaps first: an agent overlapping a now wins outright
-// (time 0, agents first), and finding the smallest such (id, row) needs only t = 0 tests: at the
-// E1 density ~90% of agents end here. It runs set-at-a-time, leaf by leaf (overlap_join): a walk
-// from the root collects the members of every leaf whose t = 0 box lies within Chebyshev
-// distance r_max(leaf) + r_max(other) of the leaf's box, keeping those within r_max(leaf) + r_b
-// of it (the boxes carry the delta0 inflation, so rounding cannot drop an overlapping member);
-// then every member of the leaf is tested against all of them with ray_disc_time's own overlap
-// term (c = |d|^2 - R^2 < 0, the same expression, so the same bits) in a loop the compiler
-// vectorizes, and the overlapping ones (a few) are compared by (id, row). Queries run in tree
-// order, so the join runs once per leaf (~37 tests per agent at the E1 density, no queue, no
-// unpredictable branches). With overlap_join off, the same answer comes from the tree search
-// below with t = 0 bounds. (2) otherwise a's own leaf is scanned (its neighbours give an early best
-// time), then the path is walked up to the root: each sibling's bound goes into the queue; the walk
-// stops once every position from which a member could still reach a before the best time (a's
-// centre
+// win). Order (leaf_queue, default): (1) overlaps first (skipped once told that no discs overlap):
+// an agent overlapping a now wins outright (time 0, agents first), and finding the smallest such
+// (id, row) needs only t = 0 tests: at the E1 density ~90% of agents end here. It runs
+// set-at-a-time, leaf by leaf (overlap_join): a walk from the root collects the members of every
+// leaf whose t = 0 box lies within Chebyshev distance r_max(leaf) + r_max(other) of the leaf's box,
+// keeping those within r_max(leaf) + r_b of it (the boxes carry the delta0 inflation, so rounding
+// cannot drop an overlapping member); then every member of the leaf is tested against all of them
+// with ray_disc_time's own overlap term (c = |d|^2 - R^2 < 0, the same expression, so the same
+// bits) in a loop the compiler vectorizes, and the overlapping ones (a few) are compared by (id,
+// row). Queries run in tree order, so the join runs once per leaf (~37 tests per agent at the E1
+// density, no queue, no unpredictable branches). With overlap_join off, the same answer comes from
+// the tree search below with t = 0 bounds. (2) otherwise a's own leaf is scanned (its neighbours
+// give an early best time), then the path is walked up to the root: each sibling's bound goes into
+// the queue; the walk stops once every position from which a member could still reach a before the
+// best time (a's centre
 // +- R_max + (|v_a| + v_max) cap per axis) lies strictly inside the cell below: all other members
 // lie outside that cell. (3) The queue is searched in bound order, descending into the child with
 // the smaller bound and queueing the other. Any visiting order is exact; the order only changes
@@ -169,13 +170,13 @@ class FtcIndex final : public FtcPath {
   // nothing (every option is exact, so a wrong hint costs time only). The thesis model gives
   // it on ticks that start without overlaps (airport-20k: the overlap join was 3-4 % of the
   // query's time there).
-  void assume_no_overlaps(bool yes) override;
+  bool assume_no_overlaps(bool yes) override;
 
   // The two halves of run(), for tests, benchmarks and experiments. The index keeps pointers
   // into `discs` and `scene`: they must stay alive and unchanged while it is queried.
   // Throws Error(input) naming the row and column when a disc has a non-finite value.
-  // With `ex`, large trees are built on its threads (the same tree, node for node); not from
-  // inside one of that executor's loops (it is not re-entrant).
+  // With `ex`, large trees are built on its threads (the same tree, node for node); one build
+  // per index at a time, which may run inside a task of Executor::both or a loop's body.
   void build(const DiscView& discs, const StaticScene& scene, double horizon,
              Executor* ex = nullptr);
   // out[i] for every disc i; deterministic whatever the executor's thread count.

@@ -28,8 +28,9 @@ class FtcPath {
   // the sum of their radii), as the engine knows at the start of a tick after one whose backoff
   // left no overlapping pair (and no insert since). A method may then skip work that only pays
   // where many overlap. It changes the cost only: the answers are the same with or without it,
-  // true or not. Off by default.
-  virtual void assume_no_overlaps(bool /*yes*/) {}
+  // true or not. Off by default. Returns whether the method acts on the hint (EXPLAIN ANALYZE
+  // counts the ticks on which it did).
+  virtual bool assume_no_overlaps(bool /*yes*/) { return false; }
 };
 
 class FieldPath {

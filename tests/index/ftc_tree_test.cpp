@@ -184,6 +184,14 @@ TEST(FtcIndex, NoOverlapsHintChangesTheCostNotTheAnswers) {
       EXPECT_EQ(compare(*t, kNoScene, 30, o, 1, nullptr, false), 0);
     }
   }
+  // Large enough (4,096 members and more) for the tree with the larger leaves to be built on
+  // every thread.
+  DiscTable many;
+  for (uint64_t i = 0; i < 6400; ++i)
+    many.push_back(i, 8.0 * static_cast<double>(i % 80) + rng.uniform(0, 1),
+                   8.0 * static_cast<double>(i / 80) + rng.uniform(0, 1), rng.uniform(-2, 2),
+                   rng.uniform(-2, 2), rng.uniform(1, 3));
+  EXPECT_EQ(compare(many, kNoScene, 30, {}, 2, nullptr, true), 0);
   QueryStats told, not_told;
   const Opt same_leaves{.leaf_size_apart = Opt{}.leaf_size};
   EXPECT_EQ(compare(apart, kNoScene, 30, same_leaves, 1, &told, true), 0);
@@ -476,11 +484,15 @@ TEST(FtcIndex, LanesAreTheScalarReferenceBitForBit) {
   EXPECT_EQ(compared, 75);
 }
 
-// Random tables of every shape, random options: the property test.
 // The pair times in lanes, the widest (AVX2 where the CPU has it) and the build's own, are
 // ray_disc_time's bit for bit: overlapping, approaching, receding, grazing and resting pairs,
 // near the origin and 10^6 m from it, leaves of 0 to 70 members (whole vectors and tails).
 TEST(FtcIndex, PairTimesInLanesAreRayDiscTimeBitForBit) {
+#if CROWDDB_TEST_AVX2_DISPATCH && !defined(__AVX2__)
+  // The AVX2 copy is in the build (whose own lanes are narrower): it must be the one taken
+  // where the CPU has AVX2.
+  EXPECT_EQ(ftc::pair_times_avx2(), __builtin_cpu_supports("avx2") != 0);
+#endif
   Rng rng(2024);
   if (!ftc::pair_times_avx2()) GTEST_LOG_(INFO) << "no AVX2 lanes here: both are the build's";
   for (int round = 0; round < 400; ++round) {
@@ -531,6 +543,8 @@ TEST(FtcIndex, PairTimesInLanesAreRayDiscTimeBitForBit) {
   }
 }
 
+// Random tables of every shape, random options, told or not that nothing overlaps (a hint that
+// may be wrong: it changes the cost only): the property test.
 TEST(FtcIndex, PropertyManySeeds) {
   const auto options = all_options();
   int failures = 0;
@@ -544,7 +558,8 @@ TEST(FtcIndex, PropertyManySeeds) {
     const StaticScene scene =
         rng.below(3) == 0 ? obstacle_scene(seed, rng.below(10), rng.below(4)) : StaticScene{};
     const Opt& o = options[rng.below(options.size())];
-    failures += compare(t, scene, horizon, o, 1 + static_cast<int>(rng.below(2)));
+    failures += compare(t, scene, horizon, o, 1 + static_cast<int>(rng.below(2)), nullptr,
+                        rng.below(2) == 0);
     if (failures) ADD_FAILURE() << "seed " << seed;
   }
 }

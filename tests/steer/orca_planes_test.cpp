@@ -110,6 +110,11 @@ TEST(OrcaPlanes, BatchMatchesTheReferenceBitForBit) {
   // Without wider lanes (no AVX2 here, or a build whose own are that wide) both PlaneLanes are
   // the same code, and the comparison between them above shows nothing: said, not hidden.
   if (!wider_plane_lanes()) std::cout << "[ note ] no lanes wider than the build's on this CPU\n";
+#if CROWDDB_TEST_AVX2_DISPATCH && !defined(__AVX2__)
+  // The AVX2 copy is in the build (whose own lanes are narrower): it must be the one taken
+  // where the CPU has AVX2.
+  EXPECT_EQ(wider_plane_lanes(), __builtin_cpu_supports("avx2") != 0);
+#endif
 }
 
 }  // namespace
