@@ -30,13 +30,14 @@ struct Query {
 };
 
 // out[k] = ray_disc_time(m[k] - q) for k < n - n % lanes; returns that count (the caller does
-// the tail).
+// the tail), and `earliest`, the smallest of those times (+inf when none).
 template <class Arch>
-uint32_t pair_times_lanes(const Member* m, uint32_t n, const Query& q, double horizon,
-                          double* out) {
+uint32_t pair_times_lanes(const Member* m, uint32_t n, const Query& q, double horizon, double* out,
+                          double& earliest) {
   using B = xsimd::batch<double, Arch>;
   constexpr uint32_t L = B::size;
   const B ax(q.x), ay(q.y), avx(q.vx), avy(q.vy), ar(q.r), hz(horizon), zero(0.0), inf(INFINITY);
+  B soonest = inf;
   uint32_t k = 0;
   for (; k + L <= n; k += L) {
     alignas(64) double x[L], y[L], vx[L], vy[L], r[L];
@@ -62,7 +63,12 @@ uint32_t pair_times_lanes(const Member* m, uint32_t n, const Query& q, double ho
     time = xsimd::select(b < zero, time, inf);
     time = xsimd::select(c < zero, zero, time);
     time.store_unaligned(out + k);
+    soonest = xsimd::min(soonest, time);
   }
+  alignas(64) double lanes[L];
+  soonest.store_aligned(lanes);
+  earliest = INFINITY;
+  for (uint32_t l = 0; l < L; ++l) earliest = lanes[l] < earliest ? lanes[l] : earliest;
   return k;
 }
 
@@ -71,9 +77,9 @@ bool pair_times_avx2();
 
 // out[k] = ray_disc_time(m[k] - q) for every k < n: the widest lanes there are (AVX2 where
 // pair_times_avx2()), or the build's own (tests compare both), and the tail one at a time.
-// Defined in ftc_tree.cpp.
+// Returns the smallest of them (+inf when none, or n = 0). Defined in ftc_tree.cpp.
 enum class Lanes { widest, build };
-void pair_times(const Member* m, uint32_t n, const Query& q, double horizon, double* out,
-                Lanes lanes = Lanes::widest);
+double pair_times(const Member* m, uint32_t n, const Query& q, double horizon, double* out,
+                  Lanes lanes = Lanes::widest);
 
 }  // namespace crowddb::ftc

@@ -5,8 +5,8 @@
 namespace crowddb::ftc {
 
 uint32_t pair_times_lanes_avx2(const Member* m, uint32_t n, const Query& q, double horizon,
-                               double* out) {
-  return pair_times_lanes<xsimd::avx2>(m, n, q, horizon, out);
+                               double* out, double& earliest) {
+  return pair_times_lanes<xsimd::avx2>(m, n, q, horizon, out, earliest);
 }
 
 }  // namespace crowddb::ftc

@@ -25,7 +25,7 @@ namespace ftc {
 #define CROWDDB_FTC_DISPATCH 1
 // ftc_pair_lanes_avx2.cpp: the lanes of AVX2, for a build whose own instruction set is narrower.
 uint32_t pair_times_lanes_avx2(const Member* m, uint32_t n, const Query& q, double horizon,
-                               double* out);
+                               double* out, double& earliest);
 #endif
 
 bool pair_times_avx2() {
@@ -38,19 +38,23 @@ bool pair_times_avx2() {
 #endif
 }
 
-void pair_times(const Member* m, uint32_t n, const Query& q, double horizon, double* out,
-                Lanes lanes) {
+double pair_times(const Member* m, uint32_t n, const Query& q, double horizon, double* out,
+                  Lanes lanes) {
+  double earliest = INFINITY;
 #if CROWDDB_FTC_DISPATCH
   uint32_t k = pair_times_avx2() && lanes == Lanes::widest
-                   ? pair_times_lanes_avx2(m, n, q, horizon, out)
-                   : pair_times_lanes<xsimd::default_arch>(m, n, q, horizon, out);
+                   ? pair_times_lanes_avx2(m, n, q, horizon, out, earliest)
+                   : pair_times_lanes<xsimd::default_arch>(m, n, q, horizon, out, earliest);
 #else
   (void)lanes;  // the build's lanes are the widest there are
-  uint32_t k = pair_times_lanes<xsimd::default_arch>(m, n, q, horizon, out);
+  uint32_t k = pair_times_lanes<xsimd::default_arch>(m, n, q, horizon, out, earliest);
 #endif
-  for (; k < n; ++k)  // the tail, one at a time (AgentSource::time's expression)
+  for (; k < n; ++k) {  // the tail, one at a time (AgentSource::time's expression)
     out[k] = ray_disc_time(m[k].x - q.x, m[k].y - q.y, m[k].vx - q.vx, m[k].vy - q.vy, q.r + m[k].r,
                            horizon);
+    earliest = std::min(earliest, out[k]);
+  }
+  return earliest;
 }
 }  // namespace ftc
 
@@ -274,8 +278,8 @@ struct AgentSource {
 // ray_disc_time of the query against members m[0, n), several at a time in lanes (AVX2's four
 // where the CPU has them and the build's own set is narrower, else the build's): the same bits as
 // AgentSource::time (index/ftc_pair_lanes.hpp).
-void lanes_pair_times(const Member* m, uint32_t n, const Probe& q, double horizon, double* out) {
-  ftc::pair_times(m, n, {q.ax, q.ay, q.avx, q.avy, q.ar}, horizon, out);
+double lanes_pair_times(const Member* m, uint32_t n, const Probe& q, double horizon, double* out) {
+  return ftc::pair_times(m, n, {q.ax, q.ay, q.avx, q.avy, q.ar}, horizon, out);
 }
 
 struct CircleSource {
@@ -687,7 +691,17 @@ void KineticTree<Src>::scan(uint32_t node, const Probe& q, double horizon, Best&
     const uint32_t n = nd.end - nd.begin;
     if (f_->lanes && n <= kLaneLeaf) {
       double times[kLaneLeaf];
-      lanes_pair_times(&items_[nd.begin], n, q, horizon, times);
+      const double earliest = lanes_pair_times(&items_[nd.begin], n, q, horizon, times);
+      // Usually no member can win (most never collide within the horizon, or later than the
+      // answer so far): the loop below would then offer only losers and never break (it breaks
+      // only once the answer has time 0), so only its count is needed. (The query's own row,
+      // at time 0 with itself unless its radius is 0, keeps its leaf in the loop.)
+      if (best.kind == Kind::none ? earliest == INFINITY : best.t > 0 && earliest > best.t) {
+        const bool self =
+            q.self != kNoRow && pos_of_[q.self] >= nd.begin && pos_of_[q.self] < nd.end;
+        c.pair_tests += n - (self ? 1 : 0);
+        return;
+      }
       for (uint32_t k = 0; k < n; ++k) {
         const Member& m = items_[nd.begin + k];
         if (best.beats(0, Src::kind, m.key)) break;
