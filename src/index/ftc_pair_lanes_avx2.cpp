@@ -4,7 +4,7 @@
 
 namespace crowddb::ftc {
 
-uint32_t pair_times_lanes_avx2(const Member* m, uint32_t n, const Query& q, double horizon,
+uint32_t pair_times_lanes_avx2(const Columns& m, uint32_t n, const Query& q, double horizon,
                                double* out, double& earliest) {
   return pair_times_lanes<xsimd::avx2>(m, n, q, horizon, out, earliest);
 }

@@ -24,7 +24,7 @@ namespace ftc {
 #if CROWDDB_FTC_AVX2 && !XSIMD_WITH_AVX2
 #define CROWDDB_FTC_DISPATCH 1
 // ftc_pair_lanes_avx2.cpp: the lanes of AVX2, for a build whose own instruction set is narrower.
-uint32_t pair_times_lanes_avx2(const Member* m, uint32_t n, const Query& q, double horizon,
+uint32_t pair_times_lanes_avx2(const Columns& m, uint32_t n, const Query& q, double horizon,
                                double* out, double& earliest);
 #endif
 
@@ -38,7 +38,7 @@ bool pair_times_avx2() {
 #endif
 }
 
-double pair_times(const Member* m, uint32_t n, const Query& q, double horizon, double* out,
+double pair_times(const Columns& m, uint32_t n, const Query& q, double horizon, double* out,
                   Lanes lanes) {
   double earliest = INFINITY;
 #if CROWDDB_FTC_DISPATCH
@@ -50,7 +50,7 @@ double pair_times(const Member* m, uint32_t n, const Query& q, double horizon, d
   uint32_t k = pair_times_lanes<xsimd::default_arch>(m, n, q, horizon, out, earliest);
 #endif
   for (; k < n; ++k) {  // the tail, one at a time (AgentSource::time's expression)
-    out[k] = ray_disc_time(m[k].x - q.x, m[k].y - q.y, m[k].vx - q.vx, m[k].vy - q.vy, q.r + m[k].r,
+    out[k] = ray_disc_time(m.x[k] - q.x, m.y[k] - q.y, m.vx[k] - q.vx, m.vy[k] - q.vy, q.r + m.r[k],
                            horizon);
     earliest = std::min(earliest, out[k]);
   }
@@ -278,7 +278,8 @@ struct AgentSource {
 // ray_disc_time of the query against members m[0, n), several at a time in lanes (AVX2's four
 // where the CPU has them and the build's own set is narrower, else the build's): the same bits as
 // AgentSource::time (index/ftc_pair_lanes.hpp).
-double lanes_pair_times(const Member* m, uint32_t n, const Probe& q, double horizon, double* out) {
+double lanes_pair_times(const ftc::Columns& m, uint32_t n, const Probe& q, double horizon,
+                        double* out) {
   return ftc::pair_times(m, n, {q.ax, q.ay, q.avx, q.avy, q.ar}, horizon, out);
 }
 
@@ -396,6 +397,13 @@ class KineticTree {
   // Reach of any member: largest radius and speeds per axis (for the bottom-up walk's stop).
   double reach_r_ = 0, reach_vx_ = 0, reach_vy_ = 0;
   std::vector<Item> items_;  // the members in tree order (copied from the source at the leaves)
+  // Their x, y, vx, vy and r again, column by column (n each, in that order), for the lanes.
+  std::vector<double> cols_;
+  ftc::Columns columns() const {
+    const double* p = cols_.data();
+    const std::size_t n = items_.size();
+    return {p, p + n, p + 2 * n, p + 3 * n, p + 4 * n};
+  }
   // build scratch: the positions the median splits partition (small, so they move cheaply)
   struct Pt {
     double x, y;  // the source's values (x - ox is monotone in x: raw order is frame order)
@@ -429,6 +437,7 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
   cells_.clear();
   if (n == 0) return;
   items_.resize(n);
+  cols_.resize(5 * std::size_t{n});
   pts_.resize(n);
   double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   for (uint32_t i = 0; i < n; ++i) {
@@ -542,6 +551,16 @@ uint32_t KineticTree<Src>::build_node(uint32_t idx, uint32_t b, uint32_t e, uint
     std::sort(items_.begin() + b, items_.begin() + e, [](const Item& p, const Item& q) {
       return p.key != q.key ? p.key < q.key : p.row < q.row;
     });
+    const std::size_t n = items_.size();
+    for (uint32_t i = b; i < e; ++i) {
+      const Item& it = items_[i];
+      double* const c = cols_.data() + i;
+      c[0] = it.x;
+      c[n] = it.y;
+      c[2 * n] = it.vx;
+      c[3 * n] = it.vy;
+      c[4 * n] = it.r;
+    }
     leaf_bounds(idx);
   } else {
     Cell lc, rc;
@@ -691,7 +710,7 @@ void KineticTree<Src>::scan(uint32_t node, const Probe& q, double horizon, Best&
     const uint32_t n = nd.end - nd.begin;
     if (f_->lanes && n <= kLaneLeaf) {
       double times[kLaneLeaf];
-      const double earliest = lanes_pair_times(&items_[nd.begin], n, q, horizon, times);
+      const double earliest = lanes_pair_times(columns().from(nd.begin), n, q, horizon, times);
       // Usually no member can win (most never collide within the horizon, or later than the
       // answer so far): the loop below would then offer only losers and never break (it breaks
       // only once the answer has time 0), so only its count is needed. (The query's own row,

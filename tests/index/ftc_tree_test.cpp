@@ -533,10 +533,21 @@ TEST(FtcIndex, PairTimesInLanesAreRayDiscTimeBitForBit) {
           break;
       }
     }
+    // Column by column, as a tree keeps them (each column a vector of its own, so reading past
+    // the n-th value is the sanitizers' to catch).
+    std::vector<double> xs(n), ys(n), vxs(n), vys(n), rs(n);
+    for (uint32_t k = 0; k < n; ++k) {
+      xs[k] = m[k].x;
+      ys[k] = m[k].y;
+      vxs[k] = m[k].vx;
+      vys[k] = m[k].vy;
+      rs[k] = m[k].r;
+    }
+    const ftc::Columns columns{xs.data(), ys.data(), vxs.data(), vys.data(), rs.data()};
     const double horizon = round % 3 ? 30 : INFINITY;
     for (ftc::Lanes lanes : {ftc::Lanes::widest, ftc::Lanes::build}) {
       std::vector<double> got(n);
-      const double earliest = ftc::pair_times(m.data(), n, q, horizon, got.data(), lanes);
+      const double earliest = ftc::pair_times(columns, n, q, horizon, got.data(), lanes);
       double want_earliest = INFINITY;
       for (uint32_t k = 0; k < n; ++k) {
         const ftc::Member& u = m[k];
