@@ -13,7 +13,7 @@ constexpr double kMaxCandidates = 8;  // one class while it costs fewer candidat
 
 }  // namespace
 
-void DiscGrid::build(const DiscView& d) {
+void DiscGrid::build(const DiscView& d, Executor* ex) {
   frame_ = Frame::of(d);
   if (!frame_.finite || d.n == 0) {
     levels_.clear();
@@ -27,7 +27,7 @@ void DiscGrid::build(const DiscView& d) {
   const double per_disc = area > 0 ? 4.5 * static_cast<double>(d.n) / area * cell * cell : INFINITY;
   if (frame_.rmax <= kClassRatio * frame_.rmin || per_disc <= kMaxCandidates) {
     levels_.resize(1);
-    levels_[0].build_all(d, frame_, frame_.rmax);
+    levels_[0].build_all(d, frame_, frame_.rmax, ex);
     return;
   }
   // Radius classes: floor(log_4(r / rmin)); a counting sort of the rows by class.
@@ -55,7 +55,7 @@ void DiscGrid::build(const DiscView& d) {
     levels_.emplace_back();
     levels_.back().build(
         d, std::span<const uint32_t>(class_rows_).subspan(start[c], start[c + 1] - start[c]),
-        frame_, rmax[c]);
+        frame_, rmax[c], ex);
   }
 }
 
@@ -90,7 +90,7 @@ void CollisionGrid::run(const DiscView& d, const StaticScene& scene, CollisionPa
                         Executor& ex, QueryStats& stats) {
   Stopwatch sw;
   out.clear();
-  grid_.build(d);
+  grid_.build(d, &ex);
   if (!grid_.usable()) {
     CollisionNaive().run(d, scene, out, ex, stats);
     return;

@@ -27,10 +27,13 @@ namespace crowddb::index {
 
 class DiscGrid {
  public:
-  // Indexes all rows of d. d's columns must outlive the queries.
-  void build(const DiscView& d);
+  // Indexes all rows of d. d's columns must outlive the queries. With `ex`, a level's keys and
+  // sort run on its threads (the same index).
+  void build(const DiscView& d, Executor* ex = nullptr);
   const Frame& frame() const { return frame_; }
   bool usable() const { return frame_.finite; }  // false: non-finite input, use the naive loop
+  // One level per class of radii (ascending); one when the radii are equal.
+  const std::vector<CellIndex>& levels() const { return levels_; }
 
   // Every overlapping pair (rows, i < j), appended unsorted.
   void pairs(PairList& out, uint64_t& tests) const;
@@ -55,6 +58,7 @@ class CollisionGrid final : public CollisionPath {
  public:
   void run(const DiscView& discs, const StaticScene& scene, CollisionPairs& out, Executor& ex,
            QueryStats& stats) override;
+  const DiscGrid* disc_grid() const override { return grid_.usable() ? &grid_ : nullptr; }
 
  private:
   DiscGrid grid_;

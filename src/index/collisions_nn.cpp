@@ -21,19 +21,20 @@ void CollisionNn::run(const DiscView& d, const StaticScene& scene, CollisionPair
       throw Error(Error::Kind::usage, "collision method 'nn' needs equal radii (row " +
                                           std::to_string(i) +
                                           " differs from row 0); use grid, sweep or naive");
-  const Frame frame = Frame::of(d);
-  if (!frame.finite) {
+  Stopwatch sw;
+  grid_.build(d, &ex);  // equal radii: one level, cells of side >= 2R
+  if (!grid_.usable()) {
     CollisionNaive().run(d, scene, out, ex, stats);
     return;
   }
-  Stopwatch sw;
-  cells_.build_all(d, frame, R, &ex);
+  const CellIndex& cells = grid_.levels().front();
+  const Frame& frame = grid_.frame();
   stats.build_seconds += sw.seconds();
   sw.restart();
   // Each candidate pair once (half neighbourhood), updating both discs' nearest neighbour:
   // the order of updates does not matter, (distance, row) is a total order.
   const double rsum = R + R, limit = rsum * rsum;
-  const std::size_t m = cells_.size();
+  const std::size_t m = cells.size();
   // On several threads each takes the cells of one range of entries and keeps its own nearest
   // per entry (a pair may touch an entry of the other range); the lists are merged by the same
   // total order, (distance, row), so the result is that of one pass.
@@ -52,13 +53,13 @@ void CollisionNn::run(const DiscView& d, const StaticScene& scene, CollisionPair
         best_row[k] = row;
       }
     };
-    part_tests[p] = cells_.for_each_candidate(
+    part_tests[p] = cells.for_each_candidate(
         [&](std::size_t a, std::size_t b) {
-          const double dx = cells_.x(b) - cells_.x(a), dy = cells_.y(b) - cells_.y(a);
+          const double dx = cells.x(b) - cells.x(a), dy = cells.y(b) - cells.y(a);
           const double d2 = dx * dx + dy * dy;  // as discs_overlap computes it
           if (d2 < limit) {
-            offer(a, d2, cells_.row(b));
-            offer(b, d2, cells_.row(a));
+            offer(a, d2, cells.row(b));
+            offer(b, d2, cells.row(a));
           }
         },
         m * p / parts, m * (p + 1) / parts);
@@ -78,7 +79,7 @@ void CollisionNn::run(const DiscView& d, const StaticScene& scene, CollisionPair
       }
     }
   for (std::size_t k = 0; k < m; ++k)
-    if (best_row[k] != kNone) out.agents.push_back(ordered(cells_.row(k), best_row[k]));
+    if (best_row[k] != kNone) out.agents.push_back(ordered(cells.row(k), best_row[k]));
   finish_pairs(out.agents);
   if (!scene.empty()) {
     obstacles_.build(scene, frame);

@@ -11,13 +11,15 @@
 // (CollisionQueryShape::need_all_pairs).
 //
 // The query is bounded: only neighbours closer than 2R matter, and they lie in the 3 x 3 block of
-// cells of side >= 2R around the disc, so a single-level CellIndex answers it exactly in
-// O(n + candidates), each candidate pair examined once for both discs. Distances are compared as
+// cells of side >= 2R around the disc, so a single-level CellIndex (DiscGrid's one level for equal
+// radii, lent to the backoff's probes) answers it exactly in O(n + candidates), each candidate
+// pair examined once for both discs. Distances are compared as
 // the oracle computes them (dx*dx + dy*dy against (R + R)^2), so "closer than 2R" agrees with
 // discs_overlap bit for bit.
 #pragma once
 
 #include "index/cell_index.hpp"
+#include "index/collisions_grid.hpp"
 #include "index/obstacle_index.hpp"
 #include "plan/access_path.hpp"
 
@@ -28,9 +30,10 @@ class CollisionNn final : public CollisionPath {
   // Throws Error(usage) when the radii are not all equal.
   void run(const DiscView& discs, const StaticScene& scene, CollisionPairs& out, Executor& ex,
            QueryStats& stats) override;
+  const DiscGrid* disc_grid() const override { return grid_.usable() ? &grid_ : nullptr; }
 
  private:
-  CellIndex cells_;
+  DiscGrid grid_;
   ObstacleIndex obstacles_;
   // Per part of the entries (one per thread): per entry, the squared distance to its nearest
   // neighbour so far, and that neighbour's row.

@@ -18,6 +18,10 @@
 
 namespace crowddb {
 
+namespace index {
+class DiscGrid;
+}
+
 class FtcPath {
  public:
   virtual ~FtcPath() = default;
@@ -53,6 +57,10 @@ class CollisionPath {
   // the pairs the method finds (heuristics, which may miss some but never invent one).
   virtual void run(const DiscView& discs, const StaticScene& scene, CollisionPairs& out,
                    Executor& ex, QueryStats& stats) = 0;
+  // The index the last run built over its discs, when the method keeps one that answers
+  // DiscGrid's overlap probes (the freeze loop then probes it rather than build its own);
+  // nullptr otherwise. Valid until the next run; it holds the discs as they were then.
+  virtual const index::DiscGrid* disc_grid() const { return nullptr; }
 };
 
 class NeighbourPath {

@@ -39,14 +39,19 @@ void freeze(const AgentTable& t, NextState& next, uint32_t i) {
 // probes of the freeze loop. Agents frozen after the grid was built sit elsewhere now: their
 // grid entries are skipped and they are checked one by one until there are enough of them to
 // rebuild. Small probe batches on small tables skip the grid altogether.
+//
+// The grid is the one the tick's collision query built over the same discs, when it lends one
+// (CollisionPath::disc_grid): the rows frozen since count as moved. A grid of its own is built
+// only without it (the model's neighbour lists answered the query, or its method keeps no grid),
+// or once enough rows have moved.
 class OverlapProbe {
  public:
-  explicit OverlapProbe(const DiscView& view) : view_(view), stale_(view.n, 0) {}
+  OverlapProbe(const DiscView& view, const index::DiscGrid* lent)
+      : view_(view), grid_(lent), built_(lent != nullptr), stale_(view.n, 0) {}
 
   void prepare(std::size_t probes) {
     if (built_ || probes * view_.n <= kBruteWork) return;
-    grid_.build(view_);
-    built_ = grid_.usable();
+    build();
   }
   void moved(std::span<const uint32_t> rows) {
     if (!built_) return;
@@ -54,11 +59,17 @@ class OverlapProbe {
       if (!stale_[r]) {
         stale_[r] = 1;
         moved_.push_back(r);
+        moved_x_.push_back(view_.x[r]);  // where it is now, and stays: frozen once, for good
+        moved_y_.push_back(view_.y[r]);
+        moved_r_.push_back(view_.radius[r]);
       }
     if (moved_.size() > std::max<std::size_t>(64, view_.n / 8)) {
-      grid_.build(view_);
+      build();
       for (uint32_t r : moved_) stale_[r] = 0;
       moved_.clear();
+      moved_x_.clear();
+      moved_y_.clear();
+      moved_r_.clear();
     }
   }
   template <class F>
@@ -71,19 +82,41 @@ class OverlapProbe {
       for (std::size_t b = 0; b < view_.n; ++b) test(static_cast<uint32_t>(b));
       return;
     }
-    grid_.for_each_overlap(x, y, r, [&](uint32_t b) {
+    grid_->for_each_overlap(x, y, r, [&](uint32_t b) {
       if (!stale_[b] && b != a) fn(b);
     });
-    for (uint32_t b : moved_) test(b);
+    // The moved rows from their own columns, a batch at a time without branches (a lent grid
+    // leaves every row frozen since the tick's query here: hundreds a probe in a jam).
+    const std::size_t m = moved_.size();
+    const double *mx = moved_x_.data(), *my = moved_y_.data(), *mr = moved_r_.data();
+    for (std::size_t u0 = 0; u0 < m; u0 += kMovedBatch) {
+      const std::size_t u1 = std::min(m, u0 + kMovedBatch);
+      uint32_t hit[kMovedBatch];
+      uint32_t h = 0;
+      for (std::size_t u = u0; u < u1; ++u) {
+        hit[h] = static_cast<uint32_t>(u);
+        h += static_cast<uint32_t>(discs_overlap(mx[u] - x, my[u] - y, r + mr[u]));
+      }
+      for (uint32_t k = 0; k < h; ++k)
+        if (moved_[hit[k]] != a) fn(moved_[hit[k]]);
+    }
   }
 
  private:
   static constexpr std::size_t kBruteWork = 1 << 16;  // pair tests below which a scan is cheaper
+  static constexpr std::size_t kMovedBatch = 64;
+  void build() {
+    own_.build(view_);
+    grid_ = &own_;
+    built_ = own_.usable();
+  }
   DiscView view_;
-  index::DiscGrid grid_;
-  bool built_ = false;
+  const index::DiscGrid* grid_;
+  index::DiscGrid own_;
+  bool built_;
   std::vector<uint8_t> stale_;
   std::vector<uint32_t> moved_;
+  std::vector<double> moved_x_, moved_y_, moved_r_;  // their columns, as moved_ lists them
 };
 
 }  // namespace
@@ -282,7 +315,7 @@ OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& s
     uint32_t a, b, k;
   };
   std::vector<Found> found;
-  OverlapProbe probe(view);
+  OverlapProbe probe(view, by_lists ? nullptr : path.disc_grid());
   std::vector<uint32_t> next_new;
   uint32_t k = 1;
   while (!newly.empty()) {
