@@ -59,8 +59,10 @@ inline DiscTable make_world(World w, std::size_t n, build::Box box, Radii r, uin
 
 // The index as shipped, and the thesis's algorithm made exact: frustum bounds (velocity
 // bounds), best-first from the root, one agent per leaf.
+// Both built on every run (rebuild_every 1): the runs are independent random worlds, not ticks,
+// and a tree refitted to another world would measure that world's tree.
 inline FtcIndexOptions ours() {
-  return {};
+  return {.rebuild_every = 1};
 }
 inline FtcIndexOptions thesis() {
   FtcIndexOptions o;
@@ -70,6 +72,7 @@ inline FtcIndexOptions thesis() {
   o.order = FtcIndexOptions::Order::best_first;
   o.seed_own_leaf = false;
   o.overlap_join = false;  // its overlap phase searches the tree as well
+  o.rebuild_every = 1;
   return o;
 }
 

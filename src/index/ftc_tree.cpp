@@ -325,6 +325,13 @@ class KineticTree {
   // With `ex` (more than one thread, kParallelBuild members or more), the subtrees below the top
   // levels are built on its threads: the same tree, node for node.
   void build(const Src& src, const Frame& f, std::size_t leaf_size, Executor* ex = nullptr);
+  // The tree of the last build over `src` as it is now: the same members in the same nodes,
+  // their columns copied anew and every node's bounds recomputed (O(n K), no splits). Only when
+  // `src` holds the same rows with the same keys, the leaf size and the frame's time axis are
+  // the build's, and the frame keeps the build's origin; else false, nothing changed, and the
+  // caller builds. The cells are the build's: members have moved off them since by at most
+  // drift_x_ / drift_y_, which the walk's stop test allows for.
+  bool refit(const Src& src, const Frame& f, std::size_t leaf_size, Executor* ex = nullptr);
   using Order = FtcIndexOptions::Order;
   // Adds this tree's members to `best`. self_pos: the query's position in tree order (it is
   // skipped as a member, and its leaf is scanned first), or kNoRow.
@@ -341,6 +348,8 @@ class KineticTree {
   void leaf_overlaps(uint32_t leaf, ProbeScratch& sc) const;
 
   bool empty() const { return nodes_.empty(); }
+  double built_ox() const { return built_ox_; }
+  double built_oy() const { return built_oy_; }
   std::size_t node_count() const { return nodes_.size(); }
   const std::vector<uint32_t>& perm() const { return perm_; }
   uint32_t pos_of(uint32_t row) const { return pos_of_[row]; }
@@ -396,6 +405,14 @@ class KineticTree {
   std::vector<Cell> cells_;        // per node
   // Reach of any member: largest radius and speeds per axis (for the bottom-up walk's stop).
   double reach_r_ = 0, reach_vx_ = 0, reach_vy_ = 0;
+  // Since the build: the farthest any member moved along x and along y (refit), and the
+  // members' positions then (raw coordinates, tree order).
+  double drift_x_ = 0, drift_y_ = 0;
+  std::vector<double> built_x_, built_y_;
+  std::vector<uint32_t> leaves_;  // refit's scratch: the leaves' node numbers
+  double built_ox_ = 0, built_oy_ = 0;
+  std::size_t built_knots_ = 0;
+  bool built_chord_ = false;
   std::vector<Item> items_;  // the members in tree order (copied from the source at the leaves)
   // Their x, y, vx, vy and r again, column by column (n each, in that order), for the lanes.
   std::vector<double> cols_;
@@ -485,6 +502,17 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
   }
   for (uint32_t i = 0; i < n; ++i) perm_[i] = items_[i].row;
   for (uint32_t i = 0; i < n; ++i) pos_of_[perm_[i]] = i;
+  built_x_.resize(n);
+  built_y_.resize(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    built_x_[i] = items_[i].x;
+    built_y_[i] = items_[i].y;
+  }
+  drift_x_ = drift_y_ = 0;
+  built_ox_ = f.ox;
+  built_oy_ = f.oy;
+  built_knots_ = f.knots.size();
+  built_chord_ = f.chord;
   for (uint32_t k = 0; k < nodes_.size(); ++k)
     if (nodes_[k].leaf())
       for (uint32_t i = nodes_[k].begin; i < nodes_[k].end; ++i) leaf_at_[i] = k;
@@ -494,6 +522,92 @@ void KineticTree<Src>::build(const Src& src, const Frame& f, std::size_t leaf_si
     reach_vx_ = std::max(reach_vx_, std::fabs(src.vx(i)));
     reach_vy_ = std::max(reach_vy_, std::fabs(src.vy(i)));
   }
+}
+
+template <class Src>
+bool KineticTree<Src>::refit(const Src& src, const Frame& f, std::size_t leaf_size, Executor* ex) {
+  const auto n = static_cast<uint32_t>(src.size());
+  if (nodes_.empty() || n != items_.size() || std::max<std::size_t>(leaf_size, 1) != leaf_size_ ||
+      f.chord != built_chord_ || f.knots.size() != built_knots_ || f.ox != built_ox_ ||
+      f.oy != built_oy_)
+    return false;
+  src_ = &src;
+  f_ = &f;
+  // Leaf by leaf (in chunks, on every thread with `ex`): the members' columns anew, the leaf's
+  // bounds; per chunk the largest moves and speeds, and whether every key is still its row's.
+  const auto m = static_cast<uint32_t>(nodes_.size());
+  leaves_.clear();
+  for (uint32_t k = 0; k < m; ++k)
+    if (nodes_[k].leaf()) leaves_.push_back(k);
+  constexpr std::size_t kLeafGrain = 16;
+  const std::size_t chunks = (leaves_.size() + kLeafGrain - 1) / kLeafGrain;
+  std::vector<double> part(4 * chunks, 0);
+  std::vector<uint8_t> same(chunks, 1);
+  const std::size_t stride = items_.size();
+  const auto refit_leaves = [&](std::size_t b, std::size_t e) {
+    double dx = 0, dy = 0, vx = 0, vy = 0;
+    bool ok = true;
+    for (std::size_t l = b; l < e; ++l) {
+      const TreeNode& nd = nodes_[leaves_[l]];
+      for (uint32_t i = nd.begin; i < nd.end; ++i) {
+        Item& it = items_[i];
+        const uint32_t row = it.row;
+        ok = ok && src.key(row) == it.key;
+        it.x = src.x(row);
+        it.y = src.y(row);
+        it.vx = src.vx(row);
+        it.vy = src.vy(row);
+        it.r = src.r(row);
+        double* const c = cols_.data() + i;
+        c[0] = it.x;
+        c[stride] = it.y;
+        c[2 * stride] = it.vx;
+        c[3 * stride] = it.vy;
+        c[4 * stride] = it.r;
+        dx = std::max(dx, std::fabs(it.x - built_x_[i]));
+        dy = std::max(dy, std::fabs(it.y - built_y_[i]));
+        vx = std::max(vx, std::fabs(it.vx));
+        vy = std::max(vy, std::fabs(it.vy));
+      }
+      leaf_bounds(leaves_[l]);
+      finish_bounds(leaves_[l]);
+    }
+    const std::size_t k = b / kLeafGrain;
+    part[4 * k] = dx;
+    part[4 * k + 1] = dy;
+    part[4 * k + 2] = vx;
+    part[4 * k + 3] = vy;
+    same[k] = ok;
+  };
+  if (ex && ex->threads() > 1 && n >= kParallelBuild)
+    ex->for_each_chunk(leaves_.size(), kLeafGrain, refit_leaves);
+  else
+    refit_leaves(0, leaves_.size());
+  double dx = 0, dy = 0;
+  reach_vx_ = reach_vy_ = 0;
+  bool ok = true;
+  for (std::size_t k = 0; k < chunks; ++k) {
+    dx = std::max(dx, part[4 * k]);
+    dy = std::max(dy, part[4 * k + 1]);
+    reach_vx_ = std::max(reach_vx_, part[4 * k + 2]);
+    reach_vy_ = std::max(reach_vy_, part[4 * k + 3]);
+    ok = ok && same[k];
+  }
+  if (!ok) {  // another row in a member's place: the tree must be built (the copies are moot)
+    nodes_.clear();
+    return false;
+  }
+  // (Rounding of the differences: a relative 1e-9 more.)
+  drift_x_ = dx * (1 + 1e-9);
+  drift_y_ = dy * (1 + 1e-9);
+  // The parents from their children (preorder: every child comes after its parent).
+  for (uint32_t k = m; k-- > 0;)
+    if (!nodes_[k].leaf()) {
+      merge_bounds(k, k + 1, nodes_[k].right);
+      finish_bounds(k);
+    }
+  reach_r_ = nodes_[0].rmax;
+  return true;
 }
 
 template <class Src>
@@ -842,8 +956,11 @@ void KineticTree<Src>::search(const Probe& q, double horizon, Best& best, ProbeS
           reach_r_ + q.ar + f.delta0 + (std::fabs(q.avx) + reach_vx_ + f.delta1) * cap;
       const double hy =
           reach_r_ + q.ar + f.delta0 + (std::fabs(q.avy) + reach_vy_ + f.delta1) * cap;
+      // (Shrunk by the drift since the build: a member outside the subtree was outside the cell
+      // then, and has moved at most that far.)
       const Cell& cell = cells_[below];
-      if (q.fx - hx > cell.x0 && q.fx + hx < cell.x1 && q.fy - hy > cell.y0 && q.fy + hy < cell.y1)
+      if (q.fx - hx > cell.x0 + drift_x_ && q.fx + hx < cell.x1 - drift_x_ &&
+          q.fy - hy > cell.y0 + drift_y_ && q.fy + hy < cell.y1 - drift_y_)
         break;
       const uint32_t p = nodes_[below].parent;
       const uint32_t sib = below == p + 1 ? nodes_[p].right : p + 1;
@@ -984,7 +1101,8 @@ std::string KineticTree<Src>::validate(const Frame& f) const {
         return "position " + std::to_string(i) + ": leaf_at is wrong";
       const double fx = s.x(row) - f.ox, fy = s.y(row) - f.oy;
       const Cell& cl = cells_[k];
-      if (fx < cl.x0 || fx > cl.x1 || fy < cl.y0 || fy > cl.y1)
+      const double mx = drift_x_ + f.delta0, my = drift_y_ + f.delta0;  // (and rounding)
+      if (fx < cl.x0 - mx || fx > cl.x1 + mx || fy < cl.y0 - my || fy > cl.y1 + my)
         return "node " + std::to_string(k) + ": row " + std::to_string(row) + " outside its cell";
       // Each member at each slice's two ends (and its middle) lies inside the slice's box.
       for (std::size_t j = 0; j < K; ++j) {
@@ -1023,6 +1141,8 @@ struct FtcIndex::Impl {
   std::vector<Slice> polygon_boxes;  // one static slice per polygon (frustum form)
   mutable ProbeScratch scratch;      // for query()
   bool no_overlaps = false;          // FtcPath::assume_no_overlaps
+  uint64_t refits = 0;               // agent tree refits since its last build
+  bool refitted = false;             // the last build refitted it
 
   void make_frame();
   // The answer for one row; pos: its position in the agent tree's order.
@@ -1169,8 +1289,29 @@ void FtcIndex::build(const DiscView& discs, const StaticScene& scene, double hor
   m.make_frame();
   m.agents.d = &m.discs;
   m.circles.c = scene.circles();
-  m.agent_tree.build(m.agents, m.frame, m.no_overlaps ? m.opt.leaf_size_apart : m.opt.leaf_size,
-                     ex);
+  const std::size_t leaf = m.no_overlaps ? m.opt.leaf_size_apart : m.opt.leaf_size;
+  bool refitted = false;
+  if (m.refits + 1 < m.opt.rebuild_every && !m.agent_tree.empty()) {
+    // The last build's origin, which its boxes and cells are relative to: every position's
+    // distance from it is larger by at most the shift, and so may be the rounding of the
+    // coordinates relative to it (M0 grows by twice the shift per axis; see "Floating point").
+    Frame& f = m.frame;
+    const Frame fresh = f;
+    const double shift =
+        std::fabs(f.ox - m.agent_tree.built_ox()) + std::fabs(f.oy - m.agent_tree.built_oy());
+    f.ox = m.agent_tree.built_ox();
+    f.oy = m.agent_tree.built_oy();
+    f.delta0 += kSlack * 4 * shift;
+    refitted = m.agent_tree.refit(m.agents, m.frame, leaf, ex);
+    if (!refitted) f = fresh;
+  }
+  m.refitted = refitted;
+  if (refitted) {
+    ++m.refits;
+  } else {
+    m.agent_tree.build(m.agents, m.frame, leaf, ex);
+    m.refits = 0;
+  }
   m.circle_tree.build(m.circles, m.frame, m.opt.leaf_size);
   m.polygon_boxes.clear();
   const double d0 = m.frame.delta0, d1 = m.frame.delta1;
@@ -1245,6 +1386,9 @@ bool FtcIndex::uses_chord_bound() const {
 bool FtcIndex::assume_no_overlaps(bool yes) {
   impl_->no_overlaps = yes;
   return true;
+}
+bool FtcIndex::refitted() const {
+  return impl_->refitted;
 }
 const FtcIndexOptions& FtcIndex::options() const {
   return impl_->opt;

@@ -15,7 +15,8 @@
 // memory in order; the copies are the rows' own values, so pair times are unchanged. It also
 // keeps orderings (tree order, row -> position, position -> leaf) and per-node aggregates:
 // kinetic bounds (below), the largest radius, the smallest key, the node's cell (its ancestors'
-// split half-planes) and its parent. Rebuilt every tick.
+// split half-planes) and its parent. Built anew every rebuild_every-th tick, and refitted on the
+// ticks between (REFIT below).
 // Static circles get a tree of their own (zero velocities); polygons (few) are tested one by one
 // through their boxes (the naive path's box filter, then the box bound, then ray_polygon_time).
 //
@@ -89,6 +90,19 @@
 // pair tests per query from 524 to 332 at best, but at the E1 density (n = 15,000, radius 1-3) it
 // raised them from 18 to 53-580 (position locality is what finds the overlapping neighbours).
 //
+// REFIT. Between builds the agent tree keeps its nodes and the rows in them and recomputes the
+// members' copies and every node's kinetic bounds from the rows as they are now: O(n K), in
+// chunks of leaves on every thread, then the parents. The invariant and the bound hold as after
+// a build (they only ask that the boxes contain the members). The cells do not: a member of
+// another subtree may have walked into a cell since the build, by at most the largest move of
+// any member since then (per axis, drift_x and drift_y), so the bottom-up walk stops only where
+// the reach box lies inside the cell shrunk by that much. The frame keeps the build's origin
+// (the boxes and cells are relative to it), with M0 grown by four times its distance from the
+// new centre. Only the search's cost changes with the tree's shape: the answers are the same,
+// refitted or built. A table whose rows are not the build's (another count, another id in a
+// member's place: inserts, removals, reordered rows), another leaf size or another time axis
+// gets a build.
+//
 // THE BIG CRUNCH (thesis §4.1: its index was worse than naive there). Every agent heads for the
 // centre c and arrives at t = A: v_b = (c - p_b) / A, so relative to a every other agent moves
 // as d_b (1 - t / A) and the first collision time A (1 - (r_a + r_b) / |d_b|) is close to A for
@@ -151,6 +165,14 @@ struct FtcIndexOptions {
   // 20,000 / 100,000 agents, ms per tick against leaf_size 16: 32 -12 / -15 / -18 / -13 %,
   // 48 -11 / -18 / -21 / -11 %, 64 -5 / -13 / -19 / -11 % (docs/benchmarks.md).
   std::size_t leaf_size_apart = 48;
+  // The agent tree is built anew on every rebuild_every-th build (run), and in between refitted:
+  // the same nodes over the same rows, their bounds recomputed from where the rows are now, no
+  // median splits. Only while the table holds the same rows with the same ids, and the leaf size
+  // and the time axis stay (else it is built); 1: built every time. The thesis model's
+  // first-to-collide query, airport at 2,000 / 20,000 / 100,000 agents, against 1: 10 -7 / -6 /
+  // -6 % (5: -6 % and 20: -4 % at 20,000; the tree drifts from the positions' medians and the
+  // searches open more nodes; docs/benchmarks.md).
+  uint64_t rebuild_every = 10;
 };
 
 // Thread-safety: build() and query() change the index (one caller at a time); query_all() may
@@ -190,6 +212,7 @@ class FtcIndex final : public FtcPath {
   // violation.
   std::string validate() const;
   std::size_t node_count() const;  // agent tree
+  bool refitted() const;           // the last build refitted the agent tree (rebuild_every)
   bool uses_chord_bound() const;   // false: fell back to frustum (horizon 0 or infinite)
   const FtcIndexOptions& options() const;
 

@@ -563,6 +563,71 @@ TEST(FtcIndex, PairTimesInLanesAreRayDiscTimeBitForBit) {
   }
 }
 
+// One index run tick after tick over a table that changes in between: its discs walk and turn,
+// some jump far (off their cells: the walk's stop allows for the drift), all of them shift by a
+// kilometre (the build's origin is kept), a row is replaced by another id or removed (a build
+// then), the no-overlap hint comes and goes (another leaf size: a build). Refitted or built, on
+// one thread or two (the refit in chunks of leaves from 4,096 members), every run answers as the
+// naive loop, and the refitted tree validates.
+TEST(FtcIndex, RefittedTreeAnswersAsTheNaiveLoop) {
+  const StaticScene scene = obstacle_scene(9, 30, 8);
+  for (int threads : {1, 2}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    Rng rng(40 + static_cast<uint64_t>(threads));
+    DiscTable t = build::uniform(threads == 1 ? 900 : 4200, {0, 0, 160, 160}, 3, 0.2, 0.6,
+                                 static_cast<uint64_t>(threads));
+    FtcIndex index({.rebuild_every = 7});
+    Executor ex(threads);
+    int refits = 0;
+    for (int step = 0; step < 30; ++step) {
+      SCOPED_TRACE("step " + std::to_string(step));
+      for (std::size_t i = 0; i < t.size(); ++i) {
+        t.x[i] += 0.1 * t.vx[i];
+        t.y[i] += 0.1 * t.vy[i];
+        if (rng.below(5) == 0) {
+          t.vx[i] = rng.uniform(-3, 3);
+          t.vy[i] = rng.uniform(-3, 3);
+        }
+        if (rng.below(100) == 0) {  // a jump across the world
+          t.x[i] = rng.uniform(0, 160);
+          t.y[i] = rng.uniform(0, 160);
+        }
+      }
+      if (step == 11)
+        for (std::size_t i = 0; i < t.size(); ++i) {
+          t.x[i] += 1000;
+          t.y[i] -= 700;
+        }
+      if (step == 17) t.id[t.size() / 2] = 1'000'000;  // another row in that place
+      if (step == 23) {                                // one row fewer
+        for (auto* col : {&t.x, &t.y, &t.vx, &t.vy, &t.radius, &t.charge}) col->pop_back();
+        t.id.pop_back();
+      }
+      index.assume_no_overlaps(step >= 5 && step < 20);
+      const DiscView d = t.view();
+      std::vector<FtcHit> got(d.n);
+      QueryStats st;
+      index.run(d, scene, 30, got, ex, st);
+      refits += index.refitted();
+      if (step == 0 || step == 5 || step == 17 || step == 20 || step == 23) {
+        EXPECT_FALSE(index.refitted());
+      }
+      EXPECT_EQ(index.validate(), "");
+      // (The naive loop over 4,200 discs is the test's cost: every third step, and the steps
+      // that change the table, on two threads.)
+      if (threads == 2 && step % 3 != 0 && step != 12 && step != 17 && step != 23) continue;
+      const std::vector<FtcHit> want = naive(d, scene, 30);
+      int bad = 0;
+      for (std::size_t i = 0; i < d.n; ++i) {
+        if (!(got[i].with == want[i].with && same_bits(got[i].time, want[i].time)) && ++bad <= 5)
+          ADD_FAILURE() << "row " << i << ": index " << describe(got[i]) << ", naive "
+                        << describe(want[i]);
+      }
+    }
+    EXPECT_GE(refits, 15);
+  }
+}
+
 // Random tables of every shape, random options, told or not that nothing overlaps (a hint that
 // may be wrong: it changes the cost only): the property test.
 TEST(FtcIndex, PropertyManySeeds) {
