@@ -43,7 +43,10 @@ void freeze(const AgentTable& t, NextState& next, uint32_t i) {
 // The grid is the one the tick's collision query built over the same discs, when it lends one
 // (CollisionPath::disc_grid): the rows frozen since count as moved. A grid of its own is built
 // only without it (the model's neighbour lists answered the query, or its method keeps no grid),
-// or once enough rows have moved.
+// or once enough rows have moved. The moved rows get a small grid of their own once there are
+// more than a batch of them (rebuilt each round, over their columns): every probe scanned them
+// all, and a jam freezes hundreds a tick (the thesis model at airport-20k: ~740 over 4 rounds,
+// ~380,000 tests a tick).
 class OverlapProbe {
  public:
   OverlapProbe(const DiscView& view, const index::DiscGrid* lent)
@@ -71,6 +74,16 @@ class OverlapProbe {
       moved_y_.clear();
       moved_r_.clear();
     }
+    moved_indexed_ = 0;
+    if (moved_.size() > kMovedBatch) {
+      DiscView mv;
+      mv.n = moved_.size();
+      mv.x = moved_x_.data();
+      mv.y = moved_y_.data();
+      mv.radius = moved_r_.data();
+      moved_grid_.build(mv);
+      if (moved_grid_.usable()) moved_indexed_ = moved_.size();
+    }
   }
   template <class F>
   void for_each_overlap(uint32_t a, F&& fn) const {
@@ -85,8 +98,14 @@ class OverlapProbe {
     grid_->for_each_overlap(x, y, r, [&](uint32_t b) {
       if (!stale_[b] && b != a) fn(b);
     });
-    // The moved rows from their own columns, a batch at a time without branches (a lent grid
-    // leaves every row frozen since the tick's query here: hundreds a probe in a jam).
+    // The moved rows: through their grid, or (a batch or fewer) from their own columns without
+    // branches.
+    if (moved_indexed_ > 0) {
+      moved_grid_.for_each_overlap(x, y, r, [&](uint32_t u) {
+        if (moved_[u] != a) fn(moved_[u]);
+      });
+      return;
+    }
     const std::size_t m = moved_.size();
     const double *mx = moved_x_.data(), *my = moved_y_.data(), *mr = moved_r_.data();
     for (std::size_t u0 = 0; u0 < m; u0 += kMovedBatch) {
@@ -117,6 +136,8 @@ class OverlapProbe {
   std::vector<uint8_t> stale_;
   std::vector<uint32_t> moved_;
   std::vector<double> moved_x_, moved_y_, moved_r_;  // their columns, as moved_ lists them
+  index::DiscGrid moved_grid_;     // over those columns (its rows: places in moved_)
+  std::size_t moved_indexed_ = 0;  // moved_grid_ holds all of moved_ (0: scan them)
 };
 
 }  // namespace
@@ -185,6 +206,9 @@ OverlapReport backoff_reference(const AgentTable& t, NextState& next, const Stat
     if (!froze) return r;
   }
 }
+
+// Newly frozen agents per chunk of a round's probes.
+constexpr std::size_t kProbeGrain = 64;
 
 // Rows whose lists fall short, at most (their pairs among each other are tested one by one).
 constexpr std::size_t kShortMost = 256;
@@ -317,19 +341,37 @@ OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& s
   std::vector<Found> found;
   OverlapProbe probe(view, by_lists ? nullptr : path.disc_grid());
   std::vector<uint32_t> next_new;
+  // A round's probes only read (positions, stamps, frozen flags change between rounds), so they
+  // run in chunks on every thread, each with lists of its own, joined in chunk order.
+  std::vector<std::vector<Found>> chunk_found;
+  std::vector<std::vector<uint32_t>> chunk_new;
   uint32_t k = 1;
   while (!newly.empty()) {
     ++iterations;
     probe.moved(newly);  // only matters when the grid was built before they were frozen
     probe.prepare(newly.size());
+    const std::size_t chunks = (newly.size() + kProbeGrain - 1) / kProbeGrain;
+    chunk_found.resize(std::max(chunk_found.size(), chunks));
+    chunk_new.resize(std::max(chunk_new.size(), chunks));
+    ex.for_each_chunk(newly.size(), kProbeGrain, [&](std::size_t b0, std::size_t e0) {
+      std::vector<Found>& fd = chunk_found[b0 / kProbeGrain];
+      std::vector<uint32_t>& nn = chunk_new[b0 / kProbeGrain];
+      fd.clear();
+      nn.clear();
+      for (std::size_t u = b0; u < e0; ++u) {
+        const uint32_t a = newly[u];
+        probe.for_each_overlap(a, [&](uint32_t b) {
+          if (stamp[b] == k && b < a) return;  // frozen together: found from b's side
+          fd.push_back({a, b, k});
+          if (!next.frozen[b] && pair_violates(t, next, std::min(a, b), std::max(a, b)))
+            nn.push_back(b);
+        });
+      }
+    });
     next_new.clear();
-    for (uint32_t a : newly) {
-      probe.for_each_overlap(a, [&](uint32_t b) {
-        if (stamp[b] == k && b < a) return;  // frozen together: found from b's side
-        found.push_back({a, b, k});
-        if (!next.frozen[b] && pair_violates(t, next, std::min(a, b), std::max(a, b)))
-          next_new.push_back(b);
-      });
+    for (std::size_t c = 0; c < chunks; ++c) {
+      found.insert(found.end(), chunk_found[c].begin(), chunk_found[c].end());
+      next_new.insert(next_new.end(), chunk_new[c].begin(), chunk_new[c].end());
     }
     std::sort(next_new.begin(), next_new.end());
     next_new.erase(std::unique(next_new.begin(), next_new.end()), next_new.end());

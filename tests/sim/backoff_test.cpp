@@ -69,8 +69,10 @@ std::unique_ptr<CollisionPath> make_path(const std::string& name) {
   return find_collision_method(name, any).make();
 }
 
+// On one thread and on two (a round's probes run in chunks on every thread), with enough agents
+// frozen for the moved rows to get a grid of their own.
 TEST(Backoff, IncrementalLoopEqualsThePlainLoop) {
-  Executor ex(1);
+  Executor ex(1), ex2(2);
   std::size_t cascades = 0, grid_probes = 0;
   const std::pair<std::size_t, uint64_t> sizes[] = {{40, 1},  {40, 2},  {40, 3},  {600, 1},
                                                     {600, 2}, {600, 3}, {4000, 1}};
@@ -92,21 +94,22 @@ TEST(Backoff, IncrementalLoopEqualsThePlainLoop) {
           grid_probes += n * 50 > (1 << 16) && plain_iter >= 2;
           std::vector<std::string> methods = {"naive", "grid", "sweep"};
           if (equal && !spawn) methods.push_back("nn");  // nn is exact for the backoff only then
-          for (const std::string& m : methods) {
-            SCOPED_TRACE(m);
-            NextState got = k.next;
-            std::size_t iter = 0;
-            const OverlapReport r = backoff(k.t, got, k.scene, *make_path(m), ex, st, iter);
-            EXPECT_EQ(iter, plain_iter);
-            EXPECT_EQ(r.agent_pairs, want.agent_pairs);
-            EXPECT_EQ(r.obstacle_hits, want.obstacle_hits);
-            EXPECT_TRUE(r.violators.empty());
-            EXPECT_EQ(got.frozen, plain.frozen);
-            EXPECT_EQ(got.x, plain.x);
-            EXPECT_EQ(got.y, plain.y);
-            EXPECT_EQ(got.vx, plain.vx);
-            EXPECT_EQ(got.vy, plain.vy);
-          }
+          for (const std::string& m : methods)
+            for (Executor* on : {&ex, &ex2}) {
+              SCOPED_TRACE(m + (on == &ex2 ? " on two threads" : ""));
+              NextState got = k.next;
+              std::size_t iter = 0;
+              const OverlapReport r = backoff(k.t, got, k.scene, *make_path(m), *on, st, iter);
+              EXPECT_EQ(iter, plain_iter);
+              EXPECT_EQ(r.agent_pairs, want.agent_pairs);
+              EXPECT_EQ(r.obstacle_hits, want.obstacle_hits);
+              EXPECT_TRUE(r.violators.empty());
+              EXPECT_EQ(got.frozen, plain.frozen);
+              EXPECT_EQ(got.x, plain.x);
+              EXPECT_EQ(got.y, plain.y);
+              EXPECT_EQ(got.vx, plain.vx);
+              EXPECT_EQ(got.vy, plain.vy);
+            }
         }
   EXPECT_GT(cascades, 20u);    // freezes that cause further freezes
   EXPECT_GE(grid_probes, 6u);  // large enough for the probes to use the grid
