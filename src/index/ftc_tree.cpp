@@ -327,10 +327,10 @@ class KineticTree {
   void build(const Src& src, const Frame& f, std::size_t leaf_size, Executor* ex = nullptr);
   // The tree of the last build over `src` as it is now: the same members in the same nodes,
   // their columns copied anew and every node's bounds recomputed (O(n K), no splits). Only when
-  // `src` holds the same rows with the same keys, the leaf size and the frame's time axis are
-  // the build's, and the frame keeps the build's origin; else false, nothing changed, and the
-  // caller builds. The cells are the build's: members have moved off them since by at most
-  // drift_x_ / drift_y_, which the walk's stop test allows for.
+  // `src` holds the same rows with the same keys, the leaf size, the frame's number of knots and
+  // its kind of bound are the build's, and the frame keeps the build's origin; else false, nothing
+  // changed, and the caller builds. The cells are the build's: members have moved off them since by
+  // at most drift_x_ / drift_y_, which the walk's stop test allows for.
   bool refit(const Src& src, const Frame& f, std::size_t leaf_size, Executor* ex = nullptr);
   using Order = FtcIndexOptions::Order;
   // Adds this tree's members to `best`. self_pos: the query's position in tree order (it is

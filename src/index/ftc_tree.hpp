@@ -100,8 +100,9 @@
 // (the boxes and cells are relative to it), with M0 grown by four times its distance from the
 // new centre. Only the search's cost changes with the tree's shape: the answers are the same,
 // refitted or built. A table whose rows are not the build's (another count, another id in a
-// member's place: inserts, removals, reordered rows), another leaf size or another time axis
-// gets a build.
+// member's place: inserts, removals, reordered rows), another leaf size, another number of knots
+// or another kind of bound (chord or frustum) gets a build; a new horizon with as many knots is
+// refitted (the bounds are recomputed at the new knots).
 //
 // THE BIG CRUNCH (thesis §4.1: its index was worse than naive there). Every agent heads for the
 // centre c and arrives at t = A: v_b = (c - p_b) / A, so relative to a every other agent moves
@@ -167,12 +168,12 @@ struct FtcIndexOptions {
   std::size_t leaf_size_apart = 48;
   // The agent tree is built anew on every rebuild_every-th build (run), and in between refitted:
   // the same nodes over the same rows, their bounds recomputed from where the rows are now, no
-  // median splits. Only while the table holds the same rows with the same ids, and the leaf size
-  // and the time axis stay (else it is built); 1: built every time. The tree drifts from the
-  // positions' medians, so the searches open a little more (pair tests +1 % at 5, +3 % at 10)
-  // while the builds cost a third. Thesis model, airport-20k, first-to-collide against 1: 30
-  // ticks -6 % at 5 and at 10, -4 % at 20; 100 ticks -3 % at 5 and at 10 (within the noise of
-  // each other); airport-2k, 100 ticks, -7 % at 10 (docs/benchmarks.md).
+  // median splits. Only while the table holds the same rows with the same ids, and the leaf size,
+  // the number of knots and the kind of bound stay (else it is built); 1: built every time. The
+  // tree drifts from the positions' medians, so the searches open a little more (pair tests +1 % at
+  // 5, +3 % at 10) while the builds cost a third. Thesis model, airport-20k, first-to-collide
+  // against 1: 30 ticks -6 % at 5 and at 10, -4 % at 20; 100 ticks -3 % at 5 and at 10 (within the
+  // noise of each other); airport-2k, 100 ticks, -7 % at 10 (docs/benchmarks.md).
   uint64_t rebuild_every = 10;
 };
 
