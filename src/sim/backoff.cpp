@@ -74,7 +74,7 @@ class OverlapProbe {
       moved_y_.clear();
       moved_r_.clear();
     }
-    moved_indexed_ = 0;
+    moved_in_grid_ = false;
     if (moved_.size() > kMovedBatch) {
       DiscView mv;
       mv.n = moved_.size();
@@ -82,7 +82,7 @@ class OverlapProbe {
       mv.y = moved_y_.data();
       mv.radius = moved_r_.data();
       moved_grid_.build(mv);
-      if (moved_grid_.usable()) moved_indexed_ = moved_.size();
+      moved_in_grid_ = moved_grid_.usable();
     }
   }
   template <class F>
@@ -100,7 +100,7 @@ class OverlapProbe {
     });
     // The moved rows: through their grid, or (a batch or fewer) from their own columns without
     // branches.
-    if (moved_indexed_ > 0) {
+    if (moved_in_grid_) {
       moved_grid_.for_each_overlap(x, y, r, [&](uint32_t u) {
         if (moved_[u] != a) fn(moved_[u]);
       });
@@ -136,8 +136,8 @@ class OverlapProbe {
   std::vector<uint8_t> stale_;
   std::vector<uint32_t> moved_;
   std::vector<double> moved_x_, moved_y_, moved_r_;  // their columns, as moved_ lists them
-  index::DiscGrid moved_grid_;     // over those columns (its rows: places in moved_)
-  std::size_t moved_indexed_ = 0;  // moved_grid_ holds all of moved_ (0: scan them)
+  index::DiscGrid moved_grid_;  // over those columns (its rows: places in moved_)
+  bool moved_in_grid_ = false;  // moved_grid_ holds all of moved_ (false: scan them)
 };
 
 }  // namespace
