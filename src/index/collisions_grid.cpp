@@ -15,6 +15,7 @@ constexpr double kMaxCandidates = 8;  // one class while it costs fewer candidat
 
 void DiscGrid::build(const DiscView& d, Executor* ex) {
   frame_ = Frame::of(d);
+  built_ = true;
   if (!frame_.finite || d.n == 0) {
     levels_.clear();
     return;

@@ -30,8 +30,16 @@ class DiscGrid {
   // Indexes all rows of d. d's columns must outlive the queries. With `ex`, a level's keys and
   // sort run on its threads (the same index).
   void build(const DiscView& d, Executor* ex = nullptr);
+  // Forgets the last build: a grid never built, or cleared, is not usable.
+  void clear() {
+    built_ = false;
+    frame_ = Frame{};
+    levels_.clear();
+  }
   const Frame& frame() const { return frame_; }
-  bool usable() const { return frame_.finite; }  // false: non-finite input, use the naive loop
+  std::size_t rows() const { return frame_.count; }  // rows of the last build
+  // false: never built, cleared, or non-finite input (use the naive loop)
+  bool usable() const { return built_ && frame_.finite; }
   // One level per class of radii (ascending); one when the radii are equal.
   const std::vector<CellIndex>& levels() const { return levels_; }
 
@@ -50,6 +58,7 @@ class DiscGrid {
 
  private:
   Frame frame_;
+  bool built_ = false;
   std::vector<CellIndex> levels_;  // ascending radius
   std::vector<uint32_t> class_rows_;
 };

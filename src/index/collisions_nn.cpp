@@ -14,6 +14,7 @@ constexpr std::size_t kParallelEntries = 4096;  // below, one pass: the merge wo
 void CollisionNn::run(const DiscView& d, const StaticScene& scene, CollisionPairs& out,
                       Executor& ex, QueryStats& stats) {
   out.clear();
+  grid_.clear();  // lent by disc_grid() only when built for these discs
   if (d.n == 0) return;
   const double R = d.radius[0];
   for (std::size_t i = 1; i < d.n; ++i)

@@ -49,8 +49,12 @@ void freeze(const AgentTable& t, NextState& next, uint32_t i) {
 // ~380,000 tests a tick).
 class OverlapProbe {
  public:
+  // A lent grid is used only when it indexes as many rows as the view (else: built on demand).
   OverlapProbe(const DiscView& view, const index::DiscGrid* lent)
-      : view_(view), grid_(lent), built_(lent != nullptr), stale_(view.n, 0) {}
+      : view_(view),
+        grid_(lent != nullptr && lent->usable() && lent->rows() == view.n ? lent : nullptr),
+        built_(grid_ != nullptr),
+        stale_(view.n, 0) {}
 
   void prepare(std::size_t probes) {
     if (built_ || probes * view_.n <= kBruteWork) return;
@@ -85,6 +89,7 @@ class OverlapProbe {
       moved_in_grid_ = moved_grid_.usable();
     }
   }
+  bool moved_in_grid() const { return moved_in_grid_; }
   template <class F>
   void for_each_overlap(uint32_t a, F&& fn) const {
     const double x = view_.x[a], y = view_.y[a], r = view_.radius[a];
@@ -345,11 +350,12 @@ OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& s
   // run in chunks on every thread, each with lists of its own, joined in chunk order.
   std::vector<std::vector<Found>> chunk_found;
   std::vector<std::vector<uint32_t>> chunk_new;
-  uint32_t k = 1;
+  uint32_t k = 1, moved_grid_rounds = 0;
   while (!newly.empty()) {
     ++iterations;
     probe.moved(newly);  // only matters when the grid was built before they were frozen
     probe.prepare(newly.size());
+    moved_grid_rounds += probe.moved_in_grid();
     const std::size_t chunks = (newly.size() + kProbeGrain - 1) / kProbeGrain;
     chunk_found.resize(std::max(chunk_found.size(), chunks));
     chunk_new.resize(std::max(chunk_new.size(), chunks));
@@ -388,6 +394,7 @@ OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& s
   // still hold; obstacle hits of agents that stayed, plus those of the moved agents where they are.
   report = {};
   report.agents_by_lists = by_lists;
+  report.moved_grid_rounds = moved_grid_rounds;
   for (auto [i, j] : first.agents) report.agent_pairs += stamp[i] == 0 && stamp[j] == 0;
   for (const Found& f : found) report.agent_pairs += stamp[f.b] == 0 || stamp[f.b] <= f.k;
   for (const auto& hit : first.obstacles) report.obstacle_hits += stamp[hit.first] == 0;

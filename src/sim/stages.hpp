@@ -153,6 +153,7 @@ struct OverlapReport {
   std::size_t obstacle_hits = 0;    // all agent-obstacle overlaps (walls are obstacles)
   std::vector<uint32_t> violators;  // rows in a new or deepened overlap, sorted, unique
   bool agents_by_lists = false;     // the model's neighbour lists ruled agent overlaps out
+  uint32_t moved_grid_rounds = 0;   // backoff rounds whose moved rows were probed via their grid
 };
 
 // Is the overlapping pair (i, j) (next-state positions) a violation: new, or deeper than at the

@@ -55,6 +55,18 @@ TEST(DiscGrid, OverlapQueryEqualsBruteForce) {
   }
 }
 
+TEST(DiscGrid, UsableOnlyOnceBuiltAndUntilCleared) {
+  const DiscTable t = build::uniform(20, build::Box{0, 0, 30, 30}, 1, 1, 2, 5);
+  DiscGrid g;
+  EXPECT_FALSE(g.usable());  // a default frame is finite; a grid never built is not usable
+  g.build(t.view());
+  EXPECT_TRUE(g.usable());
+  EXPECT_EQ(g.rows(), 20u);
+  g.clear();
+  EXPECT_FALSE(g.usable());
+  EXPECT_EQ(g.rows(), 0u);
+}
+
 TEST(CollisionGrid, NonFiniteInputFallsBackInsteadOfHanging) {
   DiscTable t = build::uniform(50, build::Box{0, 0, 20, 20}, 1, 1, 2, 3);
   t.x[7] = INFINITY;

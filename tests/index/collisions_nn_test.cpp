@@ -138,6 +138,27 @@ TEST(CollisionNn, UnequalRadiiAreAUsageError) {
   }
 }
 
+// The grid nn lends to the backoff (disc_grid()) is that of the discs of its last run, or none:
+// a run that throws or has no rows must not leave the previous run's grid out on loan.
+TEST(CollisionNn, LendsAGridOnlyForTheDiscsOfItsLastRun) {
+  const DiscTable equal = build::uniform(40, build::Box{0, 0, 50, 50}, 1, 1, 1, 4);
+  const DiscTable mixed = build::uniform(10, build::Box{}, 1, 1, 2, 1);
+  CollisionNn nn;
+  Executor ex(1);
+  QueryStats st;
+  CollisionPairs got;
+  EXPECT_EQ(nn.disc_grid(), nullptr);  // never run
+  nn.run(equal.view(), StaticScene(), got, ex, st);
+  ASSERT_NE(nn.disc_grid(), nullptr);
+  EXPECT_EQ(nn.disc_grid()->rows(), 40u);
+  EXPECT_THROW(nn.run(mixed.view(), StaticScene(), got, ex, st), Error);
+  EXPECT_EQ(nn.disc_grid(), nullptr);
+  nn.run(equal.view(), StaticScene(), got, ex, st);
+  ASSERT_NE(nn.disc_grid(), nullptr);
+  nn.run(DiscView{}, StaticScene(), got, ex, st);
+  EXPECT_EQ(nn.disc_grid(), nullptr);
+}
+
 TEST(CollisionNn, NanOrInfiniteRowsGiveTheNaivePairs) {
   CollisionNn path;
   test::expect_naive_on_non_finite_rows(path, true);

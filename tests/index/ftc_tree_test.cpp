@@ -628,6 +628,107 @@ TEST(FtcIndex, RefittedTreeAnswersAsTheNaiveLoop) {
   }
 }
 
+// One step of the refit tests' crowd: everyone walks a tenth of a tick, a fifth turn, one in a
+// hundred jumps across the 160 x 160 world.
+void walk(DiscTable& t, Rng& rng) {
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    t.x[i] += 0.1 * t.vx[i];
+    t.y[i] += 0.1 * t.vy[i];
+    if (rng.below(5) == 0) {
+      t.vx[i] = rng.uniform(-3, 3);
+      t.vy[i] = rng.uniform(-3, 3);
+    }
+    if (rng.below(100) == 0) {
+      t.x[i] = rng.uniform(0, 160);
+      t.y[i] = rng.uniform(0, 160);
+    }
+  }
+}
+
+// The refit under the other bounds and search orders, and under a new horizon: with as many
+// knots the tree is refitted (its bounds recomputed for the new times), and answers as the naive
+// loop; the thesis's frustum bound, bottom-up search and single-member leaves included.
+TEST(FtcIndex, RefitKeepsEveryBoundAndOrderExactAcrossHorizons) {
+  const StaticScene scene = obstacle_scene(3, 12, 4);
+  Opt frustum{.leaf_size = 8,
+              .bound = Opt::Bound::frustum,
+              .slices = 1,
+              .order = Opt::Order::best_first,
+              .seed_own_leaf = false};
+  Opt sliced{
+      .leaf_size = 8, .bound = Opt::Bound::chord, .slices = 3, .order = Opt::Order::bottom_up};
+  Opt single{
+      .leaf_size = 1, .bound = Opt::Bound::chord, .slices = 1, .order = Opt::Order::nearer_first};
+  for (Opt o : {frustum, sliced, single}) {
+    SCOPED_TRACE("bound " + std::to_string(static_cast<int>(o.bound)) + " order " +
+                 std::to_string(static_cast<int>(o.order)) + " leaf " +
+                 std::to_string(o.leaf_size));
+    o.rebuild_every = 6;
+    Rng rng(77);
+    DiscTable t = build::uniform(600, {0, 0, 160, 160}, 3, 0.2, 0.6, 9);
+    FtcIndex index(o);
+    Executor ex(1);
+    int refits = 0;
+    for (int step = 0; step < 14; ++step) {
+      SCOPED_TRACE("step " + std::to_string(step));
+      walk(t, rng);
+      // A shorter horizon at step 3, the first one back at step 4, an unbounded one at 9-10.
+      const double horizon = step == 3 ? 12.5 : step == 9 || step == 10 ? INFINITY : 30;
+      const DiscView d = t.view();
+      std::vector<FtcHit> got(d.n);
+      QueryStats st;
+      index.run(d, scene, horizon, got, ex, st);
+      refits += index.refitted();
+      if (step == 3 || step == 4) {
+        EXPECT_TRUE(index.refitted());  // a new horizon, as many knots
+      }
+      EXPECT_EQ(index.validate(), "");
+      const std::vector<FtcHit> want = naive(d, scene, horizon);
+      int bad = 0;
+      for (std::size_t i = 0; i < d.n; ++i)
+        if (!(got[i].with == want[i].with && same_bits(got[i].time, want[i].time)) && ++bad <= 5)
+          ADD_FAILURE() << "row " << i << ": index " << describe(got[i]) << ", naive "
+                        << describe(want[i]);
+    }
+    EXPECT_GE(refits, 8);
+  }
+}
+
+// The refit in parallel chunks of leaves makes the tree one thread makes: two indices over the
+// same moving crowd, one on one thread and one on two, give the same answers bit for bit and
+// the same search counters (nodes opened, pair tests, queue traffic) at every step.
+TEST(FtcIndex, ParallelRefitBuildsTheTreeOfOneThread) {
+  const StaticScene scene = obstacle_scene(5, 20, 6);
+  Rng rng(91);
+  DiscTable t = build::uniform(6000, {0, 0, 160, 160}, 3, 0.2, 0.6, 12);
+  FtcIndex one({.rebuild_every = 8}), two({.rebuild_every = 8});
+  Executor ex1(1), ex2(2);
+  int refits = 0;
+  for (int step = 0; step < 20; ++step) {
+    SCOPED_TRACE("step " + std::to_string(step));
+    walk(t, rng);
+    one.assume_no_overlaps(step >= 10);
+    two.assume_no_overlaps(step >= 10);
+    const DiscView d = t.view();
+    std::vector<FtcHit> a(d.n), b(d.n);
+    QueryStats sa, sb;
+    one.run(d, scene, 30, a, ex1, sa);
+    two.run(d, scene, 30, b, ex2, sb);
+    ASSERT_EQ(one.refitted(), two.refitted());
+    refits += two.refitted();
+    EXPECT_EQ(sa.nodes_visited, sb.nodes_visited);
+    EXPECT_EQ(sa.pair_tests, sb.pair_tests);
+    EXPECT_EQ(sa.queue_pushes, sb.queue_pushes);
+    EXPECT_EQ(sa.queue_pops, sb.queue_pops);
+    int bad = 0;
+    for (std::size_t i = 0; i < d.n; ++i)
+      if (!(a[i].with == b[i].with && same_bits(a[i].time, b[i].time)) && ++bad <= 5)
+        ADD_FAILURE() << "row " << i << ": one thread " << describe(a[i]) << ", two "
+                      << describe(b[i]);
+  }
+  EXPECT_GE(refits, 12);
+}
+
 // Random tables of every shape, random options, told or not that nothing overlaps (a hint that
 // may be wrong: it changes the cost only): the property test.
 TEST(FtcIndex, PropertyManySeeds) {

@@ -73,7 +73,7 @@ std::unique_ptr<CollisionPath> make_path(const std::string& name) {
 // frozen for the moved rows to get a grid of their own.
 TEST(Backoff, IncrementalLoopEqualsThePlainLoop) {
   Executor ex(1), ex2(2);
-  std::size_t cascades = 0, grid_probes = 0;
+  std::size_t cascades = 0, grid_probes = 0, moved_grid_rounds = 0;
   const std::pair<std::size_t, uint64_t> sizes[] = {{40, 1},  {40, 2},  {40, 3},  {600, 1},
                                                     {600, 2}, {600, 3}, {4000, 1}};
   for (const auto& [n, seed] : sizes)
@@ -100,6 +100,7 @@ TEST(Backoff, IncrementalLoopEqualsThePlainLoop) {
               NextState got = k.next;
               std::size_t iter = 0;
               const OverlapReport r = backoff(k.t, got, k.scene, *make_path(m), *on, st, iter);
+              moved_grid_rounds += r.moved_grid_rounds;
               EXPECT_EQ(iter, plain_iter);
               EXPECT_EQ(r.agent_pairs, want.agent_pairs);
               EXPECT_EQ(r.obstacle_hits, want.obstacle_hits);
@@ -111,8 +112,9 @@ TEST(Backoff, IncrementalLoopEqualsThePlainLoop) {
               EXPECT_EQ(got.vy, plain.vy);
             }
         }
-  EXPECT_GT(cascades, 20u);    // freezes that cause further freezes
-  EXPECT_GE(grid_probes, 6u);  // large enough for the probes to use the grid
+  EXPECT_GT(cascades, 20u);          // freezes that cause further freezes
+  EXPECT_GE(grid_probes, 6u);        // large enough for the probes to use the grid
+  EXPECT_GT(moved_grid_rounds, 0u);  // and for the moved rows to get a grid of their own
 }
 
 TEST(Backoff, ChainOfFreezesTakesOneIterationPerLink) {
