@@ -140,6 +140,7 @@ AheadInput ahead_input(const AgentTable& t, std::span<const Goal> goals, std::si
   h.x = t.x[i];
   h.y = t.y[i];
   h.goal = t.goal[i];
+  h.left_goal = t.left_goal[i];
   const double dx = t.target_x[i] - t.x[i], dy = t.target_y[i] - t.y[i];
   const double to_target = std::sqrt(dx * dx + dy * dy);
   h.way_x = to_target > 0 ? dx / to_target : 0;

@@ -104,7 +104,9 @@ struct alignas(64) AheadInput {
   double way_x = 0, way_y = 0;               // the unit vector to its waypoint (0 on it)
   double goal_x = 0, goal_y = 0, goal2 = 0;  // [m] the offset to its goal's point, its square
   uint32_t goal = 0;
+  uint32_t left_goal = 0;  // the goal it last left (orca's out-before-in; in the line's spare room)
 };
+static_assert(sizeof(AheadInput) == 64);
 AheadInput ahead_input(const AgentTable& t, std::span<const Goal> goals, std::size_t i);
 // The test for two walking rows (that they walk is the caller's part): true when it decides,
 // with a_first true when a is ahead. Antisymmetric bit for bit. Without branches: which of two

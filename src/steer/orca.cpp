@@ -271,19 +271,16 @@ class OrcaModel final : public Model {
     log.timed("ORCA linear programs", n, [&] {
       // Priority: agents yielding to a stalemate first, then the one with less of its path left;
       // idle agents come last.
-      remaining_.resize(n);
-      arrive_.resize(n);
       yielding_.resize(n);
-      rank_.resize(n);
       heading_.resize(n);
-      avoid_x_.resize(n);
-      avoid_y_.resize(n);
+      peer_.resize(n);
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
-          remaining_[i] = in.path_left[i];
+          Peer& pi = peer_[i];
+          pi.remaining = in.path_left[i];
           yielding_[i] =
               t.stall_action[i] == StallAction::yield_ahead && in.tick < t.stall_until[i];
-          arrive_[i] = arrival_time(in, i);
+          pi.arrive = arrival_time(in, i);
           // The velocity others avoid i at when i goes first: where it wants to go, as far as it
           // is held up (1 - speed / preferred speed; see the top). Once per row, not per pair.
           double ax = t.vx[i], ay = t.vy[i];
@@ -293,11 +290,14 @@ class OrcaModel final : public Model {
               want > 0 ? std::clamp(1 - std::sqrt(ax * ax + ay * ay) / want, 0.0, 1.0) : 0.0;
           ax += held * (in.pref_vx[i] - ax);
           ay += held * (in.pref_vy[i] - ay);
-          avoid_x_[i] = ax;
-          avoid_y_[i] = ay;
+          pi.avoid_x = ax;
+          pi.avoid_y = ay;
+          pi.vx = t.vx[i];
+          pi.vy = t.vy[i];
+          pi.radius = t.radius[i];
           heading_[i] = sim::ahead_input(t, in.goals, i);
           uint64_t h = in.cfg.seed ^ (t.id[i] * 0x9e3779b97f4a7c15ull);
-          rank_[i] = splitmix64(h);
+          pi.rank = splitmix64(h);
         }
       });
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
@@ -309,8 +309,10 @@ class OrcaModel final : public Model {
           // The next row's neighbours' right-of-way inputs, a cache line each, asked for now:
           // waiting for them was the largest stall of this loop (the LP stage -2.5 %).
           if (i + 1 < n)
-            for (uint32_t a = nb_.offset[i + 1]; a < nb_.offset[i + 2]; ++a)
+            for (uint32_t a = nb_.offset[i + 1]; a < nb_.offset[i + 2]; ++a) {
               __builtin_prefetch(&heading_[nb_.row[a]]);
+              __builtin_prefetch(&peer_[nb_.row[a]]);
+            }
           obstacle_planes(in, i, planes);
           const double vix = t.vx[i], viy = t.vy[i];
           const uint32_t lo = nb_.offset[i];
@@ -327,16 +329,22 @@ class OrcaModel final : public Model {
           // more than the columns' fill.
           if (ipx.size() < m)
             for (auto* col : {&ipx, &ipy, &ivx, &ivy, &ir, &itau, &ishare}) col->resize(m);
+          // The neighbour's columns come from its two records (a cache line each), not from a
+          // dozen columns of the table.
+          const double xi = t.x[i], yi = t.y[i], ri = t.radius[i], arrive_i = peer_[i].arrive;
           for (std::size_t a = 0; a < m; ++a) {
             const uint32_t j = nb_.row[lo + a];
+            const sim::AheadInput& hj = heading_[j];
+            const Peer& pj = peer_[j];
             const bool i_first = first(in, i, j);
-            const double d2 = dist2_of(t, i, j);
-            const double far = beyond + t.radius[j];
+            const double dx = hj.x - xi, dy = hj.y - yi;
+            const double d2 = dx * dx + dy * dy;
+            const double far = beyond + pj.radius;
             const bool clear = d2 > far * far * (1 + 1e-9);
             const double d = clear ? 0.0 : std::sqrt(d2);
-            const double gap = d - t.radius[i] - t.radius[j] - kSkin;
+            const double gap = d - ri - pj.radius - kSkin;
             if (!(clear || gap >= reach || d == 0)) {
-              const double nx = (t.x[j] - t.x[i]) / d, ny = (t.y[j] - t.y[i]) / d;
+              const double nx = dx / d, ny = dy / d;
               // v . n <= g  <=>  v . (-n) >= -g: the plane through -n g with normal -n.
               const double share = pick(i_first, lo_share, hi_share);
               const double g = std::max(0.0, gap) * share / in.cfg.dt;
@@ -345,15 +353,15 @@ class OrcaModel final : public Model {
             // Right of way: a neighbour that goes first is avoided where it wants to go, as far as
             // it is held up (walking as it wishes, its velocity says it already).
             // Picked by mask, not by a branch on i_first (a coin toss to the predictor).
-            const double vjx = pick(i_first, t.vx[j], avoid_x_[j]);
-            const double vjy = pick(i_first, t.vy[j], avoid_y_[j]);
-            ipx[a] = t.x[j] - t.x[i];
-            ipy[a] = t.y[j] - t.y[i];
+            const double vjx = pick(i_first, pj.vx, pj.avoid_x);
+            const double vjy = pick(i_first, pj.vy, pj.avoid_y);
+            ipx[a] = dx;
+            ipy[a] = dy;
             ivx[a] = vix - vjx;
             ivy[a] = viy - vjy;
-            ir[a] = t.radius[i] + t.radius[j];
+            ir[a] = ri + pj.radius;
             // The pair's horizon: no longer than until one of them arrives (see the top).
-            itau[a] = std::clamp(std::min(arrive_[i], arrive_[j]), in.cfg.dt, p.time_horizon);
+            itau[a] = std::clamp(std::min(arrive_i, pj.arrive), in.cfg.dt, p.time_horizon);
             ishare[a] = pick(i_first, hi_share, lo_share);
           }
           retreat_plane(in, i, planes);
@@ -673,15 +681,16 @@ class OrcaModel final : public Model {
     const AgentTable& t = in.agents;
     // (Out before in can only decide when one left the goal the other heads for: tested here,
     // the call per pair cost more than the rest of the rule.)
-    if (t.left_goal[i] == t.goal[j] || t.left_goal[j] == t.goal[i])
+    if (t.left_goal[i] == heading_[j].goal || heading_[j].left_goal == t.goal[i])
       if (const int o = sim::out_before_in(t, in.goals, i, j); o != 0) return o > 0;
     // The rest without branches: which way a pair goes is a coin toss to the branch predictor,
     // and the rule runs once per neighbour of every row.
     // (The tests as ints: & and | on them is meant, not && and ||.)
-    const bool by_path = int{remaining_[i] < remaining_[j]} |
-                         (int{remaining_[i] == remaining_[j]} & int{rank_[i] > rank_[j]});
+    const Peer &pi = peer_[i], &pj = peer_[j];
+    const bool by_path = int{pi.remaining < pj.remaining} |
+                         (int{pi.remaining == pj.remaining} & int{pi.rank > pj.rank});
     bool by_place;
-    const bool decides = int{std::isfinite(remaining_[i])} & int{std::isfinite(remaining_[j])} &
+    const bool decides = int{std::isfinite(pi.remaining)} & int{std::isfinite(pj.remaining)} &
                          int{sim::ahead(heading_[i], heading_[j], by_place)};
     // (As a mask: g++ made the ?: a jump on `decides`, a coin toss too.)
     const unsigned take = 0u - unsigned{decides};
@@ -698,11 +707,16 @@ class OrcaModel final : public Model {
   uint64_t passing_near_ = 0, passing_far_ = 0;
   FeatureLists features_;
   std::vector<double> reach_;
-  std::vector<double> remaining_;
-  std::vector<double> arrive_;
   std::vector<uint8_t> yielding_;
-  std::vector<uint64_t> rank_;
-  std::vector<double> avoid_x_, avoid_y_;
+  // Per row, what the linear programs read of it as someone's neighbour besides heading_, in
+  // one cache line (its columns were a dozen lines per neighbour): its velocity and the one
+  // others avoid it at when it goes first (see velocities), radius, time to arrive, path left,
+  // and its rank for ties.
+  struct alignas(64) Peer {
+    double vx, vy, avoid_x, avoid_y, radius, arrive, remaining;
+    uint64_t rank;
+  };
+  std::vector<Peer> peer_;
   std::vector<sim::AheadInput> heading_;  // per row: what the one ahead reads of it
   std::vector<uint64_t> infeasible_;
   StreamMarks streams_;  // who is at or behind a meeting of streams (stream gap)
