@@ -327,8 +327,17 @@ class OrcaModel final : public Model {
           const double beyond = reach + kSkin + t.radius[i];
           // Grown, never shrunk: a resize per row and column (zero-filling what it adds) cost
           // more than the columns' fill.
-          if (ipx.size() < m)
-            for (auto* col : {&ipx, &ipy, &ivx, &ivy, &ir, &itau, &ishare}) col->resize(m);
+          // Padded to whole vectors of four with a neighbour far off whose planes are dropped:
+          // the lanes take them all in one call (agent_plane one at a time did the tail).
+          const std::size_t mp = (m + 3) & ~std::size_t{3};
+          if (ipx.size() < mp)
+            for (auto* col : {&ipx, &ipy, &ivx, &ivy, &ir, &itau, &ishare}) col->resize(mp);
+          for (std::size_t a = m; a < mp; ++a) {
+            ipx[a] = 1;
+            ipy[a] = ivx[a] = ivy[a] = ishare[a] = 0;
+            ir[a] = 0.5;
+            itau[a] = 1;
+          }
           // The neighbour's columns come from its two records (a cache line each), not from a
           // dozen columns of the table.
           const double xi = t.x[i], yi = t.y[i], ri = t.radius[i], arrive_i = peer_[i].arrive;
@@ -368,10 +377,10 @@ class OrcaModel final : public Model {
           const std::size_t hard = planes.size();
           // Built in a buffer of their own and appended: resizing `planes` would zero-fill them
           // first, row by row.
-          if (soft.size() < m) soft.resize(m);
+          if (soft.size() < mp) soft.resize(mp);
           agent_planes({ipx.data(), ipy.data(), ivx.data(), ivy.data(), ir.data(), itau.data(),
                         ishare.data()},
-                       m, in.cfg.dt, vix, viy, soft.data());
+                       mp, in.cfg.dt, vix, viy, soft.data());
           planes.insert(planes.end(), soft.begin(), soft.begin() + static_cast<std::ptrdiff_t>(m));
           double px = in.pref_vx[i], py = in.pref_vy[i];
           if (p.pass_side != OrcaParams::PassSide::none) keep_to_side(in, i, px, py);
