@@ -1,7 +1,10 @@
 // The whole tick's speed on named scenarios, per steering model and thread count: median and
 // minimum ms per tick, agent-ticks per second, the tick's drift over the run (median of the first
 // and of the last tenth of the ticks), peak resident memory, the machine's load, and the final
-// state hash (which must not depend on the thread count; a difference fails the run).
+// state hash (which must not depend on the thread count; a difference fails the run). Asked for
+// more than one thread, it first prints what two CPUs at once get done against one on a kernel
+// in the level-1 cache: near 1 where the VM's two CPUs are one core's two hardware threads (seen
+// on this project's host on 2026-12-04: 0.97), and no tick can then gain near 2 from a second.
 //
 // Each case runs in a child process of its own, so that its peak memory is its own
 // (getrusage of the child) and one case's allocations do not slow the next. `--fork no` runs
@@ -39,6 +42,7 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "airport_scenario.hpp"
@@ -153,6 +157,41 @@ double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
+}
+
+// Two copies of a kernel that lives in the level-1 cache (16 KB copied back and forth), run at
+// once, against one alone: how many times one copy's work the pair gets done in the same time.
+// About 2 when the two CPUs are cores of their own; about 1 when they are the two hardware
+// threads of one core, which a VM need not show (its lscpu may say one thread per core). A
+// two-thread speed-up of the tick can then not pass this figure by much. The median of 5.
+double two_cpu_throughput() {
+  constexpr std::size_t kBytes = 16 * 1024;
+  constexpr int kReps = 40000;  // ~30 ms alone on a 2020s core
+  const auto kernel = [] {
+    std::vector<char> a(kBytes, 1), b(kBytes, 2);
+    for (int r = 0; r < kReps; ++r) {
+      std::memcpy(r % 2 ? a.data() : b.data(), r % 2 ? b.data() : a.data(), kBytes);
+      a[static_cast<std::size_t>(r) % kBytes] ^= static_cast<char>(r);
+    }
+    volatile char sink = a[7] ^ b[11];  // the copies are used
+    (void)sink;
+  };
+  const auto seconds = [](auto&& f) {
+    const auto t0 = Clock::now();
+    f();
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+  };
+  std::vector<double> ratios;
+  for (int k = 0; k < 5; ++k) {
+    const double alone = seconds(kernel);
+    const double pair = seconds([&] {
+      std::thread other(kernel);
+      kernel();
+      other.join();
+    });
+    ratios.push_back(2 * alone / pair);
+  }
+  return median(ratios);
 }
 
 Result run_case(const Case& c, const std::string& model, int threads, uint64_t ticks) {
@@ -301,6 +340,11 @@ int main(int argc, char** argv) {
     std::fprintf(out,
                  "case,model,threads,agents,ticks,median_ms,min_ms,first_tenth_ms,last_tenth_ms,"
                  "agent_ticks_per_s,peak_mb,load_before,load_after,state_hash,round\n");
+  if (std::any_of(thread_counts.begin(), thread_counts.end(), [](int t) { return t > 1; }))
+    std::printf(
+        "two CPUs at once: %.2f x one CPU's throughput on a cache-resident kernel (~2: cores of "
+        "their own; ~1: one core's two hardware threads, and two-thread speed-ups stay near it)\n",
+        two_cpu_throughput());
   std::printf("%-14s %-7s %3s %9s %6s %10s %10s %10s %10s %12s %8s %11s  %s\n", "case", "model",
               "thr", "agents", "ticks", "median ms", "min ms", "first 1/10", "last 1/10",
               "agent-t/s", "peak MB", "load", "state hash");
