@@ -1,10 +1,12 @@
 // The whole tick's speed on named scenarios, per steering model and thread count: median and
 // minimum ms per tick, agent-ticks per second, the tick's drift over the run (median of the first
 // and of the last tenth of the ticks), peak resident memory, the machine's load, and the final
-// state hash (which must not depend on the thread count; a difference fails the run). Asked for
-// more than one thread, it first prints what two CPUs at once get done against one on a kernel
-// in the level-1 cache: near 1 where the VM's two CPUs are one core's two hardware threads (seen
-// on this project's host on 2026-12-04: 0.97), and no tick can then gain near 2 from a second.
+// state hash (which must not depend on the thread count; a difference fails the run). Before
+// each run, column "2cpu": what two CPUs at once get done against one on a kernel in the level-1
+// cache (two_cpu_throughput): near 2 on cores of their own, near 1 where the VM's two CPUs are
+// one core's two hardware threads, which the host may switch between from one minute to the
+// next (seen here on 2026-12-04: 0.97 at 01:00, 2.0 at 01:10), and a tick cannot then gain near
+// 2 from a second thread.
 //
 // Each case runs in a child process of its own, so that its peak memory is its own
 // (getrusage of the child) and one case's allocations do not slow the next. `--fork no` runs
@@ -163,10 +165,10 @@ double median(std::vector<double> v) {
 // once, against one alone: how many times one copy's work the pair gets done in the same time.
 // About 2 when the two CPUs are cores of their own; about 1 when they are the two hardware
 // threads of one core, which a VM need not show (its lscpu may say one thread per core). A
-// two-thread speed-up of the tick can then not pass this figure by much. The median of 5.
+// two-thread speed-up of the tick can then not pass this figure by much. The median of 3.
 double two_cpu_throughput() {
   constexpr std::size_t kBytes = 16 * 1024;
-  constexpr int kReps = 40000;  // ~30 ms alone on a 2020s core
+  constexpr int kReps = 20000;  // ~15 ms alone on a 2020s core
   const auto kernel = [] {
     std::vector<char> a(kBytes, 1), b(kBytes, 2);
     for (int r = 0; r < kReps; ++r) {
@@ -182,7 +184,7 @@ double two_cpu_throughput() {
     return std::chrono::duration<double>(Clock::now() - t0).count();
   };
   std::vector<double> ratios;
-  for (int k = 0; k < 5; ++k) {
+  for (int k = 0; k < 3; ++k) {
     const double alone = seconds(kernel);
     const double pair = seconds([&] {
       std::thread other(kernel);
@@ -339,15 +341,10 @@ int main(int argc, char** argv) {
   if (out)
     std::fprintf(out,
                  "case,model,threads,agents,ticks,median_ms,min_ms,first_tenth_ms,last_tenth_ms,"
-                 "agent_ticks_per_s,peak_mb,load_before,load_after,state_hash,round\n");
-  if (std::any_of(thread_counts.begin(), thread_counts.end(), [](int t) { return t > 1; }))
-    std::printf(
-        "two CPUs at once: %.2f x one CPU's throughput on a cache-resident kernel (~2: cores of "
-        "their own; ~1: one core's two hardware threads, and two-thread speed-ups stay near it)\n",
-        two_cpu_throughput());
-  std::printf("%-14s %-7s %3s %9s %6s %10s %10s %10s %10s %12s %8s %11s  %s\n", "case", "model",
+                 "agent_ticks_per_s,peak_mb,load_before,load_after,two_cpu,state_hash,round\n");
+  std::printf("%-14s %-7s %3s %9s %6s %10s %10s %10s %10s %12s %8s %11s %5s  %s\n", "case", "model",
               "thr", "agents", "ticks", "median ms", "min ms", "first 1/10", "last 1/10",
-              "agent-t/s", "peak MB", "load", "state hash");
+              "agent-t/s", "peak MB", "load", "2cpu", "state hash");
   int status = 0;
   std::map<std::string, uint64_t> hash_of;  // case/model -> hash of the first thread count
   // Per case/model, per round: the median ms of each thread count (for the summary).
@@ -360,6 +357,7 @@ int main(int argc, char** argv) {
         for (int threads : order) {
           const uint64_t n = ticks ? ticks : c->ticks;
           const double load_before = load_average();
+          const double two_cpu = two_cpu_throughput();
           Result r;
           bool got = true;
           rusage ru{};
@@ -397,22 +395,23 @@ int main(int argc, char** argv) {
           const auto [it, first] = hash_of.emplace(key, r.hash);
           const bool same = first || it->second == r.hash;
           std::printf(
-              "%-14s %-7s %3d %9.0f %6llu %10.2f %10.2f %10.2f %10.2f %12.3g %8.0f %5.2f-%5.2f  "
+              "%-14s %-7s %3d %9.0f %6llu %10.2f %10.2f %10.2f %10.2f %12.3g %8.0f %5.2f-%5.2f "
+              "%5.2f  "
               "%s%s\n",
               c->name, model.c_str(), threads, r.agents, static_cast<unsigned long long>(r.ticks),
               r.median_ms, r.min_ms, r.first_ms, r.last_ms, rate, peak_mb, load_before, load_after,
-              hash, same ? "" : "  DIFFERS FROM THE FIRST THREAD COUNT");
+              two_cpu, hash, same ? "" : "  DIFFERS FROM THE FIRST THREAD COUNT");
           std::fflush(stdout);
           if (!same) status = 1;
           auto& per_round = medians[key];
           per_round.resize(static_cast<std::size_t>(rounds));
           per_round[static_cast<std::size_t>(round)][threads] = r.median_ms;
           if (out)
-            std::fprintf(out, "%s,%s,%d,%.0f,%llu,%.3f,%.3f,%.3f,%.3f,%.4g,%.0f,%.2f,%.2f,%s,%d\n",
-                         c->name, model.c_str(), threads, r.agents,
-                         static_cast<unsigned long long>(r.ticks), r.median_ms, r.min_ms,
-                         r.first_ms, r.last_ms, rate, peak_mb, load_before, load_after, hash,
-                         round + 1);
+            std::fprintf(
+                out, "%s,%s,%d,%.0f,%llu,%.3f,%.3f,%.3f,%.3f,%.4g,%.0f,%.2f,%.2f,%.2f,%s,%d\n",
+                c->name, model.c_str(), threads, r.agents, static_cast<unsigned long long>(r.ticks),
+                r.median_ms, r.min_ms, r.first_ms, r.last_ms, rate, peak_mb, load_before,
+                load_after, two_cpu, hash, round + 1);
         }
       }
     }
