@@ -284,6 +284,24 @@ struct Outputs {
   std::span<double> pot, gx, gy;
 };
 
+}  // namespace
+
+struct FieldSumScratch {
+  std::vector<std::pair<double, uint32_t>> order;  // the entries' (x, id) order
+  std::vector<FieldEntry> sorted;
+  Scratch one;                  // a world of one tile
+  std::vector<Scratch> chunks;  // per chunk of slabs
+};
+
+void FieldSumScratchDeleter::operator()(FieldSumScratch* s) const {
+  delete s;
+}
+FieldSumScratchPtr make_field_sum_scratch() {
+  return FieldSumScratchPtr(new FieldSumScratch);
+}
+
+namespace {
+
 // One combo's forward and backward sweeps over the tile's entries (read only). Each probe's sum
 // over the forward wedge goes to fwd(e, res), over the backward wedge to bwd(e, res), once each.
 template <class Fwd, class Bwd>
@@ -586,7 +604,7 @@ namespace {
 // Both modes: `cutoff` sums every tile pair by pair (any exp metric); otherwise swept tiles.
 void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, bool cutoff,
                       std::span<double> out_pot, std::span<double> out_gx, std::span<double> out_gy,
-                      Executor& ex, QueryStats& stats) {
+                      Executor& ex, QueryStats& stats, FieldSumScratch& fs) {
   Separable sep;
   if (cutoff) {
     // k d >= decay max(|dx|, |dy|): l1 and l2 >= L∞; radial >= (π/4) L2 (each frame's L1 >= L2).
@@ -623,20 +641,23 @@ void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, boo
   // in (x, id) order first, as the slabs need them anyway. A swept tile sorts its own entries by
   // (x, y, id): for a world of one such tile the order of the input does not matter.
   if (!one_tile || sums_directly(cutoff, probes, sources, n)) {
-    std::vector<std::pair<double, uint32_t>> order(n);
+    auto& order = fs.order;
+    order.resize(n);
     for (std::size_t i = 0; i < n; ++i) order[i] = {E[i].x, static_cast<uint32_t>(i)};
     std::sort(order.begin(), order.end(), [&](const auto& a, const auto& b) {
       return a.first < b.first || (a.first == b.first && E[a.second].id < E[b.second].id);
     });
-    std::vector<FieldEntry> sorted(n);
+    auto& sorted = fs.sorted;
+    sorted.resize(n);
     for (std::size_t i = 0; i < n; ++i) sorted[i] = E[order[i].second];
-    E.swap(sorted);
+    E.swap(sorted);  // (the caller's old buffer stays here for the next call)
     stats.build_seconds += clock.seconds();
     clock.restart();
   }
   if (one_tile) {
     // One tile, origin at the centre of the bounding box, nothing dropped.
-    Scratch s;
+    Scratch& s = fs.one;
+    s.pairs = 0;
     s.items.resize(n);
     for (std::size_t i = 0; i < n; ++i)
       s.items[i] = (uint64_t{i} << 1) | (E[i].slot != FieldEntry::kNoSlot);
@@ -674,8 +695,12 @@ void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, boo
   clock.restart();
 
   std::vector<uint64_t> tiles_per_slab(slabs.size(), 0), pairs_per_slab(slabs.size(), 0);
-  ex.for_each_chunk(slabs.size(), 4, [&](std::size_t begin, std::size_t end) {
-    Scratch s;
+  constexpr std::size_t kSlabGrain = 4;
+  if (fs.chunks.size() < (slabs.size() + kSlabGrain - 1) / kSlabGrain)
+    fs.chunks.resize((slabs.size() + kSlabGrain - 1) / kSlabGrain);
+  ex.for_each_chunk(slabs.size(), kSlabGrain, [&](std::size_t begin, std::size_t end) {
+    Scratch& s = fs.chunks[begin / kSlabGrain];
+    s.pairs = 0;
     for (std::size_t si = begin; si < end; ++si) {
       const Slab& sl = slabs[si];
       s.slab.clear();
@@ -721,18 +746,22 @@ void tiled_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec, boo
 
 void separable_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
                           std::span<double> out_pot, std::span<double> out_gx,
-                          std::span<double> out_gy, Executor& ex, QueryStats& stats) {
+                          std::span<double> out_gy, Executor& ex, QueryStats& stats,
+                          FieldSumScratch* scratch) {
   if (!field_index_supports(spec))
     throw Error(Error::Kind::usage, "field index: unsupported kernel or metric");
-  tiled_field_sums(E, spec, false, out_pot, out_gx, out_gy, ex, stats);
+  FieldSumScratch own;
+  tiled_field_sums(E, spec, false, out_pot, out_gx, out_gy, ex, stats, scratch ? *scratch : own);
 }
 
 void cutoff_field_sums(std::vector<FieldEntry>& E, const PotentialSpec& spec,
                        std::span<double> out_pot, std::span<double> out_gx,
-                       std::span<double> out_gy, Executor& ex, QueryStats& stats) {
+                       std::span<double> out_gy, Executor& ex, QueryStats& stats,
+                       FieldSumScratch* scratch) {
   if (!field_cutoff_supports(spec))
     throw Error(Error::Kind::usage, "field cutoff: unsupported kernel");
-  tiled_field_sums(E, spec, true, out_pot, out_gx, out_gy, ex, stats);
+  FieldSumScratch own;
+  tiled_field_sums(E, spec, true, out_pot, out_gx, out_gy, ex, stats, scratch ? *scratch : own);
 }
 
 namespace {
@@ -785,7 +814,10 @@ void FieldIndex::run(const DiscView& d, const StaticScene& scene, const Potentia
       add_probe(entries_, d.x[i], d.y[i] + spec.fd_step, 2 * n + i);
     }
   const std::size_t slots = fd ? 3 * n : n;
-  std::vector<double> pot(slots, 0.0), gx(slots, 0.0), gy(slots, 0.0);
+  std::vector<double>&pot = pot_, &gx = gx_, &gy = gy_;
+  pot.assign(slots, 0.0);
+  gx.assign(slots, 0.0);
+  gy.assign(slots, 0.0);
   sums(entries_, spec, pot, gx, gy, ex, stats);
   if (!fd) {
     for (std::size_t i = 0; i < n; ++i) {
@@ -830,7 +862,10 @@ void FieldIndex::probe(std::span<const Vec2> points, const DiscView& sources,
     }
   }
   const std::size_t slots = fd ? 3 * n : n;
-  std::vector<double> pot(slots, 0.0), gx(slots, 0.0), gy(slots, 0.0);
+  std::vector<double>&pot = pot_, &gx = gx_, &gy = gy_;
+  pot.assign(slots, 0.0);
+  gx.assign(slots, 0.0);
+  gy.assign(slots, 0.0);
   sums(entries_, spec, pot, gx, gy, ex, stats);
   const double scale = spec.A * cmax;
   for (std::size_t i = 0; i < n; ++i) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -28,14 +29,27 @@ struct FieldEntry {
   uint32_t id = 0;          // unique: tie-break, so the result never depends on sort order
 };
 
+// Working storage of the sums (sorted entries, tiles' sweeps), for a caller that sums again and
+// again (FieldIndex, tick after tick): allocated per call, its megabytes went through malloc
+// every tick, and freed on another thread than the last (the thesis model runs the field beside
+// first-to-collide) glibc gave them back to the system and faulted them in anew (2026-12-04).
+struct FieldSumScratch;
+struct FieldSumScratchDeleter {
+  void operator()(FieldSumScratch* s) const;
+};
+using FieldSumScratchPtr = std::unique_ptr<FieldSumScratch, FieldSumScratchDeleter>;
+FieldSumScratchPtr make_field_sum_scratch();
+
 // Exact separable sums: out_*[slot] = sum over source entries q other than the probe entry itself
 // of w_q K(d(p, q)), and its analytic gradient with respect to p, for K = e^{-k d} with d the
 // spec's l1 or radial (1-2 frames) metric; sign(0) = 0 conventions as PairKernel. The sums are
 // unscaled (no A, no probe charge). `entries` may be reordered. out_* must have room for every
-// slot; slots not present are left untouched. Thread count does not change the output.
+// slot; slots not present are left untouched. Thread count does not change the output; nor does
+// `scratch` (none: the call's own).
 void separable_field_sums(std::vector<FieldEntry>& entries, const PotentialSpec& spec,
                           std::span<double> out_pot, std::span<double> out_gx,
-                          std::span<double> out_gy, Executor& ex, QueryStats& stats);
+                          std::span<double> out_gy, Executor& ex, QueryStats& stats,
+                          FieldSumScratch* scratch = nullptr);
 
 // True for every exp kernel (any metric) with A finite, k finite and >= 0.
 bool field_cutoff_supports(const PotentialSpec& spec);
@@ -45,7 +59,8 @@ bool field_cutoff_supports(const PotentialSpec& spec);
 // exact within DESIGN.md's tolerance; O(n * sources within the halo), not O(n log n).
 void cutoff_field_sums(std::vector<FieldEntry>& entries, const PotentialSpec& spec,
                        std::span<double> out_pot, std::span<double> out_gx,
-                       std::span<double> out_gy, Executor& ex, QueryStats& stats);
+                       std::span<double> out_gy, Executor& ex, QueryStats& stats,
+                       FieldSumScratch* scratch = nullptr);
 
 // FieldPath "index" (separable sweeps) or "cutoff" (direct pairs within the halo):
 // set-at-a-time potential and gradient at every disc, and the field at arbitrary points.
@@ -61,12 +76,15 @@ class FieldIndex final : public FieldPath {
 
  private:
   void sums(std::vector<FieldEntry>& e, const PotentialSpec& spec, std::span<double> pot,
-            std::span<double> gx, std::span<double> gy, Executor& ex, QueryStats& stats) const {
+            std::span<double> gx, std::span<double> gy, Executor& ex, QueryStats& stats) {
     (mode_ == Mode::cutoff ? cutoff_field_sums : separable_field_sums)(e, spec, pot, gx, gy, ex,
-                                                                       stats);
+                                                                       stats, scratch_.get());
   }
   Mode mode_;
-  std::vector<FieldEntry> entries_;  // reused from tick to tick
+  // Reused from tick to tick: the entries, the unscaled sums, the sums' working storage.
+  std::vector<FieldEntry> entries_;
+  std::vector<double> pot_, gx_, gy_;
+  FieldSumScratchPtr scratch_ = make_field_sum_scratch();
 };
 
 }  // namespace crowddb
