@@ -304,6 +304,42 @@ TEST(FieldIndex, ThreadCountDoesNotChangeBits) {
   }
 }
 
+// The index keeps its working storage from call to call (FieldSumScratch): one index asked about
+// tiled, one-tile and tiny tables in turn, with and without the probes of finite differences,
+// answers each with the bits a fresh index gives, on one thread and on two, in both modes.
+TEST(FieldIndex, CalledAgainGivesTheBitsOfAFreshIndex) {
+  const DiscTable tiled = build::clustered(1500, {0, 0, 2e4, 2e4}, 30, 60, 5, 1, 3, 4);
+  DiscTable one = build::uniform(1500, {0, 0, 40, 40}, 1, 0.2, 0.3, 21);
+  random_charges(one, 21, true);
+  const DiscTable tiny = build::uniform(7, {0, 0, 10, 10}, 1, 0.2, 0.3, 2);
+  const StaticScene scene = obstacles(4, {0, 0, 2e4, 2e4}, 20, 5), none;
+  for (const FieldIndex::Mode mode : {FieldIndex::Mode::separable, FieldIndex::Mode::cutoff})
+    for (int threads : {1, 2}) {
+      Executor ex(threads);
+      FieldIndex kept(mode);
+      for (const DiscTable* t : {&tiled, static_cast<const DiscTable*>(&one), &tiny, &tiled})
+        for (const bool fd : {false, true}) {
+          PotentialSpec spec = exp_spec(Metric::radial);
+          spec.finite_difference = fd;
+          spec.fd_step = 1e-3;
+          const StaticScene& sc = t == &tiled ? scene : none;
+          FieldColumns got, want;
+          QueryStats st, fresh;
+          kept.run(t->view(), sc, spec, got, ex, st);
+          FieldIndex(mode).run(t->view(), sc, spec, want, ex, fresh);
+          if (mode == FieldIndex::Mode::separable && !fd) {  // the paths meant: tiles, one tile
+            EXPECT_EQ(st.nodes_visited > 1, t == &tiled);
+          }
+          const std::string what =
+              std::string(mode == FieldIndex::Mode::cutoff ? "cutoff" : "index") + " threads " +
+              std::to_string(threads) + " rows " + std::to_string(t->size()) + (fd ? " fd" : "");
+          EXPECT_EQ(got.potential, want.potential) << what;
+          EXPECT_EQ(got.grad_x, want.grad_x) << what;
+          EXPECT_EQ(got.grad_y, want.grad_y) << what;
+        }
+    }
+}
+
 // Worlds that fit one tile and are large enough for the tile to run its combos on every thread
 // (field_index.cpp, kParallelCombos), and to sort its entries by radix: against the naive loop,
 // and the same bits on 1, 2 and 3 threads. A uniform crowd; a lattice (ties in x, in y and on the
