@@ -195,7 +195,6 @@ double two_cpu_throughput() {
     const double alone = seconds([&] { kernel(reps); });
     std::atomic<int> ready{0};
     std::atomic<bool> go{false};
-    double pair = 0;
     std::thread other([&] {
       ready.fetch_add(1);
       while (!go.load()) {
@@ -205,7 +204,7 @@ double two_cpu_throughput() {
     while (ready.load() < 1) {
     }
     // (The other thread spins by now: its CPU is awake.)
-    pair = seconds([&] {
+    const double pair = seconds([&] {
       go.store(true);
       kernel(reps);
       other.join();

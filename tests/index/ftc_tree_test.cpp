@@ -563,6 +563,34 @@ TEST(FtcIndex, PairTimesInLanesAreRayDiscTimeBitForBit) {
   }
 }
 
+// One step of the refit tests' crowd: everyone walks a tenth of a tick, a fifth turn, one in a
+// hundred jumps across the 160 x 160 world.
+void walk(DiscTable& t, Rng& rng) {
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    t.x[i] += 0.1 * t.vx[i];
+    t.y[i] += 0.1 * t.vy[i];
+    if (rng.below(5) == 0) {
+      t.vx[i] = rng.uniform(-3, 3);
+      t.vy[i] = rng.uniform(-3, 3);
+    }
+    if (rng.below(100) == 0) {
+      t.x[i] = rng.uniform(0, 160);
+      t.y[i] = rng.uniform(0, 160);
+    }
+  }
+}
+
+// Answers that must agree row for row, bit for bit: the first five differences are reported
+// (`a` and `b` name the two sides).
+void expect_same_hits(const std::vector<FtcHit>& got, const std::vector<FtcHit>& want,
+                      const char* a, const char* b) {
+  int bad = 0;
+  for (std::size_t i = 0; i < got.size(); ++i)
+    if (!(got[i].with == want[i].with && same_bits(got[i].time, want[i].time)) && ++bad <= 5)
+      ADD_FAILURE() << "row " << i << ": " << a << " " << describe(got[i]) << ", " << b << " "
+                    << describe(want[i]);
+}
+
 // One index run tick after tick over a table that changes in between: its discs walk and turn,
 // some jump far (off their cells: the walk's stop allows for the drift), all of them shift by a
 // kilometre (the build's origin is kept), a row is replaced by another id or removed (a build
@@ -581,18 +609,7 @@ TEST(FtcIndex, RefittedTreeAnswersAsTheNaiveLoop) {
     int refits = 0;
     for (int step = 0; step < 30; ++step) {
       SCOPED_TRACE("step " + std::to_string(step));
-      for (std::size_t i = 0; i < t.size(); ++i) {
-        t.x[i] += 0.1 * t.vx[i];
-        t.y[i] += 0.1 * t.vy[i];
-        if (rng.below(5) == 0) {
-          t.vx[i] = rng.uniform(-3, 3);
-          t.vy[i] = rng.uniform(-3, 3);
-        }
-        if (rng.below(100) == 0) {  // a jump across the world
-          t.x[i] = rng.uniform(0, 160);
-          t.y[i] = rng.uniform(0, 160);
-        }
-      }
+      walk(t, rng);
       if (step == 11)
         for (std::size_t i = 0; i < t.size(); ++i) {
           t.x[i] += 1000;
@@ -616,32 +633,9 @@ TEST(FtcIndex, RefittedTreeAnswersAsTheNaiveLoop) {
       // (The naive loop over 4,200 discs is the test's cost: every third step, and the steps
       // that change the table, on two threads.)
       if (threads == 2 && step % 3 != 0 && step != 12 && step != 17 && step != 23) continue;
-      const std::vector<FtcHit> want = naive(d, scene, 30);
-      int bad = 0;
-      for (std::size_t i = 0; i < d.n; ++i) {
-        if (!(got[i].with == want[i].with && same_bits(got[i].time, want[i].time)) && ++bad <= 5)
-          ADD_FAILURE() << "row " << i << ": index " << describe(got[i]) << ", naive "
-                        << describe(want[i]);
-      }
+      expect_same_hits(got, naive(d, scene, 30), "index", "naive");
     }
     EXPECT_GE(refits, 15);
-  }
-}
-
-// One step of the refit tests' crowd: everyone walks a tenth of a tick, a fifth turn, one in a
-// hundred jumps across the 160 x 160 world.
-void walk(DiscTable& t, Rng& rng) {
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    t.x[i] += 0.1 * t.vx[i];
-    t.y[i] += 0.1 * t.vy[i];
-    if (rng.below(5) == 0) {
-      t.vx[i] = rng.uniform(-3, 3);
-      t.vy[i] = rng.uniform(-3, 3);
-    }
-    if (rng.below(100) == 0) {
-      t.x[i] = rng.uniform(0, 160);
-      t.y[i] = rng.uniform(0, 160);
-    }
   }
 }
 
@@ -683,12 +677,7 @@ TEST(FtcIndex, RefitKeepsEveryBoundAndOrderExactAcrossHorizons) {
         EXPECT_TRUE(index.refitted());  // a new horizon, as many knots
       }
       EXPECT_EQ(index.validate(), "");
-      const std::vector<FtcHit> want = naive(d, scene, horizon);
-      int bad = 0;
-      for (std::size_t i = 0; i < d.n; ++i)
-        if (!(got[i].with == want[i].with && same_bits(got[i].time, want[i].time)) && ++bad <= 5)
-          ADD_FAILURE() << "row " << i << ": index " << describe(got[i]) << ", naive "
-                        << describe(want[i]);
+      expect_same_hits(got, naive(d, scene, horizon), "index", "naive");
     }
     EXPECT_GE(refits, 8);
   }
@@ -720,11 +709,7 @@ TEST(FtcIndex, ParallelRefitBuildsTheTreeOfOneThread) {
     EXPECT_EQ(sa.pair_tests, sb.pair_tests);
     EXPECT_EQ(sa.queue_pushes, sb.queue_pushes);
     EXPECT_EQ(sa.queue_pops, sb.queue_pops);
-    int bad = 0;
-    for (std::size_t i = 0; i < d.n; ++i)
-      if (!(a[i].with == b[i].with && same_bits(a[i].time, b[i].time)) && ++bad <= 5)
-        ADD_FAILURE() << "row " << i << ": one thread " << describe(a[i]) << ", two "
-                      << describe(b[i]);
+    expect_same_hits(a, b, "one thread", "two");
   }
   EXPECT_GE(refits, 12);
 }
