@@ -32,6 +32,10 @@
 // walls, round robin, dt 0.1 s), so their figures compare with RVO2's; ring-1k is 1,000 people
 // on a circle of radius 100 m swapping with the point opposite (RVO2's Circle in metres);
 // bottleneck-2k empties a 40 x 40 m room of 2,000 people through a 2.4 m door (navigation on).
+//
+// Models: any registered steering model, or a benchmark variant (bench/model_variant.hpp):
+// `--models orca,orca-core` puts the default orca beside itself without keeping to a side, the
+// stream gap and the perturbation, which is what those three cost.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -52,6 +56,7 @@
 #include "airport_scenario.hpp"
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
+#include "model_variant.hpp"
 #include "util/rng.hpp"
 
 using namespace crowddb;
@@ -217,7 +222,8 @@ double two_cpu_throughput() {
 Result run_case(const Case& c, const std::string& model, int threads, uint64_t ticks) {
   Result r;
   try {
-    Scenario sc = parse_scenario(c.doc(model, threads), c.name);
+    Scenario sc = parse_scenario(c.doc(bench::engine_model(model), threads), c.name);
+    bench::apply_variant(model, sc.config);
     if (c.inserted > 0) insert_lattice(sc.world, c.inserted);
     Simulation sim(std::move(sc.world), sc.config);
     std::vector<double> ms;
@@ -295,11 +301,11 @@ void print_summary(const std::map<std::string, std::vector<std::map<int, double>
 }
 
 int usage(const char* why) {
-  std::fprintf(
-      stderr,
-      "tick_speed: %s\nusage: tick_speed [--cases all|NAME,...] [--models orca,cfsm,thesis] "
-      "[--threads 1,2] [--ticks N] [--rounds N] [--csv FILE] [--fork yes|no]\ncases:",
-      why);
+  std::fprintf(stderr,
+               "tick_speed: %s\nusage: tick_speed [--cases all|NAME,...] [--models "
+               "orca,cfsm,thesis,orca-core] "
+               "[--threads 1,2] [--ticks N] [--rounds N] [--csv FILE] [--fork yes|no]\ncases:",
+               why);
   for (const Case& c : kCases) std::fprintf(stderr, " %s", c.name);
   std::fprintf(stderr, "\n");
   return 2;
@@ -360,7 +366,7 @@ int main(int argc, char** argv) {
     std::fprintf(out,
                  "case,model,threads,agents,ticks,median_ms,min_ms,first_tenth_ms,last_tenth_ms,"
                  "agent_ticks_per_s,peak_mb,load_before,load_after,two_cpu,state_hash,round\n");
-  std::printf("%-14s %-7s %3s %9s %6s %10s %10s %10s %10s %12s %8s %11s %5s  %s\n", "case", "model",
+  std::printf("%-14s %-9s %3s %9s %6s %10s %10s %10s %10s %12s %8s %11s %5s  %s\n", "case", "model",
               "thr", "agents", "ticks", "median ms", "min ms", "first 1/10", "last 1/10",
               "agent-t/s", "peak MB", "load", "2cpu", "state hash");
   int status = 0;
@@ -400,7 +406,7 @@ int main(int argc, char** argv) {
           }
           const double load_after = load_average();
           if (!got || r.error[0]) {
-            std::printf("%-14s %-7s %3d  failed: %s\n", c->name, model.c_str(), threads,
+            std::printf("%-14s %-9s %3d  failed: %s\n", c->name, model.c_str(), threads,
                         got ? r.error : "the child process died");
             status = 1;
             continue;
@@ -413,7 +419,7 @@ int main(int argc, char** argv) {
           const auto [it, first] = hash_of.emplace(key, r.hash);
           const bool same = first || it->second == r.hash;
           std::printf(
-              "%-14s %-7s %3d %9.0f %6llu %10.2f %10.2f %10.2f %10.2f %12.3g %8.0f %5.2f-%5.2f "
+              "%-14s %-9s %3d %9.0f %6llu %10.2f %10.2f %10.2f %10.2f %12.3g %8.0f %5.2f-%5.2f "
               "%5.2f  "
               "%s%s\n",
               c->name, model.c_str(), threads, r.agents, static_cast<unsigned long long>(r.ticks),
