@@ -11,6 +11,9 @@ namespace {
 
 constexpr std::size_t kStreamGrain = 1024;  // rows per chunk of the marking
 constexpr std::size_t kRadixEdges = 256;    // fewer edges are sorted by comparisons
+// With at least one "follows" edge per this many rows, the search looks followers up in a table
+// of the rows (O(rows + edges)) rather than by binary searches (O(reached log edges)).
+constexpr std::size_t kEdgesPerRowForTable = 16;
 
 }  // namespace
 
@@ -92,9 +95,26 @@ void mark_meetings(const StreamView& v, StreamMarks& out, Executor& ex) {
   // edges, and nothing here reads a per-row array.
   std::vector<uint64_t>& edges = out.edges;
   out.queue.clear();
+  out.by_table = false;
   if (meetings > 0 && !edges.empty()) {
     index::radix_sort(edges, out.radix, 32, 32 + index::bits_for(n));
+    // A row's followers: by two binary searches over the edges while they are few; once there
+    // are many (a crowd jammed round its goals: most rows behind a meeting, queues long), by a
+    // table of where each row's run begins, one pass over the rows and the edges. The searches,
+    // one pair per row reached, each a chain of cache misses, were the stage's serial half there
+    // (airport-20k's last 900 of 1,000 ticks).
+    const bool table = edges.size() >= n / kEdgesPerRowForTable;
+    out.by_table = table;
+    if (table) {
+      out.start.resize(n + 1);
+      std::size_t k = 0;
+      for (std::size_t j = 0; j <= n; ++j) {
+        while (k < edges.size() && (edges[k] >> 32) < j) ++k;
+        out.start[j] = static_cast<uint32_t>(k);
+      }
+    }
     const auto followers = [&](uint32_t j) {
+      if (table) return std::pair{edges.begin() + out.start[j], edges.begin() + out.start[j + 1]};
       const auto lo = std::lower_bound(edges.begin(), edges.end(), uint64_t{j} << 32);
       const auto hi = std::lower_bound(lo, edges.end(), (uint64_t{j} + 1) << 32);
       return std::pair{lo, hi};

@@ -81,6 +81,8 @@ struct StreamMarks {
   std::vector<uint64_t> edges;
   index::RadixScratch radix;
   std::vector<uint32_t> queue;
+  std::vector<uint32_t> start;  // with many edges: per row, where its followers begin in `edges`
+  bool by_table = false;        // the last search looked followers up in `start` (tests)
 };
 
 // Marks every row at or behind a meeting. Rows with no wish are never marked (they follow no

@@ -56,6 +56,9 @@ std::size_t streams_count(const std::vector<uint8_t>& m) {
   return static_cast<std::size_t>(std::count(m.begin(), m.end(), 1));
 }
 
+// Searches by the table of rows and by binary searches (StreamMarks::by_table) so far.
+std::size_t streams_by_table = 0, streams_by_search = 0;
+
 // Marks with both and on 1 and 2 threads; every answer must equal the naive one.
 std::vector<uint8_t> streams_checked_marks(const StreamCrowd& c) {
   std::vector<uint8_t> naive;
@@ -67,6 +70,8 @@ std::vector<uint8_t> streams_checked_marks(const StreamCrowd& c) {
       mark_meetings(c.view(), marks, ex);
       EXPECT_EQ(marks.marked, naive) << threads << " threads, call " << call;
       EXPECT_EQ(marks.count, streams_count(naive));
+      if (!marks.edges.empty() && marks.count > 0)
+        ++(marks.by_table ? streams_by_table : streams_by_search);
       // The followed entries are the ones within reach that the corridor test names (kept for
       // the rows not at a meeting themselves).
       for (std::size_t i = 0; i < c.size(); ++i) {
@@ -117,6 +122,9 @@ TEST(Streams, RandomCrowdsMarkAsTheNaiveSweeps) {
   // Both answers occur often: the comparison is not over trivial inputs.
   EXPECT_GT(marked_total, 2000u);
   EXPECT_GT(unmarked_total, 2000u);
+  // And both ways of finding a row's followers were taken, on crowds with few edges and many.
+  EXPECT_GT(streams_by_table, 20u);
+  EXPECT_GT(streams_by_search, 20u);
 }
 
 // A queue of 2,000 in single file whose head meets someone coming the other way: the meeting
