@@ -15,7 +15,7 @@
 // usual case), every disc within that distance is gathered from the cells meeting its disc, row
 // by row, each row's chord as one run of adjacent cells, and nothing beyond; the gathered ones
 // (the hints among them) are ranked by (distance, id), each rank counted without branches, and
-// the first k are the answer. Otherwise (too few hints, more than 64 gathered, ids not distinct)
+// the first k are the answer. Otherwise (too few hints, more than 256 gathered, ids not distinct)
 // the hints are offered to the selection first, and with a full list whose k-th distance is
 // within 1.5 cells the same chords are scanned for anything better. Otherwise the 3 x 3 block
 // around the query's cell is scanned first, as three runs; when the k-th best so far (or the range)
