@@ -16,10 +16,6 @@
 
 namespace crowddb::bench {
 
-inline bool is_variant(const std::string& name) {
-  return name == "orca-core";
-}
-
 // The registered model a name runs (itself unless it names a variant).
 inline std::string engine_model(const std::string& name) {
   return name == "orca-core" ? "orca" : name;

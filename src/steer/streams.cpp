@@ -91,8 +91,9 @@ void mark_meetings(const StreamView& v, StreamMarks& out, Executor& ex) {
     out.edges.insert(out.edges.end(), c.begin(), c.end());
   // Breadth first from the meetings, over the edges reversed: the set reached does not depend on
   // the order. The edges sorted by the row followed (a radix sort: O(E)) give each row's
-  // followers as a run. Where nearly everyone is at a meeting, as in an airport, there are few
-  // edges, and nothing here reads a per-row array.
+  // followers as a run. Where nearly everyone is at a meeting, as in an airport's first minutes,
+  // there are few edges, found by binary searches without a per-row array; many edges (a jam)
+  // are looked up in a table of the rows (below).
   std::vector<uint64_t>& edges = out.edges;
   out.queue.clear();
   out.by_table = false;
