@@ -302,9 +302,9 @@ void print_summary(const std::map<std::string, std::vector<std::map<int, double>
 
 int usage(const char* why) {
   std::fprintf(stderr,
-               "tick_speed: %s\nusage: tick_speed [--cases all|NAME,...] [--models "
-               "orca,cfsm,thesis,orca-core] "
-               "[--threads 1,2] [--ticks N] [--rounds N] [--csv FILE] [--fork yes|no]\ncases:",
+               "tick_speed: %s\nusage: tick_speed [--cases all|NAME,...] "
+               "[--models orca,cfsm,thesis,orca-core] [--threads 1,2] [--ticks N] [--rounds N] "
+               "[--csv FILE] [--fork yes|no]\ncases:",
                why);
   for (const Case& c : kCases) std::fprintf(stderr, " %s", c.name);
   std::fprintf(stderr, "\n");
