@@ -177,7 +177,6 @@ namespace {
 constexpr double kSideTurn = 30 * std::numbers::pi / 180;
 constexpr double kTurnNearWaypoint = 2;  // [m]
 constexpr double kStanding = 1e-100;     // [m/s] a wish below this does not look for anyone
-constexpr uint32_t kCapBatch = 32;       // neighbours filtered at once for the headway caps
 
 class OrcaModel final : public Model {
  public:
@@ -304,6 +303,8 @@ class OrcaModel final : public Model {
         uint64_t infeasible = 0;  // the chunk's count, written once at its end (see find_passing)
         std::vector<HalfPlane> planes, soft;
         std::vector<double> ipx, ipy, ivx, ivy, ir, itau, ishare;  // agent_planes' inputs
+        std::vector<uint32_t> cap_pick;  // the neighbours that cap the wish (Caps)
+        std::vector<uint8_t> cap_bits;
         for (std::size_t i = b; i < e; ++i) {
           planes.clear();
           // The next row's neighbours' right-of-way inputs, a cache line each, asked for now:
@@ -341,6 +342,16 @@ class OrcaModel final : public Model {
           // The neighbour's columns come from its two records (a cache line each), not from a
           // dozen columns of the table.
           const double xi = t.x[i], yi = t.y[i], ri = t.radius[i], arrive_i = peer_[i].arrive;
+          // The wish, turned aside for someone passing, and who of the neighbours caps it.
+          double px = in.pref_vx[i], py = in.pref_vy[i];
+          if (p.pass_side != OrcaParams::PassSide::none) keep_to_side(in, i, px, py);
+          const Caps caps = caps_for(in, i, px, py);
+          const bool capping = caps.headway | caps.gap;
+          if (capping && cap_pick.size() < m) {
+            cap_pick.resize(m);
+            cap_bits.resize(m);
+          }
+          std::size_t capped = 0;
           for (std::size_t a = 0; a < m; ++a) {
             const uint32_t j = nb_.row[lo + a];
             const sim::AheadInput& hj = heading_[j];
@@ -372,6 +383,18 @@ class OrcaModel final : public Model {
             // The pair's horizon: no longer than until one of them arrives (see the top).
             itau[a] = std::clamp(std::min(arrive_i, pj.arrive), in.cfg.dt, p.time_horizon);
             ishare[a] = pick(i_first, hi_share, lo_share);
+            // follows() and follows_within_gap() on the columns at hand (the same operands),
+            // picked without branches (whether one is followed is a coin toss to the predictor).
+            if (capping) {
+              const double wx = in.pref_vx[j], wy = in.pref_vy[j];
+              const int behind = follows_at(dx, dy, caps.ux, caps.uy, ri, pj.radius, wx, wy);
+              const double gap_reach = caps.reach + pj.radius;
+              const int h = caps.headway & behind;
+              const int g = caps.gap & int{d2 < gap_reach * gap_reach} & behind;
+              cap_pick[capped] = lo + static_cast<uint32_t>(a);
+              cap_bits[capped] = static_cast<uint8_t>(h | g << 1);
+              capped += static_cast<std::size_t>(h | g);
+            }
           }
           retreat_plane(in, i, planes);
           const std::size_t hard = planes.size();
@@ -382,10 +405,7 @@ class OrcaModel final : public Model {
                         ishare.data()},
                        mp, in.cfg.dt, vix, viy, soft.data());
           planes.insert(planes.end(), soft.begin(), soft.begin() + static_cast<std::ptrdiff_t>(m));
-          double px = in.pref_vx[i], py = in.pref_vy[i];
-          if (p.pass_side != OrcaParams::PassSide::none) keep_to_side(in, i, px, py);
-          if (p.time_gap > 0 || (p.stream_gap > 0 && streams_.marked[i]))
-            cap_by_headway(in, i, px, py);
+          if (capped) cap_wish(in, i, caps, cap_pick.data(), cap_bits.data(), capped, px, py);
           const LpResult r = solve_velocity_lp(planes, hard, t.max_speed[i], px, py);
           infeasible += !r.feasible;
           vx[i] = r.vx;
@@ -478,43 +498,47 @@ class OrcaModel final : public Model {
   // The headways (see the head comment): caps the wish (px, py) of agent i at s / time_gap
   // (time_gap > 0), and, when i is at or behind a meeting of streams and not in a stalemate
   // action, at v_ahead + s / stream_gap, for every agent ahead of i that it follows (s the
-  // spacing, v_ahead the other's speed along i's wish, at least 0).
-  void cap_by_headway(const TickInput& in, std::size_t i, double& px, double& py) const {
+  // spacing, v_ahead the other's speed along i's wish, at least 0). Which neighbours cap it is
+  // asked in the linear programs' pass over its neighbours (their columns are at hand there:
+  // a pass of its own read five columns of each neighbour again); Caps holds what that asks.
+  struct Caps {
+    int headway = 0, gap = 0;  // which caps apply (none: 0, 0)
+    double v0 = 0, ux = 0, uy = 0;
+    double reach = 0;  // v0 stream_gap + r_i: with r_j, how near one followed must be to cap
+  };
+  Caps caps_for(const TickInput& in, std::size_t i, double px, double py) const {
     const AgentTable& t = in.agents;
     const OrcaParams& p = in.cfg.steering.orca;
-    const double v0 = std::sqrt(px * px + py * py);
-    if (v0 == 0) return;
-    const double ux = px / v0, uy = py / v0;
-    const bool stream = p.stream_gap > 0 && streams_.marked[i] &&
-                        !(t.stall_action[i] != StallAction::none && in.tick < t.stall_until[i]);
-    const StreamView view = stream_view(in);
-    // In batches: first the neighbours that cap it, without branches (see follows()), then
-    // their caps in list order.
-    const int headway = p.time_gap > 0, gap = stream;
+    Caps c;
+    if (!(p.time_gap > 0 || (p.stream_gap > 0 && streams_.marked[i]))) return c;
+    c.v0 = std::sqrt(px * px + py * py);
+    if (c.v0 == 0) return c;
+    c.ux = px / c.v0;
+    c.uy = py / c.v0;
+    c.headway = p.time_gap > 0;
+    c.gap = p.stream_gap > 0 && streams_.marked[i] &&
+            !(t.stall_action[i] != StallAction::none && in.tick < t.stall_until[i]);
+    // (follows_within_gap's reach, w gap + r_i + r_j, summed in the same order)
+    c.reach = c.v0 * p.stream_gap + t.radius[i];
+    return c;
+  }
+  // The caps of the picked neighbours (list entries, in list order; bit 0 of `bits` headway, bit
+  // 1 gap) applied to the wish.
+  void cap_wish(const TickInput& in, std::size_t i, const Caps& c, const uint32_t* pick,
+                const uint8_t* bits, std::size_t m, double& px, double& py) const {
+    const AgentTable& t = in.agents;
+    const OrcaParams& p = in.cfg.steering.orca;
     double v = INFINITY;
-    for (uint32_t a0 = nb_.offset[i]; a0 < nb_.offset[i + 1]; a0 += kCapBatch) {
-      const uint32_t a1 = std::min(nb_.offset[i + 1], a0 + kCapBatch);
-      uint32_t pick[kCapBatch];
-      uint8_t caps[kCapBatch];  // per picked neighbour: bit 0 headway, bit 1 gap
-      uint32_t m = 0;
-      for (uint32_t a = a0; a < a1; ++a) {
-        const int h = headway & int{follows(view, i, nb_.row[a], ux, uy)};
-        const int g = gap & int{follows_within_gap(view, i, a, ux, uy, v0)};
-        pick[m] = a;
-        caps[m] = static_cast<uint8_t>(h | g << 1);
-        m += static_cast<uint32_t>(h | g);
-      }
-      for (uint32_t u = 0; u < m; ++u) {
-        const uint32_t j = nb_.row[pick[u]];
-        const double s = std::max(std::sqrt(dist2_of(t, i, j)) - (t.radius[i] + t.radius[j]), 0.0);
-        if (caps[u] & 1) v = std::min(v, s / p.time_gap);
-        if (caps[u] & 2)
-          v = std::min(v, std::max(t.vx[j] * ux + t.vy[j] * uy, 0.0) + s / p.stream_gap);
-      }
+    for (std::size_t u = 0; u < m; ++u) {
+      const uint32_t j = nb_.row[pick[u]];
+      const double s = std::max(std::sqrt(dist2_of(t, i, j)) - (t.radius[i] + t.radius[j]), 0.0);
+      if (bits[u] & 1) v = std::min(v, s / p.time_gap);
+      if (bits[u] & 2)
+        v = std::min(v, std::max(t.vx[j] * c.ux + t.vy[j] * c.uy, 0.0) + s / p.stream_gap);
     }
-    if (v >= v0) return;
-    px = ux * v;
-    py = uy * v;
+    if (v >= c.v0) return;
+    px = c.ux * v;
+    py = c.uy * v;
   }
 
   // Keeping to one side (see the top): turns the wish (px, py) of row i kSideTurn to the pass

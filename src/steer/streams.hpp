@@ -42,14 +42,18 @@ struct StreamView {
 // branches: whether a neighbour is followed is a coin toss to the predictor, and the stream gap
 // asks it of every neighbour of nearly every row in a crowd where streams cross. (The tests as
 // ints: & and | on them is meant.)
-inline bool follows(const StreamView& v, std::size_t i, std::size_t j, double ux, double uy) {
-  const double rx = v.x[j] - v.x[i], ry = v.y[j] - v.y[i];
-  const double wx = v.wish_x[j], wy = v.wish_y[j];
+// The same on the values: (rx, ry) = p_j - p_i, radii ri and rj, j's wish (wx, wy). (Orca's linear
+// programs ask it with a neighbour's columns already at hand.)
+inline bool follows_at(double rx, double ry, double ux, double uy, double ri, double rj, double wx,
+                       double wy) {
   const double w2 = wx * wx + wy * wy, dot = wx * ux + wy * uy;
   // Ahead (not behind or beside), in the corridor, and standing or going i's way.
-  return int{!(rx * ux + ry * uy <= 0)} &
-         int{!(std::abs(ry * ux - rx * uy) > v.radius[i] + v.radius[j])} &
+  return int{!(rx * ux + ry * uy <= 0)} & int{!(std::abs(ry * ux - rx * uy) > ri + rj)} &
          (int{w2 == 0} | (int{dot >= 0} & int{dot * dot >= kSameWay * kSameWay * w2}));
+}
+inline bool follows(const StreamView& v, std::size_t i, std::size_t j, double ux, double uy) {
+  return follows_at(v.x[j] - v.x[i], v.y[j] - v.y[i], ux, uy, v.radius[i], v.radius[j], v.wish_x[j],
+                    v.wish_y[j]);
 }
 
 // Is row i at a meeting (see the top)?
