@@ -12,16 +12,16 @@
 // candidate is offered twice (test: NeighbourGrid.ListsOfTheCallBeforeChangeNothing).
 //
 // Search: when the hints are k rows within range and the farthest of them within 1.5 cells (the
-// usual case), every disc within that distance is gathered from the cells meeting its disc, row
-// by row, each row's chord as one run of adjacent cells, and nothing beyond; the gathered ones
-// (the hints among them) are ranked by (distance, id), each rank counted without branches, and
-// the first k are the answer. Otherwise (too few hints, more than 256 gathered, ids not distinct)
+// usual case), every disc within that distance is gathered from the cells meeting its bounding
+// square, row by row, each row's cells as one run, and nothing beyond; the gathered ones (the
+// hints among them) are ranked by (distance, id), each rank counted without branches, and the
+// first k are the answer. Otherwise (too few hints, more than 256 gathered, ids not distinct)
 // the hints are offered to the selection first, and with a full list whose k-th distance is
-// within 1.5 cells the same chords are scanned for anything better. Otherwise the 3 x 3 block
-// around the query's cell is scanned first, as three runs; when the k-th best so far (or the range)
-// is strictly nearer than the block's nearest outside edge, nothing beyond can contribute. Else the
-// rings beyond are visited outwards: every disc in ring rho (Chebyshev cell distance rho) is at
-// least (rho - 1) * cell away from the query, so once the list holds k entries whose worst
+// within 1.5 cells its disc's chords of cells are scanned for anything better. Otherwise the 3 x 3
+// block around the query's cell is scanned first, as three runs; when the k-th best so far (or the
+// range) is strictly nearer than the block's nearest outside edge, nothing beyond can contribute.
+// Else the rings beyond are visited outwards: every disc in ring rho (Chebyshev cell distance rho)
+// is at least (rho - 1) * cell away from the query, so once the list holds k entries whose worst
 // distance is below that bound, or the bound reaches the range, no further ring can contribute;
 // within a ring, a cell whose nearest point is farther than the k-th best so far is skipped.
 // Each run's candidates within the bound are picked without a branch, then offered to the same
