@@ -160,6 +160,7 @@
 #include "plan/access_path.hpp"
 #include "sim/stages.hpp"
 #include "steer/model.hpp"
+#include "steer/orca_pairs.hpp"
 #include "steer/orca_planes.hpp"
 #include "steer/passing.hpp"
 #include "steer/separating_line.hpp"
@@ -305,6 +306,14 @@ class OrcaModel final : public Model {
         std::vector<double> ipx, ipy, ivx, ivy, ir, itau, ishare;  // agent_planes' inputs
         std::vector<uint32_t> cap_pick;  // the neighbours that cap the wish (Caps)
         std::vector<uint8_t> cap_bits;
+        // The pass over the neighbours' outputs besides the inputs above (steer/orca_pairs.hpp),
+        // and the rows of the list padded to whole vectors of four for its lanes.
+        std::vector<double> cpx, cpy, cnx, cny;
+        std::vector<uint8_t> contact, capped_by, ask;
+        std::vector<uint32_t> rows;
+        const bool lanes = pair_lanes_avx2();
+        const PairColumns columns{heading_.data(), peer_.data(), yielding_.data(),
+                                  in.pref_vx.data(), in.pref_vy.data()};
         for (std::size_t i = b; i < e; ++i) {
           planes.clear();
           // The next row's neighbours' right-of-way inputs, a cache line each, asked for now:
@@ -318,83 +327,59 @@ class OrcaModel final : public Model {
           const double vix = t.vx[i], viy = t.vy[i];
           const uint32_t lo = nb_.offset[i];
           const std::size_t m = nb_.offset[i + 1] - lo;
-          // One pass over the neighbours: who goes first, the contact plane of those within one
-          // tick's reach (hard), and the inputs of the agent planes, which are built several at a
-          // time afterwards (steer/orca_planes.hpp).
+          // One pass over the neighbours (steer/orca_pairs.hpp): who goes first, the contact plane
+          // of those within one tick's reach (hard), the inputs of the agent planes, which are
+          // built several at a time afterwards (steer/orca_planes.hpp), and the caps.
           const double reach = 2 * in.cfg.dt * t.max_speed[i];
-          // A neighbour whose squared distance clears (reach + skin + radii)^2 by a relative
-          // 1e-9 is beyond reach in the exact test below whatever its rounding (an error of a few
-          // ulps of d): most are, and they need no square root.
           const double beyond = reach + kSkin + t.radius[i];
           // Grown, never shrunk: a resize per row and column (zero-filling what it adds) cost
           // more than the columns' fill.
+          const std::size_t mp = (m + 3) & ~std::size_t{3};
+          if (ipx.size() < mp) {
+            for (auto* col : {&ipx, &ipy, &ivx, &ivy, &ir, &itau, &ishare, &cpx, &cpy, &cnx, &cny})
+              col->resize(mp);
+            for (auto* col : {&contact, &capped_by, &ask, &cap_bits}) col->resize(mp);
+            cap_pick.resize(mp);
+            rows.resize(mp);
+          }
+          // The wish, turned aside for someone passing, and who of the neighbours caps it.
+          double px = in.pref_vx[i], py = in.pref_vy[i];
+          if (p.pass_side != OrcaParams::PassSide::none) keep_to_side(in, i, px, py);
+          const Caps caps = caps_for(in, i, px, py);
+          // The neighbour's values come from its two records (a cache line each), not from a
+          // dozen columns of the table.
+          const PairRow row{&heading_[i], &peer_[i],   yielding_[i], t.x[i],
+                            t.y[i],       t.radius[i], vix,          viy,
+                            reach,        beyond,      in.cfg.dt,    p.time_horizon,
+                            lo_share,     hi_share,    caps.headway, caps.gap,
+                            caps.ux,      caps.uy,     caps.reach};
+          const PairOut out{ipx.data(),  ipy.data(),     ivx.data(),       ivy.data(), ir.data(),
+                            itau.data(), ishare.data(),  cpx.data(),       cpy.data(), cnx.data(),
+                            cny.data(),  contact.data(), capped_by.data(), ask.data()};
+          if (lanes && m > 0) {
+            std::copy_n(nb_.row.data() + lo, m, rows.data());
+            std::fill(rows.data() + m, rows.data() + mp, rows[m - 1]);  // (outputs dropped)
+            pair_lanes(row, columns, rows.data(), mp, out);
+          }
+          // In list order: the entries the lanes left to it (out before in may decide who goes
+          // first) or all, then the contact planes (hard) and the caps. Appended without a branch
+          // where a branch would be a coin toss.
+          std::size_t capped = 0;
+          for (std::size_t a = 0; a < m; ++a) {
+            const uint32_t j = nb_.row[lo + a];
+            if (!lanes || ask[a]) pair_one(row, columns, j, first(in, row, i, j), out, a);
+            if (contact[a]) planes.push_back({cpx[a], cpy[a], cnx[a], cny[a]});
+            cap_pick[capped] = lo + static_cast<uint32_t>(a);
+            cap_bits[capped] = capped_by[a];
+            capped += capped_by[a] != 0;
+          }
           // Padded to whole vectors of four with a neighbour far off whose planes are dropped:
           // the lanes take them all in one call (agent_plane one at a time did the tail).
-          const std::size_t mp = (m + 3) & ~std::size_t{3};
-          if (ipx.size() < mp)
-            for (auto* col : {&ipx, &ipy, &ivx, &ivy, &ir, &itau, &ishare}) col->resize(mp);
           for (std::size_t a = m; a < mp; ++a) {
             ipx[a] = 1;
             ipy[a] = ivx[a] = ivy[a] = ishare[a] = 0;
             ir[a] = 0.5;
             itau[a] = 1;
-          }
-          // The neighbour's columns come from its two records (a cache line each), not from a
-          // dozen columns of the table.
-          const double xi = t.x[i], yi = t.y[i], ri = t.radius[i], arrive_i = peer_[i].arrive;
-          // The wish, turned aside for someone passing, and who of the neighbours caps it.
-          double px = in.pref_vx[i], py = in.pref_vy[i];
-          if (p.pass_side != OrcaParams::PassSide::none) keep_to_side(in, i, px, py);
-          const Caps caps = caps_for(in, i, px, py);
-          const bool capping = caps.headway | caps.gap;
-          if (capping && cap_pick.size() < m) {
-            cap_pick.resize(m);
-            cap_bits.resize(m);
-          }
-          std::size_t capped = 0;
-          for (std::size_t a = 0; a < m; ++a) {
-            const uint32_t j = nb_.row[lo + a];
-            const sim::AheadInput& hj = heading_[j];
-            const Peer& pj = peer_[j];
-            const bool i_first = first(in, i, j);
-            const double dx = hj.x - xi, dy = hj.y - yi;
-            const double d2 = dx * dx + dy * dy;
-            const double far = beyond + pj.radius;
-            const bool clear = d2 > far * far * (1 + 1e-9);
-            const double d = clear ? 0.0 : std::sqrt(d2);
-            const double gap = d - ri - pj.radius - kSkin;
-            if (!(clear || gap >= reach || d == 0)) {
-              const double nx = dx / d, ny = dy / d;
-              // v . n <= g  <=>  v . (-n) >= -g: the plane through -n g with normal -n.
-              const double share = pick(i_first, lo_share, hi_share);
-              const double g = std::max(0.0, gap) * share / in.cfg.dt;
-              planes.push_back({nx * g, ny * g, -nx, -ny});
-            }
-            // Right of way: a neighbour that goes first is avoided where it wants to go, as far as
-            // it is held up (walking as it wishes, its velocity says it already).
-            // Picked by mask, not by a branch on i_first (a coin toss to the predictor).
-            const double vjx = pick(i_first, pj.vx, pj.avoid_x);
-            const double vjy = pick(i_first, pj.vy, pj.avoid_y);
-            ipx[a] = dx;
-            ipy[a] = dy;
-            ivx[a] = vix - vjx;
-            ivy[a] = viy - vjy;
-            ir[a] = ri + pj.radius;
-            // The pair's horizon: no longer than until one of them arrives (see the top).
-            itau[a] = std::clamp(std::min(arrive_i, pj.arrive), in.cfg.dt, p.time_horizon);
-            ishare[a] = pick(i_first, hi_share, lo_share);
-            // follows() and follows_within_gap() on the columns at hand (the same operands),
-            // picked without branches (whether one is followed is a coin toss to the predictor).
-            if (capping) {
-              const double wx = in.pref_vx[j], wy = in.pref_vy[j];
-              const int behind = follows_at(dx, dy, caps.ux, caps.uy, ri, pj.radius, wx, wy);
-              const double gap_reach = caps.reach + pj.radius;
-              const int h = caps.headway & behind;
-              const int g = caps.gap & int{d2 < gap_reach * gap_reach} & behind;
-              cap_pick[capped] = lo + static_cast<uint32_t>(a);
-              cap_bits[capped] = static_cast<uint8_t>(h | g << 1);
-              capped += static_cast<std::size_t>(h | g);
-            }
           }
           retreat_plane(in, i, planes);
           const std::size_t hard = planes.size();
@@ -706,28 +691,14 @@ class OrcaModel final : public Model {
     return d / t.pref_speed[i];
   }
 
-  // Does i go before j? An agent yielding to a stalemate (see the top), then out before in
-  // (sim::out_before_in), then, for two walking to different goals, the one ahead (see the top;
-  // sim::ahead), then less path left, then the seeded rank.
-  bool first(const TickInput& in, std::size_t i, std::size_t j) const {
-    if (yielding_[i] != yielding_[j]) return yielding_[i];
-    const AgentTable& t = in.agents;
-    // (Out before in can only decide when one left the goal the other heads for: tested here,
-    // the call per pair cost more than the rest of the rule.)
-    if (t.left_goal[i] == heading_[j].goal || heading_[j].left_goal == t.goal[i])
-      if (const int o = sim::out_before_in(t, in.goals, i, j); o != 0) return o > 0;
-    // The rest without branches: which way a pair goes is a coin toss to the branch predictor,
-    // and the rule runs once per neighbour of every row.
-    // (The tests as ints: & and | on them is meant, not && and ||.)
-    const Peer &pi = peer_[i], &pj = peer_[j];
-    const bool by_path = int{pi.remaining < pj.remaining} |
-                         (int{pi.remaining == pj.remaining} & int{pi.rank > pj.rank});
-    bool by_place;
-    const bool decides = int{std::isfinite(pi.remaining)} & int{std::isfinite(pj.remaining)} &
-                         int{sim::ahead(heading_[i], heading_[j], by_place)};
-    // (As a mask: g++ made the ?: a jump on `decides`, a coin toss too.)
-    const unsigned take = 0u - unsigned{decides};
-    return ((take & unsigned{by_place}) | (~take & unsigned{by_path})) != 0;
+  // Does i (row) go before j? An agent yielding to a stalemate (see the top), then out before
+  // in (sim::out_before_in), then, for two walking to different goals, the one ahead (see the top;
+  // sim::ahead), then less path left, then the seeded rank (steer/orca_pairs.hpp).
+  bool first(const TickInput& in, const PairRow& row, std::size_t i, std::size_t j) const {
+    const int f = first_or_ask(row, heading_[j], peer_[j], yielding_[j]);
+    if (f != kAsk) return f != 0;
+    if (const int o = sim::out_before_in(in.agents, in.goals, i, j); o != 0) return o > 0;
+    return pair_rest(row, heading_[j], peer_[j]);
   }
 
   NeighbourLists nb_;
@@ -741,15 +712,7 @@ class OrcaModel final : public Model {
   FeatureLists features_;
   std::vector<double> reach_;
   std::vector<uint8_t> yielding_;
-  // Per row, what the linear programs read of it as someone's neighbour besides heading_, in
-  // one cache line (its columns were a dozen lines per neighbour): its velocity and the one
-  // others avoid it at when it goes first (see velocities), radius, time to arrive, path left,
-  // and its rank for ties.
-  struct alignas(64) Peer {
-    double vx, vy, avoid_x, avoid_y, radius, arrive, remaining;
-    uint64_t rank;
-  };
-  std::vector<Peer> peer_;
+  std::vector<Peer> peer_;  // per row: what the linear programs read of it (orca_pairs.hpp)
   std::vector<sim::AheadInput> heading_;  // per row: what the one ahead reads of it
   std::vector<uint64_t> infeasible_;
   StreamMarks streams_;  // who is at or behind a meeting of streams (stream gap)

@@ -1,0 +1,34 @@
+// The choice of pair_lanes' lanes (steer/orca_pairs.hpp).
+#include "steer/orca_pairs.hpp"
+
+namespace crowddb::steer {
+
+#if (CROWDDB_PAIRS_AVX2 && !defined(__AVX2__)) || (CROWDDB_PAIRS_NATIVE && defined(__AVX2__))
+#define CROWDDB_PAIRS_LANES 1
+// orca_pairs_avx2.cpp
+void pair_lanes_avx2_impl(const PairRow& row, const PairColumns& c, const uint32_t* rows,
+                          std::size_t m, const PairOut& out);
+#endif
+
+bool pair_lanes_avx2() {
+#if CROWDDB_PAIRS_LANES && !defined(__AVX2__)
+  // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+#elif CROWDDB_PAIRS_LANES
+  return true;                                         // a build for this machine, which has AVX2
+#else
+  return false;
+#endif
+}
+
+void pair_lanes(const PairRow& row, const PairColumns& c, const uint32_t* rows, std::size_t m,
+                const PairOut& out) {
+#if CROWDDB_PAIRS_LANES
+  pair_lanes_avx2_impl(row, c, rows, m, out);
+#else
+  (void)row, (void)c, (void)rows, (void)m, (void)out;  // never called: pair_lanes_avx2() is false
+#endif
+}
+
+}  // namespace crowddb::steer

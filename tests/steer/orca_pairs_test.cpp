@@ -1,0 +1,205 @@
+// ORCA's pass over the neighbours four at a time (pair_lanes: AVX2, chosen at run time in a
+// default build) against the reference one at a time (first_or_ask, pair_rest, pair_one): the
+// same entries to the bit, on random neighbours and on the cases each rule distinguishes
+// (yielding, out before in asked, equal and infinite paths left, ranks beyond 2^63, the one
+// ahead deciding or not, coincident centres, contacts on and beyond a tick's reach, horizons
+// below a tick and beyond tau, standing wishes, caps on and off), for lists of every length
+// padded the way orca pads them.
+#include "steer/orca_pairs.hpp"
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <iostream>
+#include <vector>
+
+#include "util/rng.hpp"
+
+namespace crowddb::steer {
+namespace {
+
+bool same_bits(double a, double b) {
+  return std::bit_cast<uint64_t>(a) == std::bit_cast<uint64_t>(b);
+}
+
+// Random records for n rows, with the values the rules compare drawn from few choices so that
+// ties, equal goals and crossings of goals come up often.
+struct Table {
+  std::vector<sim::AheadInput> heading;
+  std::vector<Peer> peer;
+  std::vector<uint8_t> yielding;
+  std::vector<double> wish_x, wish_y;
+  PairColumns columns() const {
+    return {heading.data(), peer.data(), yielding.data(), wish_x.data(), wish_y.data()};
+  }
+};
+
+double pick_of(Rng& rng, std::initializer_list<double> values) {
+  return *(values.begin() + rng.below(values.size()));
+}
+
+Table random_table(Rng& rng, std::size_t n) {
+  Table t;
+  t.heading.resize(n);
+  t.peer.resize(n);
+  t.yielding.resize(n);
+  t.wish_x.resize(n);
+  t.wish_y.resize(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    sim::AheadInput& h = t.heading[j];
+    // Positions on a coarse grid now and then: coincident centres, equal distances.
+    h.x = rng.below(4) ? rng.uniform(-3, 3) : 0.5 * static_cast<double>(rng.below(5));
+    h.y = rng.below(4) ? rng.uniform(-3, 3) : 0.5 * static_cast<double>(rng.below(5));
+    const double a = rng.uniform(0, 6.283185307179586);
+    h.way_x = rng.below(8) ? std::cos(a) : 0;
+    h.way_y = rng.below(8) ? std::sin(a) : 0;
+    h.goal_x = rng.uniform(-20, 20);
+    h.goal_y = rng.below(6) ? rng.uniform(-20, 20) : 0;
+    h.goal2 = h.goal_x * h.goal_x + h.goal_y * h.goal_y;
+    h.goal = static_cast<uint32_t>(rng.below(4));
+    h.left_goal = rng.below(3) ? ~0u : static_cast<uint32_t>(rng.below(4));
+    Peer& p = t.peer[j];
+    p.vx = rng.uniform(-1.5, 1.5);
+    p.vy = rng.uniform(-1.5, 1.5);
+    p.avoid_x = rng.uniform(-1.5, 1.5);
+    p.avoid_y = rng.uniform(-1.5, 1.5);
+    p.radius = pick_of(rng, {0.2, 0.25, 0.3, rng.uniform(0.1, 0.5)});
+    p.arrive = pick_of(rng, {INFINITY, 0.01, 0.1, 1.0, 2.0, 5.0, rng.uniform(0, 4)});
+    p.remaining = pick_of(rng, {INFINITY, 1.0, 2.0, rng.uniform(0, 30)});
+    p.rank = rng.below(2) ? rng.next() : (uint64_t{1} << 63) + rng.below(3);
+    t.yielding[j] = rng.below(8) == 0;
+    t.wish_x[j] = rng.below(6) ? rng.uniform(-1.5, 1.5) : 0;
+    t.wish_y[j] = rng.below(6) ? rng.uniform(-1.5, 1.5) : 0;
+  }
+  return t;
+}
+
+struct Entries {
+  std::vector<double> px, py, vx, vy, r, tau, share, cpx, cpy, cnx, cny;
+  std::vector<uint8_t> contact, caps, ask;
+  explicit Entries(std::size_t m)
+      : px(m),
+        py(m),
+        vx(m),
+        vy(m),
+        r(m),
+        tau(m),
+        share(m),
+        cpx(m),
+        cpy(m),
+        cnx(m),
+        cny(m),
+        contact(m),
+        caps(m),
+        ask(m) {}
+  PairOut out() {
+    return {px.data(),  py.data(),      vx.data(),   vy.data(),  r.data(),
+            tau.data(), share.data(),   cpx.data(),  cpy.data(), cnx.data(),
+            cny.data(), contact.data(), caps.data(), ask.data()};
+  }
+};
+
+TEST(OrcaPairs, LanesMatchTheReferenceBitForBit) {
+  if (!pair_lanes_avx2()) {
+    std::cout << "[ note ] no lanes for the pass over the neighbours on this CPU\n";
+    GTEST_SKIP();
+  }
+  Rng rng(20261204);
+  uint64_t compared = 0, asked = 0, contacts = 0, capped = 0, yielded = 0, decided_by_place = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const std::size_t n = 2 + rng.below(30);
+    const Table t = random_table(rng, n);
+    const auto i = static_cast<std::size_t>(rng.below(n));
+    const double dt = pick_of(rng, {0.1, 0.25, 0.05});
+    const double max_speed = rng.uniform(0.5, 3);
+    PairRow row{};
+    row.heading = &t.heading[i];
+    row.peer = &t.peer[i];
+    row.yielding = t.yielding[i];
+    row.x = t.heading[i].x;
+    row.y = t.heading[i].y;
+    row.r = t.peer[i].radius;
+    row.vx = t.peer[i].vx;
+    row.vy = t.peer[i].vy;
+    row.reach = 2 * dt * max_speed;
+    row.beyond = row.reach + kSkin + row.r;
+    row.dt = dt;
+    row.tau = pick_of(rng, {2.0, 0.5, 0.01});  // (below a tick: the clamp's bounds cross)
+    row.hi_share = pick_of(rng, {0.5, 0.8, 1.0});
+    row.lo_share = 1 - row.hi_share;
+    row.headway = static_cast<int>(rng.below(2));
+    row.gap = static_cast<int>(rng.below(2));
+    if (row.headway | row.gap) {
+      const double a = rng.uniform(0, 6.283185307179586);
+      row.ux = std::cos(a);
+      row.uy = std::sin(a);
+      row.cap_reach = rng.uniform(0, 2) + row.r;
+    }
+    // The list: any rows but i, repeats allowed (orca pads with repeats), padded to fours.
+    const std::size_t m = rng.below(14);
+    const std::size_t mp = (m + 3) & ~std::size_t{3};
+    std::vector<uint32_t> rows(mp);
+    for (std::size_t a = 0; a < m; ++a) {
+      auto j = static_cast<uint32_t>(rng.below(n));
+      if (j == i) j = static_cast<uint32_t>((j + 1) % n);
+      rows[a] = j;
+    }
+    for (std::size_t a = m; a < mp; ++a) rows[a] = rows[m - 1];
+    Entries want(mp), got(mp);
+    pair_lanes(row, t.columns(), rows.data(), mp, got.out());
+    for (std::size_t a = 0; a < m; ++a) {
+      const uint32_t j = rows[a];
+      const int f = first_or_ask(row, t.heading[j], t.peer[j], t.yielding[j]);
+      ASSERT_EQ(got.ask[a], f == kAsk) << "trial " << trial << " entry " << a;
+      if (f == kAsk) {
+        ++asked;
+        continue;
+      }
+      yielded += row.yielding != t.yielding[j];
+      bool place = false;
+      decided_by_place += row.yielding == t.yielding[j] && std::isfinite(t.peer[i].remaining) &&
+                          std::isfinite(t.peer[j].remaining) &&
+                          sim::ahead(t.heading[i], t.heading[j], place);
+      pair_one(row, t.columns(), j, f != 0, want.out(), a);
+      const auto where = ::testing::Message() << "trial " << trial << " entry " << a;
+      EXPECT_TRUE(same_bits(got.px[a], want.px[a])) << where;
+      EXPECT_TRUE(same_bits(got.py[a], want.py[a])) << where;
+      EXPECT_TRUE(same_bits(got.vx[a], want.vx[a])) << where;
+      EXPECT_TRUE(same_bits(got.vy[a], want.vy[a])) << where;
+      EXPECT_TRUE(same_bits(got.r[a], want.r[a])) << where;
+      EXPECT_TRUE(same_bits(got.tau[a], want.tau[a])) << where;
+      EXPECT_TRUE(same_bits(got.share[a], want.share[a])) << where;
+      ASSERT_EQ(got.contact[a], want.contact[a]) << where;
+      if (want.contact[a]) {
+        ++contacts;
+        EXPECT_TRUE(same_bits(got.cpx[a], want.cpx[a])) << where;
+        EXPECT_TRUE(same_bits(got.cpy[a], want.cpy[a])) << where;
+        EXPECT_TRUE(same_bits(got.cnx[a], want.cnx[a])) << where;
+        EXPECT_TRUE(same_bits(got.cny[a], want.cny[a])) << where;
+      }
+      ASSERT_EQ(got.caps[a], want.caps[a]) << where;
+      capped += want.caps[a] != 0;
+      ++compared;
+    }
+  }
+  // Each case comes up (the trials are not all of one kind).
+  EXPECT_GT(compared, 60000u);
+  EXPECT_GT(asked, 1000u);
+  EXPECT_GT(contacts, 1000u);
+  EXPECT_GT(capped, 1000u);
+  EXPECT_GT(yielded, 1000u);
+  EXPECT_GT(decided_by_place, 1000u);
+}
+
+TEST(OrcaPairs, LanesAreChosenWhereTheCpuHasThem) {
+#if CROWDDB_TEST_AVX2_DISPATCH
+  EXPECT_EQ(pair_lanes_avx2(), __builtin_cpu_supports("avx2") != 0);
+#else
+  if (!pair_lanes_avx2()) std::cout << "[ note ] no lanes for the pass over the neighbours\n";
+#endif
+}
+
+}  // namespace
+}  // namespace crowddb::steer
