@@ -153,6 +153,7 @@
 // area), so they make room. The backoff stays on as the safety net; with orca it rarely fires
 // (EXPLAIN ANALYZE counts it).
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -309,7 +310,8 @@ class OrcaModel final : public Model {
         // The pass over the neighbours' outputs besides the inputs above (steer/orca_pairs.hpp),
         // and the rows of the list padded to whole vectors of four for its lanes.
         std::vector<double> cpx, cpy, cnx, cny;
-        std::vector<uint8_t> contact, capped_by, ask;
+        std::vector<uint8_t> contact, capped_by;
+        std::vector<uint16_t> flags;  // per four entries (PairOut::lanes)
         std::vector<uint32_t> rows;
         const bool lanes = pair_lanes_avx2();
         const PairColumns columns{heading_.data(), peer_.data(), yielding_.data(),
@@ -338,7 +340,8 @@ class OrcaModel final : public Model {
           if (ipx.size() < mp) {
             for (auto* col : {&ipx, &ipy, &ivx, &ivy, &ir, &itau, &ishare, &cpx, &cpy, &cnx, &cny})
               col->resize(mp);
-            for (auto* col : {&contact, &capped_by, &ask, &cap_bits}) col->resize(mp);
+            for (auto* col : {&contact, &capped_by, &cap_bits}) col->resize(mp);
+            flags.resize(mp / 4);
             cap_pick.resize(mp);
             rows.resize(mp);
           }
@@ -353,25 +356,39 @@ class OrcaModel final : public Model {
                             reach,        beyond,      in.cfg.dt,    p.time_horizon,
                             lo_share,     hi_share,    caps.headway, caps.gap,
                             caps.ux,      caps.uy,     caps.reach};
-          const PairOut out{ipx.data(),  ipy.data(),     ivx.data(),       ivy.data(), ir.data(),
-                            itau.data(), ishare.data(),  cpx.data(),       cpy.data(), cnx.data(),
-                            cny.data(),  contact.data(), capped_by.data(), ask.data()};
+          const PairOut out{ipx.data(),  ipy.data(),     ivx.data(),       ivy.data(),  ir.data(),
+                            itau.data(), ishare.data(),  cpx.data(),       cpy.data(),  cnx.data(),
+                            cny.data(),  contact.data(), capped_by.data(), flags.data()};
           if (lanes && m > 0) {
             std::copy_n(nb_.row.data() + lo, m, rows.data());
             std::fill(rows.data() + m, rows.data() + mp, rows[m - 1]);  // (outputs dropped)
             pair_lanes(row, columns, rows.data(), mp, out);
           }
-          // In list order: the entries the lanes left to it (out before in may decide who goes
-          // first) or all, then the contact planes (hard) and the caps. Appended without a branch
-          // where a branch would be a coin toss.
+          // Four entries at a time, in list order: those the lanes left to it (out before in may
+          // decide who goes first; without lanes, all) one at a time, then the contact planes
+          // (hard) and the caps, from the flags' set bits.
           std::size_t capped = 0;
-          for (std::size_t a = 0; a < m; ++a) {
-            const uint32_t j = nb_.row[lo + a];
-            if (!lanes || ask[a]) pair_one(row, columns, j, first(in, row, i, j), out, a);
-            if (contact[a]) planes.push_back({cpx[a], cpy[a], cnx[a], cny[a]});
-            cap_pick[capped] = lo + static_cast<uint32_t>(a);
-            cap_bits[capped] = capped_by[a];
-            capped += capped_by[a] != 0;
+          for (std::size_t a0 = 0; a0 < m; a0 += 4) {
+            const uint32_t valid = m - a0 >= 4 ? 0xFu : (1u << (m - a0)) - 1;
+            uint32_t f = lanes ? flags[a0 / 4] : 0;
+            for (uint32_t one = lanes ? f >> 12 & valid : valid; one; one &= one - 1) {
+              const int l = std::countr_zero(one);
+              const std::size_t a = a0 + static_cast<std::size_t>(l);
+              const uint32_t j = nb_.row[lo + a];
+              pair_one(row, columns, j, first(in, row, i, j), out, a);
+              f = (f & ~(0x111u << l)) | uint32_t{contact[a]} << l |
+                  (capped_by[a] & 1u) << (4 + l) | (capped_by[a] >> 1u) << (8 + l);
+            }
+            for (uint32_t c = f & valid; c; c &= c - 1) {
+              const std::size_t a = a0 + static_cast<std::size_t>(std::countr_zero(c));
+              planes.push_back({cpx[a], cpy[a], cnx[a], cny[a]});
+            }
+            for (uint32_t k = (f >> 4 | f >> 8) & valid; k; k &= k - 1) {
+              const int l = std::countr_zero(k);
+              cap_pick[capped] = lo + static_cast<uint32_t>(a0) + static_cast<uint32_t>(l);
+              cap_bits[capped] = static_cast<uint8_t>((f >> (4 + l) & 1) | (f >> (8 + l) & 1) << 1);
+              ++capped;
+            }
           }
           // Padded to whole vectors of four with a neighbour far off whose planes are dropped:
           // the lanes take them all in one call (agent_plane one at a time did the tail).

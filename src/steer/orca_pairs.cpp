@@ -1,6 +1,8 @@
 // The choice of pair_lanes' lanes (steer/orca_pairs.hpp).
 #include "steer/orca_pairs.hpp"
 
+#include <atomic>
+
 namespace crowddb::steer {
 
 #if (CROWDDB_PAIRS_AVX2 && !defined(__AVX2__)) || (CROWDDB_PAIRS_NATIVE && defined(__AVX2__))
@@ -10,13 +12,21 @@ void pair_lanes_avx2_impl(const PairRow& row, const PairColumns& c, const uint32
                           std::size_t m, const PairOut& out);
 #endif
 
+namespace {
+std::atomic<bool> reference_only{false};  // use_pair_reference
+}  // namespace
+
+void use_pair_reference(bool on) {
+  reference_only = on;
+}
+
 bool pair_lanes_avx2() {
 #if CROWDDB_PAIRS_LANES && !defined(__AVX2__)
   // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
   static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
+  return avx2 && !reference_only;
 #elif CROWDDB_PAIRS_LANES
-  return true;                                         // a build for this machine, which has AVX2
+  return !reference_only;  // a build for this machine, which has AVX2
 #else
   return false;
 #endif
@@ -27,7 +37,8 @@ void pair_lanes(const PairRow& row, const PairColumns& c, const uint32_t* rows, 
 #if CROWDDB_PAIRS_LANES
   pair_lanes_avx2_impl(row, c, rows, m, out);
 #else
-  (void)row, (void)c, (void)rows, (void)m, (void)out;  // never called: pair_lanes_avx2() is false
+  // Never called: pair_lanes_avx2() is false.
+  (void)row, (void)c, (void)rows, (void)m, (void)out;
 #endif
 }
 

@@ -66,9 +66,13 @@ struct PairColumns {
 struct PairOut {
   double *px, *py, *vx, *vy, *r, *tau, *share;  // the agent plane's inputs (PlaneInputs)
   double *cpx, *cpy, *cnx, *cny;                // the contact plane, where contact[a]
-  uint8_t* contact;
-  uint8_t* caps;  // bit 0: it caps the wish by the headway, bit 1: by the stream gap
-  uint8_t* ask;   // pair_lanes only: out before in may decide (the caller computes the entry)
+  // pair_one: per entry, whether it gives a contact plane, and whether it caps the wish (bit 0:
+  // by the headway, bit 1: by the stream gap).
+  uint8_t *contact, *caps;
+  // pair_lanes instead: per four entries (a / 4), bit l of each nibble for entry 4 (a / 4) + l:
+  // bits 0-3 contact, 4-7 caps by the headway, 8-11 by the stream gap, 12-15 out before in may
+  // decide who goes first (then the rest is unspecified: the caller computes it with pair_one).
+  uint16_t* lanes;
 };
 
 // Who goes first when neither rule before it decides: for two walking to different goals the
@@ -153,12 +157,15 @@ inline void pair_one(const PairRow& row, const PairColumns& c, uint32_t j, bool 
   out.caps[a] = caps;
 }
 
-// Does this CPU take pair_lanes' four lanes (AVX2)?
+// Does this CPU take pair_lanes' four lanes (AVX2)? False while use_pair_reference(true).
 bool pair_lanes_avx2();
 
-// Entries [0, m) for the neighbours rows[0, m), m a multiple of 4, four at a time; only where
-// pair_lanes_avx2(). Sets ask[a] where out before in may decide, and then leaves the entry's
-// other outputs unspecified: the caller computes it with pair_one.
+// For tests: with true, pair_lanes_avx2() answers false, so that orca takes the reference for
+// every entry and whole runs of the two ways can be compared.
+void use_pair_reference(bool on);
+
+// Entries [0, m) for the neighbours rows[0, m), m a multiple of 4, four at a time, their flags in
+// out.lanes (not out.contact, out.caps); only where pair_lanes_avx2().
 void pair_lanes(const PairRow& row, const PairColumns& c, const uint32_t* rows, std::size_t m,
                 const PairOut& out);
 

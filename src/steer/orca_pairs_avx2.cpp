@@ -190,11 +190,8 @@ void pair_lanes_avx2_impl(const PairRow& row, const PairColumns& c, const uint32
       g_bits = gap_cap ? behind_bits & static_cast<uint32_t>(_mm256_movemask_pd(near)) : 0;
     }
     const auto ask_bits = static_cast<uint32_t>(_mm256_movemask_pd(as_mask(ask)));
-    for (int l = 0; l < 4; ++l) {
-      out.contact[a + l] = static_cast<uint8_t>(contact_bits >> l & 1);
-      out.caps[a + l] = static_cast<uint8_t>((h_bits >> l & 1) | (g_bits >> l & 1) << 1);
-      out.ask[a + l] = static_cast<uint8_t>(ask_bits >> l & 1);
-    }
+    out.lanes[a / 4] =
+        static_cast<uint16_t>(contact_bits | h_bits << 4 | g_bits << 8 | ask_bits << 12);
   }
 }
 
