@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 
+#include "index/neighbour_lanes.hpp"
 #include "index/row_buckets.hpp"
 #include "query/naive_paths.hpp"
 #include "util/stopwatch.hpp"
@@ -29,6 +30,50 @@ constexpr std::size_t kCopyGrain = 4096;   // rows per chunk of the lists' compa
 constexpr std::size_t kBuildGrain = 8192;  // rows per chunk of the grid's build
 
 }  // namespace
+
+#if (CROWDDB_NEIGHBOUR_AVX2 && !defined(__AVX2__)) || \
+    (CROWDDB_NEIGHBOUR_AVX2_NATIVE && defined(__AVX2__))
+#define CROWDDB_NEIGHBOUR_DISPATCH 1
+// neighbour_lanes_avx2.cpp: whole vectors of four (see kNeighbourPad).
+uint32_t gather_within_avx2(const double* X, const double* Y, uint32_t lo, uint32_t hi, double px,
+                            double py, double bound, uint32_t self_at, uint32_t* at, double* dist);
+void count_all_nearer_avx2(const double* dist, uint32_t m, uint32_t* before);
+#endif
+
+bool gather_lanes_avx2() {
+#if CROWDDB_NEIGHBOUR_DISPATCH && !defined(__AVX2__)
+  // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+#elif CROWDDB_NEIGHBOUR_DISPATCH
+  return true;  // a build for this machine, which has AVX2
+#else
+  return false;
+#endif
+}
+
+uint32_t gather_within_lanes(const double* X, const double* Y, uint32_t lo, uint32_t hi, double px,
+                             double py, double bound, uint32_t self_at, uint32_t* at, double* dist,
+                             GatherLanes lanes) {
+#if CROWDDB_NEIGHBOUR_DISPATCH
+  if (lanes == GatherLanes::widest && gather_lanes_avx2())
+    return gather_within_avx2(X, Y, lo, hi, px, py, bound, self_at, at, dist);
+#else
+  (void)lanes;
+#endif
+  return gather_within(X, Y, lo, hi, px, py, bound, self_at, at, dist);
+}
+
+void count_all_nearer_lanes(const double* dist, uint32_t m, uint32_t* before, GatherLanes lanes) {
+#if CROWDDB_NEIGHBOUR_DISPATCH
+  if (lanes == GatherLanes::widest && gather_lanes_avx2())
+    return count_all_nearer_avx2(dist, m, before);
+#else
+  (void)lanes;
+#endif
+  // (count_nearer: two at a time in SSE2's lanes, dist[m] padded)
+  for (uint32_t u = 0; u < m; ++u) before[u] = count_nearer(dist, m, dist[u]);
+}
 
 // Monotone in x (a product by a positive constant, then truncation, which is the floor for c >= 0;
 // below 0 clamps to 0): all the probes need, with the slack that covers rounding. A division here
@@ -83,8 +128,9 @@ void NeighbourGrid::build(const DiscView& d, double range, uint32_t k, Executor&
     for (std::size_t i = b; i < e; ++i) cell_of_[i] = row(d.y[i]) * W_ + col(d.x[i]);
   });
   bucket_rows(cell_of_, cells, start_, rows_);
-  x_.resize(d.n);
-  y_.resize(d.n);
+  // (+ 3: the gathering's lanes read whole vectors past a run's end, kNeighbourPad)
+  x_.resize(d.n + kNeighbourPad);
+  y_.resize(d.n + kNeighbourPad);
   id_.resize(d.n);
   ex.for_each_chunk(d.n, kBuildGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {
@@ -194,6 +240,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
     });
   }
   const uint32_t* const At = at_.data();
+  const GatherLanes lanes = gather_lanes_avx2() ? GatherLanes::widest : GatherLanes::scalar;
   ex.for_each_chunk(q, kGrain, [&](std::size_t b, std::size_t e) {
     const std::size_t c = b / kGrain;
     // The chunk's counters and lists are its own until the end (util/executor.hpp).
@@ -215,8 +262,9 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
       // one-by-one selection (airport-20k over 1,000 ticks, one thread: the stage 3,693 ->
       // 3,391 ms with 256; 1,024 no better). Only the ones within the bound are ranked.
       constexpr uint32_t kCollect = 256;
-      uint32_t at[kCollect];
-      double dist[kCollect + 1];
+      // (+ kNeighbourPad: the lanes write and read whole vectors)
+      uint32_t at[kCollect + kNeighbourPad];
+      double dist[kCollect + kNeighbourPad];
       uint32_t m = 0;
       // The square's rows of cells, each as one run: the chords of the disc (a square root per row
       // of cells) left out 6 % of the candidates and cost more than those (airport-20k, one
@@ -232,13 +280,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         if (hi - lo > kCollect - m) return false;
         tested += hi - lo;
         // (Within the range: the bound is a hint's distance, which is.)
-        for (uint32_t a = lo; a < hi; ++a) {
-          const double dx = X[a] - px, dy = Y[a] - py;
-          const double d2 = dx * dx + dy * dy;
-          at[m] = a;
-          dist[m] = d2;
-          m += static_cast<uint32_t>((d2 <= bound) & (a != self_at));
-        }
+        m += gather_within_lanes(X, Y, lo, hi, px, py, bound, self_at, at + m, dist + m, lanes);
       }
       if (self_at == kNoRow)  // (a subset's query: its place was not looked up) drop its own
         for (uint32_t u = 0; u < m; ++u)
@@ -248,7 +290,10 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
             break;
           }
       if (m < k) return false;
-      if (m % 2) dist[m] = INFINITY;  // whole vectors; never nearer
+      for (uint32_t u = m; u < m + kNeighbourPad; ++u) dist[u] = INFINITY;  // never nearer
+      // Each one's rank by distance: how many are nearer.
+      uint32_t nearer[kCollect];
+      count_all_nearer_lanes(dist, m, nearer, lanes);
       // Ranks by distance alone, each written to its place (past k: a spare slot); equal
       // distances share a rank, so among the first k they show as a place written twice or
       // left empty, and then the ids rank them.
@@ -261,7 +306,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
           const double du = dist[u];
           uint32_t before = 0;
           if (!by_id) {
-            before = count_nearer(dist, m, du);
+            before = nearer[u];
           } else {
             const uint64_t id = I[at[u]];
             for (uint32_t f = 0; f < m; ++f)

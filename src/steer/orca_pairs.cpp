@@ -5,7 +5,7 @@
 
 namespace crowddb::steer {
 
-#if (CROWDDB_PAIRS_AVX2 && !defined(__AVX2__)) || (CROWDDB_PAIRS_NATIVE && defined(__AVX2__))
+#if (CROWDDB_PAIRS_AVX2 && !defined(__AVX2__)) || (CROWDDB_PAIRS_AVX2_NATIVE && defined(__AVX2__))
 #define CROWDDB_PAIRS_LANES 1
 // orca_pairs_avx2.cpp
 void pair_lanes_avx2_impl(const PairRow& row, const PairColumns& c, const uint32_t* rows,
