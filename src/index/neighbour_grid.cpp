@@ -17,8 +17,9 @@ constexpr uint32_t kBatch = 32;  // candidates filtered at once before any is of
 // Cell side for k nearest: about kBlockFill * k discs per 3 x 3 block at the table's mean density.
 // Measured on the RVO2-style airport (2 * 10^4 agents, k = 10, 100 ticks; the neighbour stage's
 // ms per tick, min of 5 interleaved runs): 2 -> 9.5, 4 -> 9.0, 6 -> 8.8, 8 -> 8.6 (2 without
-// the hints: 11.3). With the hints most queries scan chords, and fewer, longer runs of cells
-// beat fewer candidates: the filter is branch-free, each run is not. 6 rather than 8: the two
+// the hints: 11.3). With the hints most queries gather the rows of cells meeting a small square
+// (then its disc's chords: 2026-11-29), and fewer, longer runs of cells beat fewer candidates:
+// the filter is branch-free, each run is not. 6 rather than 8: the two
 // are within the host's noise, and the larger cells also serve the queries without hints (the
 // first tick, rows new to a query, a k above NearestK::kInline), unmeasured.
 constexpr double kBlockFill = 6;

@@ -28,6 +28,9 @@
 
 namespace crowddb::steer {
 
+// sim::ahead's "the same way" and the caps' (follows_at), restated by the lanes as one constant.
+static_assert(kSameWay == sim::kSameWay);
+
 // Per row, what the others read of it as someone's neighbour besides sim::AheadInput, in one
 // cache line (its columns were a dozen lines per neighbour): its velocity and the one others avoid
 // it at when it goes first (orca.cpp), radius, time to arrive, path left, and its rank for ties.

@@ -60,7 +60,7 @@ void pair_lanes_avx2_impl(const PairRow& row, const PairColumns& c, const uint32
   const __m256d arrive_i = _mm256_set1_pd(pi.arrive), rem_i = _mm256_set1_pd(pi.remaining);
   const __m256i rank_i = _mm256_set1_epi64x(static_cast<int64_t>(pi.rank ^ (uint64_t{1} << 63)));
   const __m256i rank_flip = _mm256_set1_epi64x(static_cast<int64_t>(uint64_t{1} << 63));
-  const bool finite_i = std::isfinite(pi.remaining);
+  const bool finite_i = __builtin_isfinite(pi.remaining);  // (not std::isfinite: see the top)
   // i's heading record (sim::ahead's a)
   const __m256d ax = _mm256_set1_pd(hi[0]), ay = _mm256_set1_pd(hi[1]);
   const __m256d awx = _mm256_set1_pd(hi[2]), awy = _mm256_set1_pd(hi[3]);

@@ -44,6 +44,7 @@ Gathered run(std::vector<double> X, std::vector<double> Y, uint32_t lo, uint32_t
                                                at.data(), dist.data(), lanes);
   EXPECT_LE(m, hi - lo);
   EXPECT_EQ(at[room], 0xdeadbeef) << "wrote past its room";
+  EXPECT_EQ(dist[room], -1.0) << "wrote past its room";
   Gathered g;
   for (uint32_t u = 0; u < m; ++u) {
     g.at.push_back(at[u]);

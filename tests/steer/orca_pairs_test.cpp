@@ -3,7 +3,8 @@
 // same entries to the bit, on random neighbours and on the cases each rule distinguishes
 // (yielding, out before in asked, equal and infinite paths left, ranks beyond 2^63, the one
 // ahead deciding or not, coincident centres, contacts on and beyond a tick's reach, horizons
-// below a tick and beyond tau, standing wishes, caps on and off), for lists of every length
+// below a tick and beyond tau, standing wishes, caps on and off, and now and then NaN, -0.0 and
+// infinities, for the comparisons' unordered and signed-zero cases), for lists of every length
 // padded the way orca pads them.
 #include "steer/orca_pairs.hpp"
 
@@ -49,31 +50,36 @@ Table random_table(Rng& rng, std::size_t n) {
   t.yielding.resize(n);
   t.wish_x.resize(n);
   t.wish_y.resize(n);
+  // Now and then a value no crowd should hold, for the comparisons' NaN and signed-zero cases:
+  // NaN, -0.0, infinities.
+  const auto odd = [&](double usual) {
+    return rng.below(40) ? usual : pick_of(rng, {NAN, -0.0, 0.0, INFINITY, -INFINITY});
+  };
   for (std::size_t j = 0; j < n; ++j) {
     sim::AheadInput& h = t.heading[j];
     // Positions on a coarse grid now and then: coincident centres, equal distances.
-    h.x = rng.below(4) ? rng.uniform(-3, 3) : 0.5 * static_cast<double>(rng.below(5));
-    h.y = rng.below(4) ? rng.uniform(-3, 3) : 0.5 * static_cast<double>(rng.below(5));
+    h.x = odd(rng.below(4) ? rng.uniform(-3, 3) : 0.5 * static_cast<double>(rng.below(5)));
+    h.y = odd(rng.below(4) ? rng.uniform(-3, 3) : 0.5 * static_cast<double>(rng.below(5)));
     const double a = rng.uniform(0, 6.283185307179586);
-    h.way_x = rng.below(8) ? std::cos(a) : 0;
-    h.way_y = rng.below(8) ? std::sin(a) : 0;
-    h.goal_x = rng.uniform(-20, 20);
-    h.goal_y = rng.below(6) ? rng.uniform(-20, 20) : 0;
+    h.way_x = odd(rng.below(8) ? std::cos(a) : 0);
+    h.way_y = odd(rng.below(8) ? std::sin(a) : 0);
+    h.goal_x = odd(rng.uniform(-20, 20));
+    h.goal_y = odd(rng.below(6) ? rng.uniform(-20, 20) : 0);
     h.goal2 = h.goal_x * h.goal_x + h.goal_y * h.goal_y;
     h.goal = static_cast<uint32_t>(rng.below(4));
     h.left_goal = rng.below(3) ? ~0u : static_cast<uint32_t>(rng.below(4));
     Peer& p = t.peer[j];
-    p.vx = rng.uniform(-1.5, 1.5);
-    p.vy = rng.uniform(-1.5, 1.5);
-    p.avoid_x = rng.uniform(-1.5, 1.5);
-    p.avoid_y = rng.uniform(-1.5, 1.5);
+    p.vx = odd(rng.uniform(-1.5, 1.5));
+    p.vy = odd(rng.uniform(-1.5, 1.5));
+    p.avoid_x = odd(rng.uniform(-1.5, 1.5));
+    p.avoid_y = odd(rng.uniform(-1.5, 1.5));
     p.radius = pick_of(rng, {0.2, 0.25, 0.3, rng.uniform(0.1, 0.5)});
-    p.arrive = pick_of(rng, {INFINITY, 0.01, 0.1, 1.0, 2.0, 5.0, rng.uniform(0, 4)});
-    p.remaining = pick_of(rng, {INFINITY, 1.0, 2.0, rng.uniform(0, 30)});
+    p.arrive = odd(pick_of(rng, {INFINITY, 0.01, 0.1, 1.0, 2.0, 5.0, rng.uniform(0, 4)}));
+    p.remaining = odd(pick_of(rng, {INFINITY, 1.0, 2.0, rng.uniform(0, 30)}));
     p.rank = rng.below(2) ? rng.next() : (uint64_t{1} << 63) + rng.below(3);
     t.yielding[j] = rng.below(8) == 0;
-    t.wish_x[j] = rng.below(6) ? rng.uniform(-1.5, 1.5) : 0;
-    t.wish_y[j] = rng.below(6) ? rng.uniform(-1.5, 1.5) : 0;
+    t.wish_x[j] = odd(rng.below(6) ? rng.uniform(-1.5, 1.5) : 0);
+    t.wish_y[j] = odd(rng.below(6) ? rng.uniform(-1.5, 1.5) : 0);
   }
   return t;
 }
