@@ -21,15 +21,15 @@
 namespace crowddb::index {
 namespace {
 
-constexpr uint32_t kNone = ~0u;
+constexpr uint32_t kNoPlace = ~0u;
 
-struct Gathered {
+struct GatherResult {
   std::vector<uint32_t> at;
   std::vector<uint64_t> dist_bits;
 };
 
-Gathered run(std::vector<double> X, std::vector<double> Y, uint32_t lo, uint32_t hi, double px,
-             double py, double bound, uint32_t self_at, GatherLanes lanes) {
+GatherResult gather_run(std::vector<double> X, std::vector<double> Y, uint32_t lo, uint32_t hi,
+                        double px, double py, double bound, uint32_t self_at, GatherLanes lanes) {
   // The lanes read past the run's end: what lies there is on the query (it would pass).
   X.resize(std::max<std::size_t>(X.size(), hi + kNeighbourPad), px);
   Y.resize(std::max<std::size_t>(Y.size(), hi + kNeighbourPad), py);
@@ -45,7 +45,7 @@ Gathered run(std::vector<double> X, std::vector<double> Y, uint32_t lo, uint32_t
   EXPECT_LE(m, hi - lo);
   EXPECT_EQ(at[room], 0xdeadbeef) << "wrote past its room";
   EXPECT_EQ(dist[room], -1.0) << "wrote past its room";
-  Gathered g;
+  GatherResult g;
   for (uint32_t u = 0; u < m; ++u) {
     g.at.push_back(at[u]);
     g.dist_bits.push_back(std::bit_cast<uint64_t>(dist[u]));
@@ -92,9 +92,9 @@ TEST(NeighbourLanes, GatherMatchesTheReferenceBitForBit) {
     }
     // The query's own place: inside the run at any lane, or not in it at all.
     const uint32_t self_at =
-        hi > lo && rng.below(4) ? lo + static_cast<uint32_t>(rng.below(hi - lo)) : kNone;
-    const Gathered want = run(X, Y, lo, hi, px, py, bound, self_at, GatherLanes::scalar);
-    const Gathered got = run(X, Y, lo, hi, px, py, bound, self_at, GatherLanes::widest);
+        hi > lo && rng.below(4) ? lo + static_cast<uint32_t>(rng.below(hi - lo)) : kNoPlace;
+    const GatherResult want = gather_run(X, Y, lo, hi, px, py, bound, self_at, GatherLanes::scalar);
+    const GatherResult got = gather_run(X, Y, lo, hi, px, py, bound, self_at, GatherLanes::widest);
     ASSERT_EQ(got.at, want.at) << "trial " << trial;
     ASSERT_EQ(got.dist_bits, want.dist_bits) << "trial " << trial;
     ++compared;
@@ -113,9 +113,9 @@ TEST(NeighbourLanes, EveryMaskAndOwnPlace) {
     for (uint32_t self = 0; self <= 8; ++self) {
       std::vector<double> X(8), Y(8, 0.0);
       for (uint32_t a = 0; a < 8; ++a) X[a] = mask >> (a % 4) & 1 ? 1.0 : 3.0;  // bound 4: 1 in
-      const uint32_t self_at = self < 8 ? self : kNone;
-      const Gathered want = run(X, Y, 0, 8, 0, 0, 4, self_at, GatherLanes::scalar);
-      const Gathered got = run(X, Y, 0, 8, 0, 0, 4, self_at, GatherLanes::widest);
+      const uint32_t self_at = self < 8 ? self : kNoPlace;
+      const GatherResult want = gather_run(X, Y, 0, 8, 0, 0, 4, self_at, GatherLanes::scalar);
+      const GatherResult got = gather_run(X, Y, 0, 8, 0, 0, 4, self_at, GatherLanes::widest);
       EXPECT_EQ(got.at, want.at) << "mask " << mask << " self " << self;
       EXPECT_EQ(got.dist_bits, want.dist_bits) << "mask " << mask << " self " << self;
       const auto in = static_cast<std::size_t>(2 * std::popcount(mask)) -

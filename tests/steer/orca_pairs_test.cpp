@@ -23,13 +23,13 @@
 namespace crowddb::steer {
 namespace {
 
-bool same_bits(double a, double b) {
+bool pairs_same_bits(double a, double b) {
   return std::bit_cast<uint64_t>(a) == std::bit_cast<uint64_t>(b);
 }
 
 // Random records for n rows, with the values the rules compare drawn from few choices so that
 // ties, equal goals and crossings of goals come up often.
-struct Table {
+struct PairTable {
   std::vector<sim::AheadInput> heading;
   std::vector<Peer> peer;
   std::vector<uint8_t> yielding;
@@ -39,12 +39,12 @@ struct Table {
   }
 };
 
-double pick_of(Rng& rng, std::initializer_list<double> values) {
+double pair_pick_of(Rng& rng, std::initializer_list<double> values) {
   return *(values.begin() + rng.below(values.size()));
 }
 
-Table random_table(Rng& rng, std::size_t n) {
-  Table t;
+PairTable random_pair_table(Rng& rng, std::size_t n) {
+  PairTable t;
   t.heading.resize(n);
   t.peer.resize(n);
   t.yielding.resize(n);
@@ -53,7 +53,7 @@ Table random_table(Rng& rng, std::size_t n) {
   // Now and then a value no crowd should hold, for the comparisons' NaN and signed-zero cases:
   // NaN, -0.0, infinities.
   const auto odd = [&](double usual) {
-    return rng.below(40) ? usual : pick_of(rng, {NAN, -0.0, 0.0, INFINITY, -INFINITY});
+    return rng.below(40) ? usual : pair_pick_of(rng, {NAN, -0.0, 0.0, INFINITY, -INFINITY});
   };
   for (std::size_t j = 0; j < n; ++j) {
     sim::AheadInput& h = t.heading[j];
@@ -73,9 +73,9 @@ Table random_table(Rng& rng, std::size_t n) {
     p.vy = odd(rng.uniform(-1.5, 1.5));
     p.avoid_x = odd(rng.uniform(-1.5, 1.5));
     p.avoid_y = odd(rng.uniform(-1.5, 1.5));
-    p.radius = pick_of(rng, {0.2, 0.25, 0.3, rng.uniform(0.1, 0.5)});
-    p.arrive = odd(pick_of(rng, {INFINITY, 0.01, 0.1, 1.0, 2.0, 5.0, rng.uniform(0, 4)}));
-    p.remaining = odd(pick_of(rng, {INFINITY, 1.0, 2.0, rng.uniform(0, 30)}));
+    p.radius = pair_pick_of(rng, {0.2, 0.25, 0.3, rng.uniform(0.1, 0.5)});
+    p.arrive = odd(pair_pick_of(rng, {INFINITY, 0.01, 0.1, 1.0, 2.0, 5.0, rng.uniform(0, 4)}));
+    p.remaining = odd(pair_pick_of(rng, {INFINITY, 1.0, 2.0, rng.uniform(0, 30)}));
     p.rank = rng.below(2) ? rng.next() : (uint64_t{1} << 63) + rng.below(3);
     t.yielding[j] = rng.below(8) == 0;
     t.wish_x[j] = odd(rng.below(6) ? rng.uniform(-1.5, 1.5) : 0);
@@ -84,11 +84,11 @@ Table random_table(Rng& rng, std::size_t n) {
   return t;
 }
 
-struct Entries {
+struct PairEntries {
   std::vector<double> px, py, vx, vy, r, tau, share, cpx, cpy, cnx, cny;
   std::vector<uint8_t> contact, caps;
   std::vector<uint16_t> lanes;
-  explicit Entries(std::size_t m)
+  explicit PairEntries(std::size_t m)
       : px(m),
         py(m),
         vx(m),
@@ -119,9 +119,9 @@ TEST(OrcaPairs, LanesMatchTheReferenceBitForBit) {
   uint64_t compared = 0, asked = 0, contacts = 0, capped = 0, yielded = 0, decided_by_place = 0;
   for (int trial = 0; trial < 20000; ++trial) {
     const std::size_t n = 2 + rng.below(30);
-    const Table t = random_table(rng, n);
+    const PairTable t = random_pair_table(rng, n);
     const auto i = static_cast<std::size_t>(rng.below(n));
-    const double dt = pick_of(rng, {0.1, 0.25, 0.05});
+    const double dt = pair_pick_of(rng, {0.1, 0.25, 0.05});
     const double max_speed = rng.uniform(0.5, 3);
     PairRow row{};
     row.heading = &t.heading[i];
@@ -135,8 +135,8 @@ TEST(OrcaPairs, LanesMatchTheReferenceBitForBit) {
     row.reach = 2 * dt * max_speed;
     row.beyond = row.reach + kSkin + row.r;
     row.dt = dt;
-    row.tau = pick_of(rng, {2.0, 0.5, 0.01});  // (below a tick: the clamp's bounds cross)
-    row.hi_share = pick_of(rng, {0.5, 0.8, 1.0});
+    row.tau = pair_pick_of(rng, {2.0, 0.5, 0.01});  // (below a tick: the clamp's bounds cross)
+    row.hi_share = pair_pick_of(rng, {0.5, 0.8, 1.0});
     row.lo_share = 1 - row.hi_share;
     row.headway = static_cast<int>(rng.below(2));
     row.gap = static_cast<int>(rng.below(2));
@@ -156,7 +156,7 @@ TEST(OrcaPairs, LanesMatchTheReferenceBitForBit) {
       rows[a] = j;
     }
     for (std::size_t a = m; a < mp; ++a) rows[a] = rows[m - 1];
-    Entries want(mp), got(mp);
+    PairEntries want(mp), got(mp);
     pair_lanes(row, t.columns(), rows.data(), mp, got.out());
     for (std::size_t a = 0; a < m; ++a) {
       const uint32_t j = rows[a];
@@ -174,20 +174,20 @@ TEST(OrcaPairs, LanesMatchTheReferenceBitForBit) {
                           sim::ahead(t.heading[i], t.heading[j], place);
       pair_one(row, t.columns(), j, f != 0, want.out(), a);
       const auto where = ::testing::Message() << "trial " << trial << " entry " << a;
-      EXPECT_TRUE(same_bits(got.px[a], want.px[a])) << where;
-      EXPECT_TRUE(same_bits(got.py[a], want.py[a])) << where;
-      EXPECT_TRUE(same_bits(got.vx[a], want.vx[a])) << where;
-      EXPECT_TRUE(same_bits(got.vy[a], want.vy[a])) << where;
-      EXPECT_TRUE(same_bits(got.r[a], want.r[a])) << where;
-      EXPECT_TRUE(same_bits(got.tau[a], want.tau[a])) << where;
-      EXPECT_TRUE(same_bits(got.share[a], want.share[a])) << where;
+      EXPECT_TRUE(pairs_same_bits(got.px[a], want.px[a])) << where;
+      EXPECT_TRUE(pairs_same_bits(got.py[a], want.py[a])) << where;
+      EXPECT_TRUE(pairs_same_bits(got.vx[a], want.vx[a])) << where;
+      EXPECT_TRUE(pairs_same_bits(got.vy[a], want.vy[a])) << where;
+      EXPECT_TRUE(pairs_same_bits(got.r[a], want.r[a])) << where;
+      EXPECT_TRUE(pairs_same_bits(got.tau[a], want.tau[a])) << where;
+      EXPECT_TRUE(pairs_same_bits(got.share[a], want.share[a])) << where;
       ASSERT_EQ(flags >> l & 1, want.contact[a]) << where;
       if (want.contact[a]) {
         ++contacts;
-        EXPECT_TRUE(same_bits(got.cpx[a], want.cpx[a])) << where;
-        EXPECT_TRUE(same_bits(got.cpy[a], want.cpy[a])) << where;
-        EXPECT_TRUE(same_bits(got.cnx[a], want.cnx[a])) << where;
-        EXPECT_TRUE(same_bits(got.cny[a], want.cny[a])) << where;
+        EXPECT_TRUE(pairs_same_bits(got.cpx[a], want.cpx[a])) << where;
+        EXPECT_TRUE(pairs_same_bits(got.cpy[a], want.cpy[a])) << where;
+        EXPECT_TRUE(pairs_same_bits(got.cnx[a], want.cnx[a])) << where;
+        EXPECT_TRUE(pairs_same_bits(got.cny[a], want.cny[a])) << where;
       }
       ASSERT_EQ((flags >> (4 + l) & 1) | (flags >> (8 + l) & 1) << 1, want.caps[a]) << where;
       capped += want.caps[a] != 0;
@@ -205,7 +205,7 @@ TEST(OrcaPairs, LanesMatchTheReferenceBitForBit) {
 
 // People coming out of a goal area on their way on, into a crowd heading for it: the pairs where
 // out before in decides, which the lanes leave to the reference.
-constexpr const char* kOutAndIn = R"({
+constexpr const char* kPairsOutAndIn = R"({
   "name": "out-before-in", "bounds": [0, 0, 30, 16], "dt": 0.1, "seed": 5, "duration": 30,
   "goals": [{"name": "A", "area": [[12, 6], [16, 6], [16, 10], [12, 10]]},
             {"name": "B", "area": [[28, 6], [30, 6], [30, 10], [28, 10]]}],
@@ -225,7 +225,7 @@ TEST(OrcaPairs, RunsWithAndWithoutTheLanesAreTheSame) {
     for (const double time_gap : {0.0, 0.4}) {
       std::vector<uint64_t> hashes[2];
       for (const bool reference : {false, true}) {
-        Scenario sc = name == "out-and-in" ? parse_scenario(kOutAndIn, "out-and-in.json")
+        Scenario sc = name == "out-and-in" ? parse_scenario(kPairsOutAndIn, "out-and-in.json")
                                            : load_scenario(dir + name);
         sc.config.steering.model = "orca";
         sc.config.steering.orca.time_gap = time_gap;
