@@ -51,7 +51,7 @@ std::string agent(double x, double z, double tx, double tz, const std::string& e
   return os.str();
 }
 
-std::string error_of(const fs::path& p) {
+std::string import_error_of(const fs::path& p) {
   try {
     load_scenario(p);
   } catch (const Error& e) {
@@ -301,7 +301,7 @@ TEST(SteerSuiteImport, BadFilesGiveOneLineNamingFileLineAndElement) {
   };
   for (const Case& c : cases) {
     const fs::path p = write_case(c.name, c.text);
-    const std::string e = error_of(p);
+    const std::string e = import_error_of(p);
     EXPECT_NE(e, "") << c.name;
     EXPECT_EQ(e.rfind(p.string(), 0), 0u) << "does not start with the file: " << e;
     EXPECT_NE(e.find(c.expect), std::string::npos) << c.name << ": " << e;
