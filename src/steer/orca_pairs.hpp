@@ -150,11 +150,10 @@ inline void pair_one(const PairRow& row, const PairColumns& c, uint32_t j, bool 
   // operands), without branches (whether one is followed is a coin toss to the predictor).
   uint8_t caps = 0;
   if (row.headway | row.gap) {
-    const int behind =
-        follows_at(dx, dy, row.ux, row.uy, row.r, pj.radius, c.wish_x[j], c.wish_y[j]);
-    const double gap_reach = row.cap_reach + pj.radius;
-    const int h = row.headway & behind;
-    const int g = row.gap & int{d2 < gap_reach * gap_reach} & behind;
+    const double wx = c.wish_x[j], wy = c.wish_y[j];
+    const int h = row.headway & int{follows_at(dx, dy, row.ux, row.uy, row.r, pj.radius, wx, wy)};
+    const int g = row.gap & int{follows_within_gap_at(dx, dy, d2, row.cap_reach, row.ux, row.uy,
+                                                      row.r, pj.radius, wx, wy)};
     caps = static_cast<uint8_t>(h | g << 1);
   }
   out.caps[a] = caps;

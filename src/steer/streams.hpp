@@ -62,12 +62,19 @@ bool at_meeting(const StreamView& v, std::size_t i);
 // Does row i (unit wish u, speed w) follow the row of its list entry a closely enough for the
 // stream gap to cap its wish (spacing below w x gap: beyond, v_ahead + spacing / gap >= w)?
 // The distance first: it needs only the list and one radius.
+// The same on the values (orca's pass over the neighbours asks it so): (rx, ry) = p_j - p_i and
+// d2 its squared length, as the list has it; reach_i = w gap + r_i, the row's part of the reach.
+inline bool follows_within_gap_at(double rx, double ry, double d2, double reach_i, double ux,
+                                  double uy, double ri, double rj, double wx, double wy) {
+  const double reach = reach_i + rj;
+  return int{d2 < reach * reach} & int{follows_at(rx, ry, ux, uy, ri, rj, wx, wy)};
+}
 inline bool follows_within_gap(const StreamView& v, std::size_t i, uint32_t a, double ux, double uy,
                                double w) {
   const uint32_t j = v.nb->row[a];
-  const double reach = w * v.gap + v.radius[i] + v.radius[j];
   const double dx = v.x[j] - v.x[i], dy = v.y[j] - v.y[i];  // the list's own distance, bit for bit
-  return int{dx * dx + dy * dy < reach * reach} & int{follows(v, i, j, ux, uy)};
+  return follows_within_gap_at(dx, dy, dx * dx + dy * dy, w * v.gap + v.radius[i], ux, uy,
+                               v.radius[i], v.radius[j], v.wish_x[j], v.wish_y[j]);
 }
 
 // The marking; the vectors keep their capacity from call to call.
