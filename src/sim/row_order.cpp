@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "index/collision_common.hpp"  // radix_sort, bits_for
 #include "util/executor.hpp"
 
 namespace crowddb::sim {
@@ -28,11 +29,18 @@ uint32_t cell(double v, double lo) {
   return static_cast<uint32_t>(std::clamp(std::floor(v - lo), 0.0, 4294967295.0));
 }
 
-}  // namespace
+struct Keyed {
+  uint64_t key, id;
+  uint32_t row;
+};
 
-std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
+bool key_then_id(const Keyed& a, const Keyed& b) {
+  return a.key < b.key || (a.key == b.key && a.id < b.id);
+}
+
+// Each row's Z-curve key from the table's lowest corner, and the largest key.
+std::vector<Keyed> keys_of(const AgentTable& t, Executor* ex, uint64_t& key_max) {
   const std::size_t n = t.size();
-  if (n == 0) return {};
   const auto run = [&](std::size_t count, std::size_t grain, const auto& body) {
     if (ex)
       ex->for_each_chunk(count, grain, body);
@@ -56,26 +64,79 @@ std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
     xlo = std::min(xlo, cx[c]);
     ylo = std::min(ylo, cy[c]);
   }
-  struct Entry {
-    uint64_t key, id;
-    uint32_t row;
-  };
-  std::vector<Entry> e(n);
+  std::vector<Keyed> e(n);
+  std::vector<uint64_t> chunk_max(chunks, 0);
   run(n, kOrderGrain, [&](std::size_t b, std::size_t end) {
-    for (std::size_t i = b; i < end; ++i)
-      e[i] = {spread(cell(t.x[i], xlo)) | (spread(cell(t.y[i], ylo)) << 1), t.id[i],
-              static_cast<uint32_t>(i)};
+    uint64_t m = 0;  // the chunk's, written once at its end (the entries share cache lines)
+    for (std::size_t i = b; i < end; ++i) {
+      const uint64_t key = spread(cell(t.x[i], xlo)) | (spread(cell(t.y[i], ylo)) << 1);
+      e[i] = {key, t.id[i], static_cast<uint32_t>(i)};
+      m = std::max(m, key);
+    }
+    chunk_max[b / kOrderGrain] = m;
   });
-  // Ids are unique, so the order is total and the sorted sequence one: sorting pieces on every
-  // thread and merging them gives what one sort gives.
-  const auto less = [](const Entry& a, const Entry& b) {
-    return a.key < b.key || (a.key == b.key && a.id < b.id);
+  key_max = 0;
+  for (const uint64_t m : chunk_max) key_max = std::max(key_max, m);
+  return e;
+}
+
+std::vector<uint32_t> rows_of(const std::vector<Keyed>& e) {
+  std::vector<uint32_t> order(e.size());
+  for (std::size_t i = 0; i < e.size(); ++i) order[i] = e[i].row;
+  return order;
+}
+
+}  // namespace
+
+std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
+  const std::size_t n = t.size();
+  if (n == 0) return {};
+  const auto run = [&](std::size_t count, std::size_t grain, const auto& body) {
+    if (ex)
+      ex->for_each_chunk(count, grain, body);
+    else
+      body(0, count);
   };
+  uint64_t key_max = 0;
+  std::vector<Keyed> e = keys_of(t, ex, key_max);
+  if (key_max >> 32 == 0) {
+    // Keys of 32 bits at most (a world within 65 km, 2^16 cells of 1 m a side): a radix sort of
+    // (key << 32 | row) words by their key bits, stable, so rows of one key stay in row order,
+    // then each run of one key in id order. The order (key, id) is total, so this is the
+    // comparison sort's result, in a few passes over the words instead of a sort whose
+    // comparisons are coin tosses to the predictor (the reorder at airport-20k on two threads: 4.2
+    // -> 3.9 ms; at 10^6 agents: 188 -> 180 ms, the columns' gathering being the rest).
+    std::vector<uint64_t> words(n);
+    run(n, kOrderGrain, [&](std::size_t b, std::size_t end) {
+      for (std::size_t i = b; i < end; ++i) words[i] = e[i].key << 32 | i;
+    });
+    index::RadixScratch scratch;
+    index::radix_sort(words, scratch, 32, 32 + index::bits_for(key_max + 1),
+                      ex && n >= kParallelSort ? ex : nullptr);
+    std::vector<uint32_t> order(n);
+    run(n, kOrderGrain, [&](std::size_t b, std::size_t end) {
+      for (std::size_t i = b; i < end; ++i) order[i] = static_cast<uint32_t>(words[i]);
+    });
+    // Runs of one key (agents sharing a 1 m cell): by id. Short where the crowd is, a few rows a
+    // cell; std::sort keeps a run of everyone in one cell O(n log n).
+    for (std::size_t s = 0; s < n;) {
+      std::size_t f = s + 1;
+      while (f < n && words[f] >> 32 == words[s] >> 32) ++f;
+      if (f - s > 1)
+        std::sort(order.begin() + static_cast<std::ptrdiff_t>(s),
+                  order.begin() + static_cast<std::ptrdiff_t>(f),
+                  [&](uint32_t a, uint32_t b) { return t.id[a] < t.id[b]; });
+      s = f;
+    }
+    return order;
+  }
+  // Wider keys: a comparison sort. Ids are unique, so the order is total and the sorted
+  // sequence one: sorting pieces on every thread and merging them gives what one sort gives.
   const std::size_t piece =
       ex && ex->threads() > 1 && n >= kParallelSort ? (n + kPieces - 1) / kPieces : n;
   run(n, std::max<std::size_t>(piece, 1), [&](std::size_t b, std::size_t end) {
     std::sort(e.begin() + static_cast<std::ptrdiff_t>(b),
-              e.begin() + static_cast<std::ptrdiff_t>(end), less);
+              e.begin() + static_cast<std::ptrdiff_t>(end), key_then_id);
   });
   for (std::size_t width = piece; width < n; width *= 2) {
     const std::size_t pairs = (n + 2 * width - 1) / (2 * width);
@@ -85,15 +146,18 @@ std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
                           hi = std::min(n, lo + 2 * width);
         std::inplace_merge(e.begin() + static_cast<std::ptrdiff_t>(lo),
                            e.begin() + static_cast<std::ptrdiff_t>(mid),
-                           e.begin() + static_cast<std::ptrdiff_t>(hi), less);
+                           e.begin() + static_cast<std::ptrdiff_t>(hi), key_then_id);
       }
     });
   }
-  std::vector<uint32_t> order(n);
-  run(n, kOrderGrain, [&](std::size_t b, std::size_t end) {
-    for (std::size_t i = b; i < end; ++i) order[i] = e[i].row;
-  });
-  return order;
+  return rows_of(e);
+}
+
+std::vector<uint32_t> curve_order_naive(const AgentTable& t) {
+  uint64_t key_max = 0;
+  std::vector<Keyed> e = keys_of(t, nullptr, key_max);
+  std::sort(e.begin(), e.end(), key_then_id);
+  return rows_of(e);
 }
 
 }  // namespace crowddb::sim

@@ -29,8 +29,12 @@ inline constexpr std::size_t kReorderMinRows = 4096;
 inline constexpr std::size_t kParallelReorder = std::size_t{1} << 15;
 
 // The rows in Morton (Z-curve) order of their positions in cells of 1 m from the table's lowest
-// corner, ties by agent id: order[new row] = old row, for World::permute_rows. O(n log n); with
-// `ex`, on its threads (the same order).
+// corner, ties by agent id: order[new row] = old row, for World::permute_rows. A radix sort (a
+// few passes over the rows) where the keys fit 32 bits (a world within 65 km), else a comparison
+// sort, O(n log n); with `ex`, on its threads (the same order).
 std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex = nullptr);
+
+// The naive twin (tests): the same order from one comparison sort on the calling thread.
+std::vector<uint32_t> curve_order_naive(const AgentTable& t);
 
 }  // namespace crowddb::sim

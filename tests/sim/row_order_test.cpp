@@ -218,6 +218,62 @@ TEST(RowOrder, CurveOrderAndPermutationAreTheSameOnAnyThreadCount) {
   }
 }
 
+// The curve order against its naive twin (one comparison sort by key, then id) on tables made to
+// break it: rows not in id order, many agents sharing a 1 m cell (ties by id decide), everyone on
+// one point (a single run of ties), negative and huge coordinates, and a world wider than 65 km
+// (keys of more than 32 bits: the comparison sort's way); on the calling thread and on
+// executors of 1 to 3 threads, above and below the size at which the sorting goes parallel.
+TEST(RowOrder, CurveOrderEqualsTheNaiveSortOnAdversarialTables) {
+  struct Case {
+    const char* name;
+    std::size_t n;
+    double x0, x1, y0, y1;
+    double snap;  // > 0: positions rounded to multiples of this (shared cells)
+  };
+  const Case cases[] = {
+      {"uniform", 5000, 0, 100, 0, 100, 0},
+      {"shared cells", 40000, 0, 200, 0, 150, 3},
+      {"one point", 3000, 7.5, 7.5, -2.25, -2.25, 0},
+      {"negative", 6000, -5000, -4000, -80, 30, 0.5},
+      {"one row of cells", 5000, 0, 60000, 0, 1, 0},
+      {"wider than 65 km", 40000, -1e6, 1e6, 0, 50, 0},
+      {"huge", 2000, -9e8, 9e8, -9e8, 9e8, 0},
+  };
+  for (const Case& c : cases) {
+    World w(Bounds{-1e9, -1e9, 1e9, 1e9});
+    w.add_goal({"g", 0, 0, 1, 1, {}});
+    std::mt19937 rng(static_cast<unsigned>(c.n));
+    std::uniform_real_distribution<double> ux(c.x0, c.x1), uy(c.y0, c.y1);
+    for (std::size_t k = 0; k < c.n; ++k) {
+      AgentSpec a;
+      a.x = ux(rng);
+      a.y = uy(rng);
+      if (c.snap > 0) {
+        a.x = std::round(a.x / c.snap) * c.snap;
+        a.y = std::round(a.y / c.snap) * c.snap;
+      }
+      a.radius = 0.01;
+      a.pref_speed = 1;
+      a.max_speed = 1;
+      a.goal = 0;
+      w.insert(a);
+    }
+    w.apply_pending();
+    ASSERT_EQ(w.agents().size(), c.n) << c.name;
+    // Rows out of id order, so that a tie left in row order would show.
+    std::vector<uint32_t> shuffle(c.n);
+    std::iota(shuffle.begin(), shuffle.end(), 0u);
+    std::shuffle(shuffle.begin(), shuffle.end(), rng);
+    w.permute_rows(shuffle);
+    const std::vector<uint32_t> want = sim::curve_order_naive(w.agents());
+    EXPECT_EQ(sim::curve_order(w.agents()), want) << c.name;
+    for (int threads : {1, 2, 3}) {
+      Executor ex(threads);
+      EXPECT_EQ(sim::curve_order(w.agents(), &ex), want) << c.name << ", " << threads << " threads";
+    }
+  }
+}
+
 // "auto" reorders from 4096 agents under orca and cfsm, never under the thesis model; EXPLAIN
 // says when it does.
 TEST(RowOrder, AutoReordersLargeTablesOfTheOrderIndependentModels) {
