@@ -29,28 +29,22 @@ uint32_t cell(double v, double lo) {
   return static_cast<uint32_t>(std::clamp(std::floor(v - lo), 0.0, 4294967295.0));
 }
 
-struct Keyed {
-  uint64_t key, id;
-  uint32_t row;
-};
-
-bool key_then_id(const Keyed& a, const Keyed& b) {
-  return a.key < b.key || (a.key == b.key && a.id < b.id);
+// body(begin, end) over [0, count) in chunks of `grain` on ex's threads, or in one call.
+template <class F>
+void each_chunk(Executor* ex, std::size_t count, std::size_t grain, const F& body) {
+  if (ex)
+    ex->for_each_chunk(count, grain, body);
+  else
+    body(0, count);
 }
 
-// Each row's Z-curve key from the table's lowest corner, and the largest key.
-std::vector<Keyed> keys_of(const AgentTable& t, Executor* ex, uint64_t& key_max) {
+// Each row's Z-curve key from the table's lowest corner; key_max: the largest.
+std::vector<uint64_t> keys_of(const AgentTable& t, Executor* ex, uint64_t& key_max) {
   const std::size_t n = t.size();
-  const auto run = [&](std::size_t count, std::size_t grain, const auto& body) {
-    if (ex)
-      ex->for_each_chunk(count, grain, body);
-    else
-      body(0, count);
-  };
   // The lowest corner: a minimum per chunk, then over the chunks (exact, so any split).
   const std::size_t chunks = (n + kOrderGrain - 1) / kOrderGrain;
   std::vector<double> cx(chunks, INFINITY), cy(chunks, INFINITY);
-  run(n, kOrderGrain, [&](std::size_t b, std::size_t e) {
+  each_chunk(ex, n, kOrderGrain, [&](std::size_t b, std::size_t e) {
     double xlo = INFINITY, ylo = INFINITY;
     for (std::size_t i = b; i < e; ++i) {
       xlo = std::min(xlo, t.x[i]);
@@ -64,25 +58,43 @@ std::vector<Keyed> keys_of(const AgentTable& t, Executor* ex, uint64_t& key_max)
     xlo = std::min(xlo, cx[c]);
     ylo = std::min(ylo, cy[c]);
   }
-  std::vector<Keyed> e(n);
-  std::vector<uint64_t> chunk_max(chunks, 0);
-  run(n, kOrderGrain, [&](std::size_t b, std::size_t end) {
+  std::vector<uint64_t> keys(n), chunk_max(chunks, 0);
+  each_chunk(ex, n, kOrderGrain, [&](std::size_t b, std::size_t e) {
     uint64_t m = 0;  // the chunk's, written once at its end (the entries share cache lines)
-    for (std::size_t i = b; i < end; ++i) {
-      const uint64_t key = spread(cell(t.x[i], xlo)) | (spread(cell(t.y[i], ylo)) << 1);
-      e[i] = {key, t.id[i], static_cast<uint32_t>(i)};
-      m = std::max(m, key);
+    for (std::size_t i = b; i < e; ++i) {
+      keys[i] = spread(cell(t.x[i], xlo)) | (spread(cell(t.y[i], ylo)) << 1);
+      m = std::max(m, keys[i]);
     }
     chunk_max[b / kOrderGrain] = m;
   });
   key_max = 0;
   for (const uint64_t m : chunk_max) key_max = std::max(key_max, m);
+  return keys;
+}
+
+// The comparison sort's entries: ordered by key, then id (unique, so the order is total).
+struct Keyed {
+  uint64_t key, id;
+  uint32_t row;
+};
+
+bool key_then_id(const Keyed& a, const Keyed& b) {
+  return a.key < b.key || (a.key == b.key && a.id < b.id);
+}
+
+std::vector<Keyed> keyed(const AgentTable& t, const std::vector<uint64_t>& keys, Executor* ex) {
+  std::vector<Keyed> e(keys.size());
+  each_chunk(ex, keys.size(), kOrderGrain, [&](std::size_t b, std::size_t end) {
+    for (std::size_t i = b; i < end; ++i) e[i] = {keys[i], t.id[i], static_cast<uint32_t>(i)};
+  });
   return e;
 }
 
-std::vector<uint32_t> rows_of(const std::vector<Keyed>& e) {
+std::vector<uint32_t> rows_of(const std::vector<Keyed>& e, Executor* ex) {
   std::vector<uint32_t> order(e.size());
-  for (std::size_t i = 0; i < e.size(); ++i) order[i] = e[i].row;
+  each_chunk(ex, e.size(), kOrderGrain, [&](std::size_t b, std::size_t end) {
+    for (std::size_t i = b; i < end; ++i) order[i] = e[i].row;
+  });
   return order;
 }
 
@@ -91,14 +103,8 @@ std::vector<uint32_t> rows_of(const std::vector<Keyed>& e) {
 std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
   const std::size_t n = t.size();
   if (n == 0) return {};
-  const auto run = [&](std::size_t count, std::size_t grain, const auto& body) {
-    if (ex)
-      ex->for_each_chunk(count, grain, body);
-    else
-      body(0, count);
-  };
   uint64_t key_max = 0;
-  std::vector<Keyed> e = keys_of(t, ex, key_max);
+  const std::vector<uint64_t> keys = keys_of(t, ex, key_max);
   if (key_max >> 32 == 0) {
     // Keys of 32 bits at most (a world within 65 km, 2^16 cells of 1 m a side): a radix sort of
     // (key << 32 | row) words by their key bits, stable, so rows of one key stay in row order,
@@ -108,14 +114,14 @@ std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
     // 4.2 ms before, 3.9 now; at 10^6 agents 188 and 180 ms, the rest being the columns'
     // permutation and what the model and the grids keep per row.
     std::vector<uint64_t> words(n);
-    run(n, kOrderGrain, [&](std::size_t b, std::size_t end) {
-      for (std::size_t i = b; i < end; ++i) words[i] = e[i].key << 32 | i;
+    each_chunk(ex, n, kOrderGrain, [&](std::size_t b, std::size_t end) {
+      for (std::size_t i = b; i < end; ++i) words[i] = keys[i] << 32 | i;
     });
     index::RadixScratch scratch;
     index::radix_sort(words, scratch, 32, 32 + index::bits_for(key_max + 1),
                       ex && n >= kParallelSort ? ex : nullptr);
     std::vector<uint32_t> order(n);
-    run(n, kOrderGrain, [&](std::size_t b, std::size_t end) {
+    each_chunk(ex, n, kOrderGrain, [&](std::size_t b, std::size_t end) {
       for (std::size_t i = b; i < end; ++i) order[i] = static_cast<uint32_t>(words[i]);
     });
     // Runs of one key (agents sharing a 1 m cell): by id. Short where the crowd is, a few rows a
@@ -131,17 +137,18 @@ std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
     }
     return order;
   }
-  // Wider keys: a comparison sort. Ids are unique, so the order is total and the sorted
-  // sequence one: sorting pieces on every thread and merging them gives what one sort gives.
+  // Wider keys: a comparison sort. The order is total, so the sorted sequence is one: sorting
+  // pieces on every thread and merging them gives what one sort gives.
+  std::vector<Keyed> e = keyed(t, keys, ex);
   const std::size_t piece =
       ex && ex->threads() > 1 && n >= kParallelSort ? (n + kPieces - 1) / kPieces : n;
-  run(n, std::max<std::size_t>(piece, 1), [&](std::size_t b, std::size_t end) {
+  each_chunk(ex, n, std::max<std::size_t>(piece, 1), [&](std::size_t b, std::size_t end) {
     std::sort(e.begin() + static_cast<std::ptrdiff_t>(b),
               e.begin() + static_cast<std::ptrdiff_t>(end), key_then_id);
   });
   for (std::size_t width = piece; width < n; width *= 2) {
     const std::size_t pairs = (n + 2 * width - 1) / (2 * width);
-    run(pairs, 1, [&](std::size_t pb, std::size_t pe) {
+    each_chunk(ex, pairs, 1, [&](std::size_t pb, std::size_t pe) {
       for (std::size_t p = pb; p < pe; ++p) {
         const std::size_t lo = p * 2 * width, mid = std::min(n, lo + width),
                           hi = std::min(n, lo + 2 * width);
@@ -151,14 +158,14 @@ std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
       }
     });
   }
-  return rows_of(e);
+  return rows_of(e, ex);
 }
 
 std::vector<uint32_t> curve_order_naive(const AgentTable& t) {
   uint64_t key_max = 0;
-  std::vector<Keyed> e = keys_of(t, nullptr, key_max);
+  std::vector<Keyed> e = keyed(t, keys_of(t, nullptr, key_max), nullptr);
   std::sort(e.begin(), e.end(), key_then_id);
-  return rows_of(e);
+  return rows_of(e, nullptr);
 }
 
 }  // namespace crowddb::sim

@@ -98,6 +98,18 @@ std::string first_difference(const std::map<uint64_t, Agent>& a,
   return "";
 }
 
+// A disc of 1 cm at (x, y) bound for goal 0: many fit in a 1 m cell.
+AgentSpec small_disc(double x, double y) {
+  AgentSpec a;
+  a.x = x;
+  a.y = y;
+  a.radius = 0.01;
+  a.pref_speed = 1;
+  a.max_speed = 1;
+  a.goal = 0;
+  return a;
+}
+
 Scenario shipped(const std::string& name, const std::string& model, const std::string& order) {
   Scenario sc = load_scenario(test::source_path("scenarios/" + name + ".json"));
   sc.config.steering.model = model;
@@ -189,16 +201,7 @@ TEST(RowOrder, CurveOrderAndPermutationAreTheSameOnAnyThreadCount) {
   base.add_goal({"g", 60, 45, 1, 1, {}});
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> ux(0, 120), uy(0, 90);
-  for (int k = 0; k < 70000; ++k) {
-    AgentSpec a;
-    a.x = ux(rng);
-    a.y = uy(rng);
-    a.radius = 0.01;
-    a.pref_speed = 1;
-    a.max_speed = 1;
-    a.goal = 0;
-    base.insert(a);
-  }
+  for (int k = 0; k < 70000; ++k) base.insert(small_disc(ux(rng), uy(rng)));
   base.apply_pending();
   const std::vector<uint32_t> want = sim::curve_order(base.agents());
   std::vector<uint32_t> shuffle(want.size());
@@ -245,18 +248,12 @@ TEST(RowOrder, CurveOrderEqualsTheNaiveSortOnAdversarialTables) {
     std::mt19937 rng(static_cast<unsigned>(c.n));
     std::uniform_real_distribution<double> ux(c.x0, c.x1), uy(c.y0, c.y1);
     for (std::size_t k = 0; k < c.n; ++k) {
-      AgentSpec a;
-      a.x = ux(rng);
-      a.y = uy(rng);
+      double x = ux(rng), y = uy(rng);
       if (c.snap > 0) {
-        a.x = std::round(a.x / c.snap) * c.snap;
-        a.y = std::round(a.y / c.snap) * c.snap;
+        x = std::round(x / c.snap) * c.snap;
+        y = std::round(y / c.snap) * c.snap;
       }
-      a.radius = 0.01;
-      a.pref_speed = 1;
-      a.max_speed = 1;
-      a.goal = 0;
-      w.insert(a);
+      w.insert(small_disc(x, y));
     }
     w.apply_pending();
     ASSERT_EQ(w.agents().size(), c.n) << c.name;
