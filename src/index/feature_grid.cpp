@@ -43,6 +43,7 @@ void FeatureGrid::build(const StaticScene& scene, double cell) {
   const double side = std::max({x1_ - x0_, y1_ - y0_, 1e-9});
   cell_ = std::max(cell, side / 1024);
   if (!(cell_ > 0) || !std::isfinite(cell_)) cell_ = side;
+  inv_cell_ = 1 / cell_;
   W_ = static_cast<int64_t>(std::floor((x1_ - x0_) / cell_)) + 1;
   H_ = static_cast<int64_t>(std::floor((y1_ - y0_) / cell_)) + 1;
   // (cell, feature) registrations in feature order, then a counting sort by cell: each cell's
@@ -145,8 +146,18 @@ void FeatureGrid::run(const DiscView& p, std::span<const double> reach, const St
         auto clamp_col = [&](double x) { return clamp_cell(x - x0_, W_); };
         auto clamp_row = [&](double y) { return clamp_cell(y - y0_, H_); };
         // Far from every feature: nothing to look at (see the header). A point outside the
-        // grid is binned to the border cell, which is nearer to every feature than it is.
-        const uint16_t m = clear_[static_cast<std::size_t>(clamp_row(py) * W_ + clamp_col(px))];
+        // grid is binned to the border cell, which is nearer to every feature than it is. The
+        // cell by a product with the inverse, not a division (the obstacle query 44.6 -> 38.8 ms
+        // per 100 ticks at airport-20k, one thread): it is the true cell or a neighbour of it,
+        // as the division's is, and the test's margin allows for that.
+        auto near_cell = [&](double v, int64_t n) {
+          const double k = v * inv_cell_;  // truncation is the floor for k >= 0
+          return !(k >= 1)                         ? int64_t{0}
+                 : k >= static_cast<double>(n - 1) ? n - 1
+                                                   : static_cast<int64_t>(k);
+        };
+        const uint16_t m = clear_[static_cast<std::size_t>(near_cell(py - y0_, H_) * W_ +
+                                                           near_cell(px - x0_, W_))];
         const double slack = 1e-9 * (cell_ + std::abs(px) + std::abs(py) + r);
         if (m >= 3 && static_cast<double>(m - 3) * cell_ > r + slack) {
           mine.counts.push_back(0);

@@ -33,7 +33,7 @@ class FeatureGrid final : public FeaturePath {
   void build(const StaticScene& scene, double cell);
 
   uint64_t generation_ = 0;  // the scene the grid was built for (0: none)
-  double x0_ = 0, y0_ = 0, x1_ = 0, y1_ = 0, cell_ = 1;
+  double x0_ = 0, y0_ = 0, x1_ = 0, y1_ = 0, cell_ = 1, inv_cell_ = 1;
   int64_t W_ = 0, H_ = 0;
   std::vector<uint32_t> start_;  // W * H + 1
   std::vector<uint32_t> items_;  // feature numbers, ascending within a cell
