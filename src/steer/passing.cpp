@@ -59,27 +59,55 @@ int heading_class_reference(double x, double y) {
   return std::min(15, static_cast<int>(diamond_angle(x, y) * 4));
 }
 
-// heading_class without branches (which quadrant a wish points into is a coin toss to the
-// predictor, and every row asks once a tick). In each quadrant diamond_angle adds a base to a
-// numerator over s that is |y| or |x|: 1 - x / s is 1 + |x| / s exactly for x < 0, 2 - y / s is
-// 2 + |y| / s, and y / s, 3 + x / s differ from 0 + |y| / s, 3 + |x| / s only in the sign of a
-// zero numerator, which the class does not see. So the same class, from integer selects.
-int heading_class(double x, double y) {
+namespace {
+
+// diamond_angle(x, y) * scale, truncated, without branches (which quadrant a wish points into is
+// a coin toss to the predictor, and every row asks once a tick). In each quadrant diamond_angle
+// adds a base to a numerator over s that is |y| or |x|: 1 - x / s is 1 + |x| / s exactly for
+// x < 0, 2 - y / s is 2 + |y| / s, and y / s, 3 + x / s differ from 0 + |y| / s, 3 + |x| / s only
+// in the sign of a zero numerator, which the truncation does not see. So the same bin, from
+// integer selects.
+int diamond_bin(double x, double y, double scale) {
   const double ax = std::abs(x), ay = std::abs(y), s = ax + ay;
   const uint64_t up = y >= 0, right = x >= 0;    // (x < 0 is !right: the heading is never NaN)
   const uint64_t pick_y = 0 - (up ^ right ^ 1);  // all ones in the quadrants that divide |y|
   const double q = std::bit_cast<double>((std::bit_cast<uint64_t>(ay) & pick_y) |
                                          (std::bit_cast<uint64_t>(ax) & ~pick_y));
   const auto base = static_cast<double>(2 * (up ^ 1) + (up ^ right));
-  return std::min(15, static_cast<int>((base + q / s) * 4));
+  return static_cast<int>((base + q / s) * scale);
 }
 
-namespace {
+// opposite_classes' table: one mask per 1/256 of the diamond angle, the union of
+// opposite_classes_exact over that bin and the bins on either side (a wish binned into a
+// neighbour by rounding is still covered), drawn at 16 directions per bin. An arc's ends move
+// with the direction, less than a class between two of them, so the union has no gap. Built on
+// first use (about 12,000 exact masks).
+constexpr int kOppositeBins = 256;
+struct OppositeTable {
+  uint16_t mask[kOppositeBins] = {};
+  OppositeTable() {
+    constexpr int kSteps = 16;
+    for (int b = 0; b < kOppositeBins; ++b)
+      for (int k = -kSteps; k <= 2 * kSteps; ++k) {
+        // The direction at diamond angle a (its quadrant q, fraction f), on the unit diamond.
+        double a = (b + static_cast<double>(k) / kSteps) * (4.0 / kOppositeBins);
+        a = a < 0 ? a + 4 : (a >= 4 ? a - 4 : a);
+        const int q = std::min(3, static_cast<int>(a));
+        const double f = a - q;
+        const double x[4] = {1 - f, -f, f - 1, f}, y[4] = {f, 1 - f, -f, f - 1};
+        const double len = std::hypot(x[q], y[q]);
+        mask[b] |= opposite_classes_exact(x[q] / len, y[q] / len);
+      }
+  }
+};
 
-// The heading classes a wish more than 120 degrees from the unit direction (ux, uy) can fall in:
-// those of the arc within 60 degrees of (-ux, -uy), widened by 2 degrees on each side against
-// rounding (counter-clockwise from the arc's start to its end; it is less than half a turn).
-uint16_t opposite_classes(double ux, double uy) {
+}  // namespace
+
+int heading_class(double x, double y) {
+  return std::min(15, diamond_bin(x, y, 4));
+}
+
+uint16_t opposite_classes_exact(double ux, double uy) {
   constexpr double kArc = (60.0 + 2.0) * std::numbers::pi / 180;
   const double c = std::cos(kArc), s = std::sin(kArc);
   const double bx = -ux, by = -uy;
@@ -93,7 +121,10 @@ uint16_t opposite_classes(double ux, double uy) {
   return mask;
 }
 
-}  // namespace
+uint16_t opposite_classes(double ux, double uy) {
+  static const OppositeTable table;
+  return table.mask[std::min(kOppositeBins - 1, diamond_bin(ux, uy, kOppositeBins / 4))];
+}
 
 bool passing_ahead_naive(const PassingView& v, std::size_t i, double ux, double uy, double look) {
   for (std::size_t j = 0; j < v.x.size(); ++j)

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -263,6 +264,40 @@ TEST(HeadingClass, EqualsTheReferenceEverywhere) {
   std::vector<int> seen(16, 0);
   for (auto [x, y] : dirs) seen[static_cast<std::size_t>(heading_class(x, y))] = 1;
   EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 16);
+}
+
+// The table's classes hold the exact ones, and at most two more: at random directions of any
+// length, the axes and diagonals, and the directions on each of the table's 256 bin boundaries
+// (diamond angle b / 64) and a few ulps to either side, where rounding picks the bin.
+TEST(OppositeClasses, TheTableHoldsTheExactClassesAndLittleMore) {
+  std::vector<std::pair<double, double>> dirs = {{1, 0},  {0, 1},   {-1, 0}, {0, -1},    {1, 1},
+                                                 {-1, 1}, {-1, -1}, {1, -1}, {1, 1e-300}};
+  for (int b = 0; b < 256; ++b) {
+    const int q = b / 64;
+    const double f = (b % 64) / 64.0, g = 1 - f;
+    const std::pair<double, double> on[4] = {{g, f}, {-f, g}, {-g, -f}, {f, -g}};
+    auto [x, y] = on[q];
+    const double len = std::hypot(x, y);
+    x /= len, y /= len;
+    double lx = x, ly = y, hx = x, hy = y;
+    for (int u = 0; u < 4; ++u) {
+      dirs.push_back({lx, ly});
+      dirs.push_back({hx, hy});
+      lx = std::nextafter(lx, -2.0), ly = std::nextafter(ly, 2.0);
+      hx = std::nextafter(hx, 2.0), hy = std::nextafter(hy, -2.0);
+    }
+  }
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> angle(0, 2 * std::numbers::pi), scale(-3, 3);
+  for (int n = 0; n < 200000; ++n) {
+    const double a = angle(rng), m = n % 2 ? 1.0 : std::pow(10.0, scale(rng));
+    dirs.push_back({m * std::cos(a), m * std::sin(a)});
+  }
+  for (auto [x, y] : dirs) {
+    const uint16_t exact = opposite_classes_exact(x, y), table = opposite_classes(x, y);
+    ASSERT_EQ(table & exact, exact) << x << " " << y;
+    ASSERT_LE(std::popcount(table), std::popcount(exact) + 2) << x << " " << y;
+  }
 }
 
 // Keeping to one side stops near a sharp bend only: a route's corners round a pillar (15-25
