@@ -16,6 +16,18 @@ int64_t clamp_cell(double u, double cell, int64_t side) {
   return static_cast<int64_t>(c);
 }
 
+// The same by a product with the inverse cell (the queries, once per row): where u / cell lies
+// within rounding of a cell boundary, the cell may be the one beside. A disc that overlaps an
+// obstacle has its centre at least cell 2^-30 inside the obstacle's grown box (build), far more
+// than that rounding (a relative 1e-16 of at most 512 cells), so the cell beside is also one the
+// box touches and lists the obstacle.
+int64_t clamp_cell_by(double u, double inv_cell, int64_t side) {
+  const double c = u * inv_cell;
+  if (!(c >= 1)) return 0;  // also NaN; truncation is the floor from 1 on
+  if (c >= static_cast<double>(side - 1)) return side - 1;
+  return static_cast<int64_t>(c);
+}
+
 }  // namespace
 
 void ObstacleIndex::build(const StaticScene& scene, const Frame& frame) {
@@ -32,6 +44,7 @@ void ObstacleIndex::build(const StaticScene& scene, const Frame& frame) {
   side_ = static_cast<int64_t>(std::clamp(std::max(fine, base), 8.0, 512.0));
   cell_ = std::max(frame.extent / static_cast<double>(side_), frame.rmax);
   if (!(cell_ > 0)) cell_ = 1;
+  inv_cell_ = 1 / cell_;
   side_ = std::min<int64_t>(side_, static_cast<int64_t>(std::floor(frame.extent / cell_)) + 1);
 
   // Grown boxes in frame coordinates; cells [cx0, cx1] x [cy0, cy1] per obstacle.
@@ -95,8 +108,8 @@ void ObstacleIndex::overlaps(const DiscView& d, std::size_t begin, std::size_t e
   const auto nc = static_cast<uint32_t>(circles.size());
   for (std::size_t i = begin; i < end; ++i) {
     const double x = d.x[i], y = d.y[i], r = d.radius[i];
-    const int64_t cx = clamp_cell(x - frame_.x0, cell_, side_),
-                  cy = clamp_cell(y - frame_.y0, cell_, side_);
+    const int64_t cx = clamp_cell_by(x - frame_.x0, inv_cell_, side_),
+                  cy = clamp_cell_by(y - frame_.y0, inv_cell_, side_);
     const auto c = static_cast<std::size_t>(cy * side_ + cx);
     for (uint32_t k = start_[c]; k < start_[c + 1]; ++k) {
       const uint32_t id = ids_[k];

@@ -33,7 +33,7 @@ class ObstacleIndex {
  private:
   const StaticScene* scene_ = nullptr;
   Frame frame_;
-  double cell_ = 1;
+  double cell_ = 1, inv_cell_ = 1;
   int64_t side_ = 0;             // cells per axis (0: no obstacles)
   std::vector<uint32_t> start_;  // CSR offsets per cell, side_^2 + 1
   std::vector<uint32_t> ids_;    // circle c as c, polygon p as circles + p
