@@ -20,7 +20,8 @@ int64_t clamp_cell(double u, double cell, int64_t side) {
 // within rounding of a cell boundary, the cell may be the one beside. A disc that overlaps an
 // obstacle has its centre at least cell 2^-30 inside the obstacle's grown box (build), far more
 // than that rounding (a relative 1e-16 of at most 512 cells), so the cell beside is also one the
-// box touches and lists the obstacle.
+// box touches and lists the obstacle. Only while 1 / cell is finite: a cell below 2^-1024 (discs
+// of subnormal radii packed as close) takes the division (ObstacleIndex::overlaps).
 int64_t clamp_cell_by(double u, double inv_cell, int64_t side) {
   const double c = u * inv_cell;
   if (!(c >= 1)) return 0;  // also NaN; truncation is the floor from 1 on
@@ -106,10 +107,14 @@ void ObstacleIndex::overlaps(const DiscView& d, std::size_t begin, std::size_t e
   const auto polygons = scene_->polygons();
   const auto boxes = scene_->polygon_boxes();
   const auto nc = static_cast<uint32_t>(circles.size());
+  const bool by_product = std::isfinite(inv_cell_);  // (see clamp_cell_by)
   for (std::size_t i = begin; i < end; ++i) {
     const double x = d.x[i], y = d.y[i], r = d.radius[i];
-    const int64_t cx = clamp_cell_by(x - frame_.x0, inv_cell_, side_),
-                  cy = clamp_cell_by(y - frame_.y0, inv_cell_, side_);
+    const double u = x - frame_.x0, v = y - frame_.y0;
+    const int64_t cx =
+        by_product ? clamp_cell_by(u, inv_cell_, side_) : clamp_cell(u, cell_, side_);
+    const int64_t cy =
+        by_product ? clamp_cell_by(v, inv_cell_, side_) : clamp_cell(v, cell_, side_);
     const auto c = static_cast<std::size_t>(cy * side_ + cx);
     for (uint32_t k = start_[c]; k < start_[c + 1]; ++k) {
       const uint32_t id = ids_[k];

@@ -3,8 +3,10 @@
 // only against the obstacles registered in its own cell instead of all of them.
 //
 // Invariant: an obstacle is registered in every cell that its bounding box, grown by the
-// largest disc reach (Frame::reach), touches; a disc that overlaps the obstacle has its centre
-// inside that grown box, so its cell lists the obstacle. Candidates are then decided by the
+// largest disc reach (Frame::reach) and cell 2^-30, touches; a disc that overlaps the obstacle has
+// its centre inside that grown box, at least cell 2^-30 from its edge, so its cell lists the
+// obstacle, also when the query bins it by a product with 1 / cell, whose rounding may put it in
+// the cell beside (obstacle_index.cpp). Candidates are then decided by the
 // oracle's own tests (disc_hits_circle / disc_hits_polygon), and each cell lists obstacles in
 // the oracle's order (circles by row, then polygons by row): the output is identical to
 // disc_obstacle_overlaps. Build O(m + registrations), query O(1 + candidates) per disc.

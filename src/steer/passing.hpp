@@ -51,13 +51,13 @@ int heading_class(double x, double y);
 int heading_class_reference(double x, double y);
 
 // The heading classes (bit k: class k) a wish more than 120 degrees from the unit direction
-// (ux, uy) can fall in: those of the arc within 60 degrees of (-ux, -uy), widened by 2 degrees on
-// each side against rounding. PassingLookahead reads only cells holding one of them.
-// opposite_classes_exact computes the arc's ends (two headings of turned vectors) and fills the
-// classes between; opposite_classes takes them, or one or two more, from a table by a finer
-// heading (the exact form was about 1 % of the tick at airport-20k). Never fewer (tests): a
-// class too many only lets a query read a band that holds nobody passing, so the answer is the
-// same.
+// (ux, uy) (of length 1 up to rounding, as find() asks; not zero, NaN or infinite) can fall in:
+// those of the arc within 60 degrees of (-ux, -uy), widened by 2 degrees on each side against
+// rounding. PassingLookahead reads only cells holding one of them. opposite_classes_exact computes
+// the arc's ends (two headings of turned vectors) and fills the classes between; opposite_classes
+// takes them, or one or two more, from a table by a finer heading (the exact form was about 1 % of
+// the tick at airport-20k). Never fewer (tests): a class too many only lets a query read a band
+// that holds nobody passing, so the answer is the same.
 uint16_t opposite_classes(double ux, double uy);
 uint16_t opposite_classes_exact(double ux, double uy);
 

@@ -53,5 +53,25 @@ TEST(ObstacleIndex, ManySmallObstaclesAndDiscsOnTheirBoundaries) {
   EXPECT_LT(st.pair_tests, d.n * 20);  // a handful of candidates per disc, not all 404 obstacles
 }
 
+// Discs of subnormal radii spread over less than 2^-1020: the grid's cell (an eighth of that) is
+// then so small that 1 / cell overflows, and the queries must bin by the division (a product with
+// +inf put every disc past 0 in the last cell: the middle disc, inside a small square, missed it).
+TEST(ObstacleIndex, CellsTooSmallForAnInverseAnswerAsTheOracle) {
+  const double a = 4e-309, b = 6e-309;
+  const std::vector<PolygonObstacle> polys = {{{{a, a}, {b, a}, {b, b}, {a, b}}, 1}};
+  const StaticScene scene({}, polys, 1, ObstacleCharges::none, nullptr);
+  DiscTable t;
+  t.push_back(1, 0, 5e-309, 0, 0, 1e-310);
+  t.push_back(2, 5e-309, 5e-309, 0, 0, 1e-310);
+  t.push_back(3, 1e-308, 5e-309, 0, 0, 1e-310);
+  const DiscView d = t.view();
+  std::vector<std::pair<uint32_t, Collider>> want, got;
+  disc_obstacle_overlaps(d, scene, 0, d.n, want);
+  QueryStats st;
+  obstacle_overlaps(d, scene, Frame::of(d), got, st);
+  ASSERT_EQ(want.size(), 1u);  // the middle disc, inside the square
+  EXPECT_TRUE(got == want) << got.size() << " vs " << want.size();
+}
+
 }  // namespace
 }  // namespace crowddb::index

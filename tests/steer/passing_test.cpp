@@ -266,9 +266,11 @@ TEST(HeadingClass, EqualsTheReferenceEverywhere) {
   EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 16);
 }
 
-// The table's classes hold the exact ones, and at most two more: at random directions of any
-// length, the axes and diagonals, and the directions on each of the table's 256 bin boundaries
-// (diamond angle b / 64) and a few ulps to either side, where rounding picks the bin.
+// The table's classes hold the exact ones, and at most two more: at random directions of lengths
+// 10^-3 to 10^3, the axes and diagonals, and the directions on each of the table's 256 bin
+// boundaries (diamond angle b / 64) and a few ulps turned either way, where rounding picks the
+// bin. (The table's margin of a bin on either side is a defence against rounding that no
+// direction here is known to need.)
 TEST(OppositeClasses, TheTableHoldsTheExactClassesAndLittleMore) {
   std::vector<std::pair<double, double>> dirs = {{1, 0},  {0, 1},   {-1, 0}, {0, -1},    {1, 1},
                                                  {-1, 1}, {-1, -1}, {1, -1}, {1, 1e-300}};
@@ -279,12 +281,15 @@ TEST(OppositeClasses, TheTableHoldsTheExactClassesAndLittleMore) {
     auto [x, y] = on[q];
     const double len = std::hypot(x, y);
     x /= len, y /= len;
-    double lx = x, ly = y, hx = x, hy = y;
+    // Turned counter-clockwise (x away from y's side, y towards x's) and clockwise.
+    double cx = x, cy = y, wx = x, wy = y;
     for (int u = 0; u < 4; ++u) {
-      dirs.push_back({lx, ly});
-      dirs.push_back({hx, hy});
-      lx = std::nextafter(lx, -2.0), ly = std::nextafter(ly, 2.0);
-      hx = std::nextafter(hx, 2.0), hy = std::nextafter(hy, -2.0);
+      dirs.push_back({cx, cy});
+      dirs.push_back({wx, wy});
+      cx = std::nextafter(cx, -std::copysign(2.0, cy)),
+      cy = std::nextafter(cy, std::copysign(2.0, cx));
+      wx = std::nextafter(wx, std::copysign(2.0, wy)),
+      wy = std::nextafter(wy, -std::copysign(2.0, wx));
     }
   }
   std::mt19937_64 rng(11);
