@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "index/row_buckets.hpp"  // cell_by_product
 #include "query/naive_paths.hpp"
 
 namespace crowddb::index {
@@ -12,19 +13,6 @@ namespace {
 int64_t clamp_cell(double u, double cell, int64_t side) {
   const double c = std::floor(u / cell);
   if (!(c > 0)) return 0;  // also NaN
-  if (c >= static_cast<double>(side - 1)) return side - 1;
-  return static_cast<int64_t>(c);
-}
-
-// The same by a product with the inverse cell (the queries, once per row): where u / cell lies
-// within rounding of a cell boundary, the cell may be the one beside. A disc that overlaps an
-// obstacle has its centre at least cell 2^-30 inside the obstacle's grown box (build), far more
-// than that rounding (a relative 1e-16 of at most 512 cells), so the cell beside is also one the
-// box touches and lists the obstacle. Only while 1 / cell is finite: a cell below 2^-1024 (discs
-// of subnormal radii packed as close) takes the division (ObstacleIndex::overlaps).
-int64_t clamp_cell_by(double u, double inv_cell, int64_t side) {
-  const double c = u * inv_cell;
-  if (!(c >= 1)) return 0;  // also NaN; truncation is the floor from 1 on
   if (c >= static_cast<double>(side - 1)) return side - 1;
   return static_cast<int64_t>(c);
 }
@@ -107,14 +95,19 @@ void ObstacleIndex::overlaps(const DiscView& d, std::size_t begin, std::size_t e
   const auto polygons = scene_->polygons();
   const auto boxes = scene_->polygon_boxes();
   const auto nc = static_cast<uint32_t>(circles.size());
-  const bool by_product = std::isfinite(inv_cell_);  // (see clamp_cell_by)
+  // Each row's cell by a product with 1 / cell: a disc that overlaps an obstacle has its centre
+  // at least cell 2^-30 inside the obstacle's grown box (build), far more than the product's
+  // rounding (a relative 1e-16 of at most 512 cells), so where it gives the cell beside the
+  // division's, that cell too lists the obstacle (see the header). Not where 1 / cell overflows
+  // (a cell below 2^-1024: discs of subnormal radii packed as close): the division there.
+  const bool by_product = std::isfinite(inv_cell_);
   for (std::size_t i = begin; i < end; ++i) {
     const double x = d.x[i], y = d.y[i], r = d.radius[i];
     const double u = x - frame_.x0, v = y - frame_.y0;
     const int64_t cx =
-        by_product ? clamp_cell_by(u, inv_cell_, side_) : clamp_cell(u, cell_, side_);
+        by_product ? cell_by_product(u, inv_cell_, side_) : clamp_cell(u, cell_, side_);
     const int64_t cy =
-        by_product ? clamp_cell_by(v, inv_cell_, side_) : clamp_cell(v, cell_, side_);
+        by_product ? cell_by_product(v, inv_cell_, side_) : clamp_cell(v, cell_, side_);
     const auto c = static_cast<std::size_t>(cy * side_ + cx);
     for (uint32_t k = start_[c]; k < start_[c + 1]; ++k) {
       const uint32_t id = ids_[k];
