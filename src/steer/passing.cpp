@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "index/row_buckets.hpp"
+#include "steer/passing_lanes.hpp"
 #include "util/executor.hpp"
 
 namespace crowddb::steer {
@@ -126,6 +127,38 @@ uint16_t opposite_classes(double ux, double uy) {
   return table.mask[std::min(kOppositeBins - 1, diamond_bin(ux, uy, kOppositeBins / 4))];
 }
 
+#if (CROWDDB_PASSING_AVX2 && !defined(__AVX2__)) || \
+    (CROWDDB_PASSING_AVX2_NATIVE && defined(__AVX2__))
+#define CROWDDB_PASSING_DISPATCH 1
+// passing_lanes_avx2.cpp: whole vectors of four (see kPassingPad).
+uint32_t passing_filter_avx2(const PassingColumns& c, uint32_t lo, uint32_t hi, const LaneQuery& q,
+                             double same_way2, double side_reach, uint32_t* pick);
+#endif
+
+bool passing_lanes_avx2() {
+#if CROWDDB_PASSING_DISPATCH && !defined(__AVX2__)
+  // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+#elif CROWDDB_PASSING_DISPATCH
+  return true;  // a build for this machine, which has AVX2
+#else
+  return false;
+#endif
+}
+
+uint32_t passing_filter_lanes(const PassingColumns& c, uint32_t lo, uint32_t hi, const LaneQuery& q,
+                              double same_way2, double side_reach, uint32_t* pick,
+                              PassingLanes lanes) {
+#if CROWDDB_PASSING_DISPATCH
+  if (lanes == PassingLanes::widest && passing_lanes_avx2())
+    return passing_filter_avx2(c, lo, hi, q, same_way2, side_reach, pick);
+#else
+  (void)lanes;
+#endif
+  return passing_filter(c, lo, hi, q, same_way2, side_reach, pick);
+}
+
 bool passing_ahead_naive(const PassingView& v, std::size_t i, double ux, double uy, double look) {
   for (std::size_t j = 0; j < v.x.size(); ++j)
     if (j != i && passing(v, i, j, ux, uy, look)) return true;
@@ -194,11 +227,15 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
   rmax_ = 0;
   for (const double r : chunk_rmax) rmax_ = std::max(rmax_, r);
   index::bucket_rows(cell_of_, cells, start_, rows_);
-  copy_.resize(n);
+  for (auto* c : {&cx_, &cy_, &cr_, &cwx_, &cwy_}) c->resize(n + kPassingPad, 0.0);
   ex.for_each_chunk(n, kBuildGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {
       const uint32_t i = rows_[a];
-      copy_[a] = {v.x[i], v.y[i], v.radius[i], v.wish_x[i], v.wish_y[i]};
+      cx_[a] = v.x[i];
+      cy_[a] = v.y[i];
+      cr_[a] = v.radius[i];
+      cwx_[a] = v.wish_x[i];
+      cwy_[a] = v.wish_y[i];
     }
   });
   classes_.assign(cells, 0);
@@ -222,7 +259,9 @@ uint32_t PassingLookahead::find(const PassingView& v, std::size_t i, double ux, 
   const double len = std::min(look, gx + gy);
   const double ri = v.radius[i];
   const double half = ri + rmax_ + kSideReach;
-  const Copy* const C = copy_.data();
+  const PassingColumns C{cx_.data(), cy_.data(), cr_.data(), cwx_.data(), cwy_.data()};
+  const LaneQuery q{px, py, ux, uy, look, ri};
+  const PassingLanes lanes = passing_lanes_avx2() ? PassingLanes::widest : PassingLanes::scalar;
   const uint16_t against = opposite_classes(ux, uy);
   // The lane ahead, widened by eps on every side against rounding: it decides only which rows
   // are looked at; passing() decides the answer.
@@ -247,9 +286,8 @@ uint32_t PassingLookahead::find(const PassingView& v, std::size_t i, double ux, 
     if (xmin > xmax) continue;
     // The band's cells from xmin to xmax hold one run of rows in memory; it is read only when
     // one of them holds a heading coming towards the query. passing()'s first three tests on
-    // the copies, without a branch (whether a row passes them is a coin toss to the
-    // predictor): the same expressions on the same values, so a row they reject passing()
-    // would reject too. The few left are asked in full.
+    // the copies (passing_lanes.hpp): the same expressions on the same values, so a row they
+    // reject passing() would reject too. The few left are asked in full.
     const auto base = static_cast<std::size_t>(cy * W_);
     const std::size_t c0 = base + static_cast<std::size_t>(col(xmin - eps));
     const std::size_t c1 = base + static_cast<std::size_t>(col(xmax + eps));
@@ -261,18 +299,9 @@ uint32_t PassingLookahead::find(const PassingView& v, std::size_t i, double ux, 
       tests += hi - lo;
       for (uint32_t a0 = lo; a0 < hi; a0 += kBatch) {
         const uint32_t a1 = std::min(hi, a0 + kBatch);
-        uint32_t pick[kBatch];
-        uint32_t m = 0;
-        for (uint32_t a = a0; a < a1; ++a) {
-          const Copy& r = C[a];
-          const double rx = r.x - px, ry = r.y - py;
-          const double along = rx * ux + ry * uy;
-          const double w2 = r.wx * r.wx + r.wy * r.wy, dot = r.wx * ux + r.wy * uy;
-          pick[m] = a;
-          m += static_cast<uint32_t>((along > 0) & (along <= look) &
-                                     (std::abs(rx * uy - ry * ux) <= ri + r.r + kSideReach) &
-                                     (dot < 0) & (dot * dot >= kSameWay * kSameWay * w2));
-        }
+        uint32_t pick[kBatch + kPassingPad];
+        const uint32_t m =
+            passing_filter_lanes(C, a0, a1, q, kSameWay * kSameWay, kSideReach, pick, lanes);
         for (uint32_t u = 0; u < m; ++u) {
           const uint32_t j = rows_[pick[u]];
           if (j != i && passing(v, i, j, ux, uy, look)) return j;

@@ -119,10 +119,9 @@ class PassingLookahead {
   int64_t W_ = 1, H_ = 1;
   std::vector<uint32_t> start_;  // W * H + 1 offsets into rows_
   std::vector<uint32_t> rows_;   // rows in cell order (row-major cells)
-  struct Copy {
-    double x, y, r, wx, wy;
-  };
-  std::vector<Copy> copy_;          // the rows' columns in cell order, one row's together
+  // The rows' columns in cell order (passing_lanes.hpp), each padded by kPassingPad entries for
+  // the lanes.
+  std::vector<double> cx_, cy_, cr_, cwx_, cwy_;
   std::vector<uint16_t> classes_;   // per cell: bit k set when a row's heading is in class k
   std::vector<int64_t> cell_of_;    // scratch: cell per row
   std::vector<uint16_t> class_of_;  // scratch: heading class bit per row (0: standing)
