@@ -20,29 +20,27 @@ constexpr double kMinCell = 1;             // [m] about half the lane's width
 constexpr double kRowsPerCell = 4;
 constexpr uint32_t kBatch = 32;  // rows filtered at once before any is asked in full
 
-// An edge of the lane's rectangle as x over y: the part within ylo <= y <= yhi adds its x to a
-// band's range. Horizontal edges (dy = 0) add both ends when their y lies in the band.
-struct Edge {
-  double y0, y1;  // y0 <= y1
-  double xa, ya;  // one end
-  double slope;   // dx / dy (0 when horizontal)
-  double xb;      // the other end's x
-  void add(double ylo, double yhi, double& xmin, double& xmax) const {
-    const double lo = std::max(ylo, y0), hi = std::min(yhi, y1);
-    if (lo > hi) return;
-    double x0 = xa, x1 = xb;
-    if (y0 < y1) {
-      x0 = xa + (lo - ya) * slope;
-      x1 = xa + (hi - ya) * slope;
-    }
-    xmin = std::min({xmin, x0, x1});
-    xmax = std::max({xmax, x0, x1});
-  }
+// The lane's rectangle over a band of cells: its corners in order round it, from the lowest (b)
+// to the opposite one (t, the highest), run two chains, each through one of the other two
+// corners (m); along a chain x is linear in y on either side of m. Over a band, the left
+// boundary is least, and the right one greatest, where the band comes nearest its middle corner's
+// height: so each chain is read once, at its m's height clamped into the band, and the lesser of
+// the two readings is the band's least x, the greater its greatest, whichever chain is the left
+// one. (It replaced clipping the four edges to every band: the lanes' geometry was most of what a
+// look-ahead finding nobody costs.) Read only within [y_b, y_t], where each reading interpolates
+// between two corners: rounding may leave a middle corner a hair above t, and the lanes' margin
+// covers that sliver.
+struct Chain {
+  double xm, ym;        // its middle corner
+  double below, above;  // dx / dy from b to m and from m to t (0 where level or not finite)
+  double at(double y) const { return xm + (y - ym) * (y <= ym ? below : above); }
 };
 
-Edge make_edge(double x1, double y1, double x2, double y2) {
-  const double dy = y2 - y1;
-  return {std::min(y1, y2), std::max(y1, y2), x1, y1, dy != 0 ? (x2 - x1) / dy : 0, x2};
+double chain_slope(double x0, double y0, double x1, double y1) {
+  const double dy = y1 - y0;
+  const double s = dy != 0 ? (x1 - x0) / dy : 0.0;
+  // (A subnormal dy can overflow it: such a segment is only ever read at its end m.)
+  return std::isfinite(s) ? s : 0.0;
 }
 
 // A pseudo-angle of direction (x, y), not both zero: in [0, 4), increasing with the angle from
@@ -273,17 +271,27 @@ uint32_t PassingLookahead::find(const PassingView& v, std::size_t i, double ux, 
   const double fx = bx + (len + 2 * eps) * ux, fy = by + (len + 2 * eps) * uy;  // front middle
   const double qx[4] = {bx + nx, bx - nx, fx - nx, fx + nx};
   const double qy[4] = {by + ny, by - ny, fy - ny, fy + ny};
-  Edge edges[4];
-  for (int e = 0; e < 4; ++e) edges[e] = make_edge(qx[e], qy[e], qx[(e + 1) % 4], qy[(e + 1) % 4]);
-  const int64_t cy0 = row(std::min({qy[0], qy[1], qy[2], qy[3]}) - eps);
+  int lowest = 0;
+  for (int c = 1; c < 4; ++c) lowest = qy[c] < qy[lowest] ? c : lowest;
+  const int b = lowest, t = (lowest + 2) & 3;
+  Chain chains[2];
+  for (int k = 0; k < 2; ++k) {
+    const int m = (b + 1 + 2 * k) & 3;
+    chains[k] = {qx[m], qy[m], chain_slope(qx[b], qy[b], qx[m], qy[m]),
+                 chain_slope(qx[m], qy[m], qx[t], qy[t])};
+  }
+  const double yb = qy[b], yt = qy[t];
+  const int64_t cy0 = row(yb - eps);
   const int64_t cy1 = row(std::max({qy[0], qy[1], qy[2], qy[3]}) + eps);
   for (int64_t cy = cy0; cy <= cy1; ++cy) {
     // The band of cells; the grid's edge bands reach to infinity (row() clamps into them).
     const double ylo = cy == 0 ? -INFINITY : y0_ + static_cast<double>(cy) * cell_ - eps;
     const double yhi = cy == H_ - 1 ? INFINITY : y0_ + static_cast<double>(cy + 1) * cell_ + eps;
-    double xmin = INFINITY, xmax = -INFINITY;
-    for (const Edge& e : edges) e.add(ylo, yhi, xmin, xmax);
-    if (xmin > xmax) continue;
+    const double ya = std::max(ylo, yb), yz = std::min(yhi, yt);
+    if (ya > yz) continue;
+    const double x0 = chains[0].at(std::clamp(chains[0].ym, ya, yz));
+    const double x1 = chains[1].at(std::clamp(chains[1].ym, ya, yz));
+    const double xmin = std::min(x0, x1), xmax = std::max(x0, x1);
     // The band's cells from xmin to xmax hold one run of rows in memory; it is read only when
     // one of them holds a heading coming towards the query. passing()'s first three tests on
     // the copies (passing_lanes.hpp): the same expressions on the same values, so a row they

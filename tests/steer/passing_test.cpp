@@ -9,6 +9,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <tuple>
 
 #include "util/executor.hpp"
 
@@ -213,6 +214,74 @@ TEST(PassingLookahead, AnswersAsTheNaiveTwinOnExtremeInputs) {
     }
     EXPECT_GT(yes, 20u);
   }
+}
+
+// The lane's outline over each band of cells (two chains from its lowest corner to its highest):
+// someone passing at each corner of the lane and at the middle of each side (among people
+// standing, who make the cells small), for headings along
+// the axes and diagonals, a few ulps off them, with a subnormal component, and at random, from
+// query points on and off the cells' lines. One chain read where the other belongs, or a band
+// cut at the wrong corner's height, leaves someone at a corner unseen.
+TEST(PassingLookahead, AnswersAsTheNaiveTwinAtTheLanesCorners) {
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<double> angles;
+  for (int k = 0; k < 8; ++k) {
+    const double a = std::numbers::pi / 4 * k;
+    angles.insert(angles.end(), {a, std::nextafter(a, 10.0), std::nextafter(a, -10.0), a + 1e-9});
+  }
+  for (int k = 0; k < 16; ++k) angles.push_back(2 * std::numbers::pi * u(rng));
+  // Standing (never passing) on a lattice of 0.5 m over 40 x 40 m: cells of about 1 m, so that
+  // a lane crosses many. Rows i and j, the two walkers, are set for each case.
+  Crowd c;
+  for (int gx = 0; gx <= 80; ++gx)
+    for (int gy = 0; gy <= 80; ++gy) c.add(0.5 * gx + 0.13, 0.5 * gy + 0.29, 0, 0, 0.1);
+  const std::size_t i = c.size(), j = i + 1;
+  c.add(0, 0, 0, 0, 0.25);
+  c.add(0, 0, 0, 0, 0.4);
+  Executor ex(1);
+  PassingLookahead grid;
+  std::size_t cases = 0, seen = 0;
+  for (const double a : angles)
+    for (const double tiny : {0.0, 1e-310, -1e-310}) {
+      double wx = std::cos(a), wy = std::sin(a);
+      if (tiny != 0) {  // along an axis, with a subnormal component across it
+        wx = std::abs(wx) >= std::abs(wy) ? (wx < 0 ? -1.0 : 1.0) : tiny;
+        wy = std::abs(wx) == 1 ? tiny : (wy < 0 ? -1.0 : 1.0);
+      }
+      const double w = std::hypot(wx, wy), ux = wx / w, uy = wy / w;
+      for (const double ox : {0.0, 0.37, 1.0})
+        for (const double along : {1e-6, 5.0, 10 * (1 - 1e-12)})
+          for (const double side : {-1.0, 0.0, 1.0}) {
+            const double px = 20 + ox, py = 20 + ox * 0.5;
+            c.x[i] = px;
+            c.y[i] = py;
+            c.wish_x[i] = wx;
+            c.wish_y[i] = wy;
+            c.target_x[i] = px + 60 * ux;
+            c.target_y[i] = py + 60 * uy;
+            // At the lane's edge: r_i + r_j + kSideReach across (r_j the widest radius), a
+            // hair inside.
+            const double lateral = side * (0.25 + 0.4 + kSideReach) * (1 - 1e-12);
+            c.x[j] = px + along * ux - lateral * uy;
+            c.y[j] = py + along * uy + lateral * ux;
+            c.wish_x[j] = -wx;
+            c.wish_y[j] = -wy;
+            c.target_x[j] = c.x[j] - 60 * ux;
+            c.target_y[j] = c.y[j] - 60 * uy;
+            grid.build(c.view(), ex);
+            for (const auto& [q, sx, sy] : {std::tuple{i, ux, uy}, std::tuple{j, -ux, -uy}}) {
+              uint64_t tests = 0;
+              const bool want = passing_ahead_naive(c.view(), q, sx, sy, 10);
+              ASSERT_EQ(grid.ahead(c.view(), q, sx, sy, 10, tests), want)
+                  << "heading " << a << " (" << ux << ", " << uy << "), along " << along
+                  << ", side " << side << ", from " << ox << ", row " << q - i;
+              seen += want;
+            }
+            ++cases;
+          }
+    }
+  EXPECT_EQ(seen, 2 * cases);  // each of the two sees the other in every case
 }
 
 // Converging on one point from its two sides is not passing (each one's target lies in front of
