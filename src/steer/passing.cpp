@@ -22,14 +22,16 @@ constexpr uint32_t kBatch = 32;  // rows filtered at once before any is asked in
 
 // The lane's rectangle over a band of cells: its corners in order round it, from the lowest (b)
 // to the opposite one (t, the highest), run two chains, each through one of the other two
-// corners (m); along a chain x is linear in y on either side of m. Over a band, the left
-// boundary is least, and the right one greatest, where the band comes nearest its middle corner's
-// height: so each chain is read once, at its m's height clamped into the band, and the lesser of
-// the two readings is the band's least x, the greater its greatest, whichever chain is the left
-// one. (It replaced clipping the four edges to every band: the lanes' geometry was most of what a
-// look-ahead finding nobody costs.) Read only within [y_b, y_t], where each reading interpolates
-// between two corners: rounding may leave a middle corner a hair above t, and the lanes' margin
-// covers that sliver.
+// corners (m); along a chain x is linear in y on either side of m. Each m is its chain's extreme
+// in x: the corners are right angles, so the two edges out of b both rise and step in x to
+// opposite sides, and each chain runs on parallel to the other's first edge. So over a band, the
+// left boundary is least, and the right one greatest, where the band comes nearest its middle
+// corner's height: each chain is read once, at its m's height clamped into the band, and the
+// lesser of the two readings is the band's least x, the greater its greatest, whichever chain is
+// the left one. (It replaced clipping the four edges to every band: the lanes' geometry was most of
+// what a look-ahead finding nobody costs.) Read only within [y_b, y_t], where each reading
+// interpolates between two corners: rounding may leave a middle corner a hair above t, and the
+// lanes' margin covers that sliver.
 struct Chain {
   double xm, ym;        // its middle corner
   double below, above;  // dx / dy from b to m and from m to t (0 where level or not finite)
@@ -39,8 +41,15 @@ struct Chain {
 double chain_slope(double x0, double y0, double x1, double y1) {
   const double dy = y1 - y0;
   const double s = dy != 0 ? (x1 - x0) / dy : 0.0;
-  // (A subnormal dy can overflow it: such a segment is only ever read at its end m.)
+  // A level segment, or one so nearly level that the quotient overflows, is read as m's own x
+  // wherever it is read: m being its chain's extreme, never a narrower range.
   return std::isfinite(s) ? s : 0.0;
+}
+
+// The larger, or NaN when either is (std::max would drop a NaN in its second argument): the
+// widest radius bounds every lane, and a NaN must not leave it narrower.
+double widest(double a, double b) {
+  return a != a || b != b ? NAN : std::max(a, b);
 }
 
 // A pseudo-angle of direction (x, y), not both zero: in [0, 4), increasing with the angle from
@@ -209,7 +218,7 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
   ex.for_each_chunk(n, kBuildGrain, [&](std::size_t b, std::size_t e) {
     double rm = 0;  // the chunk's, written once at its end (the entries share cache lines)
     for (std::size_t i = b; i < e; ++i) {
-      rm = std::max(rm, v.radius[i]);
+      rm = widest(rm, v.radius[i]);
       cell_of_[i] = row(v.y[i]) * W_ + col(v.x[i]);
       // The row's heading class as a bit; standing rows pass nobody. A wish so small or so
       // large that its square leaves the doubles' range makes passing()'s angle test
@@ -223,7 +232,7 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
     chunk_rmax[b / kBuildGrain] = rm;
   });
   rmax_ = 0;
-  for (const double r : chunk_rmax) rmax_ = std::max(rmax_, r);
+  for (const double r : chunk_rmax) rmax_ = widest(rmax_, r);
   index::bucket_rows(cell_of_, cells, start_, rows_);
   for (auto* c : {&cx_, &cy_, &cr_, &cwx_, &cwy_}) c->resize(n + kPassingPad, 0.0);
   ex.for_each_chunk(n, kBuildGrain, [&](std::size_t b, std::size_t e) {
@@ -243,7 +252,7 @@ void PassingLookahead::build(const PassingView& v, Executor& ex) {
 
 uint32_t PassingLookahead::find(const PassingView& v, std::size_t i, double ux, double uy,
                                 double look, uint64_t& tests, uint32_t hint) const {
-  if (rows_.size() < 2 || !(look > 0)) return kNobody;
+  if (rows_.size() < 2 || look <= 0) return kNobody;
   if (hint < rows_.size() && hint != i) {
     ++tests;
     if (passing(v, i, hint, ux, uy, look)) return hint;
@@ -257,6 +266,15 @@ uint32_t PassingLookahead::find(const PassingView& v, std::size_t i, double ux, 
   const double len = std::min(look, gx + gy);
   const double ri = v.radius[i];
   const double half = ri + rmax_ + kSideReach;
+  if (!(half < INFINITY && look == look)) {
+    // A radius or a look that is not a finite number (not from a validated scene) leaves the
+    // lane without a shape, and passing() without a bound across or ahead: every row is asked.
+    for (std::size_t j = 0; j < rows_.size(); ++j) {
+      ++tests;
+      if (j != i && passing(v, i, j, ux, uy, look)) return static_cast<uint32_t>(j);
+    }
+    return kNobody;
+  }
   const PassingColumns C{cx_.data(), cy_.data(), cr_.data(), cwx_.data(), cwy_.data()};
   const LaneQuery q{px, py, ux, uy, look, ri};
   const PassingLanes lanes = passing_lanes_avx2() ? PassingLanes::widest : PassingLanes::scalar;

@@ -1,7 +1,7 @@
 // Keeping to a side's look-ahead (steer/passing.hpp) reads, per band of cells meeting a lane, a
-// run of rows in cell order and keeps those that pass passing()'s first tests: ahead within the
-// look, within the two radii plus kSideReach of the lane's line, wishing to go more than 120
-// degrees away. Whether a row passes is a coin toss to the predictor, so the filter has no
+// run of rows in cell order and keeps those that passing()'s first tests do not reject: ahead
+// within the look, within the two radii plus kSideReach of the lane's line, wishing to go more
+// than 120 degrees away. Whether a row passes is a coin toss to the predictor, so the filter has no
 // branch; it was a third of the look-ahead's time at airport-20k.
 //
 // Two ways with the same answers bit for bit: `passing_filter`, one row at a time (the
@@ -22,7 +22,7 @@ struct PassingColumns {
   const double *x, *y, *r, *wx, *wy;
 };
 
-// The query's side: its position, unit wish, look and radius plus kSideReach's first term.
+// The query's side: its position, unit wish, look ahead and radius.
 struct LaneQuery {
   double px, py, ux, uy, look, ri;
 };
@@ -31,9 +31,12 @@ struct LaneQuery {
 // and pick[] up to hi - lo + 3 entries.
 constexpr uint32_t kPassingPad = 3;
 
-// Appends each place a in [lo, hi) whose row passes passing()'s first tests to pick[] and returns
-// how many (at most hi - lo written). `side_reach` is kSideReach (passed in: the lanes' file may
-// read no other header's constants).
+// Appends each place a in [lo, hi) whose row passing()'s first tests do not reject to pick[] and
+// returns how many (at most hi - lo written). Written as the negations of passing()'s rejections
+// (not along <= 0, not beyond the look, not wider than the reach), so that a row with a NaN
+// among its values is kept when passing() would not reject it there either. `same_way2` is
+// kSameWay squared and `side_reach` kSideReach: passed in, because their headers (streams.hpp,
+// passing.hpp) hold inline functions that the lanes' file must not include.
 inline uint32_t passing_filter(const PassingColumns& c, uint32_t lo, uint32_t hi,
                                const LaneQuery& q, double same_way2, double side_reach,
                                uint32_t* pick) {
@@ -44,8 +47,8 @@ inline uint32_t passing_filter(const PassingColumns& c, uint32_t lo, uint32_t hi
     const double w2 = c.wx[a] * c.wx[a] + c.wy[a] * c.wy[a], dot = c.wx[a] * q.ux + c.wy[a] * q.uy;
     const double side = rx * q.uy - ry * q.ux;
     pick[m] = a;
-    m += static_cast<uint32_t>((along > 0) & (along <= q.look) &
-                               (std::abs(side) <= q.ri + c.r[a] + side_reach) & (dot < 0) &
+    m += static_cast<uint32_t>(!(along <= 0) & !(along > q.look) &
+                               !(std::abs(side) > q.ri + c.r[a] + side_reach) & (dot < 0) &
                                (dot * dot >= same_way2 * w2));
   }
   return m;

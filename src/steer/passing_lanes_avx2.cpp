@@ -52,9 +52,10 @@ uint32_t passing_filter_avx2(const PassingColumns& c, uint32_t a, uint32_t hi, c
     // side = rx uy - ry ux; |side| <= ri + r + side_reach
     const __m256d side = _mm256_sub_pd(_mm256_mul_pd(rx, uy), _mm256_mul_pd(ry, ux));
     const __m256d width = _mm256_add_pd(_mm256_add_pd(ri, _mm256_loadu_pd(c.r + a)), reach);
-    __m256d keep = _mm256_and_pd(_mm256_cmp_pd(along, zero, _CMP_GT_OQ),
-                                 _mm256_cmp_pd(along, look, _CMP_LE_OQ));
-    keep = _mm256_and_pd(keep, _mm256_cmp_pd(_mm256_andnot_pd(sign, side), width, _CMP_LE_OQ));
+    // !(along <= 0) & !(along > look) & !(|side| > width): true for NaN, as in the reference
+    __m256d keep = _mm256_and_pd(_mm256_cmp_pd(along, zero, _CMP_NLE_UQ),
+                                 _mm256_cmp_pd(along, look, _CMP_NGT_UQ));
+    keep = _mm256_and_pd(keep, _mm256_cmp_pd(_mm256_andnot_pd(sign, side), width, _CMP_NGT_UQ));
     keep = _mm256_and_pd(keep, _mm256_cmp_pd(dot, zero, _CMP_LT_OQ));
     keep = _mm256_and_pd(keep,
                          _mm256_cmp_pd(_mm256_mul_pd(dot, dot), _mm256_mul_pd(k2, w2), _CMP_GE_OQ));

@@ -217,11 +217,11 @@ TEST(PassingLookahead, AnswersAsTheNaiveTwinOnExtremeInputs) {
 }
 
 // The lane's outline over each band of cells (two chains from its lowest corner to its highest):
-// someone passing at each corner of the lane and at the middle of each side (among people
-// standing, who make the cells small), for headings along
-// the axes and diagonals, a few ulps off them, with a subnormal component, and at random, from
-// query points on and off the cells' lines. One chain read where the other belongs, or a band
-// cut at the wrong corner's height, leaves someone at a corner unseen.
+// someone passing at each corner of the lane and at the middle of each side, among people
+// standing who make the cells about 1 m, for headings along the axes and diagonals, a few ulps
+// off them, exactly on the axes and with a subnormal component across them, and at random. One
+// chain read where the other belongs, or a band cut at the wrong corner's height, leaves someone
+// at a corner unseen.
 TEST(PassingLookahead, AnswersAsTheNaiveTwinAtTheLanesCorners) {
   std::mt19937_64 rng(29);
   std::uniform_real_distribution<double> u(0, 1);
@@ -243,9 +243,10 @@ TEST(PassingLookahead, AnswersAsTheNaiveTwinAtTheLanesCorners) {
   PassingLookahead grid;
   std::size_t cases = 0, seen = 0;
   for (const double a : angles)
-    for (const double tiny : {0.0, 1e-310, -1e-310}) {
+    for (const int axis : {0, 1, 2, 3}) {
       double wx = std::cos(a), wy = std::sin(a);
-      if (tiny != 0) {  // along an axis, with a subnormal component across it
+      if (axis > 0) {  // the nearest axis, with a subnormal component across it or none
+        const double tiny = axis == 1 ? 1e-310 : (axis == 2 ? -1e-310 : 0.0);
         wx = std::abs(wx) >= std::abs(wy) ? (wx < 0 ? -1.0 : 1.0) : tiny;
         wy = std::abs(wx) == 1 ? tiny : (wy < 0 ? -1.0 : 1.0);
       }
@@ -282,6 +283,40 @@ TEST(PassingLookahead, AnswersAsTheNaiveTwinAtTheLanesCorners) {
           }
     }
   EXPECT_EQ(seen, 2 * cases);  // each of the two sees the other in every case
+}
+
+// A radius or a look that is not a number: the lane has no shape and every row is asked, as the
+// naive twin does (a row whose radius is NaN passes the test across at any distance).
+TEST(PassingLookahead, AnswersAsTheNaiveTwinWithRadiiOrLookNotANumber) {
+  Crowd c;
+  c.add(0, 0, 1, 0, 0.25, 30);
+  c.add(6, 8, -1, 0, NAN, 30);  // 8 m across: passing only because its radius is NaN
+  c.add(-5, 9, 0, 1, 0.25);
+  c.add(19, -13, -1, 0.2, 0.25, 30);
+  Crowd d;  // the query's own radius NaN, someone passing 7 m across
+  d.add(0, 0, 1, 0, NAN, 30);
+  d.add(6, -7, -1, 0, 0.25, 30);
+  d.add(-5, 9, 0, 1, 0.25);
+  d.add(19, 13, 0, -1, 0.25);
+  for (Crowd* crowd : {&c, &d})  // people standing, who make the cells small
+    for (int k = 0; k < 900; ++k) crowd->add(-15 + k % 30, -15 + k / 30 + 0.5, 0, 0, 0.1);
+  Executor ex(1);
+  for (const Crowd* crowd : {&c, &d}) {
+    PassingLookahead grid;
+    grid.build(crowd->view(), ex);
+    for (std::size_t i = 0; i < crowd->size(); ++i) {
+      const double w = std::hypot(crowd->wish_x[i], crowd->wish_y[i]);
+      const double ux = crowd->wish_x[i] / w, uy = crowd->wish_y[i] / w;
+      for (const double look : {10.0, double{INFINITY}, double{NAN}}) {
+        uint64_t tests = 0;
+        EXPECT_EQ(grid.ahead(crowd->view(), i, ux, uy, look, tests),
+                  passing_ahead_naive(crowd->view(), i, ux, uy, look))
+            << "row " << i << ", look " << look;
+      }
+    }
+  }
+  EXPECT_TRUE(passing_ahead_naive(c.view(), 0, 1, 0, 10));
+  EXPECT_TRUE(passing_ahead_naive(d.view(), 0, 1, 0, 10));
 }
 
 // Converging on one point from its two sides is not passing (each one's target lies in front of
