@@ -80,13 +80,11 @@ void count_all_nearer_lanes(const double* dist, uint32_t m, uint32_t* before, Ga
 // below 0 clamps to 0): all the probes need, with the slack that covers rounding. A division here
 // was a quarter of the probes' time.
 inline int64_t NeighbourGrid::col(double x) const {
-  const double c = (x - x0_) * inv_cell_;
-  return c < 0 ? 0 : (c >= static_cast<double>(W_) ? W_ - 1 : static_cast<int64_t>(c));
+  return cell_by_product(x - x0_, inv_cell_, W_);
 }
 
 inline int64_t NeighbourGrid::row(double y) const {
-  const double c = (y - y0_) * inv_cell_;
-  return c < 0 ? 0 : (c >= static_cast<double>(H_) ? H_ - 1 : static_cast<int64_t>(c));
+  return cell_by_product(y - y0_, inv_cell_, H_);
 }
 
 // Row cy's cells [cx0, cx1] meeting the disc of squared radius `bound` round (px, py), widened

@@ -25,8 +25,9 @@ Box bounding_box(std::span<const double> x, std::span<const double> y, Executor&
 // product with the inverse cell (1 / cell, finite) rather than a division: a per-row look-up's
 // cost. Where u / cell lies within rounding of a cell boundary it may give the cell beside the
 // division's, so a caller needs a margin of a cell, or more than that rounding, wherever the
-// answer depends on the cell (feature_grid's far test, obstacle_index's registrations). Below 1
-// and NaN give cell 0 (truncation is the floor from 1 on).
+// answer depends on the cell (feature_grid's far test, obstacle_index's registrations, the
+// neighbour grid's and the passing look-ahead's slack). Monotone in u. Below 1 and NaN give cell 0
+// (truncation is the floor from 1 on).
 inline int64_t cell_by_product(double u, double inv_cell, int64_t n) {
   const double c = u * inv_cell;
   if (!(c >= 1)) return 0;

@@ -172,16 +172,14 @@ bool passing_ahead_naive(const PassingView& v, std::size_t i, double ux, double 
   return false;
 }
 
+// The cells by a product with the inverse cell, clamped into the grid (the lane's margins cover
+// its rounding).
 inline int64_t PassingLookahead::col(double x) const {
-  // Truncation is the floor for c >= 0, and anything below 0 clamps to 0.
-  const double c = (x - x0_) * inv_cell_;
-  return c < 0 ? 0 : (c >= static_cast<double>(W_) ? W_ - 1 : static_cast<int64_t>(c));
+  return index::cell_by_product(x - x0_, inv_cell_, W_);
 }
 
 inline int64_t PassingLookahead::row(double y) const {
-  // Truncation is the floor for c >= 0, and anything below 0 clamps to 0.
-  const double c = (y - y0_) * inv_cell_;
-  return c < 0 ? 0 : (c >= static_cast<double>(H_) ? H_ - 1 : static_cast<int64_t>(c));
+  return index::cell_by_product(y - y0_, inv_cell_, H_);
 }
 
 // A counting sort into cells (index/row_buckets.hpp): the bounding box, each row's cell and
