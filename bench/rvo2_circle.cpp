@@ -38,6 +38,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_args.hpp"
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
 
@@ -115,23 +116,41 @@ int main(int argc, char** argv) {
   int agents = -1;
   double radius = 100, seconds = 600, sample = 2;
   unsigned seed = 7;
-  for (int a = 1; a + 1 < argc; a += 2) {
+  constexpr const char* kUsage =
+      "usage: rvo2_circle [--scene circle|fourway] [--agents N] [--radius M] [--seconds S] "
+      "[--sample S] [--seed N]\n";
+  const auto refuse = [&](const std::string& why) {
+    std::fprintf(stderr, "rvo2_circle: %s\n%s", why.c_str(), kUsage);
+    return 2;
+  };
+  for (int a = 1; a < argc; a += 2) {
     const std::string k = argv[a];
-    if (k == "--scene")
-      scene = argv[a + 1];
-    else if (k == "--agents")
-      agents = std::atoi(argv[a + 1]);
-    else if (k == "--radius")
-      radius = std::atof(argv[a + 1]);
-    else if (k == "--seconds")
-      seconds = std::atof(argv[a + 1]);
-    else if (k == "--sample")
-      sample = std::atof(argv[a + 1]);
-    else if (k == "--seed")
-      seed = static_cast<unsigned>(std::strtoul(argv[a + 1], nullptr, 10));
-    else {
-      std::fprintf(stderr, "rvo2_circle: unknown option %s\n", argv[a]);
-      return 2;
+    if (k == "--help" || k == "-h") {
+      std::printf("%s", kUsage);
+      return 0;
+    }
+    if (a + 1 >= argc) return refuse("missing value after " + k);
+    const std::string v = argv[a + 1];
+    const auto number = [&](double& out) {
+      const auto d = bench::positive_number(v);
+      if (d) out = *d;
+      return d.has_value();
+    };
+    if (k == "--scene") {
+      scene = v;
+    } else if (k == "--agents") {
+      const auto n = bench::whole_number(v, 1, 1'000'000);
+      if (!n) return refuse("--agents takes a count, not '" + v + "'");
+      agents = static_cast<int>(*n);
+    } else if (k == "--radius" || k == "--seconds" || k == "--sample") {
+      if (!number(k == "--radius" ? radius : k == "--seconds" ? seconds : sample))
+        return refuse(k + " takes a number above 0, not '" + v + "'");
+    } else if (k == "--seed") {
+      const auto n = bench::whole_number(v, 0, 4'294'967'295);
+      if (!n) return refuse("--seed takes 0 to 2^32 - 1, not '" + v + "'");
+      seed = static_cast<unsigned>(*n);
+    } else {
+      return refuse("unknown option " + k);
     }
   }
   const bool fourway = scene == "fourway";

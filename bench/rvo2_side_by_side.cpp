@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "airport_scenario.hpp"
+#include "bench_args.hpp"
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
 #include "model_variant.hpp"
@@ -73,33 +74,47 @@ int main(int argc, char** argv) {
   int agents = 20000, threads = 1, steps = 60;
   double density = 0.5;
   std::string csv, model = "orca";
-  for (int a = 1; a + 1 < argc; a += 2) {
+  const auto refuse = [](const std::string& why) {
+    std::fprintf(stderr,
+                 "rvo2_side_by_side: %s\nusage: rvo2_side_by_side [--agents N] [--threads N] "
+                 "[--steps N] [--density PEOPLE_PER_M2] [--model orca|orca-core] [--csv FILE]\n",
+                 why.c_str());
+    return 2;
+  };
+  for (int a = 1; a < argc; a += 2) {
     const std::string k = argv[a];
-    if (k == "--agents")
-      agents = std::atoi(argv[a + 1]);
-    else if (k == "--threads")
-      threads = std::atoi(argv[a + 1]);
-    else if (k == "--steps")
-      steps = std::atoi(argv[a + 1]);
-    else if (k == "--density")
-      density = std::atof(argv[a + 1]);
-    else if (k == "--model")
-      model = argv[a + 1];
-    else if (k == "--csv")
-      csv = argv[a + 1];
-    else {
-      std::fprintf(stderr, "rvo2_side_by_side: unknown option %s\n", argv[a]);
-      return 2;
+    if (k == "--help" || k == "-h") {
+      std::printf(
+          "usage: rvo2_side_by_side [--agents N] [--threads N] [--steps N] "
+          "[--density PEOPLE_PER_M2] [--model orca|orca-core] [--csv FILE]\n");
+      return 0;
     }
-  }
-  if (model != "orca" && model != "orca-core") {
-    std::fprintf(stderr, "rvo2_side_by_side: --model takes orca or orca-core, not %s\n",
-                 model.c_str());
-    return 2;
-  }
-  if (agents < 1 || threads < 1 || steps < 1 || !(density > 0)) {
-    std::fprintf(stderr, "rvo2_side_by_side: options must be positive\n");
-    return 2;
+    if (a + 1 >= argc) return refuse("missing value after " + k);
+    const std::string v = argv[a + 1];
+    const auto count = [&](long long hi, int& out) {
+      const auto n = bench::whole_number(v, 1, hi);
+      if (n) out = static_cast<int>(*n);
+      return n.has_value();
+    };
+    if (k == "--agents") {
+      if (!count(100'000'000, agents)) return refuse("--agents takes 1 to 10^8, not '" + v + "'");
+    } else if (k == "--threads") {
+      if (!count(1024, threads)) return refuse("--threads takes 1 to 1024, not '" + v + "'");
+    } else if (k == "--steps") {
+      if (!count(1'000'000, steps)) return refuse("--steps takes 1 to 10^6, not '" + v + "'");
+    } else if (k == "--density") {
+      const auto d = bench::positive_number(v);
+      if (!d) return refuse("--density takes a number above 0, not '" + v + "'");
+      density = *d;
+    } else if (k == "--model") {
+      if (v != "orca" && v != "orca-core")
+        return refuse("--model takes orca or orca-core, not '" + v + "'");
+      model = v;
+    } else if (k == "--csv") {
+      csv = v;
+    } else {
+      return refuse("unknown option " + k);
+    }
   }
   const double side = bench::airport_side(static_cast<std::size_t>(agents), density);
   const std::string doc =

@@ -54,6 +54,7 @@
 #include <vector>
 
 #include "airport_scenario.hpp"
+#include "bench_args.hpp"
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
 #include "model_variant.hpp"
@@ -300,15 +301,17 @@ void print_summary(const std::map<std::string, std::vector<std::map<int, double>
   }
 }
 
+// The usage, after `why` (nullptr: asked for with --help, on standard output, exit 0).
 int usage(const char* why) {
-  std::fprintf(stderr,
-               "tick_speed: %s\nusage: tick_speed [--cases all|NAME,...] "
+  std::FILE* out = why ? stderr : stdout;
+  if (why) std::fprintf(out, "tick_speed: %s\n", why);
+  std::fprintf(out,
+               "usage: tick_speed [--cases all|NAME,...] "
                "[--models orca,cfsm,thesis,orca-core] [--threads 1,2] [--ticks N] [--rounds N] "
-               "[--csv FILE] [--fork yes|no]\ncases:",
-               why);
-  for (const Case& c : kCases) std::fprintf(stderr, " %s", c.name);
-  std::fprintf(stderr, "\n");
-  return 2;
+               "[--csv FILE] [--fork yes|no]\ncases:");
+  for (const Case& c : kCases) std::fprintf(out, " %s", c.name);
+  std::fprintf(out, "\n");
+  return why ? 2 : 0;
 }
 
 }  // namespace
@@ -322,6 +325,7 @@ int main(int argc, char** argv) {
   bool fork_cases = true;
   for (int a = 1; a < argc; a += 2) {
     const std::string k = argv[a];
+    if (k == "--help" || k == "-h") return usage(nullptr);
     if (a + 1 >= argc) return usage(("missing value after " + k).c_str());
     const std::string v = argv[a + 1];
     if (k == "--cases") {
@@ -330,13 +334,19 @@ int main(int argc, char** argv) {
       models = split(v);
     } else if (k == "--threads") {
       thread_counts.clear();
-      for (const std::string& t : split(v)) thread_counts.push_back(std::atoi(t.c_str()));
+      for (const std::string& t : split(v)) {
+        const auto n = bench::whole_number(t, 1, 1024);
+        if (!n) return usage(("--threads takes counts from 1 to 1024, not '" + v + "'").c_str());
+        thread_counts.push_back(static_cast<int>(*n));
+      }
     } else if (k == "--ticks") {
-      ticks = std::strtoull(v.c_str(), nullptr, 10);
-      if (ticks == 0) return usage("--ticks must be a positive number");
+      const auto n = bench::whole_number(v, 1, 1'000'000'000);
+      if (!n) return usage(("--ticks takes a count from 1 to 10^9, not '" + v + "'").c_str());
+      ticks = static_cast<uint64_t>(*n);
     } else if (k == "--rounds") {
-      rounds = std::atoi(v.c_str());
-      if (rounds < 1 || rounds > 1000) return usage("--rounds takes a count from 1 to 1000");
+      const auto n = bench::whole_number(v, 1, 1000);
+      if (!n) return usage(("--rounds takes a count from 1 to 1000, not '" + v + "'").c_str());
+      rounds = static_cast<int>(*n);
     } else if (k == "--fork") {
       if (v != "yes" && v != "no") return usage("--fork takes yes or no");
       fork_cases = v == "yes";
@@ -357,8 +367,8 @@ int main(int argc, char** argv) {
     if (n != "all" && std::none_of(std::begin(kCases), std::end(kCases),
                                    [&](const Case& c) { return n == c.name; }))
       return usage(("no case named " + n).c_str());
-  for (int t : thread_counts)
-    if (t < 1) return usage("--threads takes positive counts");
+  if (thread_counts.empty()) return usage("--threads takes counts from 1 to 1024");
+  if (models.empty()) return usage("--models takes one model at least");
 
   std::FILE* out = csv.empty() ? nullptr : std::fopen(csv.c_str(), "w");
   if (!csv.empty() && !out) return usage(("cannot write " + csv).c_str());
