@@ -74,19 +74,17 @@ int main(int argc, char** argv) {
   int agents = 20000, threads = 1, steps = 60;
   double density = 0.5;
   std::string csv, model = "orca";
-  const auto refuse = [](const std::string& why) {
-    std::fprintf(stderr,
-                 "rvo2_side_by_side: %s\nusage: rvo2_side_by_side [--agents N] [--threads N] "
-                 "[--steps N] [--density PEOPLE_PER_M2] [--model orca|orca-core] [--csv FILE]\n",
-                 why.c_str());
+  constexpr const char* kUsage =
+      "usage: rvo2_side_by_side [--agents N] [--threads N] [--steps N] "
+      "[--density PEOPLE_PER_M2] [--model orca|orca-core] [--csv FILE]\n";
+  const auto refuse = [&](const std::string& why) {
+    std::fprintf(stderr, "rvo2_side_by_side: %s\n%s", why.c_str(), kUsage);
     return 2;
   };
   for (int a = 1; a < argc; a += 2) {
     const std::string k = argv[a];
     if (k == "--help" || k == "-h") {
-      std::printf(
-          "usage: rvo2_side_by_side [--agents N] [--threads N] [--steps N] "
-          "[--density PEOPLE_PER_M2] [--model orca|orca-core] [--csv FILE]\n");
+      std::printf("%s", kUsage);
       return 0;
     }
     if (a + 1 >= argc) return refuse("missing value after " + k);
