@@ -4,6 +4,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <system_error>
@@ -29,5 +30,21 @@ inline std::optional<double> positive_number(const std::string& s) {
     return std::nullopt;
   return v;
 }
+
+// A tool's usage text (ending in a newline): asked for (--help, -h), it goes to standard output
+// with exit status 0; after a complaint, to standard error with status 2.
+struct Usage {
+  const char* tool;
+  const char* text;
+  static bool asked(const std::string& option) { return option == "--help" || option == "-h"; }
+  int print() const {
+    std::printf("%s", text);
+    return 0;
+  }
+  int refuse(const std::string& why) const {
+    std::fprintf(stderr, "%s: %s\n%s", tool, why.c_str(), text);
+    return 2;
+  }
+};
 
 }  // namespace crowddb::bench

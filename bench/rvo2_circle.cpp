@@ -116,20 +116,14 @@ int main(int argc, char** argv) {
   int agents = -1;
   double radius = 100, seconds = 600, sample = 2;
   unsigned seed = 7;
-  constexpr const char* kUsage =
+  const bench::Usage usage{
+      "rvo2_circle",
       "usage: rvo2_circle [--scene circle|fourway] [--agents N] [--radius M] [--seconds S] "
-      "[--sample S] [--seed N]\n";
-  const auto refuse = [&](const std::string& why) {
-    std::fprintf(stderr, "rvo2_circle: %s\n%s", why.c_str(), kUsage);
-    return 2;
-  };
+      "[--sample S] [--seed N]\n"};
   for (int a = 1; a < argc; a += 2) {
     const std::string k = argv[a];
-    if (k == "--help" || k == "-h") {
-      std::printf("%s", kUsage);
-      return 0;
-    }
-    if (a + 1 >= argc) return refuse("missing value after " + k);
+    if (bench::Usage::asked(k)) return usage.print();
+    if (a + 1 >= argc) return usage.refuse("missing value after " + k);
     const std::string v = argv[a + 1];
     const auto number = [&](double& out) {
       const auto d = bench::positive_number(v);
@@ -140,17 +134,17 @@ int main(int argc, char** argv) {
       scene = v;
     } else if (k == "--agents") {
       const auto n = bench::whole_number(v, 1, 1'000'000);
-      if (!n) return refuse("--agents takes a count, not '" + v + "'");
+      if (!n) return usage.refuse("--agents takes a count, not '" + v + "'");
       agents = static_cast<int>(*n);
     } else if (k == "--radius" || k == "--seconds" || k == "--sample") {
       if (!number(k == "--radius" ? radius : k == "--seconds" ? seconds : sample))
-        return refuse(k + " takes a number above 0, not '" + v + "'");
+        return usage.refuse(k + " takes a number above 0, not '" + v + "'");
     } else if (k == "--seed") {
       const auto n = bench::whole_number(v, 0, 4'294'967'295);
-      if (!n) return refuse("--seed takes 0 to 2^32 - 1, not '" + v + "'");
+      if (!n) return usage.refuse("--seed takes 0 to 2^32 - 1, not '" + v + "'");
       seed = static_cast<unsigned>(*n);
     } else {
-      return refuse("unknown option " + k);
+      return usage.refuse("unknown option " + k);
     }
   }
   const bool fourway = scene == "fourway";

@@ -74,20 +74,13 @@ int main(int argc, char** argv) {
   int agents = 20000, threads = 1, steps = 60;
   double density = 0.5;
   std::string csv, model = "orca";
-  constexpr const char* kUsage =
-      "usage: rvo2_side_by_side [--agents N] [--threads N] [--steps N] "
-      "[--density PEOPLE_PER_M2] [--model orca|orca-core] [--csv FILE]\n";
-  const auto refuse = [&](const std::string& why) {
-    std::fprintf(stderr, "rvo2_side_by_side: %s\n%s", why.c_str(), kUsage);
-    return 2;
-  };
+  const bench::Usage usage{"rvo2_side_by_side",
+                           "usage: rvo2_side_by_side [--agents N] [--threads N] [--steps N] "
+                           "[--density PEOPLE_PER_M2] [--model orca|orca-core] [--csv FILE]\n"};
   for (int a = 1; a < argc; a += 2) {
     const std::string k = argv[a];
-    if (k == "--help" || k == "-h") {
-      std::printf("%s", kUsage);
-      return 0;
-    }
-    if (a + 1 >= argc) return refuse("missing value after " + k);
+    if (bench::Usage::asked(k)) return usage.print();
+    if (a + 1 >= argc) return usage.refuse("missing value after " + k);
     const std::string v = argv[a + 1];
     const auto count = [&](long long hi, int& out) {
       const auto n = bench::whole_number(v, 1, hi);
@@ -95,23 +88,24 @@ int main(int argc, char** argv) {
       return n.has_value();
     };
     if (k == "--agents") {
-      if (!count(100'000'000, agents)) return refuse("--agents takes 1 to 10^8, not '" + v + "'");
+      if (!count(100'000'000, agents))
+        return usage.refuse("--agents takes 1 to 10^8, not '" + v + "'");
     } else if (k == "--threads") {
-      if (!count(1024, threads)) return refuse("--threads takes 1 to 1024, not '" + v + "'");
+      if (!count(1024, threads)) return usage.refuse("--threads takes 1 to 1024, not '" + v + "'");
     } else if (k == "--steps") {
-      if (!count(1'000'000, steps)) return refuse("--steps takes 1 to 10^6, not '" + v + "'");
+      if (!count(1'000'000, steps)) return usage.refuse("--steps takes 1 to 10^6, not '" + v + "'");
     } else if (k == "--density") {
       const auto d = bench::positive_number(v);
-      if (!d) return refuse("--density takes a number above 0, not '" + v + "'");
+      if (!d) return usage.refuse("--density takes a number above 0, not '" + v + "'");
       density = *d;
     } else if (k == "--model") {
       if (v != "orca" && v != "orca-core")
-        return refuse("--model takes orca or orca-core, not '" + v + "'");
+        return usage.refuse("--model takes orca or orca-core, not '" + v + "'");
       model = v;
     } else if (k == "--csv") {
       csv = v;
     } else {
-      return refuse("unknown option " + k);
+      return usage.refuse("unknown option " + k);
     }
   }
   const double side = bench::airport_side(static_cast<std::size_t>(agents), density);

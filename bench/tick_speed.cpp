@@ -325,7 +325,7 @@ int main(int argc, char** argv) {
   bool fork_cases = true;
   for (int a = 1; a < argc; a += 2) {
     const std::string k = argv[a];
-    if (k == "--help" || k == "-h") return usage(nullptr);
+    if (bench::Usage::asked(k)) return usage(nullptr);
     if (a + 1 >= argc) return usage(("missing value after " + k).c_str());
     const std::string v = argv[a + 1];
     if (k == "--cases") {
