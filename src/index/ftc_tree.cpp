@@ -15,6 +15,7 @@
 #include "crowddb/error.hpp"
 #include "index/ftc_pair_lanes.hpp"
 #include "query/ftc_geometry.hpp"
+#include "util/cpu.hpp"
 #include "util/executor.hpp"
 #include "util/stopwatch.hpp"
 
@@ -30,9 +31,7 @@ uint32_t pair_times_lanes_avx2(const Columns& m, uint32_t n, const Query& q, dou
 
 bool pair_times_avx2() {
 #if CROWDDB_FTC_DISPATCH
-  // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
+  return cpu_has_avx2();
 #else
   return false;
 #endif

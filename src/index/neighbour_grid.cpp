@@ -7,6 +7,7 @@
 #include "index/neighbour_lanes.hpp"
 #include "index/row_buckets.hpp"
 #include "query/naive_paths.hpp"
+#include "util/cpu.hpp"
 #include "util/stopwatch.hpp"
 
 namespace crowddb::index {
@@ -42,12 +43,8 @@ void count_all_nearer_avx2(const double* dist, uint32_t m, uint32_t* before);
 #endif
 
 bool gather_lanes_avx2() {
-#if CROWDDB_NEIGHBOUR_DISPATCH && !defined(__AVX2__)
-  // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
-#elif CROWDDB_NEIGHBOUR_DISPATCH
-  return true;  // a build for this machine, which has AVX2
+#if CROWDDB_NEIGHBOUR_DISPATCH
+  return cpu_has_avx2();
 #else
   return false;
 #endif

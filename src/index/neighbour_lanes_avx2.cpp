@@ -8,37 +8,9 @@
 
 #include <cstdint>
 
+#include "util/lane_packs.hpp"
+
 namespace crowddb::index {
-namespace {
-
-// Per mask of passing lanes (bit l: lane l passes): the permutation that moves the passing lanes
-// to the front, in order. For the doubles as pairs of 32-bit halves (kHalves), and for the four
-// 32-bit places (kPlaces). The slots past the passing ones take lane 0: written, never counted.
-struct Packs {
-  alignas(32) int32_t halves[16][8] = {};
-  alignas(32) int32_t places[16][8] = {};
-};
-
-constexpr Packs make_packs() {
-  Packs p;
-  for (int mask = 0; mask < 16; ++mask) {
-    int slot = 0;
-    for (int lane = 0; lane < 4; ++lane)
-      if (mask & (1 << lane)) {
-        p.halves[mask][2 * slot] = 2 * lane;
-        p.halves[mask][2 * slot + 1] = 2 * lane + 1;
-        p.places[mask][slot] = lane;
-        ++slot;
-      }
-    for (; slot < 4; ++slot) p.halves[mask][2 * slot + 1] = 1;
-  }
-  return p;
-}
-
-constexpr Packs kPacks = make_packs();
-
-}  // namespace
-
 // From a = lo on, whole vectors of four, the last one's lanes past hi read (X, Y readable to
 // hi + 3) but never counted, its slots past the count written (at, dist room for hi - lo + 3).
 // Returns how many were appended.
@@ -55,8 +27,10 @@ uint32_t gather_within_avx2(const double* X, const double* Y, uint32_t a, uint32
     if (hi - a < 4) mask &= (1u << (hi - a)) - 1;  // the lanes past the run's end
     const uint32_t self = self_at - a;             // the query's own place, when among these four
     if (self < 4) mask &= ~(1u << self);
-    const __m256i halves = _mm256_load_si256(reinterpret_cast<const __m256i*>(kPacks.halves[mask]));
-    const __m256i places = _mm256_load_si256(reinterpret_cast<const __m256i*>(kPacks.places[mask]));
+    const __m256i halves =
+        _mm256_load_si256(reinterpret_cast<const __m256i*>(kFrontPacks.halves[mask]));
+    const __m256i places =
+        _mm256_load_si256(reinterpret_cast<const __m256i*>(kFrontPacks.places[mask]));
     _mm256_storeu_pd(dist + m,
                      _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(d2), halves)));
     const __m256i rows = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(a)), step);

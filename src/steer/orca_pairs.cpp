@@ -3,6 +3,8 @@
 
 #include <atomic>
 
+#include "util/cpu.hpp"
+
 namespace crowddb::steer {
 
 #if (CROWDDB_PAIRS_AVX2 && !defined(__AVX2__)) || (CROWDDB_PAIRS_AVX2_NATIVE && defined(__AVX2__))
@@ -21,12 +23,8 @@ void use_pair_reference(bool on) {
 }
 
 bool pair_lanes_avx2() {
-#if CROWDDB_PAIRS_LANES && !defined(__AVX2__)
-  // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2 && !reference_only;
-#elif CROWDDB_PAIRS_LANES
-  return !reference_only;  // a build for this machine, which has AVX2
+#if CROWDDB_PAIRS_LANES
+  return cpu_has_avx2() && !reference_only;
 #else
   return false;
 #endif

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "steer/orca_planes_lanes.hpp"
+#include "util/cpu.hpp"
 
 namespace crowddb::steer {
 
@@ -70,9 +71,7 @@ std::size_t agent_planes_avx2(const PlaneInputs& in, std::size_t m, double dt, d
 
 bool wider_plane_lanes() {
 #if CROWDDB_PLANES_DISPATCH
-  // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
+  return cpu_has_avx2();
 #else
   return false;
 #endif

@@ -6,6 +6,7 @@
 
 #include "index/row_buckets.hpp"
 #include "steer/passing_lanes.hpp"
+#include "util/cpu.hpp"
 #include "util/executor.hpp"
 
 namespace crowddb::steer {
@@ -143,12 +144,8 @@ uint32_t passing_filter_avx2(const PassingColumns& c, uint32_t lo, uint32_t hi, 
 #endif
 
 bool passing_lanes_avx2() {
-#if CROWDDB_PASSING_DISPATCH && !defined(__AVX2__)
-  // Asked once (libgcc's CPU model also checks that the OS saves the AVX registers).
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
-#elif CROWDDB_PASSING_DISPATCH
-  return true;  // a build for this machine, which has AVX2
+#if CROWDDB_PASSING_DISPATCH
+  return cpu_has_avx2();
 #else
   return false;
 #endif

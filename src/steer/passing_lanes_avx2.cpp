@@ -4,33 +4,12 @@
 // the same order. The header is included for its types only: an inline function compiled with
 // -mavx2 could be the copy the linker keeps for everyone.
 #include "steer/passing_lanes.hpp"
+#include "util/lane_packs.hpp"
 
 #ifdef __AVX2__
 #include <immintrin.h>
 
 namespace crowddb::steer {
-namespace {
-
-// Per mask of passing lanes (bit l: lane l passes): the permutation that moves their places to
-// the front, in order; the slots past them take lane 0 (written, never counted).
-struct Places {
-  alignas(32) int32_t lane[16][8] = {};
-};
-
-constexpr Places make_places() {
-  Places p;
-  for (int mask = 0; mask < 16; ++mask) {
-    int slot = 0;
-    for (int l = 0; l < 4; ++l)
-      if (mask & (1 << l)) p.lane[mask][slot++] = l;
-  }
-  return p;
-}
-
-constexpr Places kPlaces = make_places();
-
-}  // namespace
-
 uint32_t passing_filter_avx2(const PassingColumns& c, uint32_t a, uint32_t hi, const LaneQuery& q,
                              double same_way2, double side_reach, uint32_t* pick) {
   const __m256d px = _mm256_set1_pd(q.px), py = _mm256_set1_pd(q.py);
@@ -61,7 +40,8 @@ uint32_t passing_filter_avx2(const PassingColumns& c, uint32_t a, uint32_t hi, c
                          _mm256_cmp_pd(_mm256_mul_pd(dot, dot), _mm256_mul_pd(k2, w2), _CMP_GE_OQ));
     auto mask = static_cast<uint32_t>(_mm256_movemask_pd(keep));
     if (hi - a < 4) mask &= (1u << (hi - a)) - 1;  // the lanes past the run's end
-    const __m256i places = _mm256_load_si256(reinterpret_cast<const __m256i*>(kPlaces.lane[mask]));
+    const __m256i places =
+        _mm256_load_si256(reinterpret_cast<const __m256i*>(kFrontPacks.places[mask]));
     const __m256i rows = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(a)), step);
     _mm_storeu_si128(reinterpret_cast<__m128i*>(pick + m),
                      _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(rows, places)));
