@@ -559,6 +559,7 @@ const TickMetrics& Simulation::step() {
   // 5. commit: swap in the next state, advance waypoints, arrivals, goal sequences
   const uint64_t gridlock_ticks = cfg.ticks_for(cfg.gridlock_time);
   std::vector<uint64_t> lost_sight;  // ids of the walkers that lost sight of their targets
+  sim::TickMove tick_move;
   log.timed("commit", n, [&] {
     t.x.swap(e.next.x);
     t.y.swap(e.next.y);
@@ -569,6 +570,7 @@ const TickMetrics& Simulation::step() {
     // counts and the rows leaving are gathered in row order afterwards.
     struct Part {
       std::size_t frozen = 0, gridlock_started = 0, longest_frozen = 0, gridlocked = 0, arrived = 0;
+      double move2 = 0;  // the largest squared move of a row this tick (NaN: one not finite)
       std::vector<std::size_t> leaving;
       std::vector<uint64_t> lost_sight;  // ids (rows leave before the path requests)
     };
@@ -601,6 +603,11 @@ const TickMetrics& Simulation::step() {
         }
       };
       for (std::size_t i = begin; i < end; ++i) {
+        {
+          const double dx = t.x[i] - e.next.x[i], dy = t.y[i] - e.next.y[i];  // (swapped above)
+          const double d2 = dx * dx + dy * dy;
+          c.move2 = d2 <= c.move2 ? c.move2 : d2;  // (a NaN stays)
+        }
         if (t.state[i] == AgentState::arrived) continue;
         if (t.state[i] == AgentState::waiting) {
           if (m.tick < t.wait_until[i]) continue;
@@ -655,7 +662,9 @@ const TickMetrics& Simulation::step() {
       }
     });
     std::vector<std::size_t> leaving;
+    double move2 = 0;
     for (const Part& c : parts) {
+      move2 = c.move2 <= move2 ? move2 : c.move2;
       m.frozen += c.frozen;
       m.gridlock_started += c.gridlock_started;
       m.longest_frozen = std::max(m.longest_frozen, c.longest_frozen);
@@ -664,6 +673,9 @@ const TickMetrics& Simulation::step() {
       leaving.insert(leaving.end(), c.leaving.begin(), c.leaving.end());
       lost_sight.insert(lost_sight.end(), c.lost_sight.begin(), c.lost_sight.end());
     }
+    // What the stalemate stage needs to answer its search from the model's lists.
+    tick_move = {e.model->near_lists(), e.next.x, e.next.y, std::sqrt(move2),
+                 sim::RowRenumbering(n, leaving)};
     world_.remove_rows(std::move(leaving));
   });
 
@@ -673,8 +685,10 @@ const TickMetrics& Simulation::step() {
     if (!e.stall_path)
       e.stall_path = neighbour_method(cfg.access.neighbours, world_.agents().size()).make();
     e.aim.resize(world_.agents().size());
-    const sim::StallCounts sc = sim::stalemates(world_, cfg, m.tick, *e.stall_path, e.ex,
-                                                log.at("stalemates").query, &e.aim);
+    sim::OperatorStats& sop = log.at("stalemates");
+    const sim::StallCounts sc =
+        sim::stalemates(world_, cfg, m.tick, *e.stall_path, e.ex, sop.query, &e.aim, &tick_move);
+    sop.count("rows looked at, blockers from the model's lists", sc.by_lists);
     m.stalled = sc.stalled;
     m.stall_started = sc.started;
     m.longest_stall = sc.longest;

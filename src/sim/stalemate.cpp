@@ -6,6 +6,7 @@
 
 #include "sim/stages.hpp"
 #include "util/rng.hpp"
+#include "util/stopwatch.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb::sim {
@@ -147,7 +148,7 @@ std::vector<uint8_t> queue_members_naive(std::span<const uint8_t> same_way,
 }
 
 StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, NeighbourPath& path,
-                       Executor& ex, QueryStats& stats, AimMemo* aim) {
+                       Executor& ex, QueryStats& stats, AimMemo* aim, const TickMove* move) {
   AgentTable& t = world.agents_for_tick();
   const auto goals = world.goals();
   const uint64_t after = cfg.ticks_for(cfg.stall.after);
@@ -200,11 +201,47 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   if (looked_at.empty()) return c;
   // 2. blockers, queueing
   NeighbourLists nb;
-  // On every thread, however few rows are looked at: the grid's build over every row and the
-  // searches (airport-20k, 505 rows looked at, two threads: this stage 55.1 -> 47.1 ms per 100
-  // ticks against one thread for both; on 2026-12-01 one thread had measured the faster, 8.2
-  // against 10.2 ms, and the grid and the executor have changed since).
-  path.run(DiscView::of(t), looked_at, 2 * rmax + kBlockGap, 6, nb, ex, stats);
+  nb.with_dist2 = false;  // (the gaps below are computed from the positions)
+  const double block_range = 2 * rmax + kBlockGap;
+  constexpr uint32_t kBlockers = 6;
+  // From the model's lists where they are sure to hold the answer (at airport-20k nearly all of
+  // the ~500 rows looked at a tick), a few left (the densest spots) by a scan of every row each,
+  // more by the query: its grid over every row for a few searches was most of this step's cost
+  // and did not speed up on two threads.
+  std::vector<uint32_t> unsure;
+  if (move) {
+    Stopwatch sw;  // booked as the query's probes
+    lists_after_move(t, *move, looked_at, block_range, kBlockers, nb, unsure);
+    c.by_lists = looked_at.size() - unsure.size();
+    if (!unsure.empty() && unsure.size() <= kScanMost) {
+      std::vector<uint32_t> rows;
+      for (uint32_t a : unsure) rows.push_back(looked_at[a]);
+      NeighbourLists answers;
+      answers.with_dist2 = false;
+      scan_rows(t, rows, block_range, kBlockers, answers, ex);
+      fill_unsure(nb, unsure, answers);
+      stats.pair_tests += rows.size() * t.size();
+      stats.rows += rows.size();
+      c.by_scan = rows.size();
+      unsure.clear();
+    }
+    stats.query_seconds += sw.seconds();
+  }
+  if (!move) {
+    // On every thread, however few rows are looked at: the grid's build over every row and the
+    // searches (airport-20k, 505 rows looked at, two threads: this stage 55.1 -> 47.1 ms per 100
+    // ticks against one thread for both).
+    path.run(DiscView::of(t), looked_at, block_range, kBlockers, nb, ex, stats);
+    c.by_query = looked_at.size();
+  } else if (!unsure.empty()) {
+    std::vector<uint32_t> rows;
+    for (uint32_t a : unsure) rows.push_back(looked_at[a]);
+    NeighbourLists answers;
+    answers.with_dist2 = false;
+    path.run(DiscView::of(t), rows, block_range, kBlockers, answers, ex, stats);
+    fill_unsure(nb, unsure, answers);
+    c.by_query = rows.size();
+  }
   std::vector<int64_t> blocker(looked_at.size(), -1);
   std::vector<Vec2> dir(looked_at.size());
   std::vector<uint8_t> same_way(looked_at.size(), 0), queueing(looked_at.size(), 0);

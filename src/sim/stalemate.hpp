@@ -59,6 +59,7 @@
 
 #include "crowddb/simulation.hpp"
 #include "plan/access_path.hpp"
+#include "sim/moved_lists.hpp"
 #include "util/executor.hpp"
 
 namespace crowddb::sim {
@@ -68,6 +69,9 @@ class AimMemo;  // stages.hpp
 struct StallCounts {
   std::size_t stalled = 0, started = 0, longest = 0, queueing = 0, yielding = 0, sidestepping = 0;
   std::size_t making_way = 0;  // standing blockers asked to step aside this tick
+  // Rows looked at whose blockers' search the model's lists answered (`move`), a scan of every
+  // row (a few left), or the neighbour query.
+  std::size_t by_lists = 0, by_scan = 0, by_query = 0;
   // Rows (in row order) stalled where streams meet head-on: the chain of stalled blockers in
   // front ends in someone heading at them, or is a cycle with two such (not an arch at a door,
   // where all walk one way). Path searches plan round them (NavigationParams::congestion_cost).
@@ -96,8 +100,11 @@ inline bool making_way(const AgentTable& t, std::size_t i, uint64_t tick) {
 
 // The progress watch, the queueing test and (with cfg.stall.resolve) the actions, for the tick
 // `tick` just committed.
-// `aim`: the rows' aim points, shared with the goal stage (stages.hpp).
+// `aim`: the rows' aim points, shared with the goal stage (stages.hpp). `move`: what the tick did
+// since the steering model's neighbour lists, which then answer the search for blockers where
+// they are sure to (sim/moved_lists.hpp; the same answer as `path`'s); without it, `path` answers.
 StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, NeighbourPath& path,
-                       Executor& ex, QueryStats& stats, AimMemo* aim = nullptr);
+                       Executor& ex, QueryStats& stats, AimMemo* aim = nullptr,
+                       const TickMove* move = nullptr);
 
 }  // namespace crowddb::sim

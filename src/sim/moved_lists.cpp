@@ -1,0 +1,181 @@
+#include "sim/moved_lists.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "index/neighbour_lanes.hpp"
+#include "query/naive_paths.hpp"
+
+namespace crowddb::sim {
+
+RowRenumbering::RowRenumbering(std::size_t n_before, std::vector<std::size_t> removed)
+    : n_before_(n_before) {
+  // World::remove_rows: from the highest row down, the last row moves into the removed one's
+  // place. `at` holds the rows now in another place than before (place -> row before).
+  std::sort(removed.begin(), removed.end(), std::greater<>());
+  removed.erase(std::unique(removed.begin(), removed.end()), removed.end());
+  std::map<std::size_t, uint32_t> at;
+  std::size_t size = n_before;
+  auto row_at = [&](std::size_t place) {
+    const auto it = at.find(place);
+    return it != at.end() ? it->second : static_cast<uint32_t>(place);
+  };
+  for (std::size_t r : removed) {
+    if (r >= size) continue;  // not a row (remove_rows would not be given it)
+    removed_.push_back(row_at(r));
+    const std::size_t last = size - 1;
+    const uint32_t moving = row_at(last);
+    at.erase(last);
+    if (r != last)
+      at[r] = moving;
+    else
+      at.erase(r);
+    --size;
+  }
+  n_now_ = size;
+  std::sort(removed_.begin(), removed_.end());
+  for (const auto& [place, row] : at) {
+    if (place == row) continue;
+    by_now_.emplace_back(static_cast<uint32_t>(place), row);
+    by_before_.emplace_back(row, static_cast<uint32_t>(place));
+  }
+  std::sort(by_before_.begin(), by_before_.end());  // (by_now_ is in place order already)
+}
+
+uint32_t RowRenumbering::now_of(uint32_t before) const {
+  const auto it = std::lower_bound(by_before_.begin(), by_before_.end(),
+                                   std::pair<uint32_t, uint32_t>{before, 0});
+  if (it != by_before_.end() && it->first == before) return it->second;
+  if (std::binary_search(removed_.begin(), removed_.end(), before)) return kGone;
+  return before;
+}
+
+uint32_t RowRenumbering::before_of(uint32_t now) const {
+  const auto it =
+      std::lower_bound(by_now_.begin(), by_now_.end(), std::pair<uint32_t, uint32_t>{now, 0});
+  return it != by_now_.end() && it->first == now ? it->second : now;
+}
+
+void lists_after_move(const AgentTable& t, const TickMove& move, std::span<const uint32_t> queries,
+                      double range, uint32_t k, NeighbourLists& out,
+                      std::vector<uint32_t>& unsure) {
+  const std::size_t q = queries.size();
+  out.offset.assign(q + 1, 0);
+  out.row.clear();
+  out.dist2.clear();
+  unsure.clear();
+  const NeighbourLists* lists = move.lists.lists;
+  const std::size_t before = move.rows.before();
+  const bool usable = lists && lists->queries() == before && move.x.size() == before &&
+                      move.y.size() == before && move.rows.now() == t.size() &&
+                      std::isfinite(move.move_max) && move.move_max >= 0 && range >= 0 && k > 0;
+  if (!usable) {
+    for (std::size_t a = 0; a < q; ++a) unsure.push_back(static_cast<uint32_t>(a));
+    return;
+  }
+  // Someone not in row i's list was at least its bound away and is now at least bound - m_i - m,
+  // m_i its own move and m the farthest anyone moved.
+  const double range2 = move.lists.range * move.lists.range, r2 = range * range;
+  const uint32_t lists_k = move.lists.k;
+  NearestK best;
+  for (std::size_t a = 0; a < q; ++a) {
+    const uint32_t i = queries[a];
+    const uint32_t b = move.rows.before_of(i);
+    const std::span<const uint32_t> listed = lists->rows_of(b);
+    auto dist2_before = [&](uint32_t j) {  // as the lists rank them (steer::dist2_of)
+      const double dx = move.x[j] - move.x[b], dy = move.y[j] - move.y[b];
+      return dx * dx + dy * dy;
+    };
+    const double mx = t.x[i] - move.x[b], my = t.y[i] - move.y[b];
+    const double need = (range + std::sqrt(mx * mx + my * my) + move.move_max) * (1 + 1e-9);
+    const double need2 = need * need;
+    // Everyone strictly closer than the list's bound is in it (NearLists).
+    const double bound2 =
+        lists_k > 0 && listed.size() >= lists_k ? dist2_before(listed.back()) : range2;
+    if (!(bound2 >= need2)) {
+      unsure.push_back(static_cast<uint32_t>(a));
+      out.offset[a + 1] = static_cast<uint32_t>(out.row.size());
+      continue;
+    }
+    best.reset(k);
+    for (uint32_t jb : listed) {
+      const uint32_t j = move.rows.now_of(jb);
+      if (j == RowRenumbering::kGone) continue;
+      // The neighbour methods' expression (query/neighbours_naive.cpp), on the rows now.
+      const double dx = t.x[j] - t.x[i], dy = t.y[j] - t.y[i];
+      const double d2 = dx * dx + dy * dy;
+      if (d2 < r2) best.offer(j, t.id[j], d2);
+    }
+    best.finish();
+    out.row.insert(out.row.end(), best.rows().begin(), best.rows().end());
+    if (out.with_dist2) out.dist2.insert(out.dist2.end(), best.dist2().begin(), best.dist2().end());
+    out.offset[a + 1] = static_cast<uint32_t>(out.row.size());
+  }
+}
+
+void scan_rows(const AgentTable& t, std::span<const uint32_t> rows, double range, uint32_t k,
+               NeighbourLists& out, Executor& ex) {
+  const std::size_t q = rows.size();
+  const auto n = static_cast<uint32_t>(t.size());
+  // d2 <= bound is d2 < range^2 (the neighbour methods' test) for every double d2.
+  const double bound = std::nextafter(range * range, -INFINITY);
+  std::vector<std::vector<uint32_t>> found(q);
+  std::vector<std::vector<double>> found_d2(q);
+  // Blocks of rows, so the buffers stay small at any n; whole vectors of four but the last block.
+  constexpr uint32_t kBlock = 4096;
+  ex.for_each_chunk(q, 1, [&](std::size_t b, std::size_t e) {
+    std::vector<uint32_t> at(kBlock + index::kNeighbourPad);
+    std::vector<double> dist(kBlock + index::kNeighbourPad);
+    NearestK best;
+    for (std::size_t a = b; a < e; ++a) {
+      const uint32_t i = rows[a];
+      const double px = t.x[i], py = t.y[i];
+      best.reset(k);
+      for (uint32_t lo = 0; lo < n; lo += kBlock) {
+        const uint32_t hi = std::min(n, lo + kBlock);
+        const uint32_t whole = lo + ((hi - lo) & ~3u);  // the lanes read no further than this
+        uint32_t m = index::gather_within_lanes(t.x.data(), t.y.data(), lo, whole, px, py, bound, i,
+                                                at.data(), dist.data());
+        m += index::gather_within(t.x.data(), t.y.data(), whole, hi, px, py, bound, i,
+                                  at.data() + m, dist.data() + m);
+        for (uint32_t u = 0; u < m; ++u) best.offer(at[u], t.id[at[u]], dist[u]);
+      }
+      best.finish();
+      found[a].assign(best.rows().begin(), best.rows().end());
+      found_d2[a].assign(best.dist2().begin(), best.dist2().end());
+    }
+  });
+  out.offset.assign(q + 1, 0);
+  out.row.clear();
+  out.dist2.clear();
+  for (std::size_t a = 0; a < q; ++a) {
+    out.row.insert(out.row.end(), found[a].begin(), found[a].end());
+    if (out.with_dist2) out.dist2.insert(out.dist2.end(), found_d2[a].begin(), found_d2[a].end());
+    out.offset[a + 1] = static_cast<uint32_t>(out.row.size());
+  }
+}
+
+void fill_unsure(NeighbourLists& out, std::span<const uint32_t> unsure,
+                 const NeighbourLists& answers) {
+  if (unsure.empty()) return;
+  const std::size_t q = out.queries();
+  const bool d2 = out.with_dist2 && answers.with_dist2;
+  NeighbourLists all;
+  all.with_dist2 = d2;
+  all.offset.assign(q + 1, 0);
+  all.row.reserve(out.row.size() + answers.row.size());
+  std::size_t u = 0;
+  for (std::size_t a = 0; a < q; ++a) {
+    const bool from_answers = u < unsure.size() && unsure[u] == a;
+    const NeighbourLists& from = from_answers ? answers : out;
+    const std::size_t at = from_answers ? u++ : a;
+    const uint32_t lo = from.offset[at], hi = from.offset[at + 1];
+    all.row.insert(all.row.end(), from.row.begin() + lo, from.row.begin() + hi);
+    if (d2) all.dist2.insert(all.dist2.end(), from.dist2.begin() + lo, from.dist2.begin() + hi);
+    all.offset[a + 1] = static_cast<uint32_t>(all.row.size());
+  }
+  out = std::move(all);
+}
+
+}  // namespace crowddb::sim
