@@ -8,6 +8,11 @@
 #include "query/naive_paths.hpp"
 
 namespace crowddb::sim {
+namespace {
+
+constexpr std::size_t kListsGrain = 256;  // queries per chunk of lists_after_move
+
+}  // namespace
 
 RowRenumbering::RowRenumbering(std::size_t n_before, std::vector<std::size_t> removed)
     : n_before_(n_before) {
@@ -58,8 +63,8 @@ uint32_t RowRenumbering::before_of(uint32_t now) const {
 }
 
 void lists_after_move(const AgentTable& t, const TickMove& move, std::span<const uint32_t> queries,
-                      double range, uint32_t k, NeighbourLists& out,
-                      std::vector<uint32_t>& unsure) {
+                      double range, uint32_t k, NeighbourLists& out, std::vector<uint32_t>& unsure,
+                      Executor& ex) {
   const std::size_t q = queries.size();
   out.offset.assign(q + 1, 0);
   out.row.clear();
@@ -69,47 +74,61 @@ void lists_after_move(const AgentTable& t, const TickMove& move, std::span<const
   const std::size_t before = move.rows.before();
   const bool usable = lists && lists->queries() == before && move.x.size() == before &&
                       move.y.size() == before && move.rows.now() == t.size() &&
-                      std::isfinite(move.move_max) && move.move_max >= 0 && range >= 0 && k > 0;
+                      std::isfinite(move.move_max) && move.move_max >= 0 && range >= 0 && k > 0 &&
+                      k <= NearestK::kInline;
   if (!usable) {
     for (std::size_t a = 0; a < q; ++a) unsure.push_back(static_cast<uint32_t>(a));
     return;
   }
-  // Someone not in row i's list was at least its bound away and is now at least bound - m_i - m,
-  // m_i its own move and m the farthest anyone moved.
   const double range2 = move.lists.range * move.lists.range, r2 = range * range;
   const uint32_t lists_k = move.lists.k;
-  NearestK best;
+  // Each query's answer in k slots of its own (on every thread), then packed in query order.
+  const bool d2_too = out.with_dist2;
+  std::vector<uint32_t> slot_rows(q * k), count(q);
+  std::vector<double> slot_d2(d2_too ? q * k : 0);
+  std::vector<uint8_t> sure(q);
+  ex.for_each_chunk(q, kListsGrain, [&](std::size_t begin, std::size_t end) {
+    NearestK best;
+    for (std::size_t a = begin; a < end; ++a) {
+      const uint32_t i = queries[a];
+      const uint32_t b = move.rows.before_of(i);
+      const std::span<const uint32_t> listed = lists->rows_of(b);
+      auto dist2_before = [&](uint32_t j) {  // as the lists rank them (steer::dist2_of)
+        const double dx = move.x[j] - move.x[b], dy = move.y[j] - move.y[b];
+        return dx * dx + dy * dy;
+      };
+      // Someone not in row i's list was at least its bound away and is now at least
+      // bound - m_i - m, m_i its own move and m the farthest anyone moved.
+      const double mx = t.x[i] - move.x[b], my = t.y[i] - move.y[b];
+      const double need = (range + std::sqrt(mx * mx + my * my) + move.move_max) * (1 + 1e-9);
+      // Everyone strictly closer than the list's bound is in it (NearLists).
+      const double bound2 =
+          lists_k > 0 && listed.size() >= lists_k ? dist2_before(listed.back()) : range2;
+      if (!(bound2 >= need * need)) continue;
+      sure[a] = 1;
+      best.reset(k);
+      for (uint32_t jb : listed) {
+        const uint32_t j = move.rows.now_of(jb);
+        if (j == RowRenumbering::kGone) continue;
+        // The neighbour methods' expression (query/neighbours_naive.cpp), on the rows now.
+        const double dx = t.x[j] - t.x[i], dy = t.y[j] - t.y[i];
+        const double d2 = dx * dx + dy * dy;
+        if (d2 < r2) best.offer(j, t.id[j], d2);
+      }
+      best.finish();
+      count[a] = static_cast<uint32_t>(best.size());
+      std::copy(best.rows().begin(), best.rows().end(), slot_rows.begin() + a * k);
+      if (d2_too) std::copy(best.dist2().begin(), best.dist2().end(), slot_d2.begin() + a * k);
+    }
+  });
   for (std::size_t a = 0; a < q; ++a) {
-    const uint32_t i = queries[a];
-    const uint32_t b = move.rows.before_of(i);
-    const std::span<const uint32_t> listed = lists->rows_of(b);
-    auto dist2_before = [&](uint32_t j) {  // as the lists rank them (steer::dist2_of)
-      const double dx = move.x[j] - move.x[b], dy = move.y[j] - move.y[b];
-      return dx * dx + dy * dy;
-    };
-    const double mx = t.x[i] - move.x[b], my = t.y[i] - move.y[b];
-    const double need = (range + std::sqrt(mx * mx + my * my) + move.move_max) * (1 + 1e-9);
-    const double need2 = need * need;
-    // Everyone strictly closer than the list's bound is in it (NearLists).
-    const double bound2 =
-        lists_k > 0 && listed.size() >= lists_k ? dist2_before(listed.back()) : range2;
-    if (!(bound2 >= need2)) {
-      unsure.push_back(static_cast<uint32_t>(a));
-      out.offset[a + 1] = static_cast<uint32_t>(out.row.size());
-      continue;
+    if (!sure[a]) unsure.push_back(static_cast<uint32_t>(a));
+    const auto from = slot_rows.begin() + static_cast<std::ptrdiff_t>(a * k);
+    out.row.insert(out.row.end(), from, from + count[a]);
+    if (d2_too) {
+      const auto d = slot_d2.begin() + static_cast<std::ptrdiff_t>(a * k);
+      out.dist2.insert(out.dist2.end(), d, d + count[a]);
     }
-    best.reset(k);
-    for (uint32_t jb : listed) {
-      const uint32_t j = move.rows.now_of(jb);
-      if (j == RowRenumbering::kGone) continue;
-      // The neighbour methods' expression (query/neighbours_naive.cpp), on the rows now.
-      const double dx = t.x[j] - t.x[i], dy = t.y[j] - t.y[i];
-      const double d2 = dx * dx + dy * dy;
-      if (d2 < r2) best.offer(j, t.id[j], d2);
-    }
-    best.finish();
-    out.row.insert(out.row.end(), best.rows().begin(), best.rows().end());
-    if (out.with_dist2) out.dist2.insert(out.dist2.end(), best.dist2().begin(), best.dist2().end());
     out.offset[a + 1] = static_cast<uint32_t>(out.row.size());
   }
 }

@@ -211,7 +211,7 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   std::vector<uint32_t> unsure;
   if (move) {
     Stopwatch sw;  // booked as the query's probes
-    lists_after_move(t, *move, looked_at, block_range, kBlockers, nb, unsure);
+    lists_after_move(t, *move, looked_at, block_range, kBlockers, nb, unsure, ex);
     c.by_lists = looked_at.size() - unsure.size();
     if (!unsure.empty() && unsure.size() <= kScanMost) {
       std::vector<uint32_t> rows;

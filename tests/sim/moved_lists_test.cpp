@@ -143,7 +143,8 @@ TEST(ListsAfterMove, SureAnswersAreTheNaiveQuerysAndTheRestFillsIn) {
       if (rng.below(3) != 0) queries.push_back(i);
     NeighbourLists got;
     std::vector<uint32_t> unsure;
-    lists_after_move(t, m.move, queries, range, k, got, unsure);
+    Executor ex{1 + trial % 2};
+    lists_after_move(t, m.move, queries, range, k, got, unsure, ex);
     const NeighbourLists want = naive_lists(t, queries, range, k);
     ASSERT_EQ(got.queries(), queries.size());
     std::size_t u = 0;
@@ -163,7 +164,6 @@ TEST(ListsAfterMove, SureAnswersAreTheNaiveQuerysAndTheRestFillsIn) {
     std::vector<uint32_t> rows;
     for (uint32_t a : unsure) rows.push_back(queries[a]);
     NeighbourLists answers;
-    Executor ex{2};
     scan_rows(t, rows, range, k, answers, ex);
     fill_unsure(got, unsure, answers);
     for (std::size_t q = 0; q < queries.size(); ++q)
@@ -182,17 +182,18 @@ TEST(ListsAfterMove, EverythingUnsureWithoutUsableLists) {
   const std::vector<uint32_t> queries = {0, 5, 9};
   NeighbourLists got;
   std::vector<uint32_t> unsure;
+  Executor ex{1};
   TickMove none = m.move;
   none.lists = {};
-  lists_after_move(t, none, queries, 1, 6, got, unsure);
+  lists_after_move(t, none, queries, 1, 6, got, unsure, ex);
   EXPECT_EQ(unsure, (std::vector<uint32_t>{0, 1, 2}));
   TickMove nan = m.move;
   nan.move_max = NAN;
-  lists_after_move(t, nan, queries, 1, 6, got, unsure);
+  lists_after_move(t, nan, queries, 1, 6, got, unsure, ex);
   EXPECT_EQ(unsure.size(), 3u);
   TickMove short_x = m.move;
   short_x.x = short_x.x.first(10);  // positions of another table
-  lists_after_move(t, short_x, queries, 1, 6, got, unsure);
+  lists_after_move(t, short_x, queries, 1, 6, got, unsure, ex);
   EXPECT_EQ(unsure.size(), 3u);
 }
 
