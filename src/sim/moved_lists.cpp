@@ -6,11 +6,13 @@
 
 #include "index/neighbour_lanes.hpp"
 #include "query/naive_paths.hpp"
+#include "util/stopwatch.hpp"
 
 namespace crowddb::sim {
 namespace {
 
 constexpr std::size_t kListsGrain = 256;  // queries per chunk of lists_after_move
+constexpr std::size_t kMoveGrain = 4096;  // rows per chunk of largest_move
 
 }  // namespace
 
@@ -173,6 +175,62 @@ void scan_rows(const AgentTable& t, std::span<const uint32_t> rows, double range
     if (out.with_dist2) out.dist2.insert(out.dist2.end(), found_d2[a].begin(), found_d2[a].end());
     out.offset[a + 1] = static_cast<uint32_t>(out.row.size());
   }
+}
+
+double largest_move(std::span<const double> x0, std::span<const double> y0,
+                    std::span<const double> x1, std::span<const double> y1, Executor& ex) {
+  const std::size_t n = x0.size();
+  const std::size_t chunks = (n + kMoveGrain - 1) / kMoveGrain;
+  std::vector<double> part(chunks, 0);
+  // A maximum in which a NaN, once met, stays: the same in any order of rows and chunks.
+  const auto fold = [](double m, double d2) { return !std::isnan(m) && !(d2 <= m) ? d2 : m; };
+  ex.for_each_chunk(n, kMoveGrain, [&](std::size_t b, std::size_t e) {
+    double m = 0;  // written once (neighbouring chunks' entries share cache lines)
+    for (std::size_t i = b; i < e; ++i) {
+      const double dx = x1[i] - x0[i], dy = y1[i] - y0[i];
+      m = fold(m, dx * dx + dy * dy);
+    }
+    part[b / kMoveGrain] = m;
+  });
+  double m = 0;
+  for (double p : part) m = fold(m, p);
+  return std::sqrt(m);
+}
+
+AnsweredBy neighbours_after_move(const AgentTable& t, const TickMove* move,
+                                 std::span<const uint32_t> queries, double range, uint32_t k,
+                                 NeighbourPath& path, NeighbourLists& out, Executor& ex,
+                                 QueryStats& stats) {
+  AnsweredBy by;
+  if (!move) {
+    path.run(DiscView::of(t), queries, range, k, out, ex, stats);
+    by.query = queries.size();
+    return by;
+  }
+  std::vector<uint32_t> unsure;
+  Stopwatch sw;  // booked as the query's probes
+  lists_after_move(t, *move, queries, range, k, out, unsure, ex);
+  stats.query_seconds += sw.seconds();
+  by.lists = queries.size() - unsure.size();
+  if (unsure.empty()) return by;
+  std::vector<uint32_t> rows;
+  for (uint32_t a : unsure) rows.push_back(queries[a]);
+  NeighbourLists answers;
+  answers.with_dist2 = out.with_dist2;
+  if (rows.size() <= kScanMost) {
+    // A few left (the densest spots): a scan of every row each costs less than a grid.
+    sw.restart();
+    scan_rows(t, rows, range, k, answers, ex);
+    stats.query_seconds += sw.seconds();
+    stats.pair_tests += rows.size() * t.size();
+    stats.rows += rows.size();
+    by.scan = rows.size();
+  } else {
+    path.run(DiscView::of(t), rows, range, k, answers, ex, stats);
+    by.query = rows.size();
+  }
+  fill_unsure(out, unsure, answers);
+  return by;
 }
 
 void fill_unsure(NeighbourLists& out, std::span<const uint32_t> unsure,

@@ -78,6 +78,25 @@ inline constexpr std::size_t kScanMost = 16;
 void scan_rows(const AgentTable& t, std::span<const uint32_t> rows, double range, uint32_t k,
                NeighbourLists& out, Executor& ex);
 
+// The farthest any row moved from (x0, y0) to (x1, y1) (rows the same), on `ex`'s threads; NaN
+// when a position is not finite.
+double largest_move(std::span<const double> x0, std::span<const double> y0,
+                    std::span<const double> x1, std::span<const double> y1, Executor& ex);
+
+// Who answered how many queries of neighbours_after_move.
+struct AnsweredBy {
+  std::size_t lists = 0, scan = 0, query = 0;
+};
+
+// The k nearest other rows of `t` strictly within `range` of each of `queries`, nearest first,
+// ties by id, into `out` (its with_dist2 as set): from the lists before the move where they are
+// sure to hold them (lists_after_move), up to kScanMost of the rest by scan_rows, more by `path`;
+// without `move`, all by `path`. The same answer as path.run's, whichever way.
+AnsweredBy neighbours_after_move(const AgentTable& t, const TickMove* move,
+                                 std::span<const uint32_t> queries, double range, uint32_t k,
+                                 NeighbourPath& path, NeighbourLists& out, Executor& ex,
+                                 QueryStats& stats);
+
 // Puts the lists of the unsure queries (`answers`: one list per entry of `unsure`, in its order)
 // into `out` in their places, so that it holds every query's list.
 void fill_unsure(NeighbourLists& out, std::span<const uint32_t> unsure,

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "path/navigation.hpp"
+#include "sim/moved_lists.hpp"
 #include "sim/oplog.hpp"
 #include "sim/row_order.hpp"
 #include "sim/sources.hpp"
@@ -259,7 +260,9 @@ struct Simulation::Engine {
   std::vector<uint32_t> join_queries;
   NeighbourLists join_lists;
   std::unique_ptr<NeighbourPath> join_path;
-  void join_idle_groups(const World& w, const SimConfig& cfg, QueryStats& stats) {
+  // `move`: the model's lists of the tick and the move since (sim/moved_lists.hpp).
+  void join_idle_groups(const World& w, const SimConfig& cfg, QueryStats& stats,
+                        const sim::TickMove* move) {
     const AgentTable& t = w.agents();
     joined.assign(t.size(), 0);
     const bool idle = cfg.arrival == ArrivalPolicy::idle;
@@ -276,7 +279,8 @@ struct Simulation::Engine {
     }
     if (!any_standing || join_queries.empty()) return;
     if (!join_path) join_path = neighbour_method(cfg.access.neighbours, t.size()).make();
-    join_path->run(DiscView::of(t), join_queries, 2 * rmax + kJoinGap, 8, join_lists, ex, stats);
+    sim::neighbours_after_move(t, move, join_queries, 2 * rmax + kJoinGap, 8, *join_path,
+                               join_lists, ex, stats);
     for (std::size_t q = 0; q < join_queries.size(); ++q) {
       const uint32_t i = join_queries[q];
       for (uint32_t a = join_lists.offset[q]; a < join_lists.offset[q + 1]; ++a) {
@@ -565,12 +569,18 @@ const TickMetrics& Simulation::step() {
     t.y.swap(e.next.y);
     t.vx.swap(e.next.vx);
     t.vy.swap(e.next.vy);
-    e.join_idle_groups(world_, cfg, log.at("commit").query);
+    // The model's lists of the tick and the move since (e.next holds the positions before now):
+    // the idle groups' and the stalemate stage's searches are answered from them where they
+    // must hold the answer (sim/moved_lists.hpp).
+    const NearLists near = e.model->near_lists();
+    tick_move = {near, e.next.x, e.next.y,
+                 near.lists ? sim::largest_move(e.next.x, e.next.y, t.x, t.y, e.ex) : 0.0,
+                 sim::RowRenumbering(n, {})};
+    e.join_idle_groups(world_, cfg, log.at("commit").query, &tick_move);
     // Each row on its own (in chunks, on every thread: every write is to the row itself); the
     // counts and the rows leaving are gathered in row order afterwards.
     struct Part {
       std::size_t frozen = 0, gridlock_started = 0, longest_frozen = 0, gridlocked = 0, arrived = 0;
-      double move2 = 0;  // the largest squared move of a row this tick (NaN: one not finite)
       std::vector<std::size_t> leaving;
       std::vector<uint64_t> lost_sight;  // ids (rows leave before the path requests)
     };
@@ -603,11 +613,6 @@ const TickMetrics& Simulation::step() {
         }
       };
       for (std::size_t i = begin; i < end; ++i) {
-        {
-          const double dx = t.x[i] - e.next.x[i], dy = t.y[i] - e.next.y[i];  // (swapped above)
-          const double d2 = dx * dx + dy * dy;
-          c.move2 = d2 <= c.move2 ? c.move2 : d2;  // (a NaN stays)
-        }
         if (t.state[i] == AgentState::arrived) continue;
         if (t.state[i] == AgentState::waiting) {
           if (m.tick < t.wait_until[i]) continue;
@@ -662,9 +667,7 @@ const TickMetrics& Simulation::step() {
       }
     });
     std::vector<std::size_t> leaving;
-    double move2 = 0;
     for (const Part& c : parts) {
-      move2 = c.move2 <= move2 ? move2 : c.move2;
       m.frozen += c.frozen;
       m.gridlock_started += c.gridlock_started;
       m.longest_frozen = std::max(m.longest_frozen, c.longest_frozen);
@@ -673,9 +676,7 @@ const TickMetrics& Simulation::step() {
       leaving.insert(leaving.end(), c.leaving.begin(), c.leaving.end());
       lost_sight.insert(lost_sight.end(), c.lost_sight.begin(), c.lost_sight.end());
     }
-    // What the stalemate stage needs to answer its search from the model's lists.
-    tick_move = {e.model->near_lists(), e.next.x, e.next.y, std::sqrt(move2),
-                 sim::RowRenumbering(n, leaving)};
+    tick_move.rows = sim::RowRenumbering(n, leaving);  // (the lists' rows, for the stalemates)
     world_.remove_rows(std::move(leaving));
   });
 

@@ -6,7 +6,6 @@
 
 #include "sim/stages.hpp"
 #include "util/rng.hpp"
-#include "util/stopwatch.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb::sim {
@@ -206,42 +205,14 @@ StallCounts stalemates(World& world, const SimConfig& cfg, uint64_t tick, Neighb
   constexpr uint32_t kBlockers = 6;
   // From the model's lists where they are sure to hold the answer (at airport-20k nearly all of
   // the ~500 rows looked at a tick), a few left (the densest spots) by a scan of every row each,
-  // more by the query: its grid over every row for a few searches was most of this step's cost
-  // and did not speed up on two threads.
-  std::vector<uint32_t> unsure;
-  if (move) {
-    Stopwatch sw;  // booked as the query's probes
-    lists_after_move(t, *move, looked_at, block_range, kBlockers, nb, unsure, ex);
-    c.by_lists = looked_at.size() - unsure.size();
-    if (!unsure.empty() && unsure.size() <= kScanMost) {
-      std::vector<uint32_t> rows;
-      for (uint32_t a : unsure) rows.push_back(looked_at[a]);
-      NeighbourLists answers;
-      answers.with_dist2 = false;
-      scan_rows(t, rows, block_range, kBlockers, answers, ex);
-      fill_unsure(nb, unsure, answers);
-      stats.pair_tests += rows.size() * t.size();
-      stats.rows += rows.size();
-      c.by_scan = rows.size();
-      unsure.clear();
-    }
-    stats.query_seconds += sw.seconds();
-  }
-  if (!move) {
-    // On every thread, however few rows are looked at: the grid's build over every row and the
-    // searches (airport-20k, 505 rows looked at, two threads: this stage 55.1 -> 47.1 ms per 100
-    // ticks against one thread for both).
-    path.run(DiscView::of(t), looked_at, block_range, kBlockers, nb, ex, stats);
-    c.by_query = looked_at.size();
-  } else if (!unsure.empty()) {
-    std::vector<uint32_t> rows;
-    for (uint32_t a : unsure) rows.push_back(looked_at[a]);
-    NeighbourLists answers;
-    answers.with_dist2 = false;
-    path.run(DiscView::of(t), rows, block_range, kBlockers, answers, ex, stats);
-    fill_unsure(nb, unsure, answers);
-    c.by_query = rows.size();
-  }
+  // more by the query (on every thread, however few rows: the grid's build over every row and the
+  // searches), whose grid over every row for a few searches was most of this step's cost and did
+  // not speed up on two threads.
+  const AnsweredBy by =
+      neighbours_after_move(t, move, looked_at, block_range, kBlockers, path, nb, ex, stats);
+  c.by_lists = by.lists;
+  c.by_scan = by.scan;
+  c.by_query = by.query;
   std::vector<int64_t> blocker(looked_at.size(), -1);
   std::vector<Vec2> dir(looked_at.size());
   std::vector<uint8_t> same_way(looked_at.size(), 0), queueing(looked_at.size(), 0);

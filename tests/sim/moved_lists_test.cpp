@@ -169,6 +169,8 @@ TEST(ListsAfterMove, SureAnswersAreTheNaiveQuerysAndTheRestFillsIn) {
     for (std::size_t q = 0; q < queries.size(); ++q)
       ASSERT_EQ(rows_listed(got, q), rows_listed(want, q))
           << "trial " << trial << " query row " << queries[q];
+    // The squared distances too, as the query gives them (the idle groups read them).
+    EXPECT_EQ(got.dist2, want.dist2) << "trial " << trial;
   }
   // Both kinds were met: the test says something about each.
   EXPECT_GT(sure, 1000u);
@@ -195,6 +197,74 @@ TEST(ListsAfterMove, EverythingUnsureWithoutUsableLists) {
   short_x.x = short_x.x.first(10);  // positions of another table
   lists_after_move(t, short_x, queries, 1, 6, got, unsure, ex);
   EXPECT_EQ(unsure.size(), 3u);
+}
+
+TEST(LargestMove, IsTheFarthestMoveAndKeepsANaN) {
+  Rng rng(23);
+  for (std::size_t n : {0u, 1u, 7u, 4096u, 10001u}) {
+    std::vector<double> x0(n), y0(n), x1(n), y1(n);
+    double want = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      x0[i] = rng.uniform(-100, 100);
+      y0[i] = rng.uniform(-100, 100);
+      x1[i] = x0[i] + rng.uniform(-0.2, 0.2);
+      y1[i] = y0[i] + rng.uniform(-0.2, 0.2);
+      const double dx = x1[i] - x0[i], dy = y1[i] - y0[i];
+      want = std::max(want, dx * dx + dy * dy);
+    }
+    for (int threads : {1, 2}) {
+      Executor ex{threads};
+      EXPECT_EQ(largest_move(x0, y0, x1, y1, ex), std::sqrt(want)) << n;
+      if (n == 0) continue;
+      // A NaN anywhere, first, in the middle or last, whatever comes after it.
+      for (std::size_t at : {std::size_t{0}, n / 2, n - 1}) {
+        const double keep = x1[at];
+        x1[at] = NAN;
+        EXPECT_TRUE(std::isnan(largest_move(x0, y0, x1, y1, ex))) << n << " at " << at;
+        x1[at] = keep;
+      }
+    }
+  }
+}
+
+// neighbours_after_move: all three ways give the naive query's lists (and squared distances);
+// without the move the path answers all.
+TEST(ListsAfterMove, NeighboursAfterMoveAreTheQuerysEveryWay) {
+  Rng rng(29);
+  AnsweredBy total;
+  for (int trial = 0; trial < 30; ++trial) {
+    const std::size_t n = 100 + rng.below(600);
+    const double density = trial % 3 == 0 ? 0.4 : trial % 3 == 1 ? 2.0 : 3.5;
+    MovedCrowd m = make_moved_crowd(n, std::sqrt(double(n) / density), 0.15, rng, false, 5, 10);
+    const AgentTable& t = m.w.agents();
+    std::vector<uint32_t> queries;
+    const uint32_t every = trial % 2 == 0 ? 1 : 9;  // many rows, or a few
+    for (uint32_t i = 0; i < t.size(); i += every) queries.push_back(i);
+    Executor ex{1 + trial % 2};
+    QueryStats stats;
+    auto path = neighbour_method("grid", t.size()).make();
+    NeighbourLists got;
+    got.with_dist2 = trial % 4 < 2;
+    const AnsweredBy by = neighbours_after_move(t, &m.move, queries, 1.1, 6, *path, got, ex, stats);
+    EXPECT_EQ(by.lists + by.scan + by.query, queries.size());
+    const NeighbourLists want = naive_lists(t, queries, 1.1, 6);
+    EXPECT_EQ(got.offset, want.offset) << "trial " << trial;
+    EXPECT_EQ(got.row, want.row) << "trial " << trial;
+    if (got.with_dist2) {
+      EXPECT_EQ(got.dist2, want.dist2) << "trial " << trial;
+    }
+    total.lists += by.lists;
+    total.scan += by.scan;
+    total.query += by.query;
+    NeighbourLists by_path;
+    const AnsweredBy none =
+        neighbours_after_move(t, nullptr, queries, 1.1, 6, *path, by_path, ex, stats);
+    EXPECT_EQ(none.query, queries.size());
+    EXPECT_EQ(by_path.row, want.row);
+  }
+  EXPECT_GT(total.lists, 0u);
+  EXPECT_GT(total.scan, 0u);
+  EXPECT_GT(total.query, 0u);
 }
 
 TEST(ScanRows, AsTheNaiveQueryAcrossBlocksAndTails) {
