@@ -1,18 +1,20 @@
 // Neighbour lists after the tick's move, answered from the lists the steering model made before
 // it, where those are sure to hold the answer.
 //
-// The stalemate stage asks, after the commit, for the k nearest agents within a short range of
-// the rows it looks at (505 of 20,000 at airport-20k). A grid over every row for those few
-// searches was most of the stage's cost outside the progress watch, and did not get faster on two
-// threads. The model's lists (NearLists: the k' nearest strictly within range' of every row, made
-// at the start of the tick) already hold, for most rows, everyone who can be that near now: a
-// row's list holds every row strictly closer than its bound b (range', or the distance of its
-// k'-th when full), and since then no agent has moved more than m, so anyone not listed is now at
-// least b - 2 m away. Where that is at least the range asked (with a relative 1e-9 for the
-// rounding of the distances, as the backoff's use of the lists), the answer is the listed rows
-// strictly within range now, ranked as every neighbour method ranks them (NearestK: nearest
-// first, ties by id), so it is the neighbour query's answer bit for bit. The other rows (a dense
-// jam, where the k'-th is close) are left to the caller's query.
+// After the move the tick asks twice for the k nearest agents within a short range: the
+// stalemate stage for each stalled row's blockers (505 of 20,000 rows at airport-20k), and, with
+// idle arrivals or goal waits, the commit for each walker on its last goal (someone idle to join).
+// A grid over every row for those searches was most of the stalemate stage's cost outside its
+// progress watch, and did not get faster on two threads. The model's lists (NearLists: the k'
+// nearest strictly within range' of every row, made at the start of the tick) already hold, for
+// most rows, everyone who can be that near now: a row's list holds every row strictly closer than
+// its bound b (range', or the distance of its k'-th when full), and since then the row has moved
+// m_i and nobody more than m, so anyone not listed is now at least b - m_i - m away. Where that
+// is at least the range asked (with a relative 1e-9 for the rounding of the distances, as the
+// backoff's use of the lists), the answer is the listed rows strictly within range now, ranked as
+// every neighbour method ranks them (NearestK: nearest first, ties by id), so it is the neighbour
+// query's answer bit for bit. The other rows (a dense jam, where the k'-th is close) are left to
+// a scan of every row when a few, else to the neighbour query (neighbours_after_move).
 //
 // The commit removes rows (World::remove_rows: swap-removes from the highest row down), so the
 // lists' rows are mapped to the rows as they are now (RowRenumbering).
