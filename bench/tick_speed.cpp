@@ -303,15 +303,15 @@ void print_summary(const std::map<std::string, std::vector<std::map<int, double>
 
 // The usage, after `why` (nullptr: asked for with --help, on standard output, exit 0).
 int usage(const char* why) {
-  std::FILE* out = why ? stderr : stdout;
-  if (why) std::fprintf(out, "tick_speed: %s\n", why);
-  std::fprintf(out,
-               "usage: tick_speed [--cases all|NAME,...] "
-               "[--models orca,cfsm,thesis,orca-core] [--threads 1,2] [--ticks N] [--rounds N] "
-               "[--csv FILE] [--fork yes|no]\ncases:");
-  for (const Case& c : kCases) std::fprintf(out, " %s", c.name);
-  std::fprintf(out, "\n");
-  return why ? 2 : 0;
+  static const std::string text = [] {
+    std::string s =
+        "usage: tick_speed [--cases all|NAME,...] [--models orca,cfsm,thesis,orca-core] "
+        "[--threads 1,2] [--ticks N] [--rounds N] [--csv FILE] [--fork yes|no]\ncases:";
+    for (const Case& c : kCases) s += std::string(" ") + c.name;
+    return s + "\n";
+  }();
+  const bench::Usage u{"tick_speed", text.c_str()};
+  return why ? u.refuse(why) : u.print();
 }
 
 }  // namespace

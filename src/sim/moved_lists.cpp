@@ -76,20 +76,21 @@ void lists_after_move(const AgentTable& t, const TickMove& move, std::span<const
   const std::size_t before = move.rows.before();
   const bool usable = lists && lists->queries() == before && move.x.size() == before &&
                       move.y.size() == before && move.rows.now() == t.size() &&
-                      std::isfinite(move.move_max) && move.move_max >= 0 && range >= 0 && k > 0 &&
-                      k <= NearestK::kInline;
+                      std::isfinite(move.move_max) && move.move_max >= 0 && range >= 0 && k > 0;
   if (!usable) {
     for (std::size_t a = 0; a < q; ++a) unsure.push_back(static_cast<uint32_t>(a));
     return;
   }
   const double range2 = move.lists.range * move.lists.range, r2 = range * range;
   const uint32_t lists_k = move.lists.k;
-  // Each query's answer in k slots of its own (on every thread), then packed in query order.
+  // On every thread, each chunk's lists gathered in query order (ListChunks, as every neighbour
+  // method does); an unsure query gets an empty list here.
   const bool d2_too = out.with_dist2;
-  std::vector<uint32_t> slot_rows(q * k), count(q);
-  std::vector<double> slot_d2(d2_too ? q * k : 0);
   std::vector<uint8_t> sure(q);
+  ListChunks chunks;
+  chunks.reset((q + kListsGrain - 1) / kListsGrain);
   ex.for_each_chunk(q, kListsGrain, [&](std::size_t begin, std::size_t end) {
+    ListChunks::Chunk mine;
     NearestK best;
     for (std::size_t a = begin; a < end; ++a) {
       const uint32_t i = queries[a];
@@ -106,7 +107,10 @@ void lists_after_move(const AgentTable& t, const TickMove& move, std::span<const
       // Everyone strictly closer than the list's bound is in it (NearLists).
       const double bound2 =
           lists_k > 0 && listed.size() >= lists_k ? dist2_before(listed.back()) : range2;
-      if (!(bound2 >= need * need)) continue;
+      if (!(bound2 >= need * need)) {
+        mine.counts.push_back(0);
+        continue;
+      }
       sure[a] = 1;
       best.reset(k);
       for (uint32_t jb : listed) {
@@ -118,21 +122,15 @@ void lists_after_move(const AgentTable& t, const TickMove& move, std::span<const
         if (d2 < r2) best.offer(j, t.id[j], d2);
       }
       best.finish();
-      count[a] = static_cast<uint32_t>(best.size());
-      std::copy(best.rows().begin(), best.rows().end(), slot_rows.begin() + a * k);
-      if (d2_too) std::copy(best.dist2().begin(), best.dist2().end(), slot_d2.begin() + a * k);
+      mine.counts.push_back(static_cast<uint32_t>(best.size()));
+      mine.items.insert(mine.items.end(), best.rows().begin(), best.rows().end());
+      if (d2_too) mine.d2.insert(mine.d2.end(), best.dist2().begin(), best.dist2().end());
     }
+    chunks.put(begin / kListsGrain, std::move(mine));
   });
-  for (std::size_t a = 0; a < q; ++a) {
+  chunks.gather(out, &NeighbourLists::row, &ex);
+  for (std::size_t a = 0; a < q; ++a)
     if (!sure[a]) unsure.push_back(static_cast<uint32_t>(a));
-    const auto from = slot_rows.begin() + static_cast<std::ptrdiff_t>(a * k);
-    out.row.insert(out.row.end(), from, from + count[a]);
-    if (d2_too) {
-      const auto d = slot_d2.begin() + static_cast<std::ptrdiff_t>(a * k);
-      out.dist2.insert(out.dist2.end(), d, d + count[a]);
-    }
-    out.offset[a + 1] = static_cast<uint32_t>(out.row.size());
-  }
 }
 
 void scan_rows(const AgentTable& t, std::span<const uint32_t> rows, double range, uint32_t k,
@@ -141,10 +139,10 @@ void scan_rows(const AgentTable& t, std::span<const uint32_t> rows, double range
   const auto n = static_cast<uint32_t>(t.size());
   // d2 <= bound is d2 < range^2 (the neighbour methods' test) for every double d2.
   const double bound = std::nextafter(range * range, -INFINITY);
-  std::vector<std::vector<uint32_t>> found(q);
-  std::vector<std::vector<double>> found_d2(q);
   // Blocks of rows, so the buffers stay small at any n; whole vectors of four but the last block.
   constexpr uint32_t kBlock = 4096;
+  ListChunks lists;  // one chunk a query
+  lists.reset(q);
   ex.for_each_chunk(q, 1, [&](std::size_t b, std::size_t e) {
     std::vector<uint32_t> at(kBlock + index::kNeighbourPad);
     std::vector<double> dist(kBlock + index::kNeighbourPad);
@@ -163,18 +161,14 @@ void scan_rows(const AgentTable& t, std::span<const uint32_t> rows, double range
         for (uint32_t u = 0; u < m; ++u) best.offer(at[u], t.id[at[u]], dist[u]);
       }
       best.finish();
-      found[a].assign(best.rows().begin(), best.rows().end());
-      found_d2[a].assign(best.dist2().begin(), best.dist2().end());
+      ListChunks::Chunk mine;
+      mine.counts.push_back(static_cast<uint32_t>(best.size()));
+      mine.items.assign(best.rows().begin(), best.rows().end());
+      if (out.with_dist2) mine.d2.assign(best.dist2().begin(), best.dist2().end());
+      lists.put(a, std::move(mine));
     }
   });
-  out.offset.assign(q + 1, 0);
-  out.row.clear();
-  out.dist2.clear();
-  for (std::size_t a = 0; a < q; ++a) {
-    out.row.insert(out.row.end(), found[a].begin(), found[a].end());
-    if (out.with_dist2) out.dist2.insert(out.dist2.end(), found_d2[a].begin(), found_d2[a].end());
-    out.offset[a + 1] = static_cast<uint32_t>(out.row.size());
-  }
+  lists.gather(out, &NeighbourLists::row, &ex);
 }
 
 double largest_move(std::span<const double> x0, std::span<const double> y0,

@@ -64,8 +64,8 @@ struct TickMove {
 // nearest first, ties by id (NeighbourPath::run's answer), where the lists before the move are
 // sure to hold them: out gets one list per query (empty for the others) and `unsure` the
 // queries' places (indices into `queries`, ascending) whose answer is left to the caller.
-// Everything is unsure when the move cannot be used (no lists, lists of another table, or k above
-// NearestK::kInline). On `ex`'s threads; the same answer on any number.
+// Everything is unsure when the move cannot be used (no lists, or lists of another table). On
+// `ex`'s threads; the same answer on any number.
 void lists_after_move(const AgentTable& t, const TickMove& move, std::span<const uint32_t> queries,
                       double range, uint32_t k, NeighbourLists& out, std::vector<uint32_t>& unsure,
                       Executor& ex);
