@@ -72,7 +72,7 @@ class NeighbourPath {
                    uint32_t k, NeighbourLists& out, Executor& ex, QueryStats& stats) = 0;
   // The table's rows were permuted (order[new row] = old row) since the last run: a method that
   // keeps per-row state across runs (the grid's hints) carries it along, on `ex`'s threads when
-  // given. Never changes a result.
+  // given. Never changes a result. Runs beside the table's own permutation: reads nothing of it.
   virtual void rows_permuted(std::span<const uint32_t> /*order*/, Executor* /*ex*/ = nullptr) {}
 };
 

@@ -23,10 +23,6 @@ namespace crowddb::sim {
 inline constexpr double kReorderInterval = 2.0;
 // Below this many rows the columns stay in cache anyway: no reordering.
 inline constexpr std::size_t kReorderMinRows = 4096;
-// From this many rows the tick reorders on every thread; below, the threads' share of the work
-// costs less than reading what the other core wrote (2 * 10^4 rows: 2.9 ms a reorder on the
-// calling thread, 3.3 ms on two threads).
-inline constexpr std::size_t kParallelReorder = std::size_t{1} << 15;
 
 // The rows in Morton (Z-curve) order of their positions in cells of 1 m from the table's lowest
 // corner, ties by agent id: order[new row] = old row, for World::permute_rows. A radix sort (a

@@ -486,12 +486,16 @@ const TickMetrics& Simulation::step() {
   if (reorders(cfg, world_.agents().size()) &&
       (m.tick - 1) % cfg.ticks_for(sim::kReorderInterval) == 0)
     log.timed("reorder rows", world_.agents().size(), [&] {
-      Executor* const ex = world_.agents().size() >= sim::kParallelReorder ? &e.ex : nullptr;
-      const std::vector<uint32_t> order = sim::curve_order(world_.agents(), ex);
-      world_.permute_rows(order, ex);
-      e.model->rows_permuted(order, ex);
-      if (e.stall_path) e.stall_path->rows_permuted(order, ex);
-      if (e.join_path) e.join_path->rows_permuted(order, ex);
+      // The table's columns on every thread, and beside them what the model and the grids keep
+      // per row (they read only the order and their own state). Two threads at 2 * 10^4 rows:
+      // 16 -> 13 ms per 100 ticks; the columns alone on every thread gained nothing.
+      const std::vector<uint32_t> order = sim::curve_order(world_.agents(), &e.ex);
+      e.ex.both([&] { world_.permute_rows(order, &e.ex); },
+                [&] {
+                  e.model->rows_permuted(order, &e.ex);
+                  if (e.stall_path) e.stall_path->rows_permuted(order, &e.ex);
+                  if (e.join_path) e.join_path->rows_permuted(order, &e.ex);
+                });
     });
   e.refresh_scene(world_, cfg);
   const TickPlan plan = e.plan(world_, cfg);

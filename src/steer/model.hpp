@@ -71,7 +71,8 @@ class Model {
   virtual void explain(std::ostream& os, const TickInput& in, int& step) const = 0;
   // The agents' rows were permuted (order[new row] = old row) since the last tick; passed on to
   // access paths that keep per-row state across ticks (on `ex`'s threads when given). Never
-  // changes a result.
+  // changes a result. Runs beside World::permute_rows (Executor::both): reads nothing of the
+  // agents' table.
   virtual void rows_permuted(std::span<const uint32_t> /*order*/, Executor* /*ex*/ = nullptr) {}
   // The neighbour lists of the last velocities() call, over every row of its table, for the
   // backoff to rule overlaps out with (sim::lists_rule_out_overlaps); none by default.
