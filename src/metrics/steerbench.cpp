@@ -105,33 +105,50 @@ void SteerBench::tick(const World& world, const TickMetrics& m, Executor* ex) {
   const AgentTable& t = world.agents();
   const std::size_t n = t.size();
   row_slot_.resize(n, kNoSlot);
-  // 1. Every row whose slot holds its own live track and that did not arrive adds the tick to
-  // that track, on every thread: a live track is one agent's, so one row's, and a row writes
-  // nothing else. The other rows are marked for 2.
+  // 1. On every thread, each row that did not arrive adds the tick to its agent's live track:
+  // the one its slot holds, or, when the slot no longer does (the table reordered its rows), the
+  // one its id finds (a lookup that only reads, and a row writes only its own slot). A live
+  // track is one agent's, so one row's. New agents and arrivals are marked for 2.
   pending_.resize(n);
   const std::size_t chunks = (n + kTickGrain - 1) / kTickGrain;
-  std::vector<std::size_t> chunk_seen(chunks, 0);
+  std::vector<std::size_t> chunk_seen(chunks, 0), chunk_moved(chunks, 0);
   const auto own_tracks = [&](std::size_t b, std::size_t e) {
-    std::size_t seen = 0;
+    std::size_t seen = 0, moved = 0;
     for (std::size_t i = b; i < e; ++i) {
-      const uint32_t slot = row_slot_[i];
-      const bool own = holds(slot, t.id[i]) && t.state[i] != AgentState::arrived;
-      pending_[i] = !own;
-      if (!own) continue;
+      uint32_t slot = row_slot_[i];
+      pending_[i] = 0;
+      if (!holds(slot, t.id[i])) {
+        const uint32_t score = known_.find(t.id[i]);
+        if (score == kUnknown) {  // new in the table: opened in 2
+          pending_[i] = 1;
+          continue;
+        }
+        ++moved;
+        slot = score_slot_[score];
+        row_slot_[i] = slot;
+      }
+      if (slot == kNoSlot) continue;  // measured before and closed on arrival: stays closed
+      if (t.state[i] == AgentState::arrived) {
+        pending_[i] = 1;  // arrived in this tick: closed in 2, the tick not counted
+        continue;
+      }
       add_tick(tracks_[slot], t.x[i], t.y[i]);
       ++seen;
     }
     chunk_seen[b / kTickGrain] = seen;
+    chunk_moved[b / kTickGrain] = moved;
   };
   if (ex && ex->threads() > 1)
     ex->for_each_chunk(n, kTickGrain, own_tracks);
   else
     for (std::size_t b = 0; b < n; b += kTickGrain) own_tracks(b, std::min(n, b + kTickGrain));
-  std::size_t seen = 0;  // live tracks seen this tick
-  for (std::size_t c : chunk_seen) seen += c;
-  // 2. The others in row order, on one thread: new agents are opened, arrivals closed, and
-  // rows whose slot changed (the table reordered its rows) find their track by id.
+  std::size_t seen = 0;   // live tracks seen this tick
   std::size_t moved = 0;  // rows whose track had to be looked up
+  for (std::size_t c = 0; c < chunks; ++c) {
+    seen += chunk_seen[c];
+    moved += chunk_moved[c];
+  }
+  // 2. The others in row order, on one thread: new agents are opened, arrivals closed.
   for (std::size_t i = 0; i < n; ++i) {
     if (!pending_[i]) continue;
     const uint64_t id = t.id[i];

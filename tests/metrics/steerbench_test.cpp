@@ -151,8 +151,9 @@ TEST(SteerBench, CollisionEpisodesCountOncePerAgentAndEpisode) {
 
 // The tracks follow agents, not rows: the same walks give the same scores, bit for bit, whether
 // the table keeps its rows in place or shuffles them every few ticks (as the curve order does,
-// after which the tracks are laid out again in row order), with agents leaving on the way and
-// the scores read in the middle of the run.
+// after which the tracks are laid out again in row order), with agents arriving (in the very
+// ticks the rows are shuffled, so that a row finds its track by id and closes it at once) and
+// leaving on the way, and the scores read in the middle of the run.
 TEST(SteerBench, ScoresDoNotDependOnTheRowOrder) {
   auto make = [] {
     World w(Bounds{0, 0, 100, 100});
@@ -174,6 +175,13 @@ TEST(SteerBench, ScoresDoNotDependOnTheRowOrder) {
         Rng walk = Rng::stream(static_cast<uint64_t>(tick), t.id[i]);
         t.x[i] += walk.uniform(-0.1, 0.1);
         t.y[i] += walk.uniform(-0.1, 0.1);
+      }
+    }
+    if (tick % 5 == 0) {  // some arrive: the same agents in both
+      for (World* w : {&still, &shuffled}) {
+        AgentTable& t = w->agents_for_tick();
+        for (std::size_t i = 0; i < t.size(); ++i)
+          if ((t.id[i] ^ static_cast<uint64_t>(tick)) % 13 == 0) t.state[i] = AgentState::arrived;
       }
     }
     if (tick % 7 == 0) {  // some leave: the same agents in both
