@@ -7,7 +7,7 @@
 // perturbation of the wishes (0; RVO2's examples add one, the side-by-side's RVO2 loop does
 // not). The rest stays: the right of way, contact and retreat planes, the backoff, the
 // stalemate watch. What the three buy is in docs/steering.md; what they cost, in
-// docs/benchmarks.md.
+// docs/bench/journal.md ("What keeping to a side, the stream gap and the perturbation cost").
 #pragma once
 
 #include <string>

@@ -164,7 +164,7 @@ struct FtcIndexOptions {
   // bounds (branchy, one at a time) for pair times (in lanes, several at a time). The thesis
   // model's first-to-collide query on ticks without overlaps, airport at 2,000 / 5,000 /
   // 20,000 / 100,000 agents, ms per tick against leaf_size 16: 32 -12 / -15 / -18 / -13 %,
-  // 48 -11 / -18 / -21 / -11 %, 64 -5 / -13 / -19 / -11 % (docs/benchmarks.md).
+  // 48 -11 / -18 / -21 / -11 %, 64 -5 / -13 / -19 / -11 % (docs/bench/journal.md).
   std::size_t leaf_size_apart = 48;
   // The agent tree is built anew on every rebuild_every-th build (run), and in between refitted:
   // the same nodes over the same rows, their bounds recomputed from where the rows are now, no
@@ -173,7 +173,7 @@ struct FtcIndexOptions {
   // tree drifts from the positions' medians, so the searches open a little more (pair tests +1 % at
   // 5, +3 % at 10) while the builds cost a third. Thesis model, airport-20k, first-to-collide
   // against 1: 30 ticks -6 % at 5 and at 10, -4 % at 20; 100 ticks -3 % at 5 and at 10 (within the
-  // noise of each other); airport-2k, 100 ticks, -7 % at 10 (docs/benchmarks.md).
+  // noise of each other); airport-2k, 100 ticks, -7 % at 10 (docs/bench/journal.md).
   uint64_t rebuild_every = 10;
 };
 

@@ -37,7 +37,7 @@ constexpr int kMaxPathPolys = 4096;
 // explores this many polygons at most (the same number everywhere, so the same answers). 16 cut
 // short 0.2-1.7 % of the door searches' distances in the shipped airports (a wall missed, a door
 // seen wider than it is; no run changed with 256, where none was cut short in any scenario we
-// have: docs/benchmarks.md).
+// have: docs/bench/journal.md).
 constexpr int kSharedNodes = 256;
 constexpr int kMaxStraight = 512;
 static_assert(sizeof(dtPolyRef) == sizeof(uint32_t), "polygon refs are stored as 32 bits");

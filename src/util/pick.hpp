@@ -2,7 +2,7 @@
 // which mispredicts about every other time where c is a coin toss: orca's velocity and share
 // of a neighbour by who of the two goes first, cfsm's clipping by whether a neighbour lies
 // towards the heading. Those run once per neighbour of every row, every tick
-// (docs/benchmarks.md, 2026-12-02 evening).
+// (docs/bench/journal.md, 2026-12-02 evening).
 #pragma once
 
 #include <bit>
