@@ -148,35 +148,24 @@ void SteerBench::tick(const World& world, const TickMetrics& m, Executor* ex) {
     seen += chunk_seen[c];
     moved += chunk_moved[c];
   }
-  // 2. The others in row order, on one thread: new agents are opened, arrivals closed.
+  // 2. The others in row order, on one thread: arrivals close their tracks (1 found them),
+  // new agents open theirs.
   for (std::size_t i = 0; i < n; ++i) {
     if (!pending_[i]) continue;
-    const uint64_t id = t.id[i];
-    uint32_t slot = row_slot_[i];
-    if (!holds(slot, id)) {
-      ++moved;
-      const uint32_t score = known_.find(id);
-      if (score == kUnknown) {
-        // New in the table (a source, an insert): measured from here on.
-        if (t.state[i] == AgentState::arrived) {
-          row_slot_[i] = kNoSlot;
-        } else {
-          row_slot_[i] = open_agent(id, t.x[i], t.y[i]);
-          ++seen;
-        }
-        continue;
-      }
-      slot = score_slot_[score];
-      row_slot_[i] = slot;
-    }
-    if (slot == kNoSlot) continue;            // measured before and closed on arrival: stays closed
-    if (t.state[i] == AgentState::arrived) {  // arrived in this tick: the tick is not counted
+    const uint32_t slot = row_slot_[i];
+    if (holds(slot, t.id[i])) {  // arrived in this tick: the tick is not counted
       close_track(slot);
       row_slot_[i] = kNoSlot;
       continue;
     }
-    add_tick(tracks_[slot], t.x[i], t.y[i]);
-    ++seen;
+    // New in the table (a source, an insert): measured from here on.
+    ++moved;
+    if (t.state[i] == AgentState::arrived) {
+      row_slot_[i] = kNoSlot;
+    } else {
+      row_slot_[i] = open_agent(t.id[i], t.x[i], t.y[i]);
+      ++seen;
+    }
   }
   // Agents no longer in the table left it on arrival (or were deleted): their tracks were not
   // seen. (Every live track is seen at most once, so when the count says all were, no slot
