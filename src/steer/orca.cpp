@@ -180,6 +180,22 @@ constexpr double kSideTurn = 30 * std::numbers::pi / 180;
 constexpr double kTurnNearWaypoint = 2;  // [m]
 constexpr double kStanding = 1e-100;     // [m/s] a wish below this does not look for anyone
 
+// A row's scratch in the linear programs' loop, per thread and kept: made per chunk (128 rows),
+// its two dozen vectors were as many allocations each time, grown row by row.
+struct LpScratch {
+  std::vector<HalfPlane> planes, soft;
+  std::vector<double> ipx, ipy, ivx, ivy, ir, itau, ishare;  // agent_planes' inputs
+  std::vector<uint32_t> cap_pick;                            // the neighbours that cap the wish
+  std::vector<uint8_t> cap_bits;
+  // The pass over the neighbours' outputs besides the inputs above (steer/orca_pairs.hpp), and
+  // the rows of the list padded to whole vectors of four for its lanes.
+  std::vector<double> cpx, cpy, cnx, cny;
+  std::vector<uint8_t> contact, capped_by;
+  std::vector<uint16_t> flags;  // per four entries (PairOut::lanes)
+  std::vector<uint32_t> rows;
+};
+thread_local LpScratch lp_scratch;
+
 class OrcaModel final : public Model {
  public:
   void velocities(const TickInput& in, std::span<double> vx, std::span<double> vy, Executor& ex,
@@ -303,16 +319,10 @@ class OrcaModel final : public Model {
       });
       ex.for_each_chunk(n, kGrain, [&](std::size_t b, std::size_t e) {
         uint64_t infeasible = 0;  // the chunk's count, written once at its end (see find_passing)
-        std::vector<HalfPlane> planes, soft;
-        std::vector<double> ipx, ipy, ivx, ivy, ir, itau, ishare;  // agent_planes' inputs
-        std::vector<uint32_t> cap_pick;  // the neighbours that cap the wish (Caps)
-        std::vector<uint8_t> cap_bits;
-        // The pass over the neighbours' outputs besides the inputs above (steer/orca_pairs.hpp),
-        // and the rows of the list padded to whole vectors of four for its lanes.
-        std::vector<double> cpx, cpy, cnx, cny;
-        std::vector<uint8_t> contact, capped_by;
-        std::vector<uint16_t> flags;  // per four entries (PairOut::lanes)
-        std::vector<uint32_t> rows;
+        // The thread's scratch, kept across chunks and ticks (LpScratch).
+        LpScratch& sc = lp_scratch;
+        auto& [planes, soft, ipx, ipy, ivx, ivy, ir, itau, ishare, cap_pick, cap_bits, cpx, cpy,
+               cnx, cny, contact, capped_by, flags, rows] = sc;
         const bool lanes = pair_lanes_avx2();
         const PairColumns columns{heading_.data(), peer_.data(), yielding_.data(),
                                   in.pref_vx.data(), in.pref_vy.data()};
