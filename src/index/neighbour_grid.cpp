@@ -243,6 +243,15 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
     uint64_t tests_c = 0, rings_c = 0;
     ListChunks::Chunk mine;
     NearestK best;
+    if (!spatial) {  // room for the lists at the last call's mean length (else grown by doubling)
+      const auto rows = static_cast<double>(e - b);
+      const auto entries = static_cast<std::size_t>(rows * (list_mean_ * 1.25 + 1));
+      mine.counts.reserve(e - b);
+      mine.items.reserve(entries);
+      if (out.with_dist2) mine.d2.reserve(entries);
+      if (k == 0 || k > NearestK::kInline)
+        best.reserve(k ? k : static_cast<std::size_t>(list_mean_ * 2) + 16);
+    }
     // Every disc other than `self` (at `self_at` in the grid) within `bound` (< the range) of
     // (px, py), from the cells of the bound's square, ranked by (distance, id): the best k are the
     // answer when at least k were found, as the selection would give them (the same squared
@@ -542,6 +551,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
     }
   } else {
     lists.gather(out, &NeighbourLists::row, &ex);
+    list_mean_ = q ? static_cast<double>(out.row.size()) / static_cast<double>(q) : 0;
   }
   stats.rows += q;
   for (std::size_t c = 0; c < chunks; ++c) {

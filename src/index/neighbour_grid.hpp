@@ -71,6 +71,11 @@ class NeighbourGrid final : public NeighbourPath {
   // asks for: 4 k bytes a row (24 MB for the stalemate stage's k = 6 at 10^6 rows).
   std::vector<uint32_t> slot_count_, slot_row_;
   uint32_t hint_k_ = 0;  // k of the last call when its lists are in the slots (hints), else 0
+  // Entries per query of the last call gathered per chunk: the chunks' lists are made with room
+  // for a quarter more, the selection for twice as many (at k = 0, cfsm's everyone within the
+  // cut-off, growing them by doubling made cfsm's tick at 2 * 10^4 agents 10,900 allocations,
+  // now 2,200).
+  double list_mean_ = 0;
 };
 
 }  // namespace crowddb::index

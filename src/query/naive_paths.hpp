@@ -78,6 +78,12 @@ class NearestK {
     d2_.clear();
     ids_.clear();
   }
+  // Room for n candidates in an unbounded (k = 0) or long (k > kInline) list, kept over resets.
+  void reserve(std::size_t n) {
+    rows_.reserve(n);
+    d2_.reserve(n);
+    ids_.reserve(n);
+  }
   std::size_t size() const { return small_ ? n_ : rows_.size(); }
   bool full() const { return k_ && size() == k_; }
   // Every candidate strictly farther than this is rejected (k = 0: none is).
