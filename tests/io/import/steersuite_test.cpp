@@ -4,27 +4,25 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
-#include <unistd.h>
+#include <sstream>
 
 #include "crowddb/error.hpp"
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
+#include "support/cli.hpp"  // TempDir
 
 namespace crowddb {
 namespace {
 
 namespace fs = std::filesystem;
 
-// A test case file in a fresh temporary folder.
+// A test case file in the program's temporary folder, removed with it when the program ends (a
+// folder named by the process id was left behind by every run).
 fs::path write_case(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / ("crowddb_steersuite_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const fs::path p = dir / name;
-  std::ofstream(p) << text;
-  return p;
+  static const test::TempDir dir;
+  return dir.write(name, text);
 }
 
 std::string header(const std::string& bounds = "-100 100 -100 100") {
@@ -33,17 +31,16 @@ std::string header(const std::string& bounds = "-100 100 -100 100") {
   is >> x0 >> x1 >> z0 >> z1;
   std::ostringstream os;
   os << "<SteerBenchTestCase xmlns=\"http://www.magix.ucla.edu/steerbench\">\n"
-     << "  <header><version>1.0</version><name>t</name><worldBounds><xmin>" << x0
-     << "</xmin><xmax>" << x1 << "</xmax><ymin>0</ymin><ymax>0</ymax><zmin>" << z0
-     << "</zmin><zmax>" << z1 << "</zmax></worldBounds></header>\n";
+     << "  <header><version>1.0</version><name>t</name><worldBounds><xmin>" << x0 << "</xmin><xmax>"
+     << x1 << "</xmax><ymin>0</ymin><ymax>0</ymax><zmin>" << z0 << "</zmin><zmax>" << z1
+     << "</zmax></worldBounds></header>\n";
   return os.str();
 }
 
 std::string agent(double x, double z, double tx, double tz, const std::string& extra = "") {
   std::ostringstream os;
-  os << "  <agent><initialConditions><radius>0.5</radius><position><x>" << x
-     << "</x><y>0</y><z>" << z
-     << "</z></position><direction><x>1</x><y>0</y><z>0</z></direction><speed>0</speed>"
+  os << "  <agent><initialConditions><radius>0.5</radius><position><x>" << x << "</x><y>0</y><z>"
+     << z << "</z></position><direction><x>1</x><y>0</y><z>0</z></direction><speed>0</speed>"
      << extra << "</initialConditions><goalSequence><seekStaticTarget><targetLocation><x>" << tx
      << "</x><y>0</y><z>" << tz
      << "</z></targetLocation><desiredSpeed>1.3</desiredSpeed><timeDuration>1000</timeDuration>"
@@ -64,11 +61,11 @@ std::string import_error_of(const fs::path& p) {
 
 TEST(SteerSuiteImport, ExplicitAgentsObstaclesAndGoalsMapToThePlaneXZ) {
   const fs::path p = write_case(
-      "squeeze.xml",
-      "<!-- c --><?xml version=\"1.0\"?>\n" + header() +
-          "  <obstacle><xmin>-20</xmin><xmax>20</xmax><ymin>0</ymin><ymax>1</ymax>"
-          "<zmin>1.25</zmin><zmax>3</zmax></obstacle>\n" +
-          agent(-10, -0.5, 10, -0.5) + agent(10, 0.5, -10, 0.5) + "</SteerBenchTestCase>\n");
+      "squeeze.xml", "<!-- c --><?xml version=\"1.0\"?>\n" + header() +
+                         "  <obstacle><xmin>-20</xmin><xmax>20</xmax><ymin>0</ymin><ymax>1</ymax>"
+                         "<zmin>1.25</zmin><zmax>3</zmax></obstacle>\n" +
+                         agent(-10, -0.5, 10, -0.5) + agent(10, 0.5, -10, 0.5) +
+                         "</SteerBenchTestCase>\n");
   Scenario sc = load_scenario(p);
   EXPECT_EQ(sc.format, "steersuite");
   EXPECT_EQ(sc.config.dt, 0.05);
@@ -235,9 +232,8 @@ TEST(SteerSuiteImport, ConvertedScenarioRunsBitIdentically) {
 }
 
 TEST(SteerSuiteImport, InvertedWorldBoundsAndASceneBeyondThemAreWarnings) {
-  const fs::path p =
-      write_case("inverted.xml", header("-100 -200 -100 -200") + agent(0, 0, 5, 5) +
-                                     agent(3, 3, -5, -5) + "</SteerBenchTestCase>");
+  const fs::path p = write_case("inverted.xml", header("-100 -200 -100 -200") + agent(0, 0, 5, 5) +
+                                                    agent(3, 3, -5, -5) + "</SteerBenchTestCase>");
   Scenario sc = load_scenario(p);
   ASSERT_EQ(sc.warnings.size(), 2u);
   EXPECT_NE(sc.warnings[0].find("min > max"), std::string::npos) << sc.warnings[0];
@@ -263,18 +259,21 @@ TEST(SteerSuiteImport, BadFilesGiveOneLineNamingFileLineAndElement) {
            end,
        ":3: <obstacle>: min > max in x"},
       {"missing.xml",
-       header() + "  <obstacle><xmin>0</xmin><xmax>1</xmax><ymin>0</ymin><ymax>1</ymax>"
-                  "<zmin>0</zmin></obstacle>\n" +
+       header() +
+           "  <obstacle><xmin>0</xmin><xmax>1</xmax><ymin>0</ymin><ymax>1</ymax>"
+           "<zmin>0</zmin></obstacle>\n" +
            end,
        "<obstacle>: missing <zmax>"},
       {"number.xml",
-       header() + "  <agent><initialConditions><radius>wide</radius><position><x>0</x><y>0</y>"
-                  "<z>0</z></position></initialConditions><goalSequence/></agent>\n" +
+       header() +
+           "  <agent><initialConditions><radius>wide</radius><position><x>0</x><y>0</y>"
+           "<z>0</z></position></initialConditions><goalSequence/></agent>\n" +
            end,
        ":3: <radius>: expected a number, got 'wide'"},
       {"goaltype.xml",
-       header() + "  <agent><initialConditions><position><x>0</x><y>0</y><z>0</z></position>"
-                  "</initialConditions><goalSequence><fleeStaticTarget/></goalSequence></agent>\n" +
+       header() +
+           "  <agent><initialConditions><position><x>0</x><y>0</y><z>0</z></position>"
+           "</initialConditions><goalSequence><fleeStaticTarget/></goalSequence></agent>\n" +
            end,
        "<fleeStaticTarget>: goal type not supported"},
       {"inside.xml",
@@ -284,18 +283,20 @@ TEST(SteerSuiteImport, BadFilesGiveOneLineNamingFileLineAndElement) {
            agent(0, 0, 20, 20) + end,
        ":4: <agent>"},
       {"crowded.xml",
-       header() + "  <agentRegion><numAgents>100</numAgents><regionBounds><xmin>0</xmin><xmax>2"
-                  "</xmax><ymin>0</ymin><ymax>0</ymax><zmin>0</zmin><zmax>2</zmax>"
-                  "</regionBounds><initialConditions><radius>0.5</radius></initialConditions>"
-                  "<goalSequence><seekStaticTarget><targetLocation><x>9</x><y>0</y><z>9</z>"
-                  "</targetLocation><desiredSpeed>1</desiredSpeed></seekStaticTarget>"
-                  "</goalSequence></agentRegion>\n" +
+       header() +
+           "  <agentRegion><numAgents>100</numAgents><regionBounds><xmin>0</xmin><xmax>2"
+           "</xmax><ymin>0</ymin><ymax>0</ymax><zmin>0</zmin><zmax>2</zmax>"
+           "</regionBounds><initialConditions><radius>0.5</radius></initialConditions>"
+           "<goalSequence><seekStaticTarget><targetLocation><x>9</x><y>0</y><z>9</z>"
+           "</targetLocation><desiredSpeed>1</desiredSpeed></seekStaticTarget>"
+           "</goalSequence></agentRegion>\n" +
            end,
        "too crowded"},
       {"huge.xml",
-       header() + "  <agentRegion><numAgents>100000000000</numAgents><regionBounds><xmin>0"
-                  "</xmin><xmax>2</xmax><ymin>0</ymin><ymax>0</ymax><zmin>0</zmin><zmax>2</zmax>"
-                  "</regionBounds><initialConditions/><goalSequence/></agentRegion>\n" +
+       header() +
+           "  <agentRegion><numAgents>100000000000</numAgents><regionBounds><xmin>0"
+           "</xmin><xmax>2</xmax><ymin>0</ymin><ymax>0</ymax><zmin>0</zmin><zmax>2</zmax>"
+           "</regionBounds><initialConditions/><goalSequence/></agentRegion>\n" +
            end,
        ""},
   };
