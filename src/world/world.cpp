@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <sstream>
 #include <stdexcept>
@@ -357,6 +358,18 @@ void each_column(AgentTable& t, F&& f) {
 
 static_assert(sizeof(AgentTable) == 28 * sizeof(std::vector<double>));
 
+// Does every row of the column hold the same value, bit for bit (a column of lists: is every list
+// empty)? Then it reads the same in any order of the rows, and permute_rows leaves it as it is.
+template <class T>
+bool same_in_every_row(const std::vector<T>& column) {
+  if constexpr (std::is_trivially_copyable_v<T>) {
+    return std::all_of(column.begin(), column.end(),
+                       [&](const T& v) { return std::memcmp(&v, column.data(), sizeof(T)) == 0; });
+  } else {
+    return std::all_of(column.begin(), column.end(), [](const T& v) { return v.empty(); });
+  }
+}
+
 }  // namespace
 
 void World::permute_rows(std::span<const uint32_t> order, Executor* ex) {
@@ -369,10 +382,13 @@ void World::permute_rows(std::span<const uint32_t> order, Executor* ex) {
     seen[r] = 1;
   }
   // Column by column, each into a new one in one pass; with `ex`, the columns on its threads
-  // (each task owns its column; distinct old rows, a permutation).
+  // (each task owns its column; distinct old rows, a permutation). A column that holds one value
+  // in every row is not moved: most of them where everyone is alike and nobody is held up (the
+  // radii, speeds, routes, goal sequences and stalemate actions of an airport crowd).
   std::vector<std::function<void()>> gather;
   each_column(t, [&](auto& column) {
     gather.push_back([&column, order, n] {
+      if (same_in_every_row(column)) return;
       std::remove_reference_t<decltype(column)> out;
       out.reserve(n);
       for (uint32_t r : order) out.push_back(std::move(column[r]));
