@@ -146,7 +146,8 @@ void NeighbourGrid::rows_permuted(std::span<const uint32_t> order, Executor* ex)
   const std::size_t n = order.size(), last_n = slot_count_.size();
   // Hints must be distinct rows (each is offered once): only a permutation keeps them so.
   constexpr uint32_t kUnset = ~0u;
-  std::vector<uint32_t> new_of(n, kUnset);
+  std::vector<uint32_t>& new_of = new_of_;
+  new_of.assign(n, kUnset);
   for (std::size_t r = 0; r < n; ++r) {
     if (order[r] >= n || new_of[order[r]] != kUnset) {
       hint_k_ = 0;
@@ -154,7 +155,10 @@ void NeighbourGrid::rows_permuted(std::span<const uint32_t> order, Executor* ex)
     }
     new_of[order[r]] = static_cast<uint32_t>(r);
   }
-  std::vector<uint32_t> count(n, 0), rows(n * k);
+  std::vector<uint32_t>& count = spare_count_;
+  std::vector<uint32_t>& rows = spare_row_;
+  count.assign(n, 0);
+  rows.resize(n * k);  // (entries past a row's count are never read)
   const auto move = [&](std::size_t b, std::size_t end) {
     // (Locals: the stores into `rows` could alias the vectors' elements read here.)
     const uint32_t* const last_count = slot_count_.data();

@@ -38,8 +38,8 @@ void each_chunk(Executor* ex, std::size_t count, std::size_t grain, const F& bod
     body(0, count);
 }
 
-// Each row's Z-curve key from the table's lowest corner; key_max: the largest.
-std::vector<uint64_t> keys_of(const AgentTable& t, Executor* ex, uint64_t& key_max) {
+// Each row's Z-curve key from the table's lowest corner, into `keys`; key_max: the largest.
+void keys_of(const AgentTable& t, Executor* ex, std::vector<uint64_t>& keys, uint64_t& key_max) {
   const std::size_t n = t.size();
   // The lowest corner: a minimum per chunk, then over the chunks (exact, so any split).
   const std::size_t chunks = (n + kOrderGrain - 1) / kOrderGrain;
@@ -58,7 +58,8 @@ std::vector<uint64_t> keys_of(const AgentTable& t, Executor* ex, uint64_t& key_m
     xlo = std::min(xlo, cx[c]);
     ylo = std::min(ylo, cy[c]);
   }
-  std::vector<uint64_t> keys(n), chunk_max(chunks, 0);
+  keys.resize(n);  // every entry written below
+  std::vector<uint64_t> chunk_max(chunks, 0);
   each_chunk(ex, n, kOrderGrain, [&](std::size_t b, std::size_t e) {
     uint64_t m = 0;  // the chunk's, written once at its end (the entries share cache lines)
     for (std::size_t i = b; i < e; ++i) {
@@ -69,7 +70,6 @@ std::vector<uint64_t> keys_of(const AgentTable& t, Executor* ex, uint64_t& key_m
   });
   key_max = 0;
   for (const uint64_t m : chunk_max) key_max = std::max(key_max, m);
-  return keys;
 }
 
 // The comparison sort's entries: ordered by key, then id (unique, so the order is total).
@@ -101,10 +101,20 @@ std::vector<uint32_t> rows_of(const std::vector<Keyed>& e, Executor* ex) {
 }  // namespace
 
 std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
+  CurveScratch scratch;
+  std::vector<uint32_t> order;
+  curve_order(t, ex, scratch, order);
+  return order;
+}
+
+void curve_order(const AgentTable& t, Executor* ex, CurveScratch& scratch,
+                 std::vector<uint32_t>& order) {
   const std::size_t n = t.size();
-  if (n == 0) return {};
+  order.resize(n);  // every entry written below
+  if (n == 0) return;
   uint64_t key_max = 0;
-  const std::vector<uint64_t> keys = keys_of(t, ex, key_max);
+  std::vector<uint64_t>& keys = scratch.keys;
+  keys_of(t, ex, keys, key_max);
   if (key_max >> 32 == 0) {
     // Keys of 32 bits at most (a world within 65 km, 2^16 cells of 1 m a side): a radix sort of
     // (key << 32 | row) words by their key bits, stable, so rows of one key stay in row order,
@@ -113,14 +123,13 @@ std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
     // comparisons are coin tosses to the predictor. A reorder at airport-20k on two threads took
     // 4.2 ms before, 3.9 now; at 10^6 agents 188 and 180 ms, the rest being the columns'
     // permutation and what the model and the grids keep per row.
-    std::vector<uint64_t> words(n);
+    std::vector<uint64_t>& words = scratch.words;
+    words.resize(n);  // every entry written below
     each_chunk(ex, n, kOrderGrain, [&](std::size_t b, std::size_t end) {
       for (std::size_t i = b; i < end; ++i) words[i] = keys[i] << 32 | i;
     });
-    index::RadixScratch scratch;
-    index::radix_sort(words, scratch, 32, 32 + index::bits_for(key_max + 1),
+    index::radix_sort(words, scratch.radix, 32, 32 + index::bits_for(key_max + 1),
                       ex && n >= kParallelSort ? ex : nullptr);
-    std::vector<uint32_t> order(n);
     each_chunk(ex, n, kOrderGrain, [&](std::size_t b, std::size_t end) {
       for (std::size_t i = b; i < end; ++i) order[i] = static_cast<uint32_t>(words[i]);
     });
@@ -135,7 +144,7 @@ std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
                   [&](uint32_t a, uint32_t b) { return t.id[a] < t.id[b]; });
       s = f;
     }
-    return order;
+    return;
   }
   // Wider keys: a comparison sort. The order is total, so the sorted sequence is one: sorting
   // pieces on every thread and merging them gives what one sort gives.
@@ -158,12 +167,14 @@ std::vector<uint32_t> curve_order(const AgentTable& t, Executor* ex) {
       }
     });
   }
-  return rows_of(e, ex);
+  order = rows_of(e, ex);
 }
 
 std::vector<uint32_t> curve_order_naive(const AgentTable& t) {
   uint64_t key_max = 0;
-  std::vector<Keyed> e = keyed(t, keys_of(t, nullptr, key_max), nullptr);
+  std::vector<uint64_t> keys;
+  keys_of(t, nullptr, keys, key_max);
+  std::vector<Keyed> e = keyed(t, keys, nullptr);
   std::sort(e.begin(), e.end(), key_then_id);
   return rows_of(e, nullptr);
 }

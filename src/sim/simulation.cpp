@@ -168,6 +168,9 @@ struct Simulation::Engine {
   sim::Preferred pref;
   sim::AimMemo aim;  // aim points, from the stalemate watch to the next goal stage
   sim::NextState next;
+  // The reorder's order and what curve_order works in, kept from one reorder to the next.
+  sim::CurveScratch curve;
+  std::vector<uint32_t> order;
   std::vector<uint32_t> demand;  // active agents per goal row (arrival = idle only)
   sim::SourceEmitter sources;
   std::map<std::string, std::unique_ptr<CollisionPath>> collision_paths;
@@ -489,7 +492,8 @@ const TickMetrics& Simulation::step() {
       // The table's columns on every thread, and beside them what the model and the grids keep
       // per row (they read only the order and their own state). Two threads at 2 * 10^4 rows:
       // 16 -> 13 ms per 100 ticks; the columns alone on every thread gained nothing.
-      const std::vector<uint32_t> order = sim::curve_order(world_.agents(), &e.ex);
+      sim::curve_order(world_.agents(), &e.ex, e.curve, e.order);
+      const std::vector<uint32_t>& order = e.order;
       e.ex.both([&] { world_.permute_rows(order, &e.ex); },
                 [&] {
                   e.model->rows_permuted(order, &e.ex);

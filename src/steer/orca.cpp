@@ -489,11 +489,14 @@ class OrcaModel final : public Model {
   void rows_permuted(std::span<const uint32_t> order, Executor* ex = nullptr) override {
     for (auto& [name, path] : neighbour_paths_) path->rows_permuted(order, ex);
     // The witnesses move with their rows and are renamed (anything else costs time, not answers).
+    // (Into buffers kept across reorders, as the neighbour grid's: fresh pages are dear.)
     const std::size_t n = order.size();
-    std::vector<uint32_t> new_of(witness_.size(), PassingLookahead::kNobody);
+    std::vector<uint32_t>& new_of = witness_new_of_;
+    new_of.assign(witness_.size(), PassingLookahead::kNobody);
     for (std::size_t r = 0; r < n; ++r)
       if (order[r] < new_of.size()) new_of[order[r]] = static_cast<uint32_t>(r);
-    std::vector<uint32_t> moved(n, PassingLookahead::kNobody);
+    std::vector<uint32_t>& moved = witness_spare_;
+    moved.assign(n, PassingLookahead::kNobody);
     const auto move = [&](std::size_t b, std::size_t e) {
       for (std::size_t r = b; r < e; ++r)
         if (order[r] < witness_.size() && witness_[order[r]] < new_of.size())
@@ -735,6 +738,7 @@ class OrcaModel final : public Model {
   // Per row: the last row the grid found passing it (a hint for find, maybe many ticks old or
   // naming another row since; kNobody: none).
   std::vector<uint32_t> witness_;
+  std::vector<uint32_t> witness_spare_, witness_new_of_;  // rows_permuted's, kept
   uint64_t passing_near_ = 0, passing_far_ = 0;
   FeatureLists features_;
   std::vector<double> reach_;
