@@ -148,6 +148,7 @@ TEST(RowOrder, PermuteRowsMovesEveryColumnAndHandle) {
 // a single row (each kind of column: numbers, a state, a list; the odd row first, last, or a
 // zero of the other sign) must still move with its rows.
 TEST(RowOrder, PermuteRowsMovesAColumnThatDiffersInOneRow) {
+  Executor two(2);
   for (const bool last : {false, true})
     for (const bool threads : {false, true}) {
       SCOPED_TRACE(std::string(last ? "the last row" : "the first row") +
@@ -170,12 +171,10 @@ TEST(RowOrder, PermuteRowsMovesAColumnThatDiffersInOneRow) {
       std::vector<uint32_t> order(t.size());
       std::iota(order.begin(), order.end(), 0u);
       std::shuffle(order.begin(), order.end(), std::mt19937(5));
-      Executor two(2);
       w.permute_rows(order, threads ? &two : nullptr);
       EXPECT_EQ(first_difference(before, by_id(w)), "");
-      std::size_t moved_to = t.size();
-      for (std::size_t r = 0; r < t.size(); ++r)
-        if (order[r] == odd) moved_to = r;
+      const auto moved_to =
+          static_cast<std::size_t>(std::find(order.begin(), order.end(), odd) - order.begin());
       ASSERT_LT(moved_to, t.size());
       EXPECT_EQ(t.charge[moved_to], 2);
       EXPECT_TRUE(std::signbit(t.stall_dir_x[moved_to]));
