@@ -521,7 +521,7 @@ const TickMetrics& Simulation::step() {
     for (std::size_t i = 0; i < n; ++i)
       m.nudged += !standing(t.state[i]) && t.frozen_ticks[i] >= nudge_ticks;
   log.timed("goal stage", n, [&] {
-    e.aim.resize(n);
+    e.aim.resize(n, world_.goals());
     sim::goal_stage(t, world_.goals(), cfg, m.tick, e.demand, e.pref, e.ex, e.nav.get(), &e.aim);
   });
 
@@ -693,7 +693,7 @@ const TickMetrics& Simulation::step() {
   log.timed("stalemates", world_.agents().size(), [&] {
     if (!e.stall_path)
       e.stall_path = neighbour_method(cfg.access.neighbours, world_.agents().size()).make();
-    e.aim.resize(world_.agents().size());
+    e.aim.resize(world_.agents().size(), world_.goals());
     sim::OperatorStats& sop = log.at("stalemates");
     const sim::StallCounts sc =
         sim::stalemates(world_, cfg, m.tick, *e.stall_path, e.ex, sop.query, &e.aim, &tick_move);

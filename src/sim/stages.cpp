@@ -90,13 +90,21 @@ void NextState::resize(std::size_t n) {
   frozen.assign(n, 0);
 }
 
+void AimMemo::resize(std::size_t rows, std::span<const Goal> goals) {
+  const bool areas =
+      std::any_of(goals.begin(), goals.end(), [](const Goal& g) { return g.is_polygon(); });
+  entries_.resize(areas ? rows : 0);
+}
+
 Vec2 AimMemo::target(std::span<const Goal> goals, uint32_t goal, double px, double py, double r,
                      std::size_t row) {
+  const Goal& g = goals[goal];
+  if (!g.is_polygon()) return {g.x, g.y};  // goal_target's answer for a point
   Entry& e = entries_[row];
   const auto bx = std::bit_cast<uint64_t>(px), by = std::bit_cast<uint64_t>(py),
              br = std::bit_cast<uint64_t>(r);
   if (e.goal != goal || e.x != bx || e.y != by || e.r != br)
-    e = {goal, bx, by, br, goal_target(goals[goal], px, py, r)};
+    e = {goal, bx, by, br, goal_target(g, px, py, r)};
   return e.target;
 }
 

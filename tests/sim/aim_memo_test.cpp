@@ -28,7 +28,8 @@ TEST(AimMemo, AnswersAreGoalTargetsBitForBit) {
   w.add_goal({"L", 10, 1, 1, 1, {{9, 0}, {13, 0}, {13, 2}, {11, 2}, {11, 4}, {9, 4}}});
   const auto goals = w.goals();
   AimMemo memo;
-  memo.resize(8);
+  memo.resize(8, goals);
+  EXPECT_EQ(memo.rows_kept(), 8u);
   Rng rng(11);
   struct Question {
     uint32_t goal;
@@ -66,10 +67,34 @@ TEST(AimMemo, AnswersAreGoalTargetsBitForBit) {
   }
   EXPECT_GT(repeats, 2000u);
   // Resizing keeps no stale answer either: rows beyond the old size start empty.
-  memo.resize(2);
-  memo.resize(16);
+  memo.resize(2, goals);
+  memo.resize(16, goals);
   const Vec2 got = memo.target(goals, 0, 3, 3, 0.3, 12);
   EXPECT_TRUE(same_bits(got, goal_target(goals[0], 3, 3, 0.3)));
+}
+
+// Goals that are points are their own aims: the memo keeps no entry for any row, and still
+// answers goal_target bit for bit (the rows are far beyond what it holds).
+TEST(AimMemo, KeepsNothingWhenEveryGoalIsAPoint) {
+  World w(Bounds{-20, -20, 20, 20});
+  w.add_goal({"disc", -5, 5, 1, 1, {}});
+  w.add_goal({"spot", 7.25, -3.5, 0, 1, {}});
+  const auto goals = w.goals();
+  AimMemo memo;
+  memo.resize(1000, goals);
+  EXPECT_EQ(memo.rows_kept(), 0u);
+  Rng rng(5);
+  for (int k = 0; k < 200; ++k) {
+    const auto goal = static_cast<uint32_t>(rng.below(goals.size()));
+    const double x = rng.uniform(-15, 15), y = rng.uniform(-15, 15), r = rng.uniform(0, 1);
+    const std::size_t row = rng.below(1000);
+    ASSERT_TRUE(
+        same_bits(memo.target(goals, goal, x, y, r, row), goal_target(goals[goal], x, y, r)));
+  }
+  // An area among the goals: entries for every row again.
+  w.add_goal({"box", 0, 0, 1, 1, {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}});
+  memo.resize(1000, w.goals());
+  EXPECT_EQ(memo.rows_kept(), 1000u);
 }
 
 }  // namespace
