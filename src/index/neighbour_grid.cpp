@@ -140,7 +140,14 @@ void NeighbourGrid::build(const DiscView& d, double range, uint32_t k, Executor&
 
 void NeighbourGrid::rows_permuted(std::span<const uint32_t> order, Executor* ex) {
   const uint32_t k = hint_k_;
-  if (k == 0) return;
+  // A subset's hints (the stalemate stage's rows looked at, a few in a hundred) are dropped, not
+  // carried: carrying them takes lists in the new order for every row of the table (spare lists,
+  // counts and renaming: 32 MB kept at 10^6 rows and k = 6) for one call's worth of hints per
+  // reorder. The next call searches without hints: the same answer.
+  if (k == 0 || hints_of_subset_) {
+    hint_k_ = 0;
+    return;
+  }
   // Rows removed or added since the last call (arrivals, sources) do not stop this: the hints of
   // the rows they touched name the wrong discs, which costs time, never exactness.
   const std::size_t n = order.size(), last_n = slot_count_.size();
@@ -232,6 +239,7 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
   // largest item of memory at 10^6 agents), compacted in place afterwards.
   if (spatial && out.with_dist2) out.dist2.resize(d.n * k);
   hint_k_ = hintable ? k : 0;
+  hints_of_subset_ = !queries.empty();
   if (spatial) {  // each row's place in the grid (the ranked search skips the query's own)
     at_.resize(d.n);
     uint32_t* const at = at_.data();

@@ -46,8 +46,8 @@ class NeighbourGrid final : public NeighbourPath {
  public:
   void run(const DiscView& discs, std::span<const uint32_t> queries, double range, uint32_t k,
            NeighbourLists& out, Executor& ex, QueryStats& stats) override;
-  // Carries the hints along: each row's list moves to the row's new place and names the new
-  // rows of its entries.
+  // Carries the hints of a call for every row along: each row's list moves to the row's new
+  // place and names the new rows of its entries. A subset's hints are dropped.
   void rows_permuted(std::span<const uint32_t> order, Executor* ex = nullptr) override;
 
  private:
@@ -77,6 +77,7 @@ class NeighbourGrid final : public NeighbourPath {
   // peak is what it was.
   std::vector<uint32_t> spare_count_, spare_row_, new_of_;
   uint32_t hint_k_ = 0;  // k of the last call when its lists are in the slots (hints), else 0
+  bool hints_of_subset_ = false;  // the last call asked for a subset of the rows
   // Entries per query of the last call gathered per chunk: the chunks' lists are made with room
   // for a quarter more, the selection for twice as many (at k = 0, cfsm's everyone within the
   // cut-off, growing them by doubling made cfsm's tick at 2 * 10^4 agents 10,900 allocations,

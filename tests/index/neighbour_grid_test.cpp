@@ -360,6 +360,40 @@ TEST(NeighbourGrid, CarriesTheHintsThroughAPermutation) {
   expect_same(a, b);
 }
 
+// A subset's hints are dropped at a permutation (not carried: that takes lists for every row of
+// the table): the next call searches as a grid told nothing, with the naive twin's answer.
+TEST(NeighbourGrid, DropsASubsetsHintsAtAPermutation) {
+  const DiscTable t = build::uniform(3000, {0, 0, 80, 80}, 1.3, 0.25, 0.25, 43);
+  Executor ex(1);
+  std::vector<uint32_t> subset;
+  for (uint32_t i = 0; i < t.size(); i += 7) subset.push_back(i);
+  auto run = [&](NeighbourGrid& g, const DiscTable& d, NeighbourLists& out) {
+    QueryStats st;
+    g.run(d.view(), subset, 1.1, 6, out, ex, st);
+    return st.pair_tests;
+  };
+  NeighbourLists out;
+  NeighbourGrid grid;
+  run(grid, t, out);
+  const uint64_t hinted = run(grid, t, out);
+  Rng rng(9);
+  const std::vector<uint32_t> order = shuffled_rows(t.size(), rng);
+  const DiscTable p = permuted(t, order);
+  NeighbourGrid untold;
+  const uint64_t cold = run(untold, p, out);
+  NeighbourGrid warm;
+  run(warm, p, out);
+  EXPECT_NE(run(warm, p, out), cold);  // the test can tell hints from none
+  grid.rows_permuted(order);
+  NeighbourLists a, b;
+  EXPECT_EQ(run(grid, p, a), cold);
+  EXPECT_NE(cold, hinted);
+  NeighbourNaive naive;
+  QueryStats st;
+  naive.run(p.view(), subset, 1.1, 6, b, ex, st);
+  expect_same(a, b);
+}
+
 TEST(NeighbourQuery, PublicFunctionChecksItsArguments) {
   const DiscTable t = build::uniform(10, {0, 0, 10, 10}, 1, 0.2, 0.3, 1);
   EXPECT_THROW(neighbours(t.view(), 0, 3), Error);
