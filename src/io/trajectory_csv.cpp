@@ -88,12 +88,13 @@ class CsvWriter final : public TrajectoryWriter {
     check(metrics_, metrics_path_);
     open(steerbench_, partial(steerbench_path_),
          "id,collisions,time,path_length,energy,acceleration,score01,score02,arrived\n");
-    if (info.scores)
-      for (const metrics::AgentScore& a : *info.scores)
+    if (info.steerbench)
+      info.steerbench->for_each_score([&](const metrics::AgentScore& a) {
         steerbench_ << a.id << "," << a.collisions << "," << num(a.time) << ","
                     << num(a.path_length) << "," << num(a.energy) << "," << num(a.acceleration)
                     << "," << num(a.score01()) << "," << num(a.score02()) << ","
                     << (a.arrived ? 1 : 0) << "\n";
+      });
     steerbench_.close();
     check(steerbench_, steerbench_path_);
     for (const auto* p : {&path_, &metrics_path_, &steerbench_path_}) {

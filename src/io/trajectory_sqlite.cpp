@@ -319,7 +319,7 @@ class SqliteWriter final : public TrajectoryWriter {
     }
     insert_text(set_run_, "status", "complete");
     insert_text(set_run_, "last_tick", std::to_string(info.ticks));
-    if (info.scores) {
+    if (info.steerbench) {
       exec(
           "CREATE TABLE crowddb_steerbench (id INTEGER PRIMARY KEY, collisions INTEGER NOT NULL, "
           "time REAL NOT NULL, path_length REAL NOT NULL, energy REAL NOT NULL, acceleration "
@@ -327,7 +327,7 @@ class SqliteWriter final : public TrajectoryWriter {
           "NULL)");
       Statement sb(db_, "INSERT INTO crowddb_steerbench VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
                    path_.string());
-      for (const metrics::AgentScore& a : *info.scores) {
+      info.steerbench->for_each_score([&](const metrics::AgentScore& a) {
         sqlite3_stmt* st = sb.get();
         sqlite3_bind_int64(st, 1, static_cast<int64_t>(a.id));
         sqlite3_bind_int64(st, 2, static_cast<int64_t>(a.collisions));
@@ -339,7 +339,7 @@ class SqliteWriter final : public TrajectoryWriter {
         sqlite3_bind_double(st, 8, a.score02());
         sqlite3_bind_int64(st, 9, a.arrived ? 1 : 0);
         step(sb);
-      }
+      });
     }
     // Indices after the bulk load: cheaper than maintaining them row by row.
     exec("CREATE INDEX frame_id_idx ON trajectory_data(frame, id)");

@@ -172,7 +172,7 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
       info.final_hash = s.state_hash;
       info.seconds = s.wall_seconds;
       info.summary_json = s.json();
-      info.scores = &bench.scores();
+      info.steerbench = &bench;
       w->finish(info);
     }
   } catch (const Error& e) {

@@ -21,11 +21,10 @@ uint64_t cell_key(int64_t cx, int64_t cy) {
 }  // namespace
 
 void SteerBench::open_score(uint64_t id) {
-  if (scores_.size() >= kUnknown - 1)
-    throw Error(Error::Kind::input, "steerbench: more than 2^32 - 2 agents measured in one run");
-  known_.at(id) = static_cast<uint32_t>(scores_.size());
-  scores_.push_back({.id = id});
-  score_slot_.push_back(kNoSlot);
+  if (where_.size() >= kClosed - 1)
+    throw Error(Error::Kind::input, "steerbench: more than 2^31 - 2 agents measured in one run");
+  known_.at(id) = static_cast<uint32_t>(where_.size());
+  where_.push_back(kNoSlot);
 }
 
 uint32_t SteerBench::open_track(Track tr) {
@@ -39,7 +38,7 @@ uint32_t SteerBench::open_track(Track tr) {
     slot = static_cast<uint32_t>(tracks_.size());
     tracks_.push_back(tr);
   }
-  score_slot_[tr.score] = slot;
+  where_[tr.order] = slot;
   return slot;
 }
 
@@ -47,24 +46,36 @@ uint32_t SteerBench::open_agent(uint64_t id, double x, double y) {
   open_score(id);
   Track tr{x, y};
   tr.id = id;
-  tr.seen = tick_;
-  tr.score = static_cast<uint32_t>(scores_.size() - 1);
+  tr.seen = static_cast<uint32_t>(tick_);
+  tr.order = static_cast<uint32_t>(where_.size() - 1);
   return open_track(tr);
 }
 
-void SteerBench::store_sums(const Track& tr) const {
-  AgentScore& s = scores_[tr.score];
-  s.time = tr.time;
-  s.path_length = tr.path_length;
-  s.energy = tr.energy;
-  s.acceleration = tr.acceleration;
+AgentScore SteerBench::score_at(uint32_t where) const {
+  if (where & kClosed) return closed_[where & ~kClosed];
+  const Track& tr = tracks_[where];
+  return {.id = tr.id,
+          .collisions = tr.collisions,
+          .time = tr.time,
+          .path_length = tr.path_length,
+          .energy = tr.energy,
+          .acceleration = tr.acceleration,
+          .arrived = false};
+}
+
+const std::vector<AgentScore>& SteerBench::scores() const {
+  scores_.clear();
+  scores_.reserve(where_.size());
+  for_each_score([&](const AgentScore& a) { scores_.push_back(a); });
+  return scores_;
 }
 
 void SteerBench::close_track(uint32_t slot) {
   Track& tr = tracks_[slot];
-  store_sums(tr);
-  scores_[tr.score].arrived = true;
-  score_slot_[tr.score] = kNoSlot;
+  AgentScore a = score_at(slot);
+  a.arrived = true;
+  where_[tr.order] = kClosed | static_cast<uint32_t>(closed_.size());
+  closed_.push_back(a);
   tr.live = false;
   free_slots_.push_back(slot);
 }
@@ -73,8 +84,7 @@ void SteerBench::start(const World& world) {
   tick_ = 0;
   const AgentTable& t = world.agents();
   // Exactly, and without the copies of a doubling vector.
-  scores_.reserve(scores_.size() + t.size());
-  score_slot_.reserve(score_slot_.size() + t.size());
+  where_.reserve(where_.size() + t.size());
   tracks_.reserve(tracks_.size() + t.size());
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (t.state[i] == AgentState::arrived) continue;
@@ -83,7 +93,7 @@ void SteerBench::start(const World& world) {
 }
 
 void SteerBench::add_tick(Track& tr, double x, double y) const {
-  tr.seen = tick_;
+  tr.seen = static_cast<uint32_t>(tick_);
   const double dx = x - tr.x, dy = y - tr.y;
   const double vx = dx / dt_, vy = dy / dt_;
   tr.time += dt_;
@@ -118,13 +128,13 @@ void SteerBench::tick(const World& world, const TickMetrics& m, Executor* ex) {
       uint32_t slot = row_slot_[i];
       pending_[i] = 0;
       if (!holds(slot, t.id[i])) {
-        const uint32_t score = known_.find(t.id[i]);
-        if (score == kUnknown) {  // new in the table: opened in 2
+        const uint32_t order = known_.find(t.id[i]);
+        if (order == kUnknown) {  // new in the table: opened in 2
           pending_[i] = 1;
           continue;
         }
         ++moved;
-        slot = score_slot_[score];
+        slot = where_[order] & kClosed ? kNoSlot : where_[order];
         row_slot_[i] = slot;
       }
       if (slot == kNoSlot) continue;  // measured before and closed on arrival: stays closed
@@ -172,16 +182,12 @@ void SteerBench::tick(const World& world, const TickMetrics& m, Executor* ex) {
   // needs a look.)
   if (seen != tracks_.size() - free_slots_.size())
     for (uint32_t slot = 0; slot < tracks_.size(); ++slot)
-      if (tracks_[slot].live && tracks_[slot].seen != tick_) close_track(slot);
+      if (tracks_[slot].live && tracks_[slot].seen != static_cast<uint32_t>(tick_))
+        close_track(slot);
   if (moved > n / 8) lay_out_in_row_order(t);
   if (m.overlapping_pairs > 0 || m.obstacle_overlaps > 0 || !open_pairs_.empty() ||
       !open_obstacles_.empty())
     collisions(world);
-}
-
-void SteerBench::flush() const {
-  for (const Track& tr : tracks_)
-    if (tr.live) store_sums(tr);
 }
 
 void SteerBench::lay_out_in_row_order(const AgentTable& t) {
@@ -212,7 +218,7 @@ void SteerBench::lay_out_in_row_order(const AgentTable& t) {
       std::swap(dest[s], dest[d]);
     }
   tracks_.resize(live);
-  for (uint32_t s = 0; s < live; ++s) score_slot_[tracks_[s].score] = s;
+  for (uint32_t s = 0; s < live; ++s) where_[tracks_[s].order] = s;
   free_slots_.clear();
 }
 
@@ -268,8 +274,10 @@ void SteerBench::collisions(const World& world) {
     }
   }
   auto count = [&](uint64_t id) {
-    const uint32_t score = known_.find(id);
-    if (score != kUnknown && score_slot_[score] != kNoSlot) ++scores_[score].collisions;
+    const uint32_t order = known_.find(id);
+    if (order == kUnknown || where_[order] & kClosed) return;
+    uint32_t& c = tracks_[where_[order]].collisions;
+    c += c < UINT32_MAX;  // (an episode takes two ticks at least: 2^32 of them are out of reach)
   };
   for (const auto& p : pairs)
     if (!open_pairs_.count(p)) {
@@ -283,20 +291,19 @@ void SteerBench::collisions(const World& world) {
 }
 
 SteerBenchTotals SteerBench::totals() const {
-  flush();
   SteerBenchTotals s;
-  s.agents = scores_.size();
-  if (scores_.empty()) return s;
+  s.agents = where_.size();
+  if (where_.empty()) return s;
   double c = 0, tm = 0, e = 0, a = 0, p = 0;
-  for (const AgentScore& x : scores_) {
+  for_each_score([&](const AgentScore& x) {
     s.collisions += x.collisions;
     c += static_cast<double>(x.collisions);
     tm += x.time;
     e += x.energy;
     a += x.acceleration;
     p += x.path_length;
-  }
-  const double n = static_cast<double>(scores_.size());
+  });
+  const double n = static_cast<double>(where_.size());
   s.avg_collisions = c / n;
   s.avg_time = tm / n;
   s.avg_energy = e / n;
@@ -308,15 +315,14 @@ SteerBenchTotals SteerBench::totals() const {
 }
 
 void SteerBench::save(ByteWriter& out) const {
-  flush();
   out.u64(tick_);
-  out.u64(scores_.size());
-  for (const AgentScore& a : scores_) {
+  out.u64(where_.size());
+  for_each_score([&](const AgentScore& a) {
     out.u64(a.id);
     out.u64(a.collisions);
     for (double v : {a.time, a.path_length, a.energy, a.acceleration}) out.f64(v);
     out.u8(a.arrived);
-  }
+  });
   // In id order, so equal states save equal bytes (the layout of the slots does not show).
   std::vector<std::pair<uint64_t, uint32_t>> live;  // id, slot
   for (uint32_t slot = 0; slot < tracks_.size(); ++slot)
@@ -326,14 +332,16 @@ void SteerBench::save(ByteWriter& out) const {
   for (const auto& [id, slot] : live) {
     const Track& tr = tracks_[slot];
     out.u64(id);
-    out.u64(tr.score);
+    out.u64(tr.order);
     for (double v : {tr.x, tr.y, tr.vx, tr.vy}) out.f64(v);
     out.u8(tr.has_v);
-    out.u64(tr.seen);
+    // The tick it was seen, whole: the latest tick up to now with those low 32 bits (a live
+    // track was seen in the last tick).
+    out.u64(tick_ - static_cast<uint32_t>(static_cast<uint32_t>(tick_) - tr.seen));
   }
   std::vector<uint64_t> known;
-  known.reserve(scores_.size());
-  for (const AgentScore& a : scores_) known.push_back(a.id);
+  known.reserve(where_.size());
+  for_each_score([&](const AgentScore& a) { known.push_back(a.id); });
   std::sort(known.begin(), known.end());
   out.vec(known);
   out.u64(open_pairs_.size());
@@ -351,12 +359,13 @@ void SteerBench::save(ByteWriter& out) const {
 void SteerBench::restore(ByteReader& in) {
   tick_ = in.u64();
   const uint64_t count = in.count(49);
-  if (count >= kUnknown - 1) in.fail("steerbench: too many scores");
-  scores_.resize(count);
+  if (count >= kClosed - 1) in.fail("steerbench: too many scores");
+  // Every score as saved (in order of appearance); the live ones become tracks below, the
+  // others closed scores.
+  std::vector<AgentScore> all(count);
   known_.clear();
-  score_slot_.assign(count, kNoSlot);
-  for (std::size_t k = 0; k < scores_.size(); ++k) {
-    AgentScore& a = scores_[k];
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    AgentScore& a = all[k];
     a.id = in.u64();
     a.collisions = in.u64();
     for (double* v : {&a.time, &a.path_length, &a.energy, &a.acceleration}) *v = in.f64();
@@ -364,6 +373,9 @@ void SteerBench::restore(ByteReader& in) {
     if (known_.find(a.id) != kUnknown) in.fail("steerbench: an agent scored twice");
     known_.at(a.id) = static_cast<uint32_t>(k);
   }
+  where_.assign(count, kNoSlot);
+  closed_.clear();
+  scores_.clear();
   tracks_.clear();
   free_slots_.clear();
   row_slot_.clear();
@@ -371,27 +383,35 @@ void SteerBench::restore(ByteReader& in) {
     const uint64_t id = in.u64();
     Track tr{};
     tr.id = id;
-    const uint64_t score = in.u64();
-    if (score >= scores_.size() || scores_[score].id != id)
+    const uint64_t order = in.u64();
+    if (order >= all.size() || all[order].id != id)
       in.fail("steerbench: a track without its score");
-    tr.score = static_cast<uint32_t>(score);
+    tr.order = static_cast<uint32_t>(order);
     for (double* v : {&tr.x, &tr.y, &tr.vx, &tr.vy}) *v = in.f64();
     tr.has_v = in.u8() != 0;
-    tr.seen = in.u64();
-    const AgentScore& s = scores_[tr.score];
+    tr.seen = static_cast<uint32_t>(in.u64());
+    const AgentScore& s = all[order];
+    if (s.arrived) in.fail("steerbench: a track of an agent that arrived");
+    if (s.collisions > UINT32_MAX) in.fail("steerbench: more collisions than a track counts");
+    tr.collisions = static_cast<uint32_t>(s.collisions);
     tr.time = s.time;
     tr.path_length = s.path_length;
     tr.energy = s.energy;
     tr.acceleration = s.acceleration;
-    if (score_slot_[tr.score] != kNoSlot) in.fail("steerbench: a track twice");
+    if (where_[order] != kNoSlot) in.fail("steerbench: a track twice");
     open_track(tr);
+  }
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    if (where_[k] != kNoSlot) continue;
+    where_[k] = kClosed | static_cast<uint32_t>(closed_.size());
+    closed_.push_back(all[k]);
   }
   // The ids measured so far: those of the scores (the index above), written for the record.
   std::vector<uint64_t> known;
   in.vec(known);
   std::vector<uint64_t> ids;
-  ids.reserve(scores_.size());
-  for (const AgentScore& a : scores_) ids.push_back(a.id);
+  ids.reserve(all.size());
+  for (const AgentScore& a : all) ids.push_back(a.id);
   std::sort(ids.begin(), ids.end());
   if (known != ids) in.fail("steerbench: the ids measured are not those scored");
   open_pairs_.clear();
