@@ -35,8 +35,8 @@ struct Preferred {
   // kSkipWaypoint: the waypoint after the current one is in sight (popped at commit);
   // kLostSight: the way towards the current target is not (a re-plan is asked for at commit).
   std::vector<uint8_t> skip;
-  std::vector<double> left;  // [m] path_left of each row; infinite for those standing
-  void reset(std::size_t n);
+  std::vector<double> left;   // [m] path_left of each row; infinite for those standing
+  void reset(std::size_t n);  // n rows, their values left to goal_stage (it writes them all)
 };
 
 // Next-state columns written by the model, integrate and backoff, swapped in by commit.
