@@ -321,10 +321,11 @@ TEST(SteerBench, ARestoredRunEndsAsTheUninterruptedOneAndBadCheckpointsAreRefuse
   b->save(sb);
   EXPECT_EQ(sa.take(), sb.take());
 
-  // Hand-made checkpoints: scores (ids), tracks (id, score index), the ids measured.
+  // Hand-made checkpoints: scores (ids), tracks (id, score index), the ids measured, and the
+  // one id whose score says it arrived.
   auto checkpoint = [](std::vector<uint64_t> scores,
                        std::vector<std::pair<uint64_t, uint64_t>> tracks,
-                       std::vector<uint64_t> known) {
+                       std::vector<uint64_t> known, uint64_t arrived = UINT64_MAX) {
     ByteWriter out;
     out.u64(3);
     out.u64(scores.size());
@@ -332,7 +333,7 @@ TEST(SteerBench, ARestoredRunEndsAsTheUninterruptedOneAndBadCheckpointsAreRefuse
       out.u64(id);
       out.u64(0);
       for (int v = 0; v < 4; ++v) out.f64(0);
-      out.u8(0);
+      out.u8(id == arrived);
     }
     out.u64(tracks.size());
     for (const auto& [id, score] : tracks) {
@@ -364,6 +365,8 @@ TEST(SteerBench, ARestoredRunEndsAsTheUninterruptedOneAndBadCheckpointsAreRefuse
   EXPECT_TRUE(refused(checkpoint({5, 5}, {}, {5, 5})));                // an agent scored twice
   EXPECT_TRUE(refused(checkpoint({5, 6}, {}, {5, 7})));                // other ids measured
   EXPECT_TRUE(refused(checkpoint({5, 6}, {}, {5})));
+  EXPECT_FALSE(refused(checkpoint({5, 6}, {{6, 1}}, {5, 6}, 5)));  // 5 arrived, 6 walks on
+  EXPECT_TRUE(refused(checkpoint({5, 6}, {{6, 1}}, {5, 6}, 6)));   // a track of one that arrived
 }
 
 }  // namespace
