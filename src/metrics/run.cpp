@@ -85,8 +85,7 @@ struct Progress {
 
 }  // namespace
 
-RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& control,
-                      std::vector<AgentScore>* scores) {
+RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& control) {
   RunSummary s;
   s.name = sc.name;
   s.source = sc.source;
@@ -213,7 +212,6 @@ RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& con
   s.ms_per_tick_median = 1e3 * median(tick_seconds);
   s.ms_per_tick_mean =
       tick_seconds.empty() ? 0 : 1e3 * sum / static_cast<double>(tick_seconds.size());
-  if (scores) *scores = bench.scores();
   return s;
 }
 

@@ -68,8 +68,7 @@ struct RunControl {
 // Runs `sim` (built from `sc`) for sc.ticks ticks, or until everyone has arrived when
 // sc.stop_when_all_arrived. On an exception the writer is stopped: what it wrote is kept in
 // PATH.partial, marked incomplete.
-RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& control,
-                      std::vector<AgentScore>* scores = nullptr);
+RunSummary run_to_end(const Scenario& sc, Simulation& sim, const RunControl& control);
 
 // "0123456789abcdef"
 std::string hex(uint64_t v);
