@@ -19,6 +19,7 @@
 //   build/bench/tick_speed --cases all --csv docs/bench/tick_speed.csv   # all but airport-10m
 //   build/bench/tick_speed --cases airport-10m --models orca --threads 2   # ~9 GB, minutes
 //   build/bench/tick_speed --cases airport-20k --models orca --threads 1,2 --rounds 6
+//   build/bench/tick_speed --print airport-20k --threads 1 > a20k.json  # the case, for crowddb run
 //
 // `--rounds N` runs every case N times, the thread counts in turn forwards and backwards (1 2,
 // 2 1, 1 2, ...), and ends with a summary per case, model and thread count: the median, least
@@ -306,7 +307,9 @@ int usage(const char* why) {
   static const std::string text = [] {
     std::string s =
         "usage: tick_speed [--cases all|NAME,...] [--models orca,cfsm,thesis,orca-core] "
-        "[--threads 1,2] [--ticks N] [--rounds N] [--csv FILE] [--fork yes|no]\ncases:";
+        "[--threads 1,2] [--ticks N] [--rounds N] [--csv FILE] [--fork yes|no]\n"
+        "       tick_speed --print CASE [--models M] [--threads T]   (its scenario, for crowddb "
+        "run)\ncases:";
     for (const Case& c : kCases) s += std::string(" ") + c.name;
     return s + "\n";
   }();
@@ -321,7 +324,7 @@ int main(int argc, char** argv) {
   std::vector<int> thread_counts = {1, 2};
   uint64_t ticks = 0;
   int rounds = 1;
-  std::string csv;
+  std::string csv, print;
   bool fork_cases = true;
   for (int a = 1; a < argc; a += 2) {
     const std::string k = argv[a];
@@ -352,6 +355,8 @@ int main(int argc, char** argv) {
       fork_cases = v == "yes";
     } else if (k == "--csv") {
       csv = v;
+    } else if (k == "--print") {
+      print = v;
     } else {
       return usage(("unknown option " + k).c_str());
     }
@@ -369,6 +374,21 @@ int main(int argc, char** argv) {
       return usage(("no case named " + n).c_str());
   if (thread_counts.empty()) return usage("--threads takes counts from 1 to 1024");
   if (models.empty()) return usage("--models takes one model at least");
+  if (!print.empty()) {
+    // The case's document for the first model and thread count, so that the journal's
+    // `crowddb run` commands on a case (EXPLAIN ANALYZE, profiles) can be repeated.
+    const auto c = std::find_if(std::begin(kCases), std::end(kCases),
+                                [&](const Case& k) { return print == k.name; });
+    if (c == std::end(kCases)) return usage(("no case named " + print).c_str());
+    if (c->inserted > 0)
+      return usage(
+          (print + ": its agents are inserted by the benchmark, not in a document").c_str());
+    if (bench::engine_model(models.front()) != models.front())
+      return usage(
+          (models.front() + " is a benchmark variant, not a model a document names").c_str());
+    std::printf("%s\n", c->doc(models.front(), thread_counts.front()).c_str());
+    return 0;
+  }
 
   std::FILE* out = csv.empty() ? nullptr : std::fopen(csv.c_str(), "w");
   if (!csv.empty() && !out) return usage(("cannot write " + csv).c_str());
