@@ -14,6 +14,11 @@ about fifty times as long as it does natively.
 
     bench/count_instructions.py build/crowddb /tmp/a20k.json 10 30
     bench/count_instructions.py --top 30 --threads 1 build/crowddb scenarios/airport.json 100 200
+    bench/count_instructions.py --against /tmp/crowddb.before build/crowddb a20k.json 10 30
+
+With --against, the other binary is counted the same way and the two are compared: the totals,
+their ratio, whether the final state hashes agree, and the functions whose instructions changed
+most.
 """
 import argparse
 import os
@@ -57,6 +62,7 @@ def count(crowddb, scenario, ticks, threads, workdir):
         if name.startswith("PROGRAM TOTALS"):
             total = value
         else:
+            name = re.sub(r"\s*\[[^\]]*\]$", "", name)  # the object file: differs between builds
             costs[name] = costs.get(name, 0) + value
     if total is None:
         fail(f"no total in callgrind_annotate's output for {out}")
@@ -73,6 +79,8 @@ def main():
     p.add_argument("--threads", type=int, default=1,
                    help="threads (default 1; more make the count depend on the schedule)")
     p.add_argument("--top", type=int, default=20, help="functions listed (default 20)")
+    p.add_argument("--against", metavar="BASE",
+                   help="another crowddb binary to count the same way and compare with")
     a = p.parse_args()
     if a.t0 < 0 or a.t1 <= a.t0:
         fail(f"ticks: need 0 <= t0 < t1, got {a.t0} and {a.t1}")
@@ -85,18 +93,41 @@ def main():
         fail(f"{a.crowddb}: not an executable")
     if not os.path.isfile(a.scenario):
         fail(f"{a.scenario}: no such file")
-    with tempfile.TemporaryDirectory() as work:
-        total0, costs0, _ = count(a.crowddb, a.scenario, a.t0, a.threads, work)
-        total1, costs1, state = count(a.crowddb, a.scenario, a.t1, a.threads, work)
+    if a.against is not None and not os.access(a.against, os.X_OK):
+        fail(f"{a.against}: not an executable")
     ticks = a.t1 - a.t0
-    per_tick = (total1 - total0) / ticks
-    print(f"{a.scenario}: {per_tick / 1e6:.3f} M instructions per tick over ticks {a.t0 + 1}-{a.t1}, "
-          f"{a.threads} thread(s); {state}")
-    diff = {name: (c - costs0.get(name, 0)) / ticks for name, c in costs1.items()}
-    for name, c in sorted(diff.items(), key=lambda kv: -kv[1])[:a.top]:
-        if c <= 0:
+
+    def per_tick(binary):
+        with tempfile.TemporaryDirectory() as work:
+            total0, costs0, _ = count(binary, a.scenario, a.t0, a.threads, work)
+            total1, costs1, state = count(binary, a.scenario, a.t1, a.threads, work)
+        names = set(costs0) | set(costs1)
+        return ((total1 - total0) / ticks,
+                {n: (costs1.get(n, 0) - costs0.get(n, 0)) / ticks for n in names}, state)
+
+    total, costs, state = per_tick(a.crowddb)
+    span = f"ticks {a.t0 + 1}-{a.t1}, {a.threads} thread(s)"
+    if a.against is None:
+        print(f"{a.scenario}: {total / 1e6:.3f} M instructions per tick over {span}; {state}")
+        for name, c in sorted(costs.items(), key=lambda kv: -kv[1])[:a.top]:
+            if c <= 0:
+                break
+            print(f"  {c / 1e6:8.3f} M  {100 * c / total:5.1f} %  {name[:150]}")
+        return
+    base, base_costs, base_state = per_tick(a.against)
+    print(f"{a.scenario}, {span}: {total / 1e6:.3f} M instructions per tick ({a.crowddb}) against "
+          f"{base / 1e6:.3f} M ({a.against}): {100 * (total - base) / base:+.2f} %")
+    print(f"  {a.crowddb}: {state}")
+    print(f"  {a.against}: {base_state}")
+    if state != base_state:
+        print("  the final state hashes differ: the two builds do not compute the same run")
+    names = set(costs) | set(base_costs)
+    diff = {n: costs.get(n, 0) - base_costs.get(n, 0) for n in names}
+    for name, d in sorted(diff.items(), key=lambda kv: -abs(kv[1]))[:a.top]:
+        if abs(d) < 100:  # (a run's own paths and numbers printed differ by a few instructions)
             break
-        print(f"  {c / 1e6:8.3f} M  {100 * c / per_tick:5.1f} %  {name[:150]}")
+        print(f"  {d / 1e6:+9.3f} M  {base_costs.get(name, 0) / 1e6:8.3f} -> "
+              f"{costs.get(name, 0) / 1e6:8.3f} M  {name[:140]}")
 
 
 if __name__ == "__main__":
