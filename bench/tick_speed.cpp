@@ -148,6 +148,13 @@ const Case kCases[] = {
     {"bottleneck-2k", 600, bottleneck},
 };
 
+// The case of that name, or nullptr.
+const Case* find_case(const std::string& name) {
+  for (const Case& c : kCases)
+    if (name == c.name) return &c;
+  return nullptr;
+}
+
 // What a child sends back through its pipe.
 struct Result {
   uint64_t ticks = 0;
@@ -369,17 +376,14 @@ int main(int argc, char** argv) {
     if (named || (all && c.inserted == 0) || (cases.empty() && !huge)) chosen.push_back(&c);
   }
   for (const std::string& n : cases)
-    if (n != "all" && std::none_of(std::begin(kCases), std::end(kCases),
-                                   [&](const Case& c) { return n == c.name; }))
-      return usage(("no case named " + n).c_str());
+    if (n != "all" && !find_case(n)) return usage(("no case named " + n).c_str());
   if (thread_counts.empty()) return usage("--threads takes counts from 1 to 1024");
   if (models.empty()) return usage("--models takes one model at least");
   if (!print.empty()) {
     // The case's document for the first model and thread count, so that the journal's
     // `crowddb run` commands on a case (EXPLAIN ANALYZE, profiles) can be repeated.
-    const auto c = std::find_if(std::begin(kCases), std::end(kCases),
-                                [&](const Case& k) { return print == k.name; });
-    if (c == std::end(kCases)) return usage(("no case named " + print).c_str());
+    const Case* c = find_case(print);
+    if (!c) return usage(("no case named " + print).c_str());
     if (c->inserted > 0)
       return usage(
           (print + ": its agents are inserted by the benchmark, not in a document").c_str());
