@@ -86,6 +86,68 @@ void write_ticks(io::TrajectoryWriter& w, const Scenario& sc, Simulation& sim, u
   }
 }
 
+// A frame's rows go in ascending id whatever the agent table's row order (the simulation keeps
+// rows in a space-filling curve's order), in statements of many rows and one: every row holds
+// its own agent's values.
+TEST(TrajectorySqlite, AFramesRowsGoInIdOrderWithTheirAgentsValues) {
+  std::string agents;
+  for (int i = 0; i < 150; ++i) {  // two statements of 64 rows, 22 of one
+    if (i) agents += ", ";
+    agents += "{\"x\": " + std::to_string(5 + (i * 37) % 90) +
+              ", \"y\": " + std::to_string(5 + (i * 11) % 40) + ", \"radius\": 0.3, \"goal\": \"" +
+              (i % 2 ? "g" : "h") + "\"}";
+  }
+  const std::string doc = R"({"name": "many", "bounds": [0, 0, 100, 50], "dt": 0.5,
+    "goals": [{"name": "g", "x": 95, "y": 25, "arrival_radius": 2},
+              {"name": "h", "x": 2, "y": 25, "arrival_radius": 2}],
+    "agents": [)" + agents +
+                          "]}";
+  test::TempDir dir;
+  const auto out = dir / "run.sqlite";
+  Scenario sc = parse_scenario(doc, "many.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  auto w = io::make_sqlite_writer(out, 1);
+  write_ticks(*w, sc, sim, 20);
+  const AgentTable& t = sim.world().agents();
+  ASSERT_GT(t.size(), 128u);  // some have arrived
+  ASSERT_FALSE(std::is_sorted(t.id.begin(), t.id.end())) << "the rows never left id order";
+  std::vector<std::size_t> rows(t.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) rows[i] = i;
+  std::sort(rows.begin(), rows.end(), [&](auto a, auto b) { return t.id[a] < t.id[b]; });
+  const std::vector<std::size_t> want = rows;  // the last frame, by id, as the table holds it
+  w->finish({});
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open_v2(out.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  sqlite3_stmt* st = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db,
+                               "SELECT p.id, p.pos_x, p.pos_y, s.id, s.vel_x, s.vel_y, s.goal "
+                               "FROM trajectory_data p JOIN crowddb_agent_state s ON s.rowid = "
+                               "p.rowid WHERE p.frame = 20 ORDER BY p.rowid",
+                               -1, &st, nullptr),
+            SQLITE_OK);
+  std::size_t k = 0;
+  for (; sqlite3_step(st) == SQLITE_ROW && k < want.size(); ++k) {
+    const std::size_t i = want[k];
+    EXPECT_EQ(sqlite3_column_int64(st, 0), static_cast<int64_t>(t.id[i])) << "row " << k;
+    EXPECT_EQ(sqlite3_column_double(st, 1), t.x[i]) << "row " << k;
+    EXPECT_EQ(sqlite3_column_double(st, 2), t.y[i]) << "row " << k;
+    EXPECT_EQ(sqlite3_column_int64(st, 3), static_cast<int64_t>(t.id[i])) << "row " << k;
+    EXPECT_EQ(sqlite3_column_double(st, 4), t.vx[i]) << "row " << k;
+    EXPECT_EQ(sqlite3_column_double(st, 5), t.vy[i]) << "row " << k;
+    EXPECT_EQ(sqlite3_column_int64(st, 6), static_cast<int64_t>(t.goal[i])) << "row " << k;
+  }
+  EXPECT_EQ(k, want.size());
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  // Every frame: ids ascend with the row id, in both tables.
+  for (const char* table : {"trajectory_data", "crowddb_agent_state"})
+    EXPECT_EQ(
+        query(out, std::string("SELECT count(*) FROM ") + table + " a JOIN " + table +
+                       " b ON b.rowid = a.rowid + 1 AND b.frame = a.frame WHERE b.id <= a.id"),
+        std::vector<std::string>{"0"})
+        << table;
+}
+
 // A stopped run keeps what it wrote, marked incomplete, under a name no finished run has.
 TEST(TrajectorySqlite, StopKeepsEverythingWrittenMarkedIncomplete) {
   test::TempDir dir;
