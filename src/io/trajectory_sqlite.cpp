@@ -13,14 +13,17 @@
 //   crowddb_checkpoint(tick, engine, progress): the latest checkpoint of an unfinished run
 //                            (Simulation::save_state and the run's counters; emptied at finish)
 // WAL journal, frames committed in batches (io/trajectory.hpp); renamed into place at the end.
-// A frame's rows go in ascending id, so both (frame, id) indices are built at the end from rows
-// already in their order (half the time of building them from rows in the table's order).
+// A frame's rows go in ascending id, so the (frame, id) indices, made with the tables, grow at
+// their ends as rows come (no index to build at the end, and a .partial file has them too).
+// Frames and metrics are written by a thread of the writer's own (io/write_behind.hpp) while
+// the simulation goes on; checkpoints, finish and stop wait for it and run on the caller's.
 #include <sqlite3.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <utility>
@@ -29,6 +32,7 @@
 #include "io/output_lock.hpp"
 #include "io/trajectory.hpp"
 #include "io/walkable_wkt.hpp"
+#include "io/write_behind.hpp"
 
 namespace crowddb::io {
 namespace {
@@ -37,7 +41,10 @@ constexpr uint64_t kFramesPerBatch = 100;
 // A frame's rows go in statements of this many rows (the rest one by one): SQLite's work per
 // statement run is then shared, a third less time inserting than one row per statement.
 constexpr std::size_t kRowsPerInsert = 64;
-// One thread writes through the connection: SQLite's per-call mutex is not needed.
+// Jobs (a frame or a tick's metrics) waiting for the writer's thread: a frame and its metrics,
+// so at most two frames' rows are held at once (the one written and the one waiting).
+constexpr std::size_t kJobsWaiting = 2;
+// One thread at a time writes through the connection: SQLite's per-call mutex is not needed.
 constexpr int kOpenFlags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX;
 constexpr std::chrono::seconds kSecondsPerBatch{2};
 
@@ -160,7 +167,7 @@ class SqliteWriter final : public TrajectoryWriter {
         "CREATE TABLE crowddb_goals (goal INTEGER PRIMARY KEY, name TEXT NOT NULL, x REAL NOT "
         "NULL, "
         "y REAL NOT NULL, arrival_radius REAL NOT NULL)");
-
+    create_indices();
     const Bounds& b = world.bounds();
     const double fps = 1.0 / (sc.config.dt * every_);
     Statement meta(db_, "INSERT INTO metadata VALUES (?, ?)", path_.string());
@@ -202,7 +209,16 @@ class SqliteWriter final : public TrajectoryWriter {
     batch_start_ = std::chrono::steady_clock::now();
   }
 
+  struct FrameRow {
+    uint64_t id;
+    double x, y, vx, vy, radius;
+    const char* state;  // agent_state_name: a string literal
+    uint32_t goal;
+  };
+
+  // Statements, and the thread that writes frames and metrics through them.
   void prepare() {
+    behind_.emplace(kJobsWaiting);
     for (std::size_t k = 0; k < 2; ++k) {
       const std::size_t rows = k == 0 ? 1 : kRowsPerInsert;
       traj_[k] =
@@ -218,47 +234,78 @@ class SqliteWriter final : public TrajectoryWriter {
     set_run_ = Statement(db_, "INSERT OR REPLACE INTO crowddb_run VALUES (?, ?)", path_.string());
   }
 
+  // The frame's rows are copied now and written by the writer's thread.
   void frame(uint64_t tick, const World& world) override {
     if (tick % every_ != 0) return;
     const auto frame = static_cast<int64_t>(tick / every_);
     const AgentTable& t = world.agents();
-    by_id_.resize(t.size());
-    for (std::size_t i = 0; i < t.size(); ++i) by_id_[i] = {t.id[i], static_cast<uint32_t>(i)};
-    std::sort(by_id_.begin(), by_id_.end());
-    // Rows [at, at + rows) of by_id_ through statement k of each table.
-    auto insert = [&](std::size_t k, std::size_t at, std::size_t rows) {
+    std::vector<FrameRow> rows = spare_rows();
+    rows.resize(t.size());
+    for (std::size_t i = 0; i < t.size(); ++i)
+      rows[i] = {t.id[i],
+                 t.x[i],
+                 t.y[i],
+                 t.vx[i],
+                 t.vy[i],
+                 t.radius[i],
+                 agent_state_name(t, i, stall_after_),
+                 t.goal[i]};
+    behind_->post([this, frame, rows = std::move(rows)]() mutable {
+      write_frame(frame, rows);
+      std::lock_guard lock(spare_m_);
+      spare_.push_back(std::move(rows));
+    });
+  }
+
+  void metrics(const TickMetrics& m) override {
+    behind_->post([this, m] { write_metrics(m); });
+  }
+
+  void write_frame(int64_t frame, std::vector<FrameRow>& rows) {
+    std::sort(rows.begin(), rows.end(),
+              [](const FrameRow& a, const FrameRow& b) { return a.id < b.id; });
+    // Rows [at, at + n) through statement k of each table.
+    auto insert = [&](std::size_t k, std::size_t at, std::size_t n) {
       sqlite3_stmt* traj = traj_[k].get();
       sqlite3_stmt* state = state_[k].get();
-      for (std::size_t r = 0; r < rows; ++r) {
-        const auto id = static_cast<int64_t>(by_id_[at + r].first);
-        const uint32_t i = by_id_[at + r].second;
+      for (std::size_t r = 0; r < n; ++r) {
+        const FrameRow& a = rows[at + r];
+        const auto id = static_cast<int64_t>(a.id);
         const int tc = static_cast<int>(4 * r), sc = static_cast<int>(7 * r);
         sqlite3_bind_int64(traj, tc + 1, frame);
         sqlite3_bind_int64(traj, tc + 2, id);
-        sqlite3_bind_double(traj, tc + 3, t.x[i]);
-        sqlite3_bind_double(traj, tc + 4, t.y[i]);
+        sqlite3_bind_double(traj, tc + 3, a.x);
+        sqlite3_bind_double(traj, tc + 4, a.y);
         sqlite3_bind_int64(state, sc + 1, frame);
         sqlite3_bind_int64(state, sc + 2, id);
-        sqlite3_bind_double(state, sc + 3, t.vx[i]);
-        sqlite3_bind_double(state, sc + 4, t.vy[i]);
-        sqlite3_bind_double(state, sc + 5, t.radius[i]);
-        sqlite3_bind_text(state, sc + 6, agent_state_name(t, i, stall_after_), -1, SQLITE_STATIC);
-        sqlite3_bind_int64(state, sc + 7, t.goal[i]);
+        sqlite3_bind_double(state, sc + 3, a.vx);
+        sqlite3_bind_double(state, sc + 4, a.vy);
+        sqlite3_bind_double(state, sc + 5, a.radius);
+        sqlite3_bind_text(state, sc + 6, a.state, -1, SQLITE_STATIC);
+        sqlite3_bind_int64(state, sc + 7, a.goal);
       }
       step(traj_[k]);
       step(state_[k]);
     };
     std::size_t at = 0;
-    for (; at + kRowsPerInsert <= by_id_.size(); at += kRowsPerInsert)
-      insert(1, at, kRowsPerInsert);
-    for (; at < by_id_.size(); ++at) insert(0, at, 1);
+    for (; at + kRowsPerInsert <= rows.size(); at += kRowsPerInsert) insert(1, at, kRowsPerInsert);
+    for (; at < rows.size(); ++at) insert(0, at, 1);
     sqlite3_bind_int64(frame_.get(), 1, frame);
     sqlite3_bind_int64(frame_.get(), 2, geometry_hash_);
     step(frame_);
     ++frames_in_batch_;
   }
 
-  void metrics(const TickMetrics& m) override {
+  // A buffer for a frame's rows: one the writer's thread gave back, or a new one.
+  std::vector<FrameRow> spare_rows() {
+    std::lock_guard lock(spare_m_);
+    if (spare_.empty()) return {};
+    std::vector<FrameRow> rows = std::move(spare_.back());
+    spare_.pop_back();
+    return rows;
+  }
+
+  void write_metrics(const TickMetrics& m) {
     sqlite3_stmt* s = metric_.get();
     int col = 0;
     auto i64 = [&](uint64_t v) { sqlite3_bind_int64(s, ++col, static_cast<int64_t>(v)); };
@@ -290,7 +337,10 @@ class SqliteWriter final : public TrajectoryWriter {
     }
   }
 
+  // On this thread, once the frames before it are written: a checkpoint (at 10^6 agents some
+  // hundred MB) is not copied, and checkpoints are minutes apart.
   void checkpoint(uint64_t tick, const std::string& engine, const std::string& run) override {
+    behind_->drain();
     exec("DELETE FROM crowddb_checkpoint");
     Statement cp(db_, "INSERT INTO crowddb_checkpoint VALUES (?, ?, ?)", path_.string());
     sqlite3_bind_int64(cp.get(), 1, static_cast<int64_t>(tick));
@@ -344,6 +394,7 @@ class SqliteWriter final : public TrajectoryWriter {
   }
 
   void finish(const RunInfo& info) override {
+    behind_->drain();
     exec("DELETE FROM crowddb_checkpoint");  // a finished run has nothing to resume
     {
       Statement run(db_, "INSERT INTO crowddb_run VALUES (?, ?)", path_.string());
@@ -381,9 +432,7 @@ class SqliteWriter final : public TrajectoryWriter {
         step(sb);
       });
     }
-    // Indices after the bulk load: cheaper than maintaining them row by row.
-    exec("CREATE INDEX frame_id_idx ON trajectory_data(frame, id)");
-    exec("CREATE INDEX state_frame_id_idx ON crowddb_agent_state(frame, id)");
+    create_indices();  // a .partial of a crowddb before 2026-12-05 has none
     exec("COMMIT");
     release_statements();
     exec("PRAGMA journal_mode=DELETE");  // checkpoints the WAL and leaves one self-contained file
@@ -403,6 +452,7 @@ class SqliteWriter final : public TrajectoryWriter {
       lock_.reset();
       return {};
     }
+    if (behind_) behind_->wait_idle();  // what is queued is written, up to a failed write
     try {
       // Commit everything written; last_tick is the last tick with both its frame and metrics.
       if (!sqlite3_get_autocommit(db_)) {
@@ -430,6 +480,11 @@ class SqliteWriter final : public TrajectoryWriter {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.17g", v);
     return buf;
+  }
+
+  void create_indices() {
+    exec("CREATE INDEX IF NOT EXISTS frame_id_idx ON trajectory_data(frame, id)");
+    exec("CREATE INDEX IF NOT EXISTS state_frame_id_idx ON crowddb_agent_state(frame, id)");
   }
 
   void release_statements() noexcept {
@@ -471,7 +526,9 @@ class SqliteWriter final : public TrajectoryWriter {
   uint64_t last_tick_ = 0;  // the last tick whose metrics were written
   std::chrono::steady_clock::time_point batch_start_;
   std::optional<OutputLock> lock_;
-  std::vector<std::pair<uint64_t, uint32_t>> by_id_;  // a frame's (id, row), in id order
+  std::mutex spare_m_;
+  std::vector<std::vector<FrameRow>> spare_;  // frames' row buffers the thread is done with
+  std::optional<WriteBehind> behind_;         // last: stopped before the rest goes
 };
 
 }  // namespace

@@ -2,8 +2,12 @@
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
+#include <sys/resource.h>
 
 #include <algorithm>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include "support/cli.hpp"
@@ -89,7 +93,8 @@ void write_ticks(io::TrajectoryWriter& w, const Scenario& sc, Simulation& sim, u
 // A frame's rows go in ascending id whatever the agent table's row order (the simulation keeps
 // rows in a space-filling curve's order), in statements of many rows and one: every row holds
 // its own agent's values.
-TEST(TrajectorySqlite, AFramesRowsGoInIdOrderWithTheirAgentsValues) {
+// 150 agents on two goals, 75 towards each.
+std::string many_agents() {
   std::string agents;
   for (int i = 0; i < 150; ++i) {  // two statements of 64 rows, 22 of one
     if (i) agents += ", ";
@@ -97,11 +102,15 @@ TEST(TrajectorySqlite, AFramesRowsGoInIdOrderWithTheirAgentsValues) {
               ", \"y\": " + std::to_string(5 + (i * 11) % 40) + ", \"radius\": 0.3, \"goal\": \"" +
               (i % 2 ? "g" : "h") + "\"}";
   }
-  const std::string doc = R"({"name": "many", "bounds": [0, 0, 100, 50], "dt": 0.5,
+  return R"({"name": "many", "bounds": [0, 0, 100, 50], "dt": 0.5,
     "goals": [{"name": "g", "x": 95, "y": 25, "arrival_radius": 2},
               {"name": "h", "x": 2, "y": 25, "arrival_radius": 2}],
-    "agents": [)" + agents +
-                          "]}";
+    "agents": [)" +
+         agents + "]}";
+}
+
+TEST(TrajectorySqlite, AFramesRowsGoInIdOrderWithTheirAgentsValues) {
+  const std::string doc = many_agents();
   test::TempDir dir;
   const auto out = dir / "run.sqlite";
   Scenario sc = parse_scenario(doc, "many.json");
@@ -146,6 +155,36 @@ TEST(TrajectorySqlite, AFramesRowsGoInIdOrderWithTheirAgentsValues) {
                        " b ON b.rowid = a.rowid + 1 AND b.frame = a.frame WHERE b.id <= a.id"),
         std::vector<std::string>{"0"})
         << table;
+}
+
+// A write that fails on the writer's thread (here the file size limit: a full disk) comes back
+// to the run as an error naming the file, and stop() keeps what was committed before it.
+TEST(TrajectorySqlite, AFailedWriteComesBackAndTheOutputIsKept) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const auto run = [] {
+    test::TempDir dir;
+    Scenario sc = parse_scenario(many_agents(), "many.json");
+    sc.config.dt = 0.01;  // no one arrives in 2,000 ticks
+    Simulation sim(std::move(sc.world), sc.config);
+    auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
+    std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit{4 << 20, 4 << 20};  // frames of 150 agents: 4 MiB is some hundred of them
+    setrlimit(RLIMIT_FSIZE, &limit);
+    try {
+      write_ticks(*w, sc, sim, 2000);
+      w->finish({});
+    } catch (const Error& e) {
+      const auto kept = w->stop(sim.ticks(), e.what());
+      const auto frames = query(kept, "SELECT count(DISTINCT frame) FROM trajectory_data");
+      std::fprintf(stderr, "error: %s\nkept %s with %s frames\n", e.what(), kept.c_str(),
+                   frames.empty() ? "no" : frames[0].c_str());
+      std::exit(3);
+    }
+    std::exit(0);
+  };
+  EXPECT_EXIT(
+      run(), ::testing::ExitedWithCode(3),
+      "error: [^\n]*run\\.sqlite[^\n]*\nkept [^\n]*run\\.sqlite\\.partial with [1-9][0-9]* frames");
 }
 
 // A stopped run keeps what it wrote, marked incomplete, under a name no finished run has.
