@@ -21,8 +21,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -44,6 +46,10 @@ constexpr std::size_t kRowsPerInsert = 64;
 // Jobs (a frame or a tick's metrics) waiting for the writer's thread: a frame and its metrics,
 // so at most two frames' rows are held at once (the one written and the one waiting).
 constexpr std::size_t kJobsWaiting = 2;
+// Frames' rows held at once (copied, waiting or being written): 64 MB each at 10^6 agents. One
+// is as fast as two: the next frame is copied once the last one is written, the tick between
+// them overlapping the writing (airport-20k).
+constexpr std::size_t kFrameBuffers = 1;
 // One thread at a time writes through the connection: SQLite's per-call mutex is not needed.
 constexpr int kOpenFlags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX;
 constexpr std::chrono::seconds kSecondsPerBatch{2};
@@ -239,7 +245,8 @@ class SqliteWriter final : public TrajectoryWriter {
     if (tick % every_ != 0) return;
     const auto frame = static_cast<int64_t>(tick / every_);
     const AgentTable& t = world.agents();
-    std::vector<FrameRow> rows = spare_rows();
+    auto lease = std::make_shared<Lease>(*this);
+    std::vector<FrameRow>& rows = lease->rows;
     rows.resize(t.size());
     for (std::size_t i = 0; i < t.size(); ++i)
       rows[i] = {t.id[i],
@@ -250,11 +257,7 @@ class SqliteWriter final : public TrajectoryWriter {
                  t.radius[i],
                  agent_state_name(t, i, stall_after_),
                  t.goal[i]};
-    behind_->post([this, frame, rows = std::move(rows)]() mutable {
-      write_frame(frame, rows);
-      std::lock_guard lock(spare_m_);
-      spare_.push_back(std::move(rows));
-    });
+    behind_->post([this, frame, lease] { write_frame(frame, lease->rows); });
   }
 
   void metrics(const TickMetrics& m) override {
@@ -296,14 +299,31 @@ class SqliteWriter final : public TrajectoryWriter {
     ++frames_in_batch_;
   }
 
-  // A buffer for a frame's rows: one the writer's thread gave back, or a new one.
-  std::vector<FrameRow> spare_rows() {
-    std::lock_guard lock(spare_m_);
-    if (spare_.empty()) return {};
-    std::vector<FrameRow> rows = std::move(spare_.back());
-    spare_.pop_back();
-    return rows;
-  }
+  // A frame's rows, in one of kFrameBuffers buffers: taken when the frame is copied (waiting
+  // for one the writer's thread is done with), given back when its job is done or dropped.
+  struct Lease {
+    explicit Lease(SqliteWriter& owner) : w(owner) {
+      std::unique_lock lock(w.spare_m_);
+      w.spare_freed_.wait(lock, [&] { return !w.spare_.empty() || w.buffers_ < kFrameBuffers; });
+      if (w.spare_.empty()) {
+        ++w.buffers_;
+      } else {
+        rows = std::move(w.spare_.back());
+        w.spare_.pop_back();
+      }
+    }
+    ~Lease() {
+      {
+        std::lock_guard lock(w.spare_m_);
+        w.spare_.push_back(std::move(rows));
+      }
+      w.spare_freed_.notify_all();
+    }
+    Lease(const Lease&) = delete;
+    Lease& operator=(const Lease&) = delete;
+    SqliteWriter& w;
+    std::vector<FrameRow> rows;
+  };
 
   void write_metrics(const TickMetrics& m) {
     sqlite3_stmt* s = metric_.get();
@@ -527,7 +547,9 @@ class SqliteWriter final : public TrajectoryWriter {
   std::chrono::steady_clock::time_point batch_start_;
   std::optional<OutputLock> lock_;
   std::mutex spare_m_;
+  std::condition_variable spare_freed_;
   std::vector<std::vector<FrameRow>> spare_;  // frames' row buffers the thread is done with
+  std::size_t buffers_ = 0;                   // made so far, at most kFrameBuffers
   std::optional<WriteBehind> behind_;         // last: stopped before the rest goes
 };
 
