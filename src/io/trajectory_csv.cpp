@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <optional>
+#include <vector>
 
 #include "io/output_lock.hpp"
 #include "io/trajectory.hpp"
@@ -49,16 +50,32 @@ class CsvWriter final : public TrajectoryWriter {
     if (tick % every_ != 0) return;
     const uint64_t frame = tick / every_;
     const AgentTable& t = world.agents();
-    std::string line;
+    // Formatted into one buffer with to_chars (no string per number), written in pieces.
+    constexpr std::size_t kRowChars = 2 * 21 + 5 * 25 + 9 + 11 + 9;  // widest row, with commas
+    buf_.resize(1 << 16);
+    char* const buf = buf_.data();
+    char* const end = buf + buf_.size();
+    char* at = buf;
+    const auto put = [&](auto v) { at = std::to_chars(at, end, v).ptr; };
     for (std::size_t i = 0; i < t.size(); ++i) {
-      line.clear();
-      line += std::to_string(frame) + "," + std::to_string(t.id[i]);
-      for (double v : {t.x[i], t.y[i], t.vx[i], t.vy[i], t.radius[i]}) line += "," + num(v);
-      line += ",";
-      line += agent_state_name(t, i, stall_after_);
-      line += "," + std::to_string(t.goal[i]) + "\n";
-      traj_ << line;
+      if (end - at < static_cast<std::ptrdiff_t>(kRowChars)) {
+        traj_.write(buf, at - buf);
+        at = buf;
+      }
+      put(frame);
+      *at++ = ',';
+      put(t.id[i]);
+      for (double v : {t.x[i], t.y[i], t.vx[i], t.vy[i], t.radius[i]}) {
+        *at++ = ',';
+        put(v);
+      }
+      *at++ = ',';
+      for (const char* c = agent_state_name(t, i, stall_after_); *c;) *at++ = *c++;
+      *at++ = ',';
+      put(t.goal[i]);
+      *at++ = '\n';
     }
+    traj_.write(buf, at - buf);
     check(traj_, path_);
   }
 
@@ -139,6 +156,7 @@ class CsvWriter final : public TrajectoryWriter {
   std::filesystem::path path_, metrics_path_, steerbench_path_;
   uint32_t every_;
   std::ofstream traj_, metrics_, steerbench_;
+  std::vector<char> buf_;  // a frame's rows, formatted
   std::chrono::steady_clock::time_point batch_start_;
   std::optional<OutputLock> lock_;
 };

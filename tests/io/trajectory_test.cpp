@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <sstream>
 
 #include "support/cli.hpp"
@@ -90,25 +91,27 @@ void write_ticks(io::TrajectoryWriter& w, const Scenario& sc, Simulation& sim, u
   }
 }
 
-// A frame's rows go in ascending id whatever the agent table's row order (the simulation keeps
-// rows in a space-filling curve's order), in statements of many rows and one: every row holds
-// its own agent's values.
-// 150 agents on two goals, 75 towards each.
-std::string many_agents() {
+// n agents on a grid 2 m apart (48 a row), half of them towards each of two goals; agent i in
+// cell 97 i mod n (n not a multiple of 97), rows put in curve order: not in id order.
+std::string many_agents(int n = 150) {
   std::string agents;
-  for (int i = 0; i < 150; ++i) {  // two statements of 64 rows, 22 of one
+  for (int i = 0; i < n; ++i) {
     if (i) agents += ", ";
-    agents += "{\"x\": " + std::to_string(5 + (i * 37) % 90) +
-              ", \"y\": " + std::to_string(5 + (i * 11) % 40) + ", \"radius\": 0.3, \"goal\": \"" +
-              (i % 2 ? "g" : "h") + "\"}";
+    const int cell = static_cast<int>((97ll * i) % n);
+    agents += "{\"x\": " + std::to_string(2 + (cell % 48) * 2) +
+              ", \"y\": " + std::to_string(2 + (cell / 48) * 2) +
+              ", \"radius\": 0.3, \"goal\": \"" + (i % 2 ? "g" : "h") + "\"}";
   }
-  return R"({"name": "many", "bounds": [0, 0, 100, 50], "dt": 0.5,
+  return R"({"name": "many", "bounds": [0, 0, 100, 50], "dt": 0.5, "access": {"row_order": "curve"},
     "goals": [{"name": "g", "x": 95, "y": 25, "arrival_radius": 2},
               {"name": "h", "x": 2, "y": 25, "arrival_radius": 2}],
     "agents": [)" +
          agents + "]}";
 }
 
+// A frame's rows go in ascending id whatever the agent table's row order (the simulation keeps
+// rows in a space-filling curve's order), in statements of many rows and one (150 agents: two
+// statements of 64 rows, the rest one by one): every row holds its own agent's values.
 TEST(TrajectorySqlite, AFramesRowsGoInIdOrderWithTheirAgentsValues) {
   const std::string doc = many_agents();
   test::TempDir dir;
@@ -287,6 +290,56 @@ TEST(TrajectorySqlite, UnwritablePathFailsAtBegin) {
   Simulation sim(std::move(sc.world), sc.config);
   auto w = io::make_sqlite_writer("/nonexistent-dir/run.sqlite", 1);
   EXPECT_THROW(w->begin(sc, sim.world()), Error);
+}
+
+// One run written as CSV and as SQLite holds the same numbers, bit for bit, in every frame (800
+// agents: more than one buffer of the CSV writer's formatted rows).
+TEST(TrajectoryCsv, HoldsTheSameNumbersAsTheSqliteOutput) {
+  test::TempDir dir;
+  for (const char* name : {"run.csv", "run.sqlite"}) {
+    Scenario sc = parse_scenario(many_agents(800), "many.json");
+    Simulation sim(std::move(sc.world), sc.config);
+    const auto format =
+        std::string(name) == "run.csv" ? OutputSpec::Format::csv : OutputSpec::Format::sqlite;
+    auto w = io::make_writer({(dir / name).string(), format, 1});
+    write_ticks(*w, sc, sim, 5);
+    w->finish({});
+  }
+  // frame,id -> the rest of the row, as the CSV file and as SQLite's doubles printed exactly
+  std::map<std::pair<long long, long long>, std::vector<double>> csv, db;
+  std::istringstream in(test::slurp(dir / "run.csv"));
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+    ASSERT_EQ(f.size(), 9u) << line;
+    csv[{std::stoll(f[0]), std::stoll(f[1])}] = {
+        std::strtod(f[2].c_str(), nullptr), std::strtod(f[3].c_str(), nullptr),
+        std::strtod(f[4].c_str(), nullptr), std::strtod(f[5].c_str(), nullptr),
+        std::strtod(f[6].c_str(), nullptr), static_cast<double>(std::stoll(f[8]))};
+  }
+  sqlite3* h = nullptr;
+  ASSERT_EQ(sqlite3_open_v2((dir / "run.sqlite").c_str(), &h, SQLITE_OPEN_READONLY, nullptr),
+            SQLITE_OK);
+  sqlite3_stmt* st = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(h,
+                               "SELECT p.frame, p.id, pos_x, pos_y, vel_x, vel_y, radius, goal "
+                               "FROM trajectory_data p JOIN crowddb_agent_state s USING (frame, "
+                               "id)",
+                               -1, &st, nullptr),
+            SQLITE_OK);
+  while (sqlite3_step(st) == SQLITE_ROW) {
+    std::vector<double> v;
+    for (int c = 2; c < 8; ++c) v.push_back(sqlite3_column_double(st, c));
+    db[{sqlite3_column_int64(st, 0), sqlite3_column_int64(st, 1)}] = v;
+  }
+  sqlite3_finalize(st);
+  sqlite3_close(h);
+  EXPECT_GT(csv.size(), 5u * 800u);  // 6 frames, a few agents arrive on the way
+  EXPECT_EQ(csv.size(), db.size());
+  EXPECT_TRUE(csv == db);
 }
 
 TEST(TrajectoryCsv, RoundTripsExactly) {
