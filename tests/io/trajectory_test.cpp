@@ -123,34 +123,26 @@ TEST(TrajectorySqlite, AFramesRowsGoInIdOrderWithTheirAgentsValues) {
   const AgentTable& t = sim.world().agents();
   ASSERT_GT(t.size(), 128u);  // some have arrived
   ASSERT_FALSE(std::is_sorted(t.id.begin(), t.id.end())) << "the rows never left id order";
-  std::vector<std::size_t> rows(t.size());
+  std::vector<std::size_t> rows(t.size());  // the last frame, by id, as the table holds it
   for (std::size_t i = 0; i < rows.size(); ++i) rows[i] = i;
   std::sort(rows.begin(), rows.end(), [&](auto a, auto b) { return t.id[a] < t.id[b]; });
-  const std::vector<std::size_t> want = rows;  // the last frame, by id, as the table holds it
   w->finish({});
-  sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open_v2(out.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
-  sqlite3_stmt* st = nullptr;
-  ASSERT_EQ(sqlite3_prepare_v2(db,
-                               "SELECT p.id, p.pos_x, p.pos_y, s.id, s.vel_x, s.vel_y, s.goal "
-                               "FROM trajectory_data p JOIN crowddb_agent_state s ON s.rowid = "
-                               "p.rowid WHERE p.frame = 20 ORDER BY p.rowid",
-                               -1, &st, nullptr),
-            SQLITE_OK);
   std::size_t k = 0;
-  for (; sqlite3_step(st) == SQLITE_ROW && k < want.size(); ++k) {
-    const std::size_t i = want[k];
-    EXPECT_EQ(sqlite3_column_int64(st, 0), static_cast<int64_t>(t.id[i])) << "row " << k;
-    EXPECT_EQ(sqlite3_column_double(st, 1), t.x[i]) << "row " << k;
-    EXPECT_EQ(sqlite3_column_double(st, 2), t.y[i]) << "row " << k;
-    EXPECT_EQ(sqlite3_column_int64(st, 3), static_cast<int64_t>(t.id[i])) << "row " << k;
-    EXPECT_EQ(sqlite3_column_double(st, 4), t.vx[i]) << "row " << k;
-    EXPECT_EQ(sqlite3_column_double(st, 5), t.vy[i]) << "row " << k;
-    EXPECT_EQ(sqlite3_column_int64(st, 6), static_cast<int64_t>(t.goal[i])) << "row " << k;
+  for (test::Rows r(out,
+                    "SELECT p.id, p.pos_x, p.pos_y, s.id, s.vel_x, s.vel_y, s.goal FROM "
+                    "trajectory_data p JOIN crowddb_agent_state s ON s.rowid = p.rowid WHERE "
+                    "p.frame = 20 ORDER BY p.rowid");
+       r.next() && k < rows.size(); ++k) {
+    const std::size_t i = rows[k];
+    EXPECT_EQ(r.i64(0), static_cast<int64_t>(t.id[i])) << "row " << k;
+    EXPECT_EQ(r.real(1), t.x[i]) << "row " << k;
+    EXPECT_EQ(r.real(2), t.y[i]) << "row " << k;
+    EXPECT_EQ(r.i64(3), static_cast<int64_t>(t.id[i])) << "row " << k;
+    EXPECT_EQ(r.real(4), t.vx[i]) << "row " << k;
+    EXPECT_EQ(r.real(5), t.vy[i]) << "row " << k;
+    EXPECT_EQ(r.i64(6), static_cast<int64_t>(t.goal[i])) << "row " << k;
   }
-  EXPECT_EQ(k, want.size());
-  sqlite3_finalize(st);
-  sqlite3_close(db);
+  EXPECT_EQ(k, rows.size());
   // Every frame: ids ascend with the row id, in both tables.
   for (const char* table : {"trajectory_data", "crowddb_agent_state"})
     EXPECT_EQ(
@@ -320,23 +312,14 @@ TEST(TrajectoryCsv, HoldsTheSameNumbersAsTheSqliteOutput) {
         std::strtod(f[4].c_str(), nullptr), std::strtod(f[5].c_str(), nullptr),
         std::strtod(f[6].c_str(), nullptr), static_cast<double>(std::stoll(f[8]))};
   }
-  sqlite3* h = nullptr;
-  ASSERT_EQ(sqlite3_open_v2((dir / "run.sqlite").c_str(), &h, SQLITE_OPEN_READONLY, nullptr),
-            SQLITE_OK);
-  sqlite3_stmt* st = nullptr;
-  ASSERT_EQ(sqlite3_prepare_v2(h,
-                               "SELECT p.frame, p.id, pos_x, pos_y, vel_x, vel_y, radius, goal "
-                               "FROM trajectory_data p JOIN crowddb_agent_state s USING (frame, "
-                               "id)",
-                               -1, &st, nullptr),
-            SQLITE_OK);
-  while (sqlite3_step(st) == SQLITE_ROW) {
+  for (test::Rows r(dir / "run.sqlite",
+                    "SELECT p.frame, p.id, pos_x, pos_y, vel_x, vel_y, radius, goal FROM "
+                    "trajectory_data p JOIN crowddb_agent_state s USING (frame, id)");
+       r.next();) {
     std::vector<double> v;
-    for (int c = 2; c < 8; ++c) v.push_back(sqlite3_column_double(st, c));
-    db[{sqlite3_column_int64(st, 0), sqlite3_column_int64(st, 1)}] = v;
+    for (int c = 2; c < 8; ++c) v.push_back(r.real(c));
+    db[{r.i64(0), r.i64(1)}] = v;
   }
-  sqlite3_finalize(st);
-  sqlite3_close(h);
   EXPECT_GT(csv.size(), 5u * 800u);  // 6 frames, a few agents arrive on the way
   EXPECT_EQ(csv.size(), db.size());
   EXPECT_TRUE(csv == db);

@@ -25,4 +25,28 @@ inline std::vector<std::string> query(const std::filesystem::path& db, const std
   return out;
 }
 
+// The rows of a query, read with SQLite's own types (doubles bit for bit):
+//   for (Rows r(db, "SELECT ..."); r.next();) r.i64(0), r.real(1) ...
+class Rows {
+ public:
+  Rows(const std::filesystem::path& db, const std::string& sql) {
+    EXPECT_EQ(sqlite3_open_v2(db.c_str(), &h_, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+    EXPECT_EQ(sqlite3_prepare_v2(h_, sql.c_str(), -1, &st_, nullptr), SQLITE_OK)
+        << sqlite3_errmsg(h_);
+  }
+  ~Rows() {
+    sqlite3_finalize(st_);
+    sqlite3_close(h_);
+  }
+  Rows(const Rows&) = delete;
+  Rows& operator=(const Rows&) = delete;
+  bool next() { return st_ && sqlite3_step(st_) == SQLITE_ROW; }
+  int64_t i64(int column) const { return sqlite3_column_int64(st_, column); }
+  double real(int column) const { return sqlite3_column_double(st_, column); }
+
+ private:
+  sqlite3* h_ = nullptr;
+  sqlite3_stmt* st_ = nullptr;
+};
+
 }  // namespace crowddb::test
