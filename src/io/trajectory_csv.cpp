@@ -3,7 +3,8 @@
 // SteerBench metrics per agent (src/metrics/steerbench.hpp). Numbers are written in shortest
 // round-trip form, so a CSV run reads back bit-identical. The streams are flushed in batches
 // (io/trajectory.hpp); a stopped run keeps its .partial files (the metrics file's last row is
-// the last tick).
+// the last tick). Frames and metrics are written by a thread of the writer's own
+// (io/write_behind.hpp) while the simulation goes on; finish and stop wait for it.
 #include <charconv>
 #include <chrono>
 #include <cstdio>
@@ -11,11 +12,16 @@
 #include <optional>
 #include <vector>
 
+#include "io/frame_copy.hpp"
 #include "io/output_lock.hpp"
 #include "io/trajectory.hpp"
+#include "io/write_behind.hpp"
 
 namespace crowddb::io {
 namespace {
+
+// A frame and its tick's metrics may wait for the writer's thread.
+constexpr std::size_t kJobsWaiting = 2;
 
 class CsvWriter final : public TrajectoryWriter {
  public:
@@ -44,12 +50,22 @@ class CsvWriter final : public TrajectoryWriter {
     open(metrics_, partial(metrics_path_),
          "tick,time,agents,entered,arrived,frozen,freeze_iterations,overlapping_pairs,"
          "obstacle_overlaps,gridlocked,stalled,queueing,longest_stall,tick_seconds,state_hash\n");
+    behind_.emplace(kJobsWaiting);
   }
 
+  // The frame's rows are copied now and written by the writer's thread.
   void frame(uint64_t tick, const World& world) override {
     if (tick % every_ != 0) return;
     const uint64_t frame = tick / every_;
-    const AgentTable& t = world.agents();
+    FrameCopies::Rows rows = copies_.copy(world.agents(), stall_after_);
+    behind_->post([this, frame, rows] { write_frame(frame, *rows); });
+  }
+
+  void metrics(const TickMetrics& m) override {
+    behind_->post([this, m] { write_metrics(m); });
+  }
+
+  void write_frame(uint64_t frame, const std::vector<FrameRow>& rows) {
     // Formatted into one buffer with to_chars (no string per number), written in pieces.
     constexpr std::size_t kRowChars = 2 * 21 + 5 * 25 + 9 + 11 + 9;  // widest row, with commas
     buf_.resize(1 << 16);
@@ -57,29 +73,29 @@ class CsvWriter final : public TrajectoryWriter {
     char* const end = buf + buf_.size();
     char* at = buf;
     const auto put = [&](auto v) { at = std::to_chars(at, end, v).ptr; };
-    for (std::size_t i = 0; i < t.size(); ++i) {
+    for (const FrameRow& r : rows) {
       if (end - at < static_cast<std::ptrdiff_t>(kRowChars)) {
         traj_.write(buf, at - buf);
         at = buf;
       }
       put(frame);
       *at++ = ',';
-      put(t.id[i]);
-      for (double v : {t.x[i], t.y[i], t.vx[i], t.vy[i], t.radius[i]}) {
+      put(r.id);
+      for (double v : {r.x, r.y, r.vx, r.vy, r.radius}) {
         *at++ = ',';
         put(v);
       }
       *at++ = ',';
-      for (const char* c = agent_state_name(t, i, stall_after_); *c;) *at++ = *c++;
+      for (const char* c = r.state; *c;) *at++ = *c++;
       *at++ = ',';
-      put(t.goal[i]);
+      put(r.goal);
       *at++ = '\n';
     }
     traj_.write(buf, at - buf);
     check(traj_, path_);
   }
 
-  void metrics(const TickMetrics& m) override {
+  void write_metrics(const TickMetrics& m) {
     char hash[24];
     std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(m.state_hash));
     metrics_ << m.tick << "," << num(m.time) << "," << m.agents << "," << m.entered << ","
@@ -99,6 +115,7 @@ class CsvWriter final : public TrajectoryWriter {
   }
 
   void finish(const RunInfo& info) override {
+    behind_->drain();
     traj_.close();
     metrics_.close();
     check(traj_, path_);
@@ -125,6 +142,7 @@ class CsvWriter final : public TrajectoryWriter {
   }
 
   std::filesystem::path stop(uint64_t, const std::string&) noexcept override {
+    if (behind_) behind_->wait_idle();  // what is queued is written, up to a failed write
     const bool begun = traj_.is_open();
     if (traj_.is_open()) traj_.close();
     if (metrics_.is_open()) metrics_.close();
@@ -159,6 +177,8 @@ class CsvWriter final : public TrajectoryWriter {
   std::vector<char> buf_;  // a frame's rows, formatted
   std::chrono::steady_clock::time_point batch_start_;
   std::optional<OutputLock> lock_;
+  FrameCopies copies_{1};              // one frame's rows at a time (64 MB at 10^6 agents)
+  std::optional<WriteBehind> behind_;  // last: stopped before the rest goes
 };
 
 }  // namespace

@@ -31,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "io/frame_copy.hpp"
 #include "io/output_lock.hpp"
 #include "io/trajectory.hpp"
 #include "io/walkable_wkt.hpp"
@@ -215,13 +216,6 @@ class SqliteWriter final : public TrajectoryWriter {
     batch_start_ = std::chrono::steady_clock::now();
   }
 
-  struct FrameRow {
-    uint64_t id;
-    double x, y, vx, vy, radius;
-    const char* state;  // agent_state_name: a string literal
-    uint32_t goal;
-  };
-
   // Statements, and the thread that writes frames and metrics through them.
   void prepare() {
     behind_.emplace(kJobsWaiting);
@@ -244,20 +238,8 @@ class SqliteWriter final : public TrajectoryWriter {
   void frame(uint64_t tick, const World& world) override {
     if (tick % every_ != 0) return;
     const auto frame = static_cast<int64_t>(tick / every_);
-    const AgentTable& t = world.agents();
-    auto lease = std::make_shared<Lease>(*this);
-    std::vector<FrameRow>& rows = lease->rows;
-    rows.resize(t.size());
-    for (std::size_t i = 0; i < t.size(); ++i)
-      rows[i] = {t.id[i],
-                 t.x[i],
-                 t.y[i],
-                 t.vx[i],
-                 t.vy[i],
-                 t.radius[i],
-                 agent_state_name(t, i, stall_after_),
-                 t.goal[i]};
-    behind_->post([this, frame, lease] { write_frame(frame, lease->rows); });
+    FrameCopies::Rows rows = copies_.copy(world.agents(), stall_after_);
+    behind_->post([this, frame, rows] { write_frame(frame, *rows); });
   }
 
   void metrics(const TickMetrics& m) override {
@@ -298,32 +280,6 @@ class SqliteWriter final : public TrajectoryWriter {
     step(frame_);
     ++frames_in_batch_;
   }
-
-  // A frame's rows, in one of kFrameBuffers buffers: taken when the frame is copied (waiting
-  // for one the writer's thread is done with), given back when its job is done or dropped.
-  struct Lease {
-    explicit Lease(SqliteWriter& owner) : w(owner) {
-      std::unique_lock lock(w.spare_m_);
-      w.spare_freed_.wait(lock, [&] { return !w.spare_.empty() || w.buffers_ < kFrameBuffers; });
-      if (w.spare_.empty()) {
-        ++w.buffers_;
-      } else {
-        rows = std::move(w.spare_.back());
-        w.spare_.pop_back();
-      }
-    }
-    ~Lease() {
-      {
-        std::lock_guard lock(w.spare_m_);
-        w.spare_.push_back(std::move(rows));
-      }
-      w.spare_freed_.notify_all();
-    }
-    Lease(const Lease&) = delete;
-    Lease& operator=(const Lease&) = delete;
-    SqliteWriter& w;
-    std::vector<FrameRow> rows;
-  };
 
   void write_metrics(const TickMetrics& m) {
     sqlite3_stmt* s = metric_.get();
@@ -546,11 +502,8 @@ class SqliteWriter final : public TrajectoryWriter {
   uint64_t last_tick_ = 0;  // the last tick whose metrics were written
   std::chrono::steady_clock::time_point batch_start_;
   std::optional<OutputLock> lock_;
-  std::mutex spare_m_;
-  std::condition_variable spare_freed_;
-  std::vector<std::vector<FrameRow>> spare_;  // frames' row buffers the thread is done with
-  std::size_t buffers_ = 0;                   // made so far, at most kFrameBuffers
-  std::optional<WriteBehind> behind_;         // last: stopped before the rest goes
+  FrameCopies copies_{kFrameBuffers};
+  std::optional<WriteBehind> behind_;  // last: stopped before the rest goes
 };
 
 }  // namespace

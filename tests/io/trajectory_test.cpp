@@ -153,15 +153,17 @@ TEST(TrajectorySqlite, AFramesRowsGoInIdOrderWithTheirAgentsValues) {
 }
 
 // A write that fails on the writer's thread (here the file size limit: a full disk) comes back
-// to the run as an error naming the file, and stop() keeps what was committed before it.
-TEST(TrajectorySqlite, AFailedWriteComesBackAndTheOutputIsKept) {
+// to the run as an error naming the file, and stop() keeps what was written before it.
+TEST(TrajectoryOutput, AFailedWriteComesBackAndTheOutputIsKept) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
-  const auto run = [] {
+  const auto run = [](const char* name) {
     test::TempDir dir;
     Scenario sc = parse_scenario(many_agents(), "many.json");
     sc.config.dt = 0.01;  // no one arrives in 2,000 ticks
     Simulation sim(std::move(sc.world), sc.config);
-    auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
+    const bool csv = std::string(name) == "run.csv";
+    auto w = io::make_writer(
+        {(dir / name).string(), csv ? OutputSpec::Format::csv : OutputSpec::Format::sqlite, 1});
     std::signal(SIGXFSZ, SIG_IGN);
     rlimit limit{4 << 20, 4 << 20};  // frames of 150 agents: 4 MiB is some hundred of them
     setrlimit(RLIMIT_FSIZE, &limit);
@@ -170,16 +172,26 @@ TEST(TrajectorySqlite, AFailedWriteComesBackAndTheOutputIsKept) {
       w->finish({});
     } catch (const Error& e) {
       const auto kept = w->stop(sim.ticks(), e.what());
-      const auto frames = query(kept, "SELECT count(DISTINCT frame) FROM trajectory_data");
+      std::string frames = "no";
+      if (csv) {  // whole frames of 150 rows, and a last one cut short
+        const std::string text = test::slurp(kept);
+        frames = std::to_string(std::count(text.begin(), text.end(), '\n') / 150);
+      } else {
+        const auto n = query(kept, "SELECT count(DISTINCT frame) FROM trajectory_data");
+        if (!n.empty()) frames = n[0];
+      }
       std::fprintf(stderr, "error: %s\nkept %s with %s frames\n", e.what(), kept.c_str(),
-                   frames.empty() ? "no" : frames[0].c_str());
+                   frames.c_str());
       std::exit(3);
     }
     std::exit(0);
   };
   EXPECT_EXIT(
-      run(), ::testing::ExitedWithCode(3),
+      run("run.sqlite"), ::testing::ExitedWithCode(3),
       "error: [^\n]*run\\.sqlite[^\n]*\nkept [^\n]*run\\.sqlite\\.partial with [1-9][0-9]* frames");
+  EXPECT_EXIT(run("run.csv"), ::testing::ExitedWithCode(3),
+              "error: [^\n]*run\\.csv: write failed\nkept [^\n]*run\\.csv\\.partial with "
+              "[1-9][0-9]* frames");
 }
 
 // A stopped run keeps what it wrote, marked incomplete, under a name no finished run has.
