@@ -44,8 +44,8 @@ constexpr uint64_t kFramesPerBatch = 100;
 // A frame's rows go in statements of this many rows (the rest one by one): SQLite's work per
 // statement run is then shared, a third less time inserting than one row per statement.
 constexpr std::size_t kRowsPerInsert = 64;
-// Jobs (a frame or a tick's metrics) waiting for the writer's thread: a frame and its metrics,
-// so at most two frames' rows are held at once (the one written and the one waiting).
+// Jobs (a frame or a tick's metrics) waiting for the writer's thread: a frame and its tick's
+// metrics.
 constexpr std::size_t kJobsWaiting = 2;
 // Frames' rows held at once (copied, waiting or being written): 64 MB each at 10^6 agents. One
 // is as fast as two: the next frame is copied once the last one is written, the tick between
