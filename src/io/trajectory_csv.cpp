@@ -20,9 +20,6 @@
 namespace crowddb::io {
 namespace {
 
-// A frame and its tick's metrics may wait for the writer's thread.
-constexpr std::size_t kJobsWaiting = 2;
-
 class CsvWriter final : public TrajectoryWriter {
  public:
   CsvWriter(std::filesystem::path path, uint32_t every)
@@ -50,7 +47,7 @@ class CsvWriter final : public TrajectoryWriter {
     open(metrics_, partial(metrics_path_),
          "tick,time,agents,entered,arrived,frozen,freeze_iterations,overlapping_pairs,"
          "obstacle_overlaps,gridlocked,stalled,queueing,longest_stall,tick_seconds,state_hash\n");
-    behind_.emplace(kJobsWaiting);
+    behind_.emplace(kWriterJobsWaiting);
   }
 
   // The frame's rows are copied now and written by the writer's thread.

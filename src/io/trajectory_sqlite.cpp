@@ -44,9 +44,6 @@ constexpr uint64_t kFramesPerBatch = 100;
 // A frame's rows go in statements of this many rows (the rest one by one): SQLite's work per
 // statement run is then shared, a third less time inserting than one row per statement.
 constexpr std::size_t kRowsPerInsert = 64;
-// Jobs (a frame or a tick's metrics) waiting for the writer's thread: a frame and its tick's
-// metrics.
-constexpr std::size_t kJobsWaiting = 2;
 // Frames' rows held at once (copied, waiting or being written): 64 MB each at 10^6 agents. One
 // is as fast as two: the next frame is copied once the last one is written, the tick between
 // them overlapping the writing (airport-20k).
@@ -218,7 +215,7 @@ class SqliteWriter final : public TrajectoryWriter {
 
   // Statements, and the thread that writes frames and metrics through them.
   void prepare() {
-    behind_.emplace(kJobsWaiting);
+    behind_.emplace(kWriterJobsWaiting);
     for (std::size_t k = 0; k < 2; ++k) {
       const std::size_t rows = k == 0 ? 1 : kRowsPerInsert;
       traj_[k] =

@@ -17,6 +17,9 @@
 
 namespace crowddb::io {
 
+// The trajectory writers' queues: a frame and its tick's metrics may wait.
+inline constexpr std::size_t kWriterJobsWaiting = 2;
+
 class WriteBehind {
  public:
   explicit WriteBehind(std::size_t max_waiting) : max_waiting_(max_waiting ? max_waiting : 1) {
