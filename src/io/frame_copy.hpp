@@ -39,18 +39,20 @@ class FrameCopies {
   // The rows of `t` in the table's order, each with its state (agent_state_name); the buffer
   // goes back to be reused when the last copy of the pointer is gone (the job done or dropped).
   Rows copy(const AgentTable& t, uint64_t stall_after) {
-    std::unique_ptr<std::vector<FrameRow>> rows;
+    std::unique_ptr<std::vector<FrameRow>> buffer;
     {
       std::unique_lock lock(m_);
       freed_.wait(lock, [&] { return !spare_.empty() || made_ < most_; });
       if (spare_.empty()) {
-        rows = std::make_unique<std::vector<FrameRow>>();
+        buffer = std::make_unique<std::vector<FrameRow>>();
         ++made_;
       } else {
-        rows = std::move(spare_.back());
+        buffer = std::move(spare_.back());
         spare_.pop_back();
       }
     }
+    // Owned by the pointer before it grows: a resize that throws (out of memory) gives it back.
+    Rows rows(buffer.release(), [this](std::vector<FrameRow>* done) { give_back(done); });
     rows->resize(t.size());
     for (std::size_t i = 0; i < t.size(); ++i) {
       FrameRow& r = (*rows)[i];
@@ -63,7 +65,7 @@ class FrameCopies {
       r.state = agent_state_name(t, i, stall_after);
       r.goal = t.goal[i];
     }
-    return Rows(rows.release(), [this](std::vector<FrameRow>* done) { give_back(done); });
+    return rows;
   }
 
  private:

@@ -117,7 +117,8 @@ class SqliteWriter final : public TrajectoryWriter {
   SqliteWriter(std::filesystem::path path, uint32_t every)
       : path_(std::move(path)), partial_(path_.string() + ".partial"), every_(every ? every : 1) {}
   ~SqliteWriter() override {
-    if (db_) stop(last_tick_, "the run ended without finishing its output");
+    // UINT64_MAX: stop() takes the last tick written once the writer's thread is done.
+    if (db_) stop(UINT64_MAX, "the run ended without finishing its output");
     lock_.reset();
   }
 

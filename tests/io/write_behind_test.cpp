@@ -26,9 +26,25 @@ TEST(WriteBehind, RunsTheJobsInOrderOnItsOwnThread) {
     ASSERT_EQ(done.size(), 1000u);
     for (int i = 0; i < 1000; ++i) ASSERT_EQ(done[i], i);
     EXPECT_EQ(elsewhere.load(), 1000);
-    behind.post([&] { done.push_back(-1); });
-  }  // the destructor runs what is still waiting
-  EXPECT_EQ(done.back(), -1);
+  }
+}
+
+// The destructor runs the jobs still waiting when it is called, then stops the thread.
+TEST(WriteBehind, TheDestructorRunsWhatIsStillWaiting) {
+  std::vector<int> done;
+  std::promise<void> gate;
+  std::shared_future<void> open = gate.get_future().share();
+  std::future<void> opener;  // outlives `behind`: the gate opens while its destructor waits
+  {
+    WriteBehind behind(2);
+    behind.post([open] { open.wait(); });
+    behind.post([&] { done.push_back(1); });
+    opener = std::async(std::launch::async, [&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      gate.set_value();
+    });
+  }
+  EXPECT_EQ(done, std::vector<int>{1});
 }
 
 // The first failure comes back from drain() and every later post(); the jobs after it never run.
