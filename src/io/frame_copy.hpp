@@ -14,6 +14,11 @@
 
 namespace crowddb::io {
 
+// The trajectory writers' frames held at once (copied, waiting or being written). One is as fast
+// as two: the next frame is copied once the last one is written, the tick between them
+// overlapping the writing (airport-20k).
+inline constexpr std::size_t kWriterFrameBuffers = 1;
+
 struct FrameRow {
   uint64_t id;
   double x, y, vx, vy, radius;

@@ -174,7 +174,7 @@ class CsvWriter final : public TrajectoryWriter {
   std::vector<char> buf_;  // a frame's rows, formatted
   std::chrono::steady_clock::time_point batch_start_;
   std::optional<OutputLock> lock_;
-  FrameCopies copies_{1};              // one frame's rows at a time (64 MB at 10^6 agents)
+  FrameCopies copies_{kWriterFrameBuffers};
   std::optional<WriteBehind> behind_;  // last: stopped before the rest goes
 };
 

@@ -21,11 +21,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <condition_variable>
 #include <cstdio>
 #include <cstring>
 #include <memory>
-#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <utility>
@@ -44,10 +42,6 @@ constexpr uint64_t kFramesPerBatch = 100;
 // A frame's rows go in statements of this many rows (the rest one by one): SQLite's work per
 // statement run is then shared, a third less time inserting than one row per statement.
 constexpr std::size_t kRowsPerInsert = 64;
-// Frames' rows held at once (copied, waiting or being written): 64 MB each at 10^6 agents. One
-// is as fast as two: the next frame is copied once the last one is written, the tick between
-// them overlapping the writing (airport-20k).
-constexpr std::size_t kFrameBuffers = 1;
 // One thread at a time writes through the connection: SQLite's per-call mutex is not needed.
 constexpr int kOpenFlags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX;
 constexpr std::chrono::seconds kSecondsPerBatch{2};
@@ -500,7 +494,7 @@ class SqliteWriter final : public TrajectoryWriter {
   uint64_t last_tick_ = 0;  // the last tick whose metrics were written
   std::chrono::steady_clock::time_point batch_start_;
   std::optional<OutputLock> lock_;
-  FrameCopies copies_{kFrameBuffers};
+  FrameCopies copies_{kWriterFrameBuffers};
   std::optional<WriteBehind> behind_;  // last: stopped before the rest goes
 };
 
