@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <set>
+#include <span>
 #include <sstream>
 #include <tuple>
 #include <unordered_map>
@@ -263,6 +264,9 @@ struct Loader {
       polygon_src;                                 // /obstacles index of each circle / polygon row
   mutable std::unique_ptr<ObstacleLookup> lookup;  // built at the first obstacle question
   mutable std::vector<uint32_t> near;              // its last answer
+  // Agents from this row on were each placed clear of every agent before them, so no
+  // overlapping pair reaches past it (warn_overlaps looks at the rows before it only).
+  std::size_t may_overlap_end = 0;
 
   // Why a point is not walkable (a goal or an agent's centre), or empty when it is: outside the
   // walkable WKT area or the walled bounds, or strictly inside an obstacle.
@@ -500,19 +504,41 @@ struct Loader {
     }
   }
 
-  // `label`: which agent of a group (empty for an explicit agent).
-  void add_agent(Node& n, AgentSpec spec, std::vector<Vec2> via, const std::string& label = {}) {
+  // Which agent of a group an error names ("agent 3 of 40"); count 0: an explicit agent. Spelled
+  // out only on an error: at 10^6 agents the strings cost a tenth of a second.
+  struct Who {
+    uint64_t index = 0, count = 0;
+    std::string str() const {
+      return count == 0 ? "agent"
+                        : "agent " + std::to_string(index + 1) + " of " + std::to_string(count);
+    }
+  };
+
+  // `placed_clear`: the caller checked the agent against every agent before it (a uniform
+  // placement), so it overlaps none of them.
+  void add_agent(Node& n, AgentSpec spec, std::vector<Vec2> via, bool placed_clear, Who who) {
     try {
       World::validate_spec(spec, sc.world.goals().size());
     } catch (const InvalidRow& e) {
       n.fail(e.field(), e.what());
     }
     if (const std::string why = outside_walkable(spec.x, spec.y); !why.empty())
-      n.fail("", (label.empty() ? "agent" : label) + " at (" + Node::fmt(spec.x) + ", " +
-                     Node::fmt(spec.y) + ") " + why);
-    agents.push_back(spec);
+      n.fail("", who.str() + " at (" + Node::fmt(spec.x) + ", " + Node::fmt(spec.y) + ") " + why);
+    agents.push_back(std::move(spec));
     routes.push_back(std::move(via));
-    placed->add(spec.x, spec.y, spec.radius);
+    placed->add(agents.back().x, agents.back().y, agents.back().radius);
+    if (!placed_clear) may_overlap_end = agents.size();
+  }
+
+  // Room for `more` agents, growing geometrically (many small groups must not reallocate for
+  // every one).
+  void reserve_agents(uint64_t more) {
+    const std::size_t want = agents.size() + more;
+    if (want <= agents.capacity()) return;
+    const std::size_t cap = std::max(want, 2 * agents.capacity());
+    agents.reserve(cap);
+    routes.reserve(cap);
+    placed->reserve(cap);
   }
 
   void read_agents(Node& root) {
@@ -538,7 +564,7 @@ struct Loader {
       s.goal = goal_sequence(a, "goal", s.then);
       std::vector<Vec2> via = a.has("via") ? a.points("via") : std::vector<Vec2>{};
       a.finish();
-      add_agent(a, s, std::move(via));
+      add_agent(a, std::move(s), std::move(via), false, {});
     }
   }
 
@@ -658,6 +684,7 @@ struct Loader {
                                  " agents, fewer than count " + std::to_string(count));
       }
 
+      reserve_agents(count);
       for (uint64_t i = 0; i < count; ++i) {
         AgentSpec s = base;
         s.radius =
@@ -730,7 +757,7 @@ struct Loader {
         }
         s.vx = v * std::cos(angle);
         s.vy = v * std::sin(angle);
-        add_agent(g, s, via, "agent " + std::to_string(i + 1) + " of " + std::to_string(count));
+        add_agent(g, std::move(s), via, type == "uniform", {i, count});
       }
     }
   }
@@ -799,11 +826,14 @@ struct Loader {
   }
 
   void warn_overlaps() {
+    // A pair (i, j), i < j, with j placed clear of everyone before it cannot overlap, so both
+    // lie before may_overlap_end: the same count and first pair as over every agent.
+    const std::span<const AgentSpec> suspects(agents.data(), may_overlap_end);
     double rmax = 0;
-    for (const AgentSpec& s : agents) rmax = std::max(rmax, s.radius);
+    for (const AgentSpec& s : suspects) rmax = std::max(rmax, s.radius);
     io::DiscGrid all(2 * rmax);
-    all.reserve(agents.size());
-    for (const AgentSpec& s : agents) all.add(s.x, s.y, s.radius);
+    all.reserve(suspects.size());
+    for (const AgentSpec& s : suspects) all.add(s.x, s.y, s.radius);
     const io::DiscGrid::PairCount pairs = all.count_pairs(kOverlapCountCap);
     if (pairs.found)
       sc.warnings.push_back(
@@ -1109,16 +1139,20 @@ Scenario parse_document(std::string_view text, const std::string& source, const 
   }
   sc.world.set_walls(sc.config.walls);  // the loader checked every agent against them already
   sc.world.reserve(loader.agents.size());
+  // Applied a few thousand at a time: a change waiting in the world's batch takes 128 bytes, and
+  // one batch of every agent would be 128 MB written and read once at 10^6 agents.
+  constexpr std::size_t kInsertsPerBatch = 4096;
   for (std::size_t i = 0; i < loader.agents.size(); ++i) {
-    const AgentId id = sc.world.insert(loader.agents[i]);
-    (void)id;
+    sc.world.insert(loader.agents[i]);
+    if ((i + 1) % kInsertsPerBatch == 0) sc.world.apply_pending();
   }
   sc.world.apply_pending();
   AgentTable& t = sc.world.agents_for_tick();
-  for (std::size_t i = 0; i < loader.routes.size(); ++i) {
-    t.route[i] = loader.routes[i];
-    sc.world.refresh_target(i);
-  }
+  for (std::size_t i = 0; i < loader.routes.size(); ++i)
+    if (!loader.routes[i].empty()) {  // the rows without one have their goal's target already
+      t.route[i] = std::move(loader.routes[i]);
+      sc.world.refresh_target(i);
+    }
   return sc;
 }
 

@@ -284,6 +284,40 @@ TEST(ScenarioJson, OverlapWarningCountsPairsExactly) {
       << sc.warnings[0];
 }
 
+// Agents that a uniform placement put clear of every agent before them are not searched for
+// overlaps; agents placed after them without that check (a grid here) still are, against them
+// too: explicit agents, a uniform group, a grid across it, and another uniform group, counted
+// exactly as by brute force.
+TEST(ScenarioJson, OverlapWarningCountsPairsAcrossPlacements) {
+  const std::string text = R"({"bounds": [0, 0, 100, 100], "seed": 5,
+    "goals": [{"name": "g", "x": 90, "y": 90}],
+    "agents": [{"x": 40, "y": 40, "radius": 0.5, "goal": "g"}, {"x": 40.6, "y": 40, "radius": 0.5, "goal": "g"}],
+    "groups": [{"count": 300, "radius": [0.3, 0.6], "goal": "g", "placement": {"type": "uniform", "region": [0, 0, 30, 30]}},
+               {"count": 100, "radius": 0.6, "goal": "g", "placement": {"type": "grid", "region": [1, 1, 30, 30], "spacing": 3}},
+               {"count": 200, "radius": 0.4, "goal": "g", "placement": {"type": "uniform", "region": [0, 0, 30, 30], "gap": 0.1}}]})";
+  const Scenario sc = parse_scenario(text, "s.json");
+  const AgentTable& t = sc.world.agents();
+  ASSERT_EQ(t.size(), 602u);
+  std::size_t pairs = 0, fi = 0, fj = 0, last_j = 0;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    for (std::size_t j = i + 1; j < t.size(); ++j)
+      if (std::hypot(t.x[i] - t.x[j], t.y[i] - t.y[j]) < t.radius[i] + t.radius[j]) {
+        if (!pairs++) {
+          fi = i;
+          fj = j;
+        }
+        last_j = std::max(last_j, j);
+      }
+  ASSERT_GT(pairs, 1u);
+  EXPECT_EQ(fi, 0u);        // the explicit pair
+  EXPECT_GE(last_j, 302u);  // and some of the grid's
+  ASSERT_EQ(sc.warnings.size(), 1u);
+  EXPECT_NE(sc.warnings[0].find("overlapping: " + std::to_string(pairs) + " pairs (first: agents " +
+                                std::to_string(fi) + " and " + std::to_string(fj) + " "),
+            std::string::npos)
+      << sc.warnings[0];
+}
+
 // Work is bounded by the input, not by its numbers: 20,000 agents on one spot (2 * 10^8 pairs)
 // are counted up to a cap; a huge placement gap fails at once instead of scanning 10^18 cells.
 TEST(ScenarioJson, HugePilesAndGapsStayCheap) {
