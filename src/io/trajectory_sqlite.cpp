@@ -26,6 +26,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -45,6 +46,9 @@ constexpr std::size_t kRowsPerInsert = 64;
 // One thread at a time writes through the connection: SQLite's per-call mutex is not needed.
 constexpr int kOpenFlags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX;
 constexpr std::chrono::seconds kSecondsPerBatch{2};
+// How long finishing waits for the output's readers (a viewer following the run) to let go of
+// the file: leaving the write-ahead log needs it to itself.
+constexpr std::chrono::seconds kReadersTimeout{10};
 
 // INSERT INTO table VALUES (?, ...), ... with `rows` rows of `columns` values.
 std::string insert_rows_sql(const char* table, int columns, std::size_t rows) {
@@ -403,7 +407,7 @@ class SqliteWriter final : public TrajectoryWriter {
     create_indices();  // a .partial of a crowddb before 2026-12-05 has none
     exec("COMMIT");
     release_statements();
-    exec("PRAGMA journal_mode=DELETE");  // checkpoints the WAL and leaves one self-contained file
+    leave_wal();
     if (sqlite3_close(db_) != SQLITE_OK)
       throw Error(Error::Kind::io, path_.string() + ": cannot close output");
     db_ = nullptr;
@@ -459,6 +463,22 @@ class SqliteWriter final : public TrajectoryWriter {
     for (Statement* s :
          {&traj_[0], &traj_[1], &state_[0], &state_[1], &frame_, &metric_, &set_run_})
       *s = Statement();
+  }
+
+  // Checkpoints the write-ahead log and leaves one self-contained file. That needs the file to
+  // itself, and SQLite does not wait for a reader here (its busy timeout does not apply): we do,
+  // up to kReadersTimeout, so a viewer's query at the run's end does not leave it a .partial.
+  void leave_wal() {
+    const auto give_up = std::chrono::steady_clock::now() + kReadersTimeout;
+    for (;;) {
+      const int rc = sqlite3_exec(db_, "PRAGMA journal_mode=DELETE", nullptr, nullptr, nullptr);
+      if (rc == SQLITE_OK) return;
+      if (rc != SQLITE_BUSY || std::chrono::steady_clock::now() >= give_up)
+        throw Error(Error::Kind::io,
+                    path_.string() + ": " + sqlite3_errmsg(db_) +
+                        (rc == SQLITE_BUSY ? " (a reader kept it open for 10 s)" : ""));
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
   }
 
   void exec(const char* sql) {

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <map>
 #include <sstream>
+#include <thread>
 
 #include "support/cli.hpp"
 #include "support/sqlite_query.hpp"
@@ -259,6 +260,32 @@ TEST(TrajectorySqlite, BatchesAreCommittedWhileTheRunGoesOn) {
     EXPECT_EQ(seen.i64(3), last);
   }
   w->finish({});
+  EXPECT_EQ(query(dir / "run.sqlite", "SELECT value FROM crowddb_run WHERE key = 'status'"),
+            std::vector<std::string>{"complete"});
+}
+
+// A reader in the middle of a query when the run ends (a viewer following the output) delays
+// the end; it does not cost it: the output is finished, not left as a .partial.
+TEST(TrajectorySqlite, AReaderInTheMiddleOfAQueryDelaysTheEndOnly) {
+  test::TempDir dir;
+  Scenario sc = parse_scenario(kScenario, "two.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
+  write_ticks(*w, sc, sim, 250);  // 100 frames a batch at most: two committed
+  auto reader =
+      std::make_unique<test::Rows>(dir / "run.sqlite.partial", "SELECT frame FROM trajectory_data");
+  ASSERT_TRUE(reader->next());  // its read transaction stays open until the statement is done
+  std::thread done_reading([&reader] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    reader.reset();
+  });
+  try {
+    w->finish({});
+  } catch (const Error& e) {
+    ADD_FAILURE() << e.what();
+  }
+  done_reading.join();
+  EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.partial"));
   EXPECT_EQ(query(dir / "run.sqlite", "SELECT value FROM crowddb_run WHERE key = 'status'"),
             std::vector<std::string>{"complete"});
 }
