@@ -241,6 +241,7 @@ const TickMetrics& step(PySimulation& p, uint64_t n) {
 }
 
 void record(PySimulation& p, const std::filesystem::path& path, uint32_t every) {
+  PySimulation::Busy busy(p);  // step() writes through the writer without the GIL
   if (p.writer) throw Error(Error::Kind::usage, "already recording: call close() first");
   if (every == 0) throw Error(Error::Kind::input, "every: must be >= 1");
   Scenario meta;
@@ -262,6 +263,7 @@ void record(PySimulation& p, const std::filesystem::path& path, uint32_t every) 
 }
 
 void close(PySimulation& p) {
+  PySimulation::Busy busy(p);
   if (!p.writer) return;
   io::RunInfo info;
   info.threads = p.sim->config().threads;

@@ -2,6 +2,8 @@
 import json
 import sqlite3
 import subprocess
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -134,6 +136,29 @@ def test_record_writes_a_trajectory_file(tmp_path):
     assert frames == [0, 1, 2, 3, 4]  # frame = tick / every (JuPedSim: frames at its frame rate)
     (rows,) = con.execute("SELECT count(*) FROM trajectory_data WHERE frame = 0").fetchone()
     assert rows == 6
+
+
+def test_the_trajectory_file_is_not_closed_or_replaced_mid_step(tmp_path):
+    # step() runs without the GIL and writes through the recording: another thread's close()
+    # or record() meanwhile is refused, not a race; afterwards both work.
+    w = crowddb.World((0, 0, 400, 400))
+    w.add_goal("g", x=399, y=200, radius=1)
+    gx, gy = np.meshgrid(np.arange(5.0, 395.0, 3.0), np.arange(5.0, 395.0, 3.0))
+    w.insert_agents(gx.ravel(), gy.ravel(), "g", radius=0.3)
+    sim = crowddb.Simulation(w)
+    sim.record(tmp_path / "run.sqlite", every=25)
+    stepping = threading.Thread(target=sim.step, args=(200,))
+    stepping.start()
+    time.sleep(0.2)  # the step takes seconds
+    with pytest.raises(crowddb.UsageError, match="another thread"):
+        sim.close()
+    with pytest.raises(crowddb.UsageError, match="another thread"):
+        sim.record(tmp_path / "other.sqlite")
+    stepping.join()
+    assert sim.tick == 200
+    sim.close()
+    con = sqlite3.connect(tmp_path / "run.sqlite")
+    assert con.execute("SELECT max(frame) FROM trajectory_data").fetchone() == (8,)
 
 
 def test_checkpoint_round_trip(source_dir):
