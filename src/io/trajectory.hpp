@@ -12,6 +12,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
 #include "metrics/steerbench.hpp"
+#include "util/byte_codec.hpp"
 
 namespace crowddb::io {
 
@@ -68,9 +70,12 @@ class TrajectoryWriter {
   virtual void finish(const RunInfo& info) = 0;
   // A checkpoint after `tick` (whose frame and metrics are written): the simulation's state
   // and the run's, committed at once with every frame up to it. Only the SQLite writer keeps
-  // them (table crowddb_checkpoint, latest only); the CSV writer ignores them.
-  virtual void checkpoint(uint64_t /*tick*/, const std::string& /*engine*/,
-                          const std::string& /*run*/) {}
+  // them (table crowddb_checkpoint, latest only); the CSV writer ignores them. Each record
+  // comes as a function that streams its bytes to a sink, the same bytes at every call, so
+  // that it need never be in memory whole.
+  using RecordBytes = std::function<void(const ByteSink&)>;
+  virtual void checkpoint(uint64_t /*tick*/, const RecordBytes& /*engine*/,
+                          const RecordBytes& /*run*/) {}
   // Stops an unfinished run: keeps everything written so far in PATH.partial, marked incomplete
   // up to `tick` because of `reason`, and releases the lock. Returns the file kept, or an empty
   // path when nothing was begun. Safe to call at any time, never throws.

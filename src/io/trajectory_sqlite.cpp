@@ -309,16 +309,28 @@ class SqliteWriter final : public TrajectoryWriter {
     }
   }
 
-  // On this thread, once the frames before it are written: a checkpoint (at 10^6 agents some
-  // hundred MB) is not copied, and checkpoints are minutes apart.
-  void checkpoint(uint64_t tick, const std::string& engine, const std::string& run) override {
+  // On this thread, once the frames before it are written. A record is streamed twice: once
+  // to count its bytes, then into a blob of that size made in place (a zeroblob costs SQLite no
+  // memory), so that neither it nor SQLite ever holds a checkpoint whole (at 10^6 agents some
+  // hundred MB; checkpoints are minutes apart).
+  void checkpoint(uint64_t tick, const RecordBytes& engine, const RecordBytes& run) override {
     behind_->drain();
+    const auto size_of = [](const RecordBytes& record) {
+      sqlite3_int64 bytes = 0;
+      record(
+          [&bytes](std::string_view piece) { bytes += static_cast<sqlite3_int64>(piece.size()); });
+      return bytes;
+    };
+    const sqlite3_int64 engine_bytes = size_of(engine), run_bytes = size_of(run);
     exec("DELETE FROM crowddb_checkpoint");
-    Statement cp(db_, "INSERT INTO crowddb_checkpoint VALUES (?, ?, ?)", path_.string());
+    Statement cp(db_, "INSERT INTO crowddb_checkpoint VALUES (?, zeroblob(?), zeroblob(?))",
+                 path_.string());
     sqlite3_bind_int64(cp.get(), 1, static_cast<int64_t>(tick));
-    sqlite3_bind_blob64(cp.get(), 2, engine.data(), engine.size(), SQLITE_STATIC);
-    sqlite3_bind_blob64(cp.get(), 3, run.data(), run.size(), SQLITE_STATIC);
+    sqlite3_bind_int64(cp.get(), 2, engine_bytes);
+    sqlite3_bind_int64(cp.get(), 3, run_bytes);
     step(cp);
+    write_blob("engine", static_cast<sqlite3_int64>(tick), engine, engine_bytes);
+    write_blob("progress", static_cast<sqlite3_int64>(tick), run, run_bytes);
     insert_text(set_run_, "last_tick", std::to_string(last_tick_));
     exec("COMMIT");
     exec("BEGIN");
@@ -479,6 +491,32 @@ class SqliteWriter final : public TrajectoryWriter {
                         (rc == SQLITE_BUSY ? " (a reader kept it open for 10 s)" : ""));
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
+  }
+
+  // Streams `record` into column `column` of crowddb_checkpoint's row `tick` (made with a
+  // zeroblob of `bytes`); fails if the record does not fill it exactly.
+  void write_blob(const char* column, sqlite3_int64 tick, const RecordBytes& record,
+                  sqlite3_int64 bytes) {
+    sqlite3_blob* blob = nullptr;
+    if (sqlite3_blob_open(db_, "main", "crowddb_checkpoint", column, tick, 1, &blob) != SQLITE_OK) {
+      sqlite3_blob_close(blob);
+      throw Error(Error::Kind::io, path_.string() + ": checkpoint: " + sqlite3_errmsg(db_));
+    }
+    const std::unique_ptr<sqlite3_blob, int (*)(sqlite3_blob*)> owned(blob, sqlite3_blob_close);
+    sqlite3_int64 at = 0;
+    record([&](std::string_view piece) {
+      if (piece.size() > static_cast<std::size_t>(bytes - at) ||
+          sqlite3_blob_write(blob, piece.data(), static_cast<int>(piece.size()),
+                             static_cast<int>(at)) != SQLITE_OK)
+        throw Error(Error::Kind::io, path_.string() + ": checkpoint: " +
+                                         (piece.size() > static_cast<std::size_t>(bytes - at)
+                                              ? std::string("the record grew between two reads")
+                                              : std::string(sqlite3_errmsg(db_))));
+      at += static_cast<sqlite3_int64>(piece.size());
+    });
+    if (at != bytes)
+      throw Error(Error::Kind::io,
+                  path_.string() + ": checkpoint: the record shrank between two reads");
   }
 
   void exec(const char* sql) {

@@ -412,8 +412,20 @@ void metrics_fields(Io&& io, M& m) {
 }  // namespace
 
 std::string Simulation::save_state() const {
-  const Engine& e = *engine_;
   ByteWriter out(kCheckpointMagic);
+  write_state(out);
+  return out.seal();
+}
+
+void Simulation::save_state(const std::function<void(std::string_view)>& sink) const {
+  ByteWriter out(kCheckpointMagic);
+  out.stream_to(sink);
+  write_state(out);
+  out.seal();
+}
+
+void Simulation::write_state(ByteWriter& out) const {
+  const Engine& e = *engine_;
   out.u32(kCheckpointVersion);
   out.u64(fingerprint(world_, config_));
   world_.save_agents(out);
@@ -433,7 +445,6 @@ std::string Simulation::save_state() const {
   out.u8(e.nav != nullptr);
   if (e.nav) e.nav->save(out);
   out.text(kCheckpointMagic);  // a trailer: the bytes ended where they should
-  return out.seal();
 }
 
 void Simulation::restore_state(std::string_view bytes, const std::string& what) {

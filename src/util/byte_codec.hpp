@@ -4,12 +4,15 @@
 // size and ends in Error(input) naming the byte offset, never a crash.
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "crowddb/error.hpp"
@@ -19,22 +22,40 @@ namespace crowddb {
 
 // A checksum of bytes (8 at a time through StateHasher's mix): a checkpoint ends with the
 // checksum of everything before it, so damage anywhere is caught before anything is parsed.
-inline uint64_t checksum(std::string_view bytes) {
-  StateHasher h;
-  std::size_t i = 0;
-  for (; i + 8 <= bytes.size(); i += 8) {
-    uint64_t w = 0;
-    for (int k = 0; k < 8; ++k)
-      w |= static_cast<uint64_t>(static_cast<uint8_t>(bytes[i + k])) << (8 * k);
-    h.add(w);
+// Taken in pieces (a record streamed out as it is written): whole words first, then the rest.
+class Checksum {
+ public:
+  // Bytes whose count is a multiple of 8, in order.
+  void add_words(std::string_view bytes) {
+    for (std::size_t i = 0; i + 8 <= bytes.size(); i += 8) h_.add(word(bytes.data() + i, 8));
+    count_ += bytes.size();
   }
-  uint64_t tail = 0;
-  for (int k = 0; i < bytes.size(); ++i, ++k)
-    tail |= static_cast<uint64_t>(static_cast<uint8_t>(bytes[i])) << (8 * k);
-  h.add(tail);
-  h.add(static_cast<uint64_t>(bytes.size()));
-  return h.digest();
+  // The last bytes (any count) and the checksum of all.
+  uint64_t finish(std::string_view rest) {
+    const std::size_t whole = rest.size() & ~std::size_t{7};
+    add_words(rest.substr(0, whole));
+    h_.add(word(rest.data() + whole, rest.size() - whole));
+    h_.add(static_cast<uint64_t>(count_ + rest.size() - whole));
+    return h_.digest();
+  }
+
+ private:
+  static uint64_t word(const char* p, std::size_t n) {
+    uint64_t w = 0;
+    for (std::size_t k = 0; k < n; ++k)
+      w |= static_cast<uint64_t>(static_cast<uint8_t>(p[k])) << (8 * k);
+    return w;
+  }
+  StateHasher h_;
+  uint64_t count_ = 0;
+};
+
+inline uint64_t checksum(std::string_view bytes) {
+  return Checksum().finish(bytes);
 }
+
+// Where a streamed record's bytes go, piece by piece, in order.
+using ByteSink = std::function<void(std::string_view)>;
 
 class ByteWriter {
  public:
@@ -42,13 +63,26 @@ class ByteWriter {
   explicit ByteWriter(std::string_view magic = {}) {
     if (!magic.empty()) text(magic);
   }
-  void u8(uint8_t v) { out_.push_back(static_cast<char>(v)); }
+  // Streams the record to `sink` instead of keeping it, so that it never sits whole in memory (a
+  // checkpoint of 10^6 agents is 200 MB): from now on, each time `chunk` bytes are waiting they
+  // go to the sink (a multiple of 8 bytes, the checksum kept as they pass), and seal() hands on
+  // the rest and returns nothing. The sink sees exactly the bytes seal() would have returned.
+  void stream_to(ByteSink sink, std::size_t chunk = std::size_t{1} << 20) {
+    sink_ = std::move(sink);
+    chunk_ = std::max<std::size_t>(chunk, 8);
+    spill_if_full();
+  }
+  void u8(uint8_t v) {
+    out_.push_back(static_cast<char>(v));
+    if (out_.size() >= chunk_) spill_if_full();
+  }
   void u32(uint32_t v) { uint_le(v); }
   void u64(uint64_t v) { uint_le(v); }
   void f64(double v) { u64(std::bit_cast<uint64_t>(v)); }
   void text(std::string_view s) {
     u64(s.size());
     out_.append(s);
+    spill_if_full();
   }
   // A vector of integers, doubles or one-byte enums.
   template <class T>
@@ -58,9 +92,17 @@ class ByteWriter {
   }
   const std::string& bytes() const { return out_; }
   std::string take() { return std::move(out_); }
-  // The record with the checksum of every byte before it appended.
+  // The record with the checksum of every byte before it appended (streamed: handed on, and
+  // the string returned is empty).
   std::string seal() {
-    u64(checksum(out_));
+    const uint64_t sum = spilled_.finish(out_);
+    const std::size_t limit = std::exchange(chunk_, SIZE_MAX);  // the rest goes on in one piece
+    u64(sum);
+    if (sink_) {
+      sink_(out_);
+      out_.clear();
+    }
+    chunk_ = limit;
     return take();
   }
 
@@ -84,7 +126,19 @@ class ByteWriter {
       u8(static_cast<uint8_t>(x));
     }
   }
+  // Hands the waiting whole words to the sink once `chunk_` bytes wait (never without a sink).
+  void spill_if_full() {
+    if (!sink_ || out_.size() < chunk_) return;
+    const std::size_t whole = out_.size() & ~std::size_t{7};
+    const std::string_view words(out_.data(), whole);
+    spilled_.add_words(words);
+    sink_(words);
+    out_.erase(0, whole);
+  }
   std::string out_;
+  ByteSink sink_;
+  std::size_t chunk_ = SIZE_MAX;  // no sink: everything stays in out_
+  Checksum spilled_;              // of the bytes handed on so far
 };
 
 class ByteReader {

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <thread>
 
+#include "metrics/run.hpp"
 #include "support/cli.hpp"
 #include "support/sqlite_query.hpp"
 
@@ -288,6 +289,38 @@ TEST(TrajectorySqlite, AReaderInTheMiddleOfAQueryDelaysTheEndOnly) {
   EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.partial"));
   EXPECT_EQ(query(dir / "run.sqlite", "SELECT value FROM crowddb_run WHERE key = 'status'"),
             std::vector<std::string>{"complete"});
+}
+
+// A checkpoint goes into the output streamed, a megabyte at a time, never whole in memory: what
+// the file holds is the simulation's save_state() of that tick, byte for byte (8,000 agents: a
+// record of more than one piece).
+TEST(TrajectorySqlite, ACheckpointInTheOutputIsTheSimulationsStateByteForByte) {
+  test::TempDir dir;
+  Scenario sc = parse_scenario(R"({"bounds": [0, 0, 400, 400], "seed": 2,
+    "goals": [{"name": "g", "x": 399, "y": 200}],
+    "groups": [{"count": 8000, "radius": 0.3, "goal": "g",
+                "placement": {"type": "uniform", "region": [0, 0, 400, 400]}}]})",
+                               "big.json");
+  sc.ticks = 100;
+  Simulation sim(std::move(sc.world), sc.config);
+  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
+  w->begin(sc, sim.world());
+  metrics::RunControl control;
+  control.writer = w.get();
+  control.checkpoint_every = 1e9;  // only the one an interruption writes
+  int asked = 0;
+  control.interrupted = [&asked] { return ++asked == 13; };  // before tick 13: after tick 12
+  EXPECT_THROW(metrics::run_to_end(sc, sim, control), Error);
+  ASSERT_EQ(sim.ticks(), 12u);
+  const std::string state = sim.save_state();
+  ASSERT_GT(state.size(), std::size_t{1} << 20);
+  test::Rows saved(dir / "run.sqlite.partial",
+                   "SELECT tick, engine, length(progress) FROM crowddb_checkpoint");
+  ASSERT_TRUE(saved.next());
+  EXPECT_EQ(saved.i64(0), 12);
+  EXPECT_TRUE(saved.blob(1) == state) << "the checkpoint is not save_state()";
+  EXPECT_GT(saved.i64(2), 0);
+  EXPECT_FALSE(saved.next());
 }
 
 // Two runs writing one output: the second stops at once and the first is untouched.

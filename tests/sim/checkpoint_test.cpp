@@ -90,6 +90,21 @@ TEST(Checkpoint, ARestoredRunContinuesBitIdenticallyOnAnyThreadCount) {
   }
 }
 
+// The checkpoint streamed to a sink (as crowddb run writes it into its output) is the
+// checkpoint returned whole, byte for byte.
+TEST(Checkpoint, StreamedIsTheSameBytes) {
+  Simulation sim = build("bottleneck", 2);
+  for (int t = 0; t < 40; ++t) sim.step();
+  std::string streamed;
+  std::size_t pieces = 0;
+  sim.save_state([&](std::string_view piece) {
+    streamed.append(piece);
+    ++pieces;
+  });
+  EXPECT_EQ(streamed, sim.save_state());
+  EXPECT_GE(pieces, 1u);
+}
+
 TEST(Checkpoint, CountersContinueToo) {
   Simulation a = build("airport", 2);
   for (int t = 0; t < 150; ++t) a.step();

@@ -43,6 +43,10 @@ class Rows {
   bool next() { return st_ && sqlite3_step(st_) == SQLITE_ROW; }
   int64_t i64(int column) const { return sqlite3_column_int64(st_, column); }
   double real(int column) const { return sqlite3_column_double(st_, column); }
+  std::string blob(int column) const {
+    const auto* p = static_cast<const char*>(sqlite3_column_blob(st_, column));
+    return p ? std::string(p, static_cast<std::size_t>(sqlite3_column_bytes(st_, column))) : "";
+  }
 
  private:
   sqlite3* h_ = nullptr;
