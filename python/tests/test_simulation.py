@@ -149,11 +149,17 @@ def test_the_trajectory_file_is_not_closed_or_replaced_mid_step(tmp_path):
     sim.record(tmp_path / "run.sqlite", every=25)
     stepping = threading.Thread(target=sim.step, args=(200,))
     stepping.start()
-    time.sleep(0.2)  # the step takes seconds
+    # Until the thread is inside step(), record() says "already recording" (and changes nothing).
+    deadline = time.monotonic() + 30
+    while True:
+        with pytest.raises(crowddb.UsageError) as refused:
+            sim.record(tmp_path / "other.sqlite")
+        if "another thread" in str(refused.value) or time.monotonic() > deadline:
+            break
+        time.sleep(0.001)
+    assert "another thread" in str(refused.value)
     with pytest.raises(crowddb.UsageError, match="another thread"):
-        sim.close()
-    with pytest.raises(crowddb.UsageError, match="another thread"):
-        sim.record(tmp_path / "other.sqlite")
+        sim.close()  # the step takes seconds
     stepping.join()
     assert sim.tick == 200
     sim.close()

@@ -46,8 +46,8 @@ constexpr std::size_t kRowsPerInsert = 64;
 // One thread at a time writes through the connection: SQLite's per-call mutex is not needed.
 constexpr int kOpenFlags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX;
 constexpr std::chrono::seconds kSecondsPerBatch{2};
-// How long finishing waits for the output's readers (a viewer following the run) to let go of
-// the file: leaving the write-ahead log needs it to itself.
+// How long finishing waits for other connections to the output (a viewer following the run) to
+// close: leaving the write-ahead log needs the file to itself.
 constexpr std::chrono::seconds kReadersTimeout{10};
 
 // INSERT INTO table VALUES (?, ...), ... with `rows` rows of `columns` values.
@@ -322,15 +322,24 @@ class SqliteWriter final : public TrajectoryWriter {
       return bytes;
     };
     const sqlite3_int64 engine_bytes = size_of(engine), run_bytes = size_of(run);
-    exec("DELETE FROM crowddb_checkpoint");
-    Statement cp(db_, "INSERT INTO crowddb_checkpoint VALUES (?, zeroblob(?), zeroblob(?))",
-                 path_.string());
-    sqlite3_bind_int64(cp.get(), 1, static_cast<int64_t>(tick));
-    sqlite3_bind_int64(cp.get(), 2, engine_bytes);
-    sqlite3_bind_int64(cp.get(), 3, run_bytes);
-    step(cp);
-    write_blob("engine", static_cast<sqlite3_int64>(tick), engine, engine_bytes);
-    write_blob("progress", static_cast<sqlite3_int64>(tick), run, run_bytes);
+    // In a savepoint: a record that fails half way (a full disk, an error while it is streamed)
+    // leaves the previous checkpoint as it was, not a zero-filled one that a stop would commit.
+    exec("SAVEPOINT checkpoint");
+    try {
+      exec("DELETE FROM crowddb_checkpoint");
+      Statement cp(db_, "INSERT INTO crowddb_checkpoint VALUES (?, zeroblob(?), zeroblob(?))",
+                   path_.string());
+      sqlite3_bind_int64(cp.get(), 1, static_cast<int64_t>(tick));
+      sqlite3_bind_int64(cp.get(), 2, engine_bytes);
+      sqlite3_bind_int64(cp.get(), 3, run_bytes);
+      step(cp);
+      write_blob("engine", static_cast<sqlite3_int64>(tick), engine, engine_bytes);
+      write_blob("progress", static_cast<sqlite3_int64>(tick), run, run_bytes);
+    } catch (...) {
+      sqlite3_exec(db_, "ROLLBACK TO checkpoint; RELEASE checkpoint", nullptr, nullptr, nullptr);
+      throw;
+    }
+    exec("RELEASE checkpoint");
     insert_text(set_run_, "last_tick", std::to_string(last_tick_));
     exec("COMMIT");
     exec("BEGIN");
@@ -478,8 +487,10 @@ class SqliteWriter final : public TrajectoryWriter {
   }
 
   // Checkpoints the write-ahead log and leaves one self-contained file. That needs the file to
-  // itself, and SQLite does not wait for a reader here (its busy timeout does not apply): we do,
-  // up to kReadersTimeout, so a viewer's query at the run's end does not leave it a .partial.
+  // itself: in WAL mode every open connection holds it, even between queries, and SQLite does
+  // not wait here (its busy timeout does not apply). We do, up to kReadersTimeout, so that a
+  // reader that opens the file for a query or two does not leave the output a .partial; one
+  // that keeps it open longer still does (with this error).
   void leave_wal() {
     const auto give_up = std::chrono::steady_clock::now() + kReadersTimeout;
     for (;;) {
@@ -488,7 +499,7 @@ class SqliteWriter final : public TrajectoryWriter {
       if (rc != SQLITE_BUSY || std::chrono::steady_clock::now() >= give_up)
         throw Error(Error::Kind::io,
                     path_.string() + ": " + sqlite3_errmsg(db_) +
-                        (rc == SQLITE_BUSY ? " (a reader kept it open for 10 s)" : ""));
+                        (rc == SQLITE_BUSY ? " (another connection kept it open for 10 s)" : ""));
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }

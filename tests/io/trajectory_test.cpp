@@ -265,9 +265,11 @@ TEST(TrajectorySqlite, BatchesAreCommittedWhileTheRunGoesOn) {
             std::vector<std::string>{"complete"});
 }
 
-// A reader in the middle of a query when the run ends (a viewer following the output) delays
-// the end; it does not cost it: the output is finished, not left as a .partial.
-TEST(TrajectorySqlite, AReaderInTheMiddleOfAQueryDelaysTheEndOnly) {
+// A reader with the file open when the run ends (in the middle of a query here) delays the end
+// until it closes the file (up to 10 s); it does not cost it: the output is finished, not left
+// as a .partial. (One that keeps the file open past 10 s still does: SQLite can leave its
+// write-ahead log only with the file to itself.)
+TEST(TrajectorySqlite, AReaderThatClosesTheFileSoonDelaysTheEndOnly) {
   test::TempDir dir;
   Scenario sc = parse_scenario(kScenario, "two.json");
   Simulation sim(std::move(sc.world), sc.config);
@@ -321,6 +323,44 @@ TEST(TrajectorySqlite, ACheckpointInTheOutputIsTheSimulationsStateByteForByte) {
   EXPECT_TRUE(saved.blob(1) == state) << "the checkpoint is not save_state()";
   EXPECT_GT(saved.i64(2), 0);
   EXPECT_FALSE(saved.next());
+}
+
+// A checkpoint whose record fails half way while it is streamed into the file leaves the
+// previous checkpoint as it was (a stop then commits everything else written).
+TEST(TrajectorySqlite, ACheckpointThatFailsHalfWayLeavesThePreviousOne) {
+  test::TempDir dir;
+  Scenario sc = parse_scenario(kScenario, "two.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
+  write_ticks(*w, sc, sim, 6);
+  const std::size_t mb = std::size_t{1} << 20;
+  const std::string good(3 * mb, 'a'), run(100, 'r');
+  const auto pieces_of = [mb](const std::string& bytes) {
+    return [&bytes, mb](const ByteSink& sink) {
+      for (std::size_t at = 0; at < bytes.size(); at += mb)
+        sink(std::string_view(bytes).substr(at, mb));
+    };
+  };
+  w->checkpoint(5, pieces_of(good), pieces_of(run));
+  int passes = 0;
+  const auto fails_when_written = [&](const ByteSink& sink) {
+    const std::string piece(mb, 'b');
+    sink(piece);
+    if (++passes == 2) throw Error(Error::Kind::io, "serializing failed");
+    sink(piece);
+  };
+  EXPECT_THROW(w->checkpoint(6, fails_when_written, pieces_of(run)), Error);
+  EXPECT_EQ(passes, 2);
+  w->stop(6, "test");
+  test::Rows saved(dir / "run.sqlite.partial",
+                   "SELECT tick, engine, progress FROM crowddb_checkpoint");
+  ASSERT_TRUE(saved.next());
+  EXPECT_EQ(saved.i64(0), 5);
+  EXPECT_TRUE(saved.blob(1) == good);
+  EXPECT_EQ(saved.blob(2), run);
+  EXPECT_FALSE(saved.next());
+  EXPECT_EQ(query(dir / "run.sqlite.partial", "SELECT max(tick) FROM crowddb_tick_metrics"),
+            std::vector<std::string>{"6"});
 }
 
 // Two runs writing one output: the second stops at once and the first is untouched.
