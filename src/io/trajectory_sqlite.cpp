@@ -47,8 +47,11 @@ constexpr std::size_t kRowsPerInsert = 64;
 constexpr int kOpenFlags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX;
 constexpr std::chrono::seconds kSecondsPerBatch{2};
 // How long finishing waits for other connections to the output (a viewer following the run) to
-// close: leaving the write-ahead log needs the file to itself.
-constexpr std::chrono::seconds kReadersTimeout{10};
+// close, for a file in a rollback journal (which needs it to itself); after that the file is
+// finished in WAL mode instead.
+constexpr std::chrono::seconds kOthersTimeout{2};
+// And how long it then waits for them to finish a query, to take every row into the file.
+constexpr std::chrono::seconds kQueriesTimeout{10};
 
 // INSERT INTO table VALUES (?, ...), ... with `rows` rows of `columns` values.
 std::string insert_rows_sql(const char* table, int columns, std::size_t rows) {
@@ -428,7 +431,7 @@ class SqliteWriter final : public TrajectoryWriter {
     create_indices();  // a .partial of a crowddb before 2026-12-05 has none
     exec("COMMIT");
     release_statements();
-    leave_wal();
+    const bool rollback_journal = leave_wal();
     if (sqlite3_close(db_) != SQLITE_OK)
       throw Error(Error::Kind::io, path_.string() + ": cannot close output");
     db_ = nullptr;
@@ -437,6 +440,12 @@ class SqliteWriter final : public TrajectoryWriter {
     if (ec)
       throw Error(Error::Kind::io,
                   path_.string() + ": cannot move output into place: " + ec.message());
+    if (!rollback_journal) {
+      // The emptied log and its index under the old name: the other connection keeps its open
+      // copies; the next run writing here must not find them.
+      std::filesystem::remove(partial_ + "-wal", ec);
+      std::filesystem::remove(partial_ + "-shm", ec);
+    }
     lock_.reset();
   }
 
@@ -486,22 +495,38 @@ class SqliteWriter final : public TrajectoryWriter {
       *s = Statement();
   }
 
-  // Checkpoints the write-ahead log and leaves one self-contained file. That needs the file to
-  // itself: in WAL mode every open connection holds it, even between queries, and SQLite does
-  // not wait here (its busy timeout does not apply). We do, up to kReadersTimeout, so that a
-  // reader that opens the file for a query or two does not leave the output a .partial; one
-  // that keeps it open longer still does (with this error).
-  void leave_wal() {
-    const auto give_up = std::chrono::steady_clock::now() + kReadersTimeout;
-    for (;;) {
-      const int rc = sqlite3_exec(db_, "PRAGMA journal_mode=DELETE", nullptr, nullptr, nullptr);
-      if (rc == SQLITE_OK) return;
-      if (rc != SQLITE_BUSY || std::chrono::steady_clock::now() >= give_up)
-        throw Error(Error::Kind::io,
-                    path_.string() + ": " + sqlite3_errmsg(db_) +
-                        (rc == SQLITE_BUSY ? " (another connection kept it open for 10 s)" : ""));
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  // Leaves one self-contained file: checkpoints the write-ahead log into it and switches to a
+  // rollback journal. The switch needs the file to itself (in WAL mode every open connection
+  // holds it, even between its queries) and SQLite does not wait for that (its busy timeout
+  // does not apply): we wait up to kOthersTimeout. If another connection still has the file
+  // open (a viewer following the run), the log is checkpointed and emptied instead, once no
+  // query of theirs is reading from it: every row is then in the file, which stays in WAL mode.
+  // Returns whether it left WAL mode.
+  bool leave_wal() {
+    const auto retry = [&](std::chrono::seconds patience, const auto& attempt) {
+      const auto give_up = std::chrono::steady_clock::now() + patience;
+      for (;;) {
+        const int rc = attempt();
+        if (rc != SQLITE_BUSY || std::chrono::steady_clock::now() >= give_up) return rc;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    };
+    int rc = retry(kOthersTimeout, [&] {
+      return sqlite3_exec(db_, "PRAGMA journal_mode=DELETE", nullptr, nullptr, nullptr);
+    });
+    if (rc == SQLITE_OK) return true;
+    if (rc == SQLITE_BUSY) {
+      rc = retry(kQueriesTimeout, [&] {
+        int log = 0, done = 0;
+        const int r =
+            sqlite3_wal_checkpoint_v2(db_, nullptr, SQLITE_CHECKPOINT_TRUNCATE, &log, &done);
+        return r == SQLITE_OK && log != 0 ? SQLITE_BUSY : r;  // truncated: the log is empty
+      });
+      if (rc == SQLITE_OK) return false;
     }
+    throw Error(Error::Kind::io,
+                path_.string() + ": " + sqlite3_errmsg(db_) +
+                    (rc == SQLITE_BUSY ? " (another connection kept reading it for 10 s)" : ""));
   }
 
   // Streams `record` into column `column` of crowddb_checkpoint's row `tick` (made with a

@@ -291,6 +291,45 @@ TEST(TrajectorySqlite, AReaderThatClosesTheFileSoonDelaysTheEndOnly) {
   EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.partial"));
   EXPECT_EQ(query(dir / "run.sqlite", "SELECT value FROM crowddb_run WHERE key = 'status'"),
             std::vector<std::string>{"complete"});
+  EXPECT_EQ(query(dir / "run.sqlite", "PRAGMA journal_mode"), std::vector<std::string>{"delete"});
+}
+
+// A reader that keeps the file open through the run's end (a viewer following the run, between
+// two of its queries): the run still ends complete, with every row in the file, which is left in
+// WAL mode (a rollback journal would need the file to itself); the reader reads on.
+TEST(TrajectorySqlite, AReaderThatKeepsTheFileOpenDoesNotCostTheEnd) {
+  test::TempDir dir;
+  Scenario sc = parse_scenario(kScenario, "two.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
+  write_ticks(*w, sc, sim, 250);
+  sqlite3* viewer = nullptr;
+  ASSERT_EQ(
+      sqlite3_open_v2((dir / "run.sqlite.partial").c_str(), &viewer, SQLITE_OPEN_READONLY, nullptr),
+      SQLITE_OK);
+  const auto frames_seen = [viewer] {
+    sqlite3_stmt* st = nullptr;
+    sqlite3_prepare_v2(viewer, "SELECT count(*) FROM frame_data", -1, &st, nullptr);
+    const int64_t n = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int64(st, 0) : -1;
+    sqlite3_finalize(st);  // the query done, the connection stays open
+    return n;
+  };
+  EXPECT_GT(frames_seen(), 100);
+  try {
+    w->finish({});
+  } catch (const Error& e) {
+    ADD_FAILURE() << e.what();
+  }
+  for (const char* left :
+       {"run.sqlite.partial", "run.sqlite.partial-wal", "run.sqlite.partial-shm"})
+    EXPECT_FALSE(std::filesystem::exists(dir / left)) << left;
+  EXPECT_EQ(query(dir / "run.sqlite", "SELECT value FROM crowddb_run WHERE key = 'status'"),
+            std::vector<std::string>{"complete"});
+  EXPECT_EQ(query(dir / "run.sqlite", "SELECT count(*) FROM frame_data"),
+            std::vector<std::string>{"251"});  // frames 0 to 250
+  EXPECT_EQ(query(dir / "run.sqlite", "PRAGMA journal_mode"), std::vector<std::string>{"wal"});
+  EXPECT_EQ(frames_seen(), 251);
+  sqlite3_close(viewer);
 }
 
 // A checkpoint goes into the output streamed, a megabyte at a time, never whole in memory: what
