@@ -270,7 +270,7 @@ void close(PySimulation& p) {
   info.ticks = p.sim->ticks();
   info.final_hash = p.sim->state_hash();
   auto w = std::move(p.writer);
-  py::gil_scoped_release release;  // finishing may wait for a reader of the file (up to 10 s)
+  py::gil_scoped_release release;  // finishing may wait for a reader of the file (seconds)
   w->finish(info);
 }
 

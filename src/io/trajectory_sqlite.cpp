@@ -517,16 +517,17 @@ class SqliteWriter final : public TrajectoryWriter {
     if (rc == SQLITE_OK) return true;
     if (rc == SQLITE_BUSY) {
       rc = retry(kQueriesTimeout, [&] {
-        int log = 0, done = 0;
-        const int r =
-            sqlite3_wal_checkpoint_v2(db_, nullptr, SQLITE_CHECKPOINT_TRUNCATE, &log, &done);
-        return r == SQLITE_OK && log != 0 ? SQLITE_BUSY : r;  // truncated: the log is empty
+        return sqlite3_wal_checkpoint_v2(db_, nullptr, SQLITE_CHECKPOINT_TRUNCATE, nullptr,
+                                         nullptr);
       });
       if (rc == SQLITE_OK) return false;
+      if (rc == SQLITE_BUSY)
+        throw Error(Error::Kind::io,
+                    path_.string() + ": another program kept reading the file for " +
+                        std::to_string((kOthersTimeout + kQueriesTimeout).count()) +
+                        " s at the run's end; every row is in " + partial_ + " and its -wal file");
     }
-    throw Error(Error::Kind::io,
-                path_.string() + ": " + sqlite3_errmsg(db_) +
-                    (rc == SQLITE_BUSY ? " (another connection kept reading it for 10 s)" : ""));
+    throw Error(Error::Kind::io, path_.string() + ": " + sqlite3_errmsg(db_));
   }
 
   // Streams `record` into column `column` of crowddb_checkpoint's row `tick` (made with a

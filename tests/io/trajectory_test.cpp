@@ -265,10 +265,8 @@ TEST(TrajectorySqlite, BatchesAreCommittedWhileTheRunGoesOn) {
             std::vector<std::string>{"complete"});
 }
 
-// A reader with the file open when the run ends (in the middle of a query here) delays the end
-// until it closes the file (up to 10 s); it does not cost it: the output is finished, not left
-// as a .partial. (One that keeps the file open past 10 s still does: SQLite can leave its
-// write-ahead log only with the file to itself.)
+// A reader with the file open when the run ends (in the middle of a query here) that closes it
+// within 2 s delays the end only: the output is finished in a rollback journal, one file.
 TEST(TrajectorySqlite, AReaderThatClosesTheFileSoonDelaysTheEndOnly) {
   test::TempDir dir;
   Scenario sc = parse_scenario(kScenario, "two.json");
@@ -330,6 +328,34 @@ TEST(TrajectorySqlite, AReaderThatKeepsTheFileOpenDoesNotCostTheEnd) {
   EXPECT_EQ(query(dir / "run.sqlite", "PRAGMA journal_mode"), std::vector<std::string>{"wal"});
   EXPECT_EQ(frames_seen(), 251);
   sqlite3_close(viewer);
+}
+
+// A reader in the middle of a long query at the run's end (one that outlasts the 2 s wait for
+// the file): the end waits for the query, then empties the log into the file, left in WAL mode.
+TEST(TrajectorySqlite, AReaderInALongQueryIsWaitedFor) {
+  test::TempDir dir;
+  Scenario sc = parse_scenario(kScenario, "two.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
+  write_ticks(*w, sc, sim, 250);
+  auto reader =
+      std::make_unique<test::Rows>(dir / "run.sqlite.partial", "SELECT frame FROM trajectory_data");
+  ASSERT_TRUE(reader->next());  // its read transaction stays open until the statement is done
+  std::thread done_reading([&reader] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+    reader.reset();
+  });
+  try {
+    w->finish({});
+  } catch (const Error& e) {
+    ADD_FAILURE() << e.what();
+  }
+  done_reading.join();
+  EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.partial"));
+  EXPECT_EQ(query(dir / "run.sqlite", "SELECT value FROM crowddb_run WHERE key = 'status'"),
+            std::vector<std::string>{"complete"});
+  EXPECT_EQ(query(dir / "run.sqlite", "SELECT count(*) FROM frame_data"),
+            std::vector<std::string>{"251"});
 }
 
 // A checkpoint goes into the output streamed, a megabyte at a time, never whole in memory: what
