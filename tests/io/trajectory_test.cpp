@@ -265,19 +265,19 @@ TEST(TrajectorySqlite, BatchesAreCommittedWhileTheRunGoesOn) {
             std::vector<std::string>{"complete"});
 }
 
-// A reader with the file open when the run ends (in the middle of a query here) that closes it
-// within 2 s delays the end only: the output is finished in a rollback journal, one file.
-TEST(TrajectorySqlite, AReaderThatClosesTheFileSoonDelaysTheEndOnly) {
-  test::TempDir dir;
+// 250 ticks written to dir/run.sqlite, then finished while a reader is in the middle of a query
+// on the .partial (its read transaction open until the statement is done), which lets go of the
+// file after `hold`. Finishing must not fail; the output must be complete, frames 0 to 250.
+void finish_during_a_query(const test::TempDir& dir, std::chrono::milliseconds hold) {
   Scenario sc = parse_scenario(kScenario, "two.json");
   Simulation sim(std::move(sc.world), sc.config);
   auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
   write_ticks(*w, sc, sim, 250);  // 100 frames a batch at most: two committed
   auto reader =
       std::make_unique<test::Rows>(dir / "run.sqlite.partial", "SELECT frame FROM trajectory_data");
-  ASSERT_TRUE(reader->next());  // its read transaction stays open until the statement is done
-  std::thread done_reading([&reader] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ASSERT_TRUE(reader->next());
+  std::thread done_reading([&reader, hold] {
+    std::this_thread::sleep_for(hold);
     reader.reset();
   });
   try {
@@ -289,6 +289,15 @@ TEST(TrajectorySqlite, AReaderThatClosesTheFileSoonDelaysTheEndOnly) {
   EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.partial"));
   EXPECT_EQ(query(dir / "run.sqlite", "SELECT value FROM crowddb_run WHERE key = 'status'"),
             std::vector<std::string>{"complete"});
+  EXPECT_EQ(query(dir / "run.sqlite", "SELECT count(*) FROM frame_data"),
+            std::vector<std::string>{"251"});
+}
+
+// A reader with the file open when the run ends (in the middle of a query here) that closes it
+// within 2 s delays the end only: the output is finished in a rollback journal, one file.
+TEST(TrajectorySqlite, AReaderThatClosesTheFileSoonDelaysTheEndOnly) {
+  test::TempDir dir;
+  finish_during_a_query(dir, std::chrono::milliseconds(300));
   EXPECT_EQ(query(dir / "run.sqlite", "PRAGMA journal_mode"), std::vector<std::string>{"delete"});
 }
 
@@ -331,31 +340,10 @@ TEST(TrajectorySqlite, AReaderThatKeepsTheFileOpenDoesNotCostTheEnd) {
 }
 
 // A reader in the middle of a long query at the run's end (one that outlasts the 2 s wait for
-// the file): the end waits for the query, then empties the log into the file, left in WAL mode.
+// the file): the end waits for the query, then empties the log into the file.
 TEST(TrajectorySqlite, AReaderInALongQueryIsWaitedFor) {
   test::TempDir dir;
-  Scenario sc = parse_scenario(kScenario, "two.json");
-  Simulation sim(std::move(sc.world), sc.config);
-  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
-  write_ticks(*w, sc, sim, 250);
-  auto reader =
-      std::make_unique<test::Rows>(dir / "run.sqlite.partial", "SELECT frame FROM trajectory_data");
-  ASSERT_TRUE(reader->next());  // its read transaction stays open until the statement is done
-  std::thread done_reading([&reader] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(2500));
-    reader.reset();
-  });
-  try {
-    w->finish({});
-  } catch (const Error& e) {
-    ADD_FAILURE() << e.what();
-  }
-  done_reading.join();
-  EXPECT_FALSE(std::filesystem::exists(dir / "run.sqlite.partial"));
-  EXPECT_EQ(query(dir / "run.sqlite", "SELECT value FROM crowddb_run WHERE key = 'status'"),
-            std::vector<std::string>{"complete"});
-  EXPECT_EQ(query(dir / "run.sqlite", "SELECT count(*) FROM frame_data"),
-            std::vector<std::string>{"251"});
+  finish_during_a_query(dir, std::chrono::milliseconds(2500));
 }
 
 // A checkpoint goes into the output streamed, a megabyte at a time, never whole in memory: what
