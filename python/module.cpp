@@ -17,6 +17,7 @@
 #include "crowddb/simulation.hpp"
 #include "io/trajectory.hpp"
 #include "metrics/run.hpp"
+#include "util/streamed_record.hpp"
 
 namespace py = pybind11;
 using namespace pybind11::literals;
@@ -279,19 +280,15 @@ void close(PySimulation& p) {
 // string of it besides (at 10^6 agents 194 MB, which as a string grows and then copies).
 py::bytes save_state(PySimulation& p) {
   PySimulation::Busy busy(p);
-  std::size_t size = 0;
-  p.get().save_state([&size](std::string_view piece) { size += piece.size(); });
+  const StreamedRecord state = [&p](const ByteSink& sink) { p.get().save_state(sink); };
+  const std::size_t size = streamed_size(state);
   py::object out = py::reinterpret_steal<py::object>(
       PyBytes_FromStringAndSize(nullptr, static_cast<Py_ssize_t>(size)));
   if (!out) throw py::error_already_set();
-  char* at = PyBytes_AS_STRING(out.ptr());
-  std::size_t written = 0;
-  p.get().save_state([&](std::string_view piece) {
-    if (piece.size() > size - written) throw std::logic_error("save_state: the state grew");
-    std::memcpy(at + written, piece.data(), piece.size());
-    written += piece.size();
+  char* const room = PyBytes_AS_STRING(out.ptr());
+  stream_into(state, size, [room](std::string_view piece, std::size_t at) {
+    std::memcpy(room + at, piece.data(), piece.size());
   });
-  if (written != size) throw std::logic_error("save_state: the state shrank");
   return py::reinterpret_borrow<py::bytes>(out);
 }
 

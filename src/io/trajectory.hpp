@@ -12,7 +12,6 @@
 #pragma once
 
 #include <filesystem>
-#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -20,7 +19,7 @@
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
 #include "metrics/steerbench.hpp"
-#include "util/byte_codec.hpp"
+#include "util/streamed_record.hpp"
 
 namespace crowddb::io {
 
@@ -73,9 +72,8 @@ class TrajectoryWriter {
   // them (table crowddb_checkpoint, latest only); the CSV writer ignores them. Each record
   // comes as a function that streams its bytes to a sink, the same bytes at every call, so
   // that it need never be in memory whole.
-  using RecordBytes = std::function<void(const ByteSink&)>;
-  virtual void checkpoint(uint64_t /*tick*/, const RecordBytes& /*engine*/,
-                          const RecordBytes& /*run*/) {}
+  virtual void checkpoint(uint64_t /*tick*/, const StreamedRecord& /*engine*/,
+                          const StreamedRecord& /*run*/) {}
   // Stops an unfinished run: keeps everything written so far in PATH.partial, marked incomplete
   // up to `tick` because of `reason`, and releases the lock. Returns the file kept, or an empty
   // path when nothing was begun. Safe to call at any time, never throws.

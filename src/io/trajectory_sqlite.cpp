@@ -316,15 +316,9 @@ class SqliteWriter final : public TrajectoryWriter {
   // to count its bytes, then into a blob of that size made in place (a zeroblob costs SQLite no
   // memory), so that neither it nor SQLite ever holds a checkpoint whole (at 10^6 agents some
   // hundred MB; checkpoints are minutes apart).
-  void checkpoint(uint64_t tick, const RecordBytes& engine, const RecordBytes& run) override {
+  void checkpoint(uint64_t tick, const StreamedRecord& engine, const StreamedRecord& run) override {
     behind_->drain();
-    const auto size_of = [](const RecordBytes& record) {
-      sqlite3_int64 bytes = 0;
-      record(
-          [&bytes](std::string_view piece) { bytes += static_cast<sqlite3_int64>(piece.size()); });
-      return bytes;
-    };
-    const sqlite3_int64 engine_bytes = size_of(engine), run_bytes = size_of(run);
+    const std::size_t engine_bytes = streamed_size(engine), run_bytes = streamed_size(run);
     // In a savepoint: a record that fails half way (a full disk, an error while it is streamed)
     // leaves the previous checkpoint as it was, not a zero-filled one that a stop would commit.
     exec("SAVEPOINT checkpoint");
@@ -333,8 +327,8 @@ class SqliteWriter final : public TrajectoryWriter {
       Statement cp(db_, "INSERT INTO crowddb_checkpoint VALUES (?, zeroblob(?), zeroblob(?))",
                    path_.string());
       sqlite3_bind_int64(cp.get(), 1, static_cast<int64_t>(tick));
-      sqlite3_bind_int64(cp.get(), 2, engine_bytes);
-      sqlite3_bind_int64(cp.get(), 3, run_bytes);
+      sqlite3_bind_int64(cp.get(), 2, static_cast<sqlite3_int64>(engine_bytes));
+      sqlite3_bind_int64(cp.get(), 3, static_cast<sqlite3_int64>(run_bytes));
       step(cp);
       write_blob("engine", static_cast<sqlite3_int64>(tick), engine, engine_bytes);
       write_blob("progress", static_cast<sqlite3_int64>(tick), run, run_bytes);
@@ -531,29 +525,20 @@ class SqliteWriter final : public TrajectoryWriter {
   }
 
   // Streams `record` into column `column` of crowddb_checkpoint's row `tick` (made with a
-  // zeroblob of `bytes`); fails if the record does not fill it exactly.
-  void write_blob(const char* column, sqlite3_int64 tick, const RecordBytes& record,
-                  sqlite3_int64 bytes) {
+  // zeroblob of `bytes`).
+  void write_blob(const char* column, sqlite3_int64 tick, const StreamedRecord& record,
+                  std::size_t bytes) {
     sqlite3_blob* blob = nullptr;
     if (sqlite3_blob_open(db_, "main", "crowddb_checkpoint", column, tick, 1, &blob) != SQLITE_OK) {
       sqlite3_blob_close(blob);
       throw Error(Error::Kind::io, path_.string() + ": checkpoint: " + sqlite3_errmsg(db_));
     }
     const std::unique_ptr<sqlite3_blob, int (*)(sqlite3_blob*)> owned(blob, sqlite3_blob_close);
-    sqlite3_int64 at = 0;
-    record([&](std::string_view piece) {
-      if (piece.size() > static_cast<std::size_t>(bytes - at) ||
-          sqlite3_blob_write(blob, piece.data(), static_cast<int>(piece.size()),
+    stream_into(record, bytes, [&](std::string_view piece, std::size_t at) {
+      if (sqlite3_blob_write(blob, piece.data(), static_cast<int>(piece.size()),
                              static_cast<int>(at)) != SQLITE_OK)
-        throw Error(Error::Kind::io, path_.string() + ": checkpoint: " +
-                                         (piece.size() > static_cast<std::size_t>(bytes - at)
-                                              ? std::string("the record grew between two reads")
-                                              : std::string(sqlite3_errmsg(db_))));
-      at += static_cast<sqlite3_int64>(piece.size());
+        throw Error(Error::Kind::io, path_.string() + ": checkpoint: " + sqlite3_errmsg(db_));
     });
-    if (at != bytes)
-      throw Error(Error::Kind::io,
-                  path_.string() + ": checkpoint: the record shrank between two reads");
   }
 
   void exec(const char* sql) {
