@@ -16,7 +16,7 @@
 #include <unordered_map>
 
 #include "crowddb/scenario.hpp"
-#include "io/disc_grid.hpp"
+#include "world/placement_grid.hpp"
 #include "io/scenario_doc.hpp"
 #include "io/walkable_wkt.hpp"
 #include "steer/model.hpp"
@@ -257,7 +257,7 @@ struct Loader {
   std::map<std::string, uint32_t> goal_rows;
   std::vector<AgentSpec> agents;               // in insertion order
   std::vector<std::vector<Vec2>> routes;       // per agent (via points)
-  std::unique_ptr<io::DiscGrid> placed;        // every agent placed so far
+  std::unique_ptr<PlacementGrid> placed;        // every agent placed so far
   const io::WalkableArea* walkable = nullptr;  // the "walkable" WKT, if given
   std::size_t walkable_pieces = 0;             // polygons [0, walkable_pieces) are its blocked area
   std::vector<std::size_t> circle_src,
@@ -831,10 +831,10 @@ struct Loader {
     const std::span<const AgentSpec> suspects(agents.data(), may_overlap_end);
     double rmax = 0;
     for (const AgentSpec& s : suspects) rmax = std::max(rmax, s.radius);
-    io::DiscGrid all(2 * rmax);
+    PlacementGrid all(2 * rmax);
     all.reserve(suspects.size());
     for (const AgentSpec& s : suspects) all.add(s.x, s.y, s.radius);
-    const io::DiscGrid::PairCount pairs = all.count_pairs(kOverlapCountCap);
+    const PlacementGrid::PairCount pairs = all.count_pairs(kOverlapCountCap);
     if (pairs.found)
       sc.warnings.push_back(
           "agents spawned overlapping: " + std::string(pairs.capped ? "at least " : "") +
@@ -1108,7 +1108,7 @@ Scenario parse_document(std::string_view text, const std::string& source, const 
   loader.read_obstacles(root);
   loader.check_goals(root);
   double rmax = 1;
-  loader.placed = std::make_unique<io::DiscGrid>(2 * rmax);
+  loader.placed = std::make_unique<PlacementGrid>(2 * rmax);
   // Cell size for the placement grid: twice the largest radius any agent may have.
   if (root.has("groups") && root.raw("groups").is_array())
     for (const json& g : root.raw("groups"))
@@ -1118,7 +1118,7 @@ Scenario parse_document(std::string_view text, const std::string& source, const 
         if (r.is_array() && r.size() == 2 && r[1].is_number())
           rmax = std::max(rmax, r[1].get<double>());
       }
-  if (std::isfinite(rmax)) loader.placed = std::make_unique<io::DiscGrid>(2 * rmax);
+  if (std::isfinite(rmax)) loader.placed = std::make_unique<PlacementGrid>(2 * rmax);
   loader.read_agents(root);
   loader.read_groups(root);
   loader.read_sources(root);

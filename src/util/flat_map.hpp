@@ -1,7 +1,7 @@
 // A map from 64-bit keys to small values that only grows: open addressing with linear probing,
 // at most half full, one value reserved to mark an empty slot. For tables of up to one entry
 // per agent that are looked up once per agent and never erased (SteerBench's measured ids,
-// io::DiscGrid's cells): 12–16 bytes a slot where a node-based map costs 40 or more an entry and a
+// PlacementGrid's cells): 12–16 bytes a slot where a node-based map costs 40 or more an entry and a
 // cache miss or two a lookup.
 #pragma once
 

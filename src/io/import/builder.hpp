@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "crowddb/world.hpp"
-#include "io/disc_grid.hpp"
 #include "io/import/importer.hpp"
 #include "util/rng.hpp"
+#include "world/placement_grid.hpp"
 
 namespace crowddb::io {
 
@@ -87,7 +87,7 @@ class DocBuilder {
   Box extent_;
   std::vector<std::vector<Vec2>> polygons_;
   std::vector<Disc> circles_;
-  DiscGrid agents_{2.0};  // agent discs (cells of 2 m: agents are 0.2-0.5 m)
+  PlacementGrid agents_{2.0};  // agent discs (cells of 2 m: agents are 0.2-0.5 m)
 };
 
 // Distance formatting for messages: shortest form.

@@ -1,6 +1,7 @@
-// A spatial hash of discs for placing agents without overlaps: the scenario reader's groups and
-// the importers' random placement. Exact (the same predicate as the engine's overlap test) and
-// bounded: a query window wider than the discs are many scans the discs instead of the cells.
+// A spatial hash of discs for placing agents without overlaps: the scenario reader's groups, the
+// importers' random placement and the sources' free spots. Exact (the same predicate as the
+// engine's overlap test) and bounded: a query window wider than the discs are many scans the discs
+// instead of the cells. Discs are added one at a time (index::DiscGrid is built over a table).
 #pragma once
 
 #include <algorithm>
@@ -11,11 +12,11 @@
 #include "util/flat_map.hpp"
 #include "world/geometry.hpp"
 
-namespace crowddb::io {
+namespace crowddb {
 
-class DiscGrid {
+class PlacementGrid {
  public:
-  explicit DiscGrid(double cell) : cell_(cell > 0 ? cell : 1) {}
+  explicit PlacementGrid(double cell) : cell_(cell > 0 ? cell : 1) {}
   void add(double x, double y, double r) {
     const std::size_t i = discs_.size();
     rmax_ = std::max(rmax_, r);
@@ -103,4 +104,4 @@ class DiscGrid {
   FlatMap<std::size_t, kEnd> heads_;
 };
 
-}  // namespace crowddb::io
+}  // namespace crowddb
