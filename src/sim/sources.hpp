@@ -20,7 +20,10 @@ namespace crowddb::sim {
 
 class SourceEmitter {
  public:
-  SourceEmitter(const World& world, uint64_t seed);
+  // How a drawn spot is tested against the agents: through a placement grid, or (the tests'
+  // oracle) against every agent near the area and every one entering this tick, one by one.
+  enum class FreeSpots { grid, naive };
+  SourceEmitter(const World& world, uint64_t seed, FreeSpots free_spots = FreeSpots::grid);
   // Inserts (as pending changes) the agents that enter at the start of tick `tick` (time
   // (tick - 1) dt). Returns how many.
   std::size_t emit(World& world, const SimConfig& cfg, const StaticScene& scene, uint64_t tick);
@@ -32,11 +35,15 @@ class SourceEmitter {
 
  private:
   static constexpr int kTries = 20;
+  // Free-spot tests one by one, in passes over the discs they look at, before a grid is built
+  // over those discs: building it costs some 50-100 tests a disc (a hash table's cache misses).
+  static constexpr uint64_t kScansBeforeGrid = 64;
   struct State {
     uint64_t entered = 0;
     Rng rng;
   };
   std::vector<State> state_;
+  bool naive_;
 };
 
 // Agents a source lets in over its whole life: count, or fewer when `end` comes first.

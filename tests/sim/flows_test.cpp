@@ -6,9 +6,11 @@
 #include <cstdint>
 #include <map>
 
+#include "crowddb/query.hpp"
 #include "crowddb/scenario.hpp"
 #include "crowddb/simulation.hpp"
 #include "sim/sources.hpp"
+#include "util/rng.hpp"
 
 namespace crowddb {
 namespace {
@@ -291,6 +293,76 @@ TEST(Sources, AreDeterministicAcrossThreads) {
     for (uint64_t s = 0; s < r.sc.ticks; ++s) h[k].push_back(r.sim->step().state_hash);
   }
   EXPECT_EQ(h[0], h[1]);
+}
+
+// The sources' free spots through the placement grid are the naive loop's, spot for spot: a
+// crowd of mixed radii (some piled on one spot, pairs touching exactly, one disc of 5 m), three
+// sources over it (a box, a triangle with radii drawn, a small box inside the crowd), obstacles
+// and walls, hundreds of agents due in a tick and areas filling up.
+TEST(Sources, FreeSpotsThroughTheGridAreTheNaiveLoops) {
+  for (const uint64_t seed : {1u, 2u, 3u}) {
+    SCOPED_TRACE(seed);
+    const auto world = [seed] {
+      Scenario sc = parse_scenario(R"({"bounds": [0, 0, 60, 60],
+        "goals": [{"name": "g", "x": 59, "y": 30}],
+        "obstacles": [{"type": "circle", "x": 20, "y": 20, "radius": 3},
+                      {"type": "polygon", "vertices": [[40, 40], [45, 40], [45, 45]]}],
+        "sources": [{"area": [0, 0, 30, 30], "rate": 4000, "count": 1500, "goal": "g"},
+                    {"polygon": [[10, 10], [50, 10], [30, 50]], "rate": 3000, "count": 900,
+                     "radius": [0.1, 0.8], "goal": "g"},
+                    {"area": [29, 29, 31, 31], "rate": 1000, "count": 50, "goal": "g"}]})",
+                                   "sources.json");
+      World w = std::move(sc.world);
+      Rng rng(seed);
+      for (int k = 0; k < 2500; ++k) {
+        AgentSpec a;
+        a.x = rng.uniform(0.5, 59.5);
+        a.y = rng.uniform(0.5, 59.5);
+        a.radius = rng.uniform(0.1, 0.6);
+        a.goal = 0;
+        try {
+          w.insert(a);
+          if (k % 100 == 0) {  // the same spot twice, and a disc touching it exactly
+            w.insert(a);
+            a.x += 2 * a.radius;
+            w.insert(a);
+          }
+        } catch (const Error&) {  // in an obstacle
+        }
+      }
+      AgentSpec big;
+      big.x = 50;
+      big.y = 15;
+      big.radius = 5;
+      big.goal = 0;
+      w.insert(big);
+      w.apply_pending();
+      return w;
+    };
+    World by_grid = world(), by_loop = world();
+    SimConfig cfg;
+    cfg.dt = 0.1;
+    const StaticScene scene({by_grid.circles().begin(), by_grid.circles().end()},
+                            {by_grid.polygons().begin(), by_grid.polygons().end()}, 0.1,
+                            ObstacleCharges::none, &by_grid.bounds());
+    sim::SourceEmitter grid(by_grid, seed),
+        loop(by_loop, seed, sim::SourceEmitter::FreeSpots::naive);
+    std::size_t entered = 0;
+    for (uint64_t tick = 1; tick <= 6; ++tick) {
+      const std::size_t made = grid.emit(by_grid, cfg, scene, tick);
+      ASSERT_EQ(made, loop.emit(by_loop, cfg, scene, tick)) << "tick " << tick;
+      entered += made;
+      by_grid.apply_pending();
+      by_loop.apply_pending();
+      const AgentTable &a = by_grid.agents(), &b = by_loop.agents();
+      ASSERT_EQ(a.size(), b.size());
+      for (std::size_t i = 0; i < a.size(); ++i)
+        ASSERT_TRUE(a.x[i] == b.x[i] && a.y[i] == b.y[i] && a.radius[i] == b.radius[i])
+            << "tick " << tick << " row " << i;
+    }
+    EXPECT_GT(entered, 300u);              // many entered
+    EXPECT_GT(grid.waiting(by_grid), 0u);  // and some found no room
+  }
 }
 
 // Two people meet head-on in a corridor only one body wide. Under the collision-free speed model
