@@ -69,9 +69,9 @@ class TrajectoryWriter {
   virtual void finish(const RunInfo& info) = 0;
   // A checkpoint after `tick` (whose frame and metrics are written): the simulation's state
   // and the run's, committed at once with every frame up to it. Only the SQLite writer keeps
-  // them (table crowddb_checkpoint, latest only); the CSV writer ignores them. Each record
-  // comes as a function that streams its bytes to a sink, the same bytes at every call, so
-  // that it need never be in memory whole.
+  // them (tables crowddb_checkpoint and crowddb_checkpoint_piece, latest only); the CSV writer
+  // ignores them. Each record comes as a function that streams its bytes to a sink, the same bytes
+  // at every call, so that it need never be in memory whole.
   virtual void checkpoint(uint64_t /*tick*/, const StreamedRecord& /*engine*/,
                           const StreamedRecord& /*run*/) {}
   // Stops an unfinished run: keeps everything written so far in PATH.partial, marked incomplete
@@ -80,8 +80,11 @@ class TrajectoryWriter {
   virtual std::filesystem::path stop(uint64_t tick, const std::string& reason) noexcept = 0;
 };
 
+// `checkpoint_piece`: the longest blob a checkpoint record is kept in, longer records in several
+// (0: 256 MiB; SQLite keeps a value to 10^9 bytes); tests make records of several pieces.
 std::unique_ptr<TrajectoryWriter> make_sqlite_writer(const std::filesystem::path& path,
-                                                     uint32_t every);
+                                                     uint32_t every,
+                                                     std::size_t checkpoint_piece = 0);
 std::unique_ptr<TrajectoryWriter> make_csv_writer(const std::filesystem::path& path,
                                                   uint32_t every);
 

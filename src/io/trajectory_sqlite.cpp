@@ -12,6 +12,10 @@
 //                            resume_options (the command line's settings, for crowddb resume)
 //   crowddb_checkpoint(tick, engine, progress): the latest checkpoint of an unfinished run
 //                            (Simulation::save_state and the run's counters; emptied at finish)
+//   crowddb_checkpoint_piece(record, part, bytes): the rest of a record longer than one piece
+//                            (kCheckpointPiece), parts 1, 2, ... in order after the first piece
+//                            in crowddb_checkpoint (SQLite keeps a value to 10^9 bytes; the state
+//                            is ~200 bytes an agent, 10^9 bytes at 5·10^6 agents)
 // WAL journal, frames committed in batches (io/trajectory.hpp); renamed into place at the end.
 // A frame's rows go in ascending id, so the (frame, id) indices, made with the tables, grow at
 // their ends as rows come (no index to build at the end, and a .partial file has them too).
@@ -52,6 +56,9 @@ constexpr std::chrono::seconds kSecondsPerBatch{2};
 constexpr std::chrono::seconds kOthersTimeout{2};
 // And how long it then waits for them to finish a query, to take every row into the file.
 constexpr std::chrono::seconds kQueriesTimeout{10};
+// The longest blob a checkpoint record is kept in (a record may be longer: the rest goes into
+// crowddb_checkpoint_piece). Below SQLite's 10^9 bytes a value and blob I/O's 2^31 offsets.
+constexpr std::size_t kCheckpointPiece = std::size_t{1} << 28;
 
 // INSERT INTO table VALUES (?, ...), ... with `rows` rows of `columns` values.
 std::string insert_rows_sql(const char* table, int columns, std::size_t rows) {
@@ -115,8 +122,11 @@ std::string resume_options(const Scenario& sc) {
 
 class SqliteWriter final : public TrajectoryWriter {
  public:
-  SqliteWriter(std::filesystem::path path, uint32_t every)
-      : path_(std::move(path)), partial_(path_.string() + ".partial"), every_(every ? every : 1) {}
+  SqliteWriter(std::filesystem::path path, uint32_t every, std::size_t checkpoint_piece)
+      : path_(std::move(path)),
+        partial_(path_.string() + ".partial"),
+        every_(every ? every : 1),
+        piece_(checkpoint_piece ? checkpoint_piece : kCheckpointPiece) {}
   ~SqliteWriter() override {
     // UINT64_MAX: stop() takes the last tick written once the writer's thread is done.
     if (db_) stop(UINT64_MAX, "the run ended without finishing its output");
@@ -169,6 +179,7 @@ class SqliteWriter final : public TrajectoryWriter {
     exec(
         "CREATE TABLE crowddb_checkpoint (tick INTEGER PRIMARY KEY, engine BLOB NOT NULL, "
         "progress BLOB NOT NULL)");
+    create_piece_table();
     exec(
         "CREATE TABLE crowddb_goals (goal INTEGER PRIMARY KEY, name TEXT NOT NULL, x REAL NOT "
         "NULL, "
@@ -313,7 +324,7 @@ class SqliteWriter final : public TrajectoryWriter {
   }
 
   // On this thread, once the frames before it are written. A record is streamed twice: once
-  // to count its bytes, then into a blob of that size made in place (a zeroblob costs SQLite no
+  // to count its bytes, then into blobs of that size made in place (a zeroblob costs SQLite no
   // memory), so that neither it nor SQLite ever holds a checkpoint whole (at 10^6 agents some
   // hundred MB; checkpoints are minutes apart).
   void checkpoint(uint64_t tick, const StreamedRecord& engine, const StreamedRecord& run) override {
@@ -324,14 +335,15 @@ class SqliteWriter final : public TrajectoryWriter {
     exec("SAVEPOINT checkpoint");
     try {
       exec("DELETE FROM crowddb_checkpoint");
+      exec("DELETE FROM crowddb_checkpoint_piece");
       Statement cp(db_, "INSERT INTO crowddb_checkpoint VALUES (?, zeroblob(?), zeroblob(?))",
                    path_.string());
       sqlite3_bind_int64(cp.get(), 1, static_cast<int64_t>(tick));
-      sqlite3_bind_int64(cp.get(), 2, static_cast<sqlite3_int64>(engine_bytes));
-      sqlite3_bind_int64(cp.get(), 3, static_cast<sqlite3_int64>(run_bytes));
+      sqlite3_bind_int64(cp.get(), 2, static_cast<sqlite3_int64>(std::min(engine_bytes, piece_)));
+      sqlite3_bind_int64(cp.get(), 3, static_cast<sqlite3_int64>(std::min(run_bytes, piece_)));
       step(cp);
-      write_blob("engine", static_cast<sqlite3_int64>(tick), engine, engine_bytes);
-      write_blob("progress", static_cast<sqlite3_int64>(tick), run, run_bytes);
+      write_record("engine", static_cast<sqlite3_int64>(tick), engine, engine_bytes);
+      write_record("progress", static_cast<sqlite3_int64>(tick), run, run_bytes);
     } catch (...) {
       sqlite3_exec(db_, "ROLLBACK TO checkpoint; RELEASE checkpoint", nullptr, nullptr, nullptr);
       throw;
@@ -359,6 +371,7 @@ class SqliteWriter final : public TrajectoryWriter {
     exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA synchronous=NORMAL");
     exec("BEGIN");
+    create_piece_table();  // a .partial of a crowddb before 2026-12-06 has none
     {
       Statement g(db_, "SELECT hash, wkt FROM geometry LIMIT 1", path_.string());
       if (sqlite3_step(g.get()) != SQLITE_ROW)
@@ -386,6 +399,7 @@ class SqliteWriter final : public TrajectoryWriter {
   void finish(const RunInfo& info) override {
     behind_->drain();
     exec("DELETE FROM crowddb_checkpoint");  // a finished run has nothing to resume
+    exec("DELETE FROM crowddb_checkpoint_piece");
     {
       Statement run(db_, "INSERT INTO crowddb_run VALUES (?, ?)", path_.string());
       for (const auto& [k, v] :
@@ -478,6 +492,16 @@ class SqliteWriter final : public TrajectoryWriter {
     return buf;
   }
 
+  void create_piece_table() {
+    exec(
+        "CREATE TABLE IF NOT EXISTS crowddb_checkpoint_piece (record TEXT NOT NULL, part INTEGER "
+        "NOT NULL, bytes BLOB NOT NULL, PRIMARY KEY (record, part))");
+    // Never more than this connection's SQLite takes in a value (10^9 bytes unless built
+    // otherwise).
+    piece_ =
+        std::min(piece_, static_cast<std::size_t>(sqlite3_limit(db_, SQLITE_LIMIT_LENGTH, -1)));
+  }
+
   void create_indices() {
     exec("CREATE INDEX IF NOT EXISTS frame_id_idx ON trajectory_data(frame, id)");
     exec("CREATE INDEX IF NOT EXISTS state_frame_id_idx ON crowddb_agent_state(frame, id)");
@@ -524,20 +548,53 @@ class SqliteWriter final : public TrajectoryWriter {
     throw Error(Error::Kind::io, path_.string() + ": " + sqlite3_errmsg(db_));
   }
 
-  // Streams `record` into column `column` of crowddb_checkpoint's row `tick` (made with a
-  // zeroblob of `bytes`).
-  void write_blob(const char* column, sqlite3_int64 tick, const StreamedRecord& record,
-                  std::size_t bytes) {
-    sqlite3_blob* blob = nullptr;
-    if (sqlite3_blob_open(db_, "main", "crowddb_checkpoint", column, tick, 1, &blob) != SQLITE_OK) {
-      sqlite3_blob_close(blob);
-      throw Error(Error::Kind::io, path_.string() + ": checkpoint: " + sqlite3_errmsg(db_));
+  // Streams `record` (`bytes` long) into column `column` of crowddb_checkpoint's row `tick`
+  // (made with a zeroblob of its first piece's size) and, past one piece, into rows of
+  // crowddb_checkpoint_piece made here.
+  void write_record(const char* column, sqlite3_int64 tick, const StreamedRecord& record,
+                    std::size_t bytes) {
+    struct Place {
+      const char* table;
+      const char* column;
+      sqlite3_int64 row;
+    };
+    std::vector<Place> places{{"crowddb_checkpoint", column, tick}};
+    if (bytes > piece_) {
+      Statement more(db_, "INSERT INTO crowddb_checkpoint_piece VALUES (?, ?, zeroblob(?))",
+                     path_.string());
+      for (std::size_t part = 1; part * piece_ < bytes; ++part) {
+        sqlite3_bind_text(more.get(), 1, column, -1, SQLITE_STATIC);
+        sqlite3_bind_int64(more.get(), 2, static_cast<sqlite3_int64>(part));
+        sqlite3_bind_int64(more.get(), 3,
+                           static_cast<sqlite3_int64>(std::min(piece_, bytes - part * piece_)));
+        step(more);
+        places.push_back({"crowddb_checkpoint_piece", "bytes", sqlite3_last_insert_rowid(db_)});
+      }
     }
-    const std::unique_ptr<sqlite3_blob, int (*)(sqlite3_blob*)> owned(blob, sqlite3_blob_close);
+    const auto failed = [&] {
+      return Error(Error::Kind::io, path_.string() + ": checkpoint: " + sqlite3_errmsg(db_));
+    };
+    std::unique_ptr<sqlite3_blob, int (*)(sqlite3_blob*)> blob(nullptr, sqlite3_blob_close);
+    std::size_t open = places.size();  // the part `blob` is open on
     stream_into(record, bytes, [&](std::string_view piece, std::size_t at) {
-      if (sqlite3_blob_write(blob, piece.data(), static_cast<int>(piece.size()),
-                             static_cast<int>(at)) != SQLITE_OK)
-        throw Error(Error::Kind::io, path_.string() + ": checkpoint: " + sqlite3_errmsg(db_));
+      while (!piece.empty()) {
+        const std::size_t part = at / piece_, offset = at % piece_;
+        const std::size_t n = std::min(piece.size(), piece_ - offset);
+        if (part != open) {
+          blob.reset();
+          sqlite3_blob* b = nullptr;
+          const int rc = sqlite3_blob_open(db_, "main", places[part].table, places[part].column,
+                                           places[part].row, 1, &b);
+          blob.reset(b);
+          if (rc != SQLITE_OK) throw failed();
+          open = part;
+        }
+        if (sqlite3_blob_write(blob.get(), piece.data(), static_cast<int>(n),
+                               static_cast<int>(offset)) != SQLITE_OK)
+          throw failed();
+        piece.remove_prefix(n);
+        at += n;
+      }
     });
   }
 
@@ -565,6 +622,7 @@ class SqliteWriter final : public TrajectoryWriter {
   std::filesystem::path path_;
   std::string partial_;
   uint32_t every_;
+  std::size_t piece_;  // [bytes] the longest blob of a checkpoint record
   sqlite3* db_ = nullptr;
   Statement traj_[2], state_[2];  // one row, kRowsPerInsert rows
   Statement frame_, metric_, set_run_;
@@ -578,11 +636,84 @@ class SqliteWriter final : public TrajectoryWriter {
   std::optional<WriteBehind> behind_;  // last: stopped before the rest goes
 };
 
+// The latest checkpoint's records into p.engine and p.progress, each read straight into its
+// place (SQLite's blob I/O: no copy of a piece in between): the first piece from
+// crowddb_checkpoint, the rest in order from crowddb_checkpoint_piece (absent in the files of a
+// crowddb before 2026-12-06).
+void read_checkpoint(sqlite3* db, const std::string& where, PartialRun& p) {
+  struct Piece {
+    const char* table;
+    const char* column;
+    sqlite3_int64 row;
+    std::string* into;
+    std::size_t at, bytes;
+  };
+  std::vector<Piece> pieces;
+  {
+    Statement q(db, "SELECT tick, length(engine), length(progress) FROM crowddb_checkpoint", where);
+    if (sqlite3_step(q.get()) != SQLITE_ROW)
+      throw Error(Error::Kind::input,
+                  where + ": no checkpoint yet (the run stopped before its first; run it again)");
+    const sqlite3_int64 tick = sqlite3_column_int64(q.get(), 0);
+    p.tick = static_cast<uint64_t>(tick);
+    pieces.push_back({"crowddb_checkpoint", "engine", tick, &p.engine, 0,
+                      static_cast<std::size_t>(sqlite3_column_int64(q.get(), 1))});
+    pieces.push_back({"crowddb_checkpoint", "progress", tick, &p.progress, 0,
+                      static_cast<std::size_t>(sqlite3_column_int64(q.get(), 2))});
+  }
+  bool has_pieces = false;
+  {
+    Statement t(db,
+                "SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name = "
+                "'crowddb_checkpoint_piece'",
+                where);
+    has_pieces = sqlite3_step(t.get()) == SQLITE_ROW && sqlite3_column_int64(t.get(), 0) > 0;
+  }
+  if (has_pieces) {
+    Statement q(db,
+                "SELECT rowid, record, part, length(bytes) FROM crowddb_checkpoint_piece ORDER BY "
+                "record, part",
+                where);
+    sqlite3_int64 expected[2] = {1, 1};  // the next part of engine, of progress
+    std::size_t end[2] = {pieces[0].bytes, pieces[1].bytes};  // their bytes so far
+    int rc;
+    while ((rc = sqlite3_step(q.get())) == SQLITE_ROW) {
+      const auto* r = reinterpret_cast<const char*>(sqlite3_column_text(q.get(), 1));
+      const std::string record = r ? r : "";
+      const int k = record == "engine" ? 0 : record == "progress" ? 1 : -1;
+      if (k < 0)
+        throw Error(Error::Kind::input,
+                    where + ": a checkpoint piece of an unknown record '" + record + "'");
+      const sqlite3_int64 part = sqlite3_column_int64(q.get(), 2);
+      if (part != expected[k])
+        throw Error(Error::Kind::input, where + ": checkpoint record " + record + ": part " +
+                                            std::to_string(expected[k]) + " missing");
+      ++expected[k];
+      const std::size_t bytes = static_cast<std::size_t>(sqlite3_column_int64(q.get(), 3));
+      pieces.push_back({"crowddb_checkpoint_piece", "bytes", sqlite3_column_int64(q.get(), 0),
+                        pieces[static_cast<std::size_t>(k)].into, end[k], bytes});
+      end[k] += bytes;
+    }
+    if (rc != SQLITE_DONE) throw Error(Error::Kind::input, where + ": " + sqlite3_errmsg(db));
+  }
+  for (const Piece& x : pieces) x.into->resize(std::max(x.into->size(), x.at + x.bytes));
+  // (Each record's bytes are then checked whole: its length and checksum, when restored.)
+  for (const Piece& x : pieces) {
+    if (x.bytes == 0) continue;
+    sqlite3_blob* b = nullptr;
+    const int rc = sqlite3_blob_open(db, "main", x.table, x.column, x.row, 0, &b);
+    const std::unique_ptr<sqlite3_blob, int (*)(sqlite3_blob*)> blob(b, sqlite3_blob_close);
+    if (rc != SQLITE_OK ||
+        sqlite3_blob_read(b, x.into->data() + x.at, static_cast<int>(x.bytes), 0) != SQLITE_OK)
+      throw Error(Error::Kind::input, where + ": " + sqlite3_errmsg(db));
+  }
+}
+
 }  // namespace
 
 std::unique_ptr<TrajectoryWriter> make_sqlite_writer(const std::filesystem::path& path,
-                                                     uint32_t every) {
-  return std::make_unique<SqliteWriter>(path, every);
+                                                     uint32_t every, std::size_t checkpoint_piece) {
+  return std::make_unique<SqliteWriter>(path, every, checkpoint_piece);
 }
 
 std::string PartialRun::value(const std::string& key) const {
@@ -649,17 +780,7 @@ PartialRun read_partial_run(const std::filesystem::path& file) {
     if (p.value("resume_options").empty())
       throw Error(Error::Kind::input,
                   where + ": written by a crowddb without checkpoints; it cannot be resumed");
-    Statement q(db, "SELECT tick, engine, progress FROM crowddb_checkpoint", where);
-    if (sqlite3_step(q.get()) != SQLITE_ROW)
-      throw Error(Error::Kind::input,
-                  where + ": no checkpoint yet (the run stopped before its first; run it again)");
-    p.tick = static_cast<uint64_t>(sqlite3_column_int64(q.get(), 0));
-    const auto blob = [&](int col) {
-      const auto* b = static_cast<const char*>(sqlite3_column_blob(q.get(), col));
-      return std::string(b ? b : "", static_cast<std::size_t>(sqlite3_column_bytes(q.get(), col)));
-    };
-    p.engine = blob(1);
-    p.progress = blob(2);
+    read_checkpoint(db, where, p);
   } catch (const Error& e) {
     close();
     const std::string msg = e.what();
@@ -681,7 +802,7 @@ std::unique_ptr<TrajectoryWriter> resume_sqlite_writer(const PartialRun& partial
   }
   if (every < 1 || every > 1u << 30)
     throw Error(Error::Kind::input, partial.path.string() + ".partial: bad frame_every");
-  auto w = std::make_unique<SqliteWriter>(partial.path, static_cast<uint32_t>(every));
+  auto w = std::make_unique<SqliteWriter>(partial.path, static_cast<uint32_t>(every), 0);
   w->reopen(partial.tick, dt, stall_after, format);
   return w;
 }

@@ -346,11 +346,9 @@ TEST(TrajectorySqlite, AReaderInALongQueryIsWaitedFor) {
   finish_during_a_query(dir, std::chrono::milliseconds(2500));
 }
 
-// A checkpoint goes into the output streamed, a megabyte at a time, never whole in memory: what
-// the file holds is the simulation's save_state() of that tick, byte for byte (8,000 agents: a
-// record of more than one piece).
-TEST(TrajectorySqlite, ACheckpointInTheOutputIsTheSimulationsStateByteForByte) {
-  test::TempDir dir;
+// 8,000 agents interrupted before tick 13 with the output at `out`, whose checkpoint records are
+// kept in pieces of at most `piece` bytes (0: the default). Returns the simulation's state then.
+std::string interrupted_after_12(const std::filesystem::path& out, std::size_t piece) {
   Scenario sc = parse_scenario(R"({"bounds": [0, 0, 400, 400], "seed": 2,
     "goals": [{"name": "g", "x": 399, "y": 200}],
     "groups": [{"count": 8000, "radius": 0.3, "goal": "g",
@@ -358,7 +356,7 @@ TEST(TrajectorySqlite, ACheckpointInTheOutputIsTheSimulationsStateByteForByte) {
                                "big.json");
   sc.ticks = 100;
   Simulation sim(std::move(sc.world), sc.config);
-  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
+  auto w = io::make_sqlite_writer(out, 1, piece);
   w->begin(sc, sim.world());
   metrics::RunControl control;
   control.writer = w.get();
@@ -366,8 +364,16 @@ TEST(TrajectorySqlite, ACheckpointInTheOutputIsTheSimulationsStateByteForByte) {
   int asked = 0;
   control.interrupted = [&asked] { return ++asked == 13; };  // before tick 13: after tick 12
   EXPECT_THROW(metrics::run_to_end(sc, sim, control), Error);
-  ASSERT_EQ(sim.ticks(), 12u);
-  const std::string state = sim.save_state();
+  EXPECT_EQ(sim.ticks(), 12u);
+  return sim.save_state();
+}
+
+// A checkpoint goes into the output streamed, a megabyte at a time, never whole in memory: what
+// the file holds is the simulation's save_state() of that tick, byte for byte (8,000 agents: a
+// record of more than one piece).
+TEST(TrajectorySqlite, ACheckpointInTheOutputIsTheSimulationsStateByteForByte) {
+  test::TempDir dir;
+  const std::string state = interrupted_after_12(dir / "run.sqlite", 0);
   ASSERT_GT(state.size(), std::size_t{1} << 20);
   test::Rows saved(dir / "run.sqlite.partial",
                    "SELECT tick, engine, length(progress) FROM crowddb_checkpoint");
@@ -376,44 +382,138 @@ TEST(TrajectorySqlite, ACheckpointInTheOutputIsTheSimulationsStateByteForByte) {
   EXPECT_TRUE(saved.blob(1) == state) << "the checkpoint is not save_state()";
   EXPECT_GT(saved.i64(2), 0);
   EXPECT_FALSE(saved.next());
+  EXPECT_EQ(query(dir / "run.sqlite.partial", "SELECT count(*) FROM crowddb_checkpoint_piece"),
+            std::vector<std::string>{"0"});
+}
+
+// A record longer than SQLite keeps in one value (10^9 bytes: the state of some 5·10^6 agents)
+// is kept in pieces and read back whole: here pieces of 100,003 bytes, an odd size, so that the
+// streamed words straddle them. `crowddb resume` of such a file ends as the run uninterrupted.
+TEST(TrajectorySqlite, ACheckpointInPiecesIsReadBackByteForByte) {
+  test::TempDir dir;
+  const std::size_t piece = 100'003;
+  const std::string state = interrupted_after_12(dir / "run.sqlite", piece);
+  const auto partial = dir / "run.sqlite.partial";
+  const auto parts = [&](const char* record) {
+    return std::stoull(
+        query(partial, std::string("SELECT count(*) FROM crowddb_checkpoint_piece WHERE "
+                                   "record = '") +
+                           record + "'")
+            .at(0));
+  };
+  const io::PartialRun saved = io::read_partial_run(partial);
+  EXPECT_EQ(saved.tick, 12u);
+  EXPECT_TRUE(saved.engine == state) << "not save_state(): " << saved.engine.size() << " bytes";
+  EXPECT_EQ(parts("engine"), (state.size() - 1) / piece);  // the first piece is not a part
+  ASSERT_GT(saved.progress.size(), piece);
+  EXPECT_EQ(parts("progress"), (saved.progress.size() - 1) / piece);
+
+  const test::CliResult r = test::run_cli("resume --quiet " + partial.string(), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  Scenario sc = parse_scenario(saved.value("scenario_json"), "big.json");
+  Simulation sim(std::move(sc.world), sc.config);
+  for (int t = 0; t < 100; ++t) sim.step();
+  char hash[24];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(sim.state_hash()));
+  EXPECT_EQ(query(dir / "run.sqlite",
+                  "SELECT value FROM crowddb_run WHERE key = "
+                  "'final_state_hash'"),
+            std::vector<std::string>{hash});
+}
+
+// A piece gone from the file is named, not read as a shorter record.
+TEST(TrajectorySqlite, ACheckpointWithAPieceMissingIsRefusedByName) {
+  test::TempDir dir;
+  interrupted_after_12(dir / "run.sqlite", 100'003);
+  const std::string partial = (dir / "run.sqlite.partial").string();
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(partial.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(
+      sqlite3_exec(db, "DELETE FROM crowddb_checkpoint_piece WHERE record = 'engine' AND part = 2",
+                   nullptr, nullptr, nullptr),
+      SQLITE_OK);
+  sqlite3_close(db);
+  try {
+    io::read_partial_run(partial);
+    ADD_FAILURE() << "read a checkpoint without its part 2";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), partial + ": checkpoint record engine: part 2 missing");
+  }
 }
 
 // A checkpoint whose record fails half way while it is streamed into the file leaves the
 // previous checkpoint as it was (a stop then commits everything else written).
 TEST(TrajectorySqlite, ACheckpointThatFailsHalfWayLeavesThePreviousOne) {
+  // In one blob each, and in pieces of 1,000,003 bytes: the failed record's first pieces are
+  // written before it fails.
+  for (const std::size_t piece : {std::size_t{0}, std::size_t{1'000'003}}) {
+    SCOPED_TRACE(piece);
+    test::TempDir dir;
+    Scenario sc = parse_scenario(kScenario, "two.json");
+    Simulation sim(std::move(sc.world), sc.config);
+    auto w = io::make_sqlite_writer(dir / "run.sqlite", 1, piece);
+    write_ticks(*w, sc, sim, 6);
+    const std::size_t mb = std::size_t{1} << 20;
+    std::string good(3 * mb, 'a');
+    for (std::size_t k = 0; k < good.size(); ++k) good[k] = static_cast<char>(k % 251);
+    const std::string run(100, 'r');
+    const auto pieces_of = [mb](const std::string& bytes) {
+      return [&bytes, mb](const ByteSink& sink) {
+        for (std::size_t at = 0; at < bytes.size(); at += mb)
+          sink(std::string_view(bytes).substr(at, mb));
+      };
+    };
+    w->checkpoint(5, pieces_of(good), pieces_of(run));
+    int passes = 0;
+    const auto fails_when_written = [&](const ByteSink& sink) {
+      const std::string written(mb, 'b');
+      sink(written);
+      if (++passes == 2) throw Error(Error::Kind::io, "serializing failed");
+      sink(written);
+    };
+    EXPECT_THROW(w->checkpoint(6, fails_when_written, pieces_of(run)), Error);
+    EXPECT_EQ(passes, 2);
+    w->stop(6, "test");
+    const io::PartialRun saved = io::read_partial_run(dir / "run.sqlite.partial");
+    EXPECT_EQ(saved.tick, 5u);
+    EXPECT_TRUE(saved.engine == good);
+    EXPECT_EQ(saved.progress, run);
+    EXPECT_EQ(query(dir / "run.sqlite.partial", "SELECT count(*) FROM crowddb_checkpoint"),
+              std::vector<std::string>{"1"});
+    EXPECT_EQ(query(dir / "run.sqlite.partial", "SELECT count(*) FROM crowddb_checkpoint_piece"),
+              std::vector<std::string>{piece ? "3" : "0"});
+    EXPECT_EQ(query(dir / "run.sqlite.partial", "SELECT max(tick) FROM crowddb_tick_metrics"),
+              std::vector<std::string>{"6"});
+  }
+}
+
+// Each checkpoint replaces every piece of the one before, whether it needs more pieces or fewer.
+TEST(TrajectorySqlite, ACheckpointReplacesEveryPieceOfTheOneBefore) {
   test::TempDir dir;
   Scenario sc = parse_scenario(kScenario, "two.json");
   Simulation sim(std::move(sc.world), sc.config);
-  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1);
-  write_ticks(*w, sc, sim, 6);
-  const std::size_t mb = std::size_t{1} << 20;
-  const std::string good(3 * mb, 'a'), run(100, 'r');
-  const auto pieces_of = [mb](const std::string& bytes) {
-    return [&bytes, mb](const ByteSink& sink) {
-      for (std::size_t at = 0; at < bytes.size(); at += mb)
-        sink(std::string_view(bytes).substr(at, mb));
-    };
+  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1, 1'000'003);
+  write_ticks(*w, sc, sim, 8);
+  const auto record = [](std::size_t bytes, char first) {
+    std::string r(bytes, first);
+    for (std::size_t k = 0; k < bytes; ++k) r[k] = static_cast<char>(first + k % 7);
+    return r;
   };
-  w->checkpoint(5, pieces_of(good), pieces_of(run));
-  int passes = 0;
-  const auto fails_when_written = [&](const ByteSink& sink) {
-    const std::string piece(mb, 'b');
-    sink(piece);
-    if (++passes == 2) throw Error(Error::Kind::io, "serializing failed");
-    sink(piece);
+  const auto whole = [](const std::string& bytes) {
+    return [&bytes](const ByteSink& sink) { sink(bytes); };
   };
-  EXPECT_THROW(w->checkpoint(6, fails_when_written, pieces_of(run)), Error);
-  EXPECT_EQ(passes, 2);
-  w->stop(6, "test");
-  test::Rows saved(dir / "run.sqlite.partial",
-                   "SELECT tick, engine, progress FROM crowddb_checkpoint");
-  ASSERT_TRUE(saved.next());
-  EXPECT_EQ(saved.i64(0), 5);
-  EXPECT_TRUE(saved.blob(1) == good);
-  EXPECT_EQ(saved.blob(2), run);
-  EXPECT_FALSE(saved.next());
-  EXPECT_EQ(query(dir / "run.sqlite.partial", "SELECT max(tick) FROM crowddb_tick_metrics"),
-            std::vector<std::string>{"6"});
+  const std::string a = record(3'500'000, 'a'), b = record(1'500'000, 'b'),
+                    c = record(2'500'000, 'c'), run = record(10, 'r');
+  w->checkpoint(5, whole(a), whole(run));
+  w->checkpoint(6, whole(b), whole(run));
+  w->checkpoint(7, whole(c), whole(run));
+  w->stop(8, "test");
+  const io::PartialRun saved = io::read_partial_run(dir / "run.sqlite.partial");
+  EXPECT_EQ(saved.tick, 7u);
+  EXPECT_TRUE(saved.engine == c);
+  EXPECT_EQ(saved.progress, run);
+  EXPECT_EQ(query(dir / "run.sqlite.partial", "SELECT count(*) FROM crowddb_checkpoint_piece"),
+            std::vector<std::string>{"2"});
 }
 
 // Two runs writing one output: the second stops at once and the first is untouched.
