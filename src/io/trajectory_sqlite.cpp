@@ -496,10 +496,11 @@ class SqliteWriter final : public TrajectoryWriter {
     exec(
         "CREATE TABLE IF NOT EXISTS crowddb_checkpoint_piece (record TEXT NOT NULL, part INTEGER "
         "NOT NULL, bytes BLOB NOT NULL, PRIMARY KEY (record, part))");
-    // Never more than this connection's SQLite takes in a value (10^9 bytes unless built
-    // otherwise).
-    piece_ =
-        std::min(piece_, static_cast<std::size_t>(sqlite3_limit(db_, SQLITE_LIMIT_LENGTH, -1)));
+    // SQLite's limit (10^9 bytes unless built otherwise) is on a row: crowddb_checkpoint's row
+    // holds the first piece of both records, with room to spare for the other columns.
+    const auto limit = static_cast<std::size_t>(sqlite3_limit(db_, SQLITE_LIMIT_LENGTH, -1));
+    piece_ = std::max<std::size_t>(
+        1, std::min(piece_, (limit - std::min<std::size_t>(limit, 4096)) / 2));
   }
 
   void create_indices() {
@@ -639,8 +640,18 @@ class SqliteWriter final : public TrajectoryWriter {
 // The latest checkpoint's records into p.engine and p.progress, each read straight into its
 // place (SQLite's blob I/O: no copy of a piece in between): the first piece from
 // crowddb_checkpoint, the rest in order from crowddb_checkpoint_piece (absent in the files of a
-// crowddb before 2026-12-06).
+// crowddb before 2026-12-06). In one read transaction, so that a run still writing the file
+// cannot mix two checkpoints; the lengths claimed are checked against the file's size before
+// anything is allocated for them (a header may claim more than the file holds).
 void read_checkpoint(sqlite3* db, const std::string& where, PartialRun& p) {
+  const auto fail = [&](const std::string& what) {
+    return Error(Error::Kind::input, where + ": " + what);
+  };
+  const auto step_row = [&](const Statement& q) {
+    const int rc = sqlite3_step(q.get());
+    if (rc != SQLITE_ROW && rc != SQLITE_DONE) throw fail(sqlite3_errmsg(db));
+    return rc == SQLITE_ROW;
+  };
   struct Piece {
     const char* table;
     const char* column;
@@ -648,18 +659,29 @@ void read_checkpoint(sqlite3* db, const std::string& where, PartialRun& p) {
     std::string* into;
     std::size_t at, bytes;
   };
+  // A blob's length, refused unless it is a blob (a NULL, a number or a text is no record).
+  const auto blob_bytes = [&](const Statement& q, int type_col, const std::string& what) {
+    const auto* type = reinterpret_cast<const char*>(sqlite3_column_text(q.get(), type_col));
+    if (!type || std::strcmp(type, "blob") != 0)
+      throw fail(what + " is " + (type ? type : "null") + ", not a blob");
+    return static_cast<std::size_t>(sqlite3_column_int64(q.get(), type_col + 1));
+  };
+  Statement begin(db, "BEGIN", where), commit(db, "COMMIT", where);
+  step_row(begin);
   std::vector<Piece> pieces;
   {
-    Statement q(db, "SELECT tick, length(engine), length(progress) FROM crowddb_checkpoint", where);
-    if (sqlite3_step(q.get()) != SQLITE_ROW)
-      throw Error(Error::Kind::input,
-                  where + ": no checkpoint yet (the run stopped before its first; run it again)");
-    const sqlite3_int64 tick = sqlite3_column_int64(q.get(), 0);
-    p.tick = static_cast<uint64_t>(tick);
-    pieces.push_back({"crowddb_checkpoint", "engine", tick, &p.engine, 0,
-                      static_cast<std::size_t>(sqlite3_column_int64(q.get(), 1))});
-    pieces.push_back({"crowddb_checkpoint", "progress", tick, &p.progress, 0,
-                      static_cast<std::size_t>(sqlite3_column_int64(q.get(), 2))});
+    Statement q(db,
+                "SELECT rowid, tick, typeof(engine), length(engine), typeof(progress), "
+                "length(progress) FROM crowddb_checkpoint",
+                where);
+    if (!step_row(q))
+      throw fail("no checkpoint yet (the run stopped before its first; run it again)");
+    const sqlite3_int64 row = sqlite3_column_int64(q.get(), 0);
+    p.tick = static_cast<uint64_t>(sqlite3_column_int64(q.get(), 1));
+    pieces.push_back({"crowddb_checkpoint", "engine", row, &p.engine, 0,
+                      blob_bytes(q, 2, "the checkpoint's engine record")});
+    pieces.push_back({"crowddb_checkpoint", "progress", row, &p.progress, 0,
+                      blob_bytes(q, 4, "the checkpoint's progress record")});
   }
   bool has_pieces = false;
   {
@@ -667,37 +689,42 @@ void read_checkpoint(sqlite3* db, const std::string& where, PartialRun& p) {
                 "SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name = "
                 "'crowddb_checkpoint_piece'",
                 where);
-    has_pieces = sqlite3_step(t.get()) == SQLITE_ROW && sqlite3_column_int64(t.get(), 0) > 0;
+    has_pieces = step_row(t) && sqlite3_column_int64(t.get(), 0) > 0;
   }
+  std::size_t end[2] = {pieces[0].bytes, pieces[1].bytes};  // engine's, progress's bytes so far
   if (has_pieces) {
     Statement q(db,
-                "SELECT rowid, record, part, length(bytes) FROM crowddb_checkpoint_piece ORDER BY "
-                "record, part",
+                "SELECT rowid, record, part, typeof(bytes), length(bytes) FROM "
+                "crowddb_checkpoint_piece ORDER BY record, part",
                 where);
     sqlite3_int64 expected[2] = {1, 1};  // the next part of engine, of progress
-    std::size_t end[2] = {pieces[0].bytes, pieces[1].bytes};  // their bytes so far
-    int rc;
-    while ((rc = sqlite3_step(q.get())) == SQLITE_ROW) {
+    while (step_row(q)) {
       const auto* r = reinterpret_cast<const char*>(sqlite3_column_text(q.get(), 1));
       const std::string record = r ? r : "";
       const int k = record == "engine" ? 0 : record == "progress" ? 1 : -1;
-      if (k < 0)
-        throw Error(Error::Kind::input,
-                    where + ": a checkpoint piece of an unknown record '" + record + "'");
+      if (k < 0) throw fail("a checkpoint piece of an unknown record '" + record + "'");
       const sqlite3_int64 part = sqlite3_column_int64(q.get(), 2);
       if (part != expected[k])
-        throw Error(Error::Kind::input, where + ": checkpoint record " + record + ": part " +
-                                            std::to_string(expected[k]) + " missing");
+        throw fail("checkpoint record " + record + ": part " + std::to_string(expected[k]) +
+                   " missing");
       ++expected[k];
-      const std::size_t bytes = static_cast<std::size_t>(sqlite3_column_int64(q.get(), 3));
+      const std::size_t bytes =
+          blob_bytes(q, 3, "checkpoint record " + record + " part " + std::to_string(part));
       pieces.push_back({"crowddb_checkpoint_piece", "bytes", sqlite3_column_int64(q.get(), 0),
                         pieces[static_cast<std::size_t>(k)].into, end[k], bytes});
       end[k] += bytes;
     }
-    if (rc != SQLITE_DONE) throw Error(Error::Kind::input, where + ": " + sqlite3_errmsg(db));
   }
-  for (const Piece& x : pieces) x.into->resize(std::max(x.into->size(), x.at + x.bytes));
-  // (Each record's bytes are then checked whole: its length and checksum, when restored.)
+  {
+    Statement q(db, "SELECT page_count * page_size FROM pragma_page_count, pragma_page_size",
+                where);
+    const auto file_bytes =
+        step_row(q) ? static_cast<std::size_t>(sqlite3_column_int64(q.get(), 0)) : 0;
+    if (end[0] > file_bytes || end[1] > file_bytes || end[0] + end[1] > file_bytes)
+      throw fail("the checkpoint claims more bytes than the file holds");
+  }
+  p.engine.resize(end[0]);
+  p.progress.resize(end[1]);
   for (const Piece& x : pieces) {
     if (x.bytes == 0) continue;
     sqlite3_blob* b = nullptr;
@@ -705,8 +732,10 @@ void read_checkpoint(sqlite3* db, const std::string& where, PartialRun& p) {
     const std::unique_ptr<sqlite3_blob, int (*)(sqlite3_blob*)> blob(b, sqlite3_blob_close);
     if (rc != SQLITE_OK ||
         sqlite3_blob_read(b, x.into->data() + x.at, static_cast<int>(x.bytes), 0) != SQLITE_OK)
-      throw Error(Error::Kind::input, where + ": " + sqlite3_errmsg(db));
+      throw fail(sqlite3_errmsg(db));
   }
+  // (Each record's bytes are checked whole, its length and checksum, when it is restored.)
+  step_row(commit);
 }
 
 }  // namespace
@@ -786,6 +815,9 @@ PartialRun read_partial_run(const std::filesystem::path& file) {
     const std::string msg = e.what();
     if (msg.rfind(where, 0) == 0) throw;
     throw Error(Error::Kind::input, where + ": not an interrupted crowddb run (" + msg + ")");
+  } catch (const std::exception& e) {  // out of memory for the checkpoint, say
+    close();
+    throw Error(Error::Kind::io, where + ": cannot read the checkpoint (" + e.what() + ")");
   }
   close();
   return p;

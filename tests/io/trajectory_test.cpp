@@ -415,10 +415,32 @@ TEST(TrajectorySqlite, ACheckpointInPiecesIsReadBackByteForByte) {
   for (int t = 0; t < 100; ++t) sim.step();
   char hash[24];
   std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(sim.state_hash()));
+  EXPECT_EQ(
+      query(dir / "run.sqlite", "SELECT value FROM crowddb_run WHERE key = 'final_state_hash'"),
+      std::vector<std::string>{hash});
+  // A finished run has nothing to resume: no checkpoint, no piece of one.
   EXPECT_EQ(query(dir / "run.sqlite",
-                  "SELECT value FROM crowddb_run WHERE key = "
-                  "'final_state_hash'"),
-            std::vector<std::string>{hash});
+                  "SELECT (SELECT count(*) FROM crowddb_checkpoint) + "
+                  "(SELECT count(*) FROM crowddb_checkpoint_piece)"),
+            std::vector<std::string>{"0"});
+}
+
+// The .partial of a crowddb from before checkpoints in pieces has no crowddb_checkpoint_piece:
+// it is read, resumed and finished all the same.
+TEST(TrajectorySqlite, AnInterruptedRunWithoutTheTableOfPiecesIsResumed) {
+  test::TempDir dir;
+  const std::string state = interrupted_after_12(dir / "run.sqlite", 0);
+  const auto partial = dir / "run.sqlite.partial";
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(partial.string().c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "DROP TABLE crowddb_checkpoint_piece", nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  EXPECT_TRUE(io::read_partial_run(partial).engine == state);
+  const test::CliResult r = test::run_cli("resume --quiet " + partial.string(), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(query(dir / "run.sqlite", "SELECT value FROM crowddb_run WHERE key = 'status'"),
+            std::vector<std::string>{"complete"});
 }
 
 // A piece gone from the file is named, not read as a shorter record.
@@ -487,12 +509,14 @@ TEST(TrajectorySqlite, ACheckpointThatFailsHalfWayLeavesThePreviousOne) {
   }
 }
 
-// Each checkpoint replaces every piece of the one before, whether it needs more pieces or fewer.
+// Each checkpoint replaces every piece of the one before, whether it needs more pieces or fewer,
+// and a record of exactly two pieces or of none reads back as it was.
 TEST(TrajectorySqlite, ACheckpointReplacesEveryPieceOfTheOneBefore) {
   test::TempDir dir;
   Scenario sc = parse_scenario(kScenario, "two.json");
   Simulation sim(std::move(sc.world), sc.config);
-  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1, 1'000'003);
+  const std::size_t piece = 1'000'003;
+  auto w = io::make_sqlite_writer(dir / "run.sqlite", 1, piece);
   write_ticks(*w, sc, sim, 8);
   const auto record = [](std::size_t bytes, char first) {
     std::string r(bytes, first);
@@ -502,18 +526,24 @@ TEST(TrajectorySqlite, ACheckpointReplacesEveryPieceOfTheOneBefore) {
   const auto whole = [](const std::string& bytes) {
     return [&bytes](const ByteSink& sink) { sink(bytes); };
   };
-  const std::string a = record(3'500'000, 'a'), b = record(1'500'000, 'b'),
-                    c = record(2'500'000, 'c'), run = record(10, 'r');
-  w->checkpoint(5, whole(a), whole(run));
-  w->checkpoint(6, whole(b), whole(run));
-  w->checkpoint(7, whole(c), whole(run));
+  struct Case {
+    std::size_t engine, progress, parts;
+  };
+  uint64_t tick = 1;
+  for (const Case& c : {Case{3'500'000, 10, 3}, Case{1'500'000, 10, 1}, Case{2 * piece, 0, 1},
+                        Case{0, piece + 1, 1}, Case{2'500'000, 10, 2}}) {
+    SCOPED_TRACE(c.engine);
+    const std::string engine = record(c.engine, 'a'), run = record(c.progress, 'r');
+    w->checkpoint(tick, whole(engine), whole(run));
+    const io::PartialRun saved = io::read_partial_run(dir / "run.sqlite.partial");
+    EXPECT_EQ(saved.tick, tick);
+    EXPECT_TRUE(saved.engine == engine);
+    EXPECT_EQ(saved.progress, run);
+    EXPECT_EQ(query(dir / "run.sqlite.partial", "SELECT count(*) FROM crowddb_checkpoint_piece"),
+              std::vector<std::string>{std::to_string(c.parts)});
+    ++tick;
+  }
   w->stop(8, "test");
-  const io::PartialRun saved = io::read_partial_run(dir / "run.sqlite.partial");
-  EXPECT_EQ(saved.tick, 7u);
-  EXPECT_TRUE(saved.engine == c);
-  EXPECT_EQ(saved.progress, run);
-  EXPECT_EQ(query(dir / "run.sqlite.partial", "SELECT count(*) FROM crowddb_checkpoint_piece"),
-            std::vector<std::string>{"2"});
 }
 
 // Two runs writing one output: the second stops at once and the first is untouched.
