@@ -46,6 +46,30 @@ void SourceEmitter::restore(ByteReader& in, const World& world) {
   }
 }
 
+bool SourceEmitter::touches_an_obstacle(const StaticScene& scene, const AgentSpec& a) {
+  const std::size_t circles = scene.circles().size(), count = circles + scene.polygons().size();
+  const auto hits = [&](std::size_t k) {
+    return k < circles ? disc_hits_circle(scene.circles()[k], a.x, a.y, a.radius)
+                       : disc_hits_polygon(scene.polygons()[k - circles],
+                                           scene.polygon_boxes()[k - circles], a.x, a.y, a.radius);
+  };
+  if (naive_ || count <= kObstaclesForALookup) {
+    for (std::size_t k = 0; k < count; ++k)
+      if (hits(k)) return true;
+    return false;
+  }
+  // Among many obstacles, those whose box holds the disc (grown by a micrometre against the
+  // rounding of the box's and the disc's bounds): the same answer as the loop over all.
+  if (!lookup_ || lookup_obstacles_ != count) {
+    lookup_.emplace(scene.circles(), scene.polygons());
+    lookup_obstacles_ = count;
+  }
+  lookup_->candidates(a.x, a.y, a.radius + 1e-6, near_obstacles_);
+  for (const uint32_t k : near_obstacles_)
+    if (hits(k)) return true;
+  return false;
+}
+
 std::size_t SourceEmitter::waiting(const World& world) const {
   std::size_t n = 0;
   for (std::size_t i = 0; i < state_.size(); ++i)
@@ -94,6 +118,7 @@ std::size_t SourceEmitter::emit(World& world, const SimConfig& cfg, const Static
       const std::size_t discs = near.size() + nx.size();
       if (!grid && !naive_ && tested > kScansBeforeGrid * discs) {
         grid.emplace(2 * std::max(rmax, table_rmax));
+        ++grids_built_;
         grid->reserve(discs);
         for (uint32_t j : near) grid->add(t.x[j], t.y[j], t.radius[j]);
         for (std::size_t j = 0; j < nx.size(); ++j) grid->add(nx[j], ny[j], nr[j]);
@@ -117,13 +142,7 @@ std::size_t SourceEmitter::emit(World& world, const SimConfig& cfg, const Static
         a.x = st.rng.uniform(x0, x1);
         a.y = st.rng.uniform(y0, y1);
         if (!point_in_polygon(src.area, a.x, a.y)) continue;
-        bool free = !touches_a_disc(a);
-        for (std::size_t c = 0; free && c < scene.circles().size(); ++c)
-          if (disc_hits_circle(scene.circles()[c], a.x, a.y, a.radius)) free = false;
-        for (std::size_t p = 0; free && p < scene.polygons().size(); ++p)
-          if (disc_hits_polygon(scene.polygons()[p], scene.polygon_boxes()[p], a.x, a.y, a.radius))
-            free = false;
-        placed = free;
+        placed = !touches_a_disc(a) && !touches_an_obstacle(scene, a);
       }
       if (!placed) break;  // the area is full: try again next tick
       world.insert(a);

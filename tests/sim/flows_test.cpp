@@ -300,13 +300,27 @@ TEST(Sources, AreDeterministicAcrossThreads) {
 // sources over it (a box, a triangle with radii drawn, a small box inside the crowd), obstacles
 // and walls, hundreds of agents due in a tick and areas filling up.
 TEST(Sources, FreeSpotsThroughTheGridAreTheNaiveLoops) {
-  for (const uint64_t seed : {1u, 2u, 3u}) {
+  for (const uint64_t seed : {1u, 2u, 3u, 4u}) {
     SCOPED_TRACE(seed);
-    const auto world = [seed] {
+    const bool crowd = seed != 4;  // without one, more spots are decided by the obstacles
+    // 120 obstacles more, scattered: enough for the spots to be tested through a lookup.
+    std::string more;
+    Rng place(seed + 100);
+    for (int o = 0; o < 120; ++o) {
+      const double x = place.uniform(2, 55), y = place.uniform(2, 55), d = place.uniform(0.2, 2);
+      more += o % 2 ? R"(, {"type": "circle", "x": )" + std::to_string(x) + R"(, "y": )" +
+                          std::to_string(y) + R"(, "radius": )" + std::to_string(d) + "}"
+                    : R"(, {"type": "polygon", "vertices": [[)" + std::to_string(x) + ", " +
+                          std::to_string(y) + "], [" + std::to_string(x + d) + ", " +
+                          std::to_string(y) + "], [" + std::to_string(x) + ", " +
+                          std::to_string(y + d) + "]]}";
+    }
+    const auto world = [seed, crowd, &more] {
       Scenario sc = parse_scenario(R"({"bounds": [0, 0, 60, 60],
         "goals": [{"name": "g", "x": 59, "y": 30}],
         "obstacles": [{"type": "circle", "x": 20, "y": 20, "radius": 3},
-                      {"type": "polygon", "vertices": [[40, 40], [45, 40], [45, 45]]}],
+                      {"type": "polygon", "vertices": [[40, 40], [45, 40], [45, 45]]})" +
+                                       more + R"(],
         "sources": [{"area": [0, 0, 30, 30], "rate": 4000, "count": 1500, "goal": "g"},
                     {"polygon": [[10, 10], [50, 10], [30, 50]], "rate": 3000, "count": 900,
                      "radius": [0.1, 0.8], "goal": "g"},
@@ -314,7 +328,7 @@ TEST(Sources, FreeSpotsThroughTheGridAreTheNaiveLoops) {
                                    "sources.json");
       World w = std::move(sc.world);
       Rng rng(seed);
-      for (int k = 0; k < 2500; ++k) {
+      for (int k = 0; k < (crowd ? 2500 : 0); ++k) {
         AgentSpec a;
         a.x = rng.uniform(0.5, 59.5);
         a.y = rng.uniform(0.5, 59.5);
@@ -335,7 +349,10 @@ TEST(Sources, FreeSpotsThroughTheGridAreTheNaiveLoops) {
       big.y = 15;
       big.radius = 5;
       big.goal = 0;
-      w.insert(big);
+      try {
+        w.insert(big);
+      } catch (const Error&) {  // in an obstacle
+      }
       w.apply_pending();
       return w;
     };
@@ -362,6 +379,8 @@ TEST(Sources, FreeSpotsThroughTheGridAreTheNaiveLoops) {
     }
     EXPECT_GT(entered, 300u);              // many entered
     EXPECT_GT(grid.waiting(by_grid), 0u);  // and some found no room
+    EXPECT_GT(grid.grids_built(), 0u);     // the grid answered (not only the loop)
+    EXPECT_EQ(loop.grids_built(), 0u);
   }
 }
 
