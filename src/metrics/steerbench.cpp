@@ -2,17 +2,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <unordered_map>
 
 #include "crowddb/error.hpp"
 #include "util/byte_codec.hpp"
 #include "util/executor.hpp"
 #include "world/geometry.hpp"
+#include "world/obstacle_lookup.hpp"
 
 namespace crowddb::metrics {
 namespace {
 
 constexpr double kCollision = 0.001;  // [m] SteerSuite's COLLISION_EPSILON
+// Obstacles beyond which the collision count looks only at those near each agent.
+constexpr std::size_t kObstaclesForALookup = 16;
 
 uint64_t cell_key(int64_t cx, int64_t cy) {
   return (static_cast<uint64_t>(cx) << 32) ^ static_cast<uint64_t>(cy & 0xffffffff);
@@ -233,6 +237,15 @@ void SteerBench::collisions(const World& world) {
     }
   std::set<std::pair<uint64_t, uint64_t>> pairs;
   std::set<std::pair<uint64_t, int64_t>> obstacles;
+  // Among more than a few obstacles, each agent is tested against those near it only.
+  const std::size_t obstacle_count = world.circles().size() + world.polygons().size();
+  const bool by_lookup = obstacle_count > kObstaclesForALookup;
+  if (by_lookup && (!lookup_ || lookup_obstacles_ != obstacle_count)) {
+    lookup_.emplace(world.circles(), world.polygons());  // (obstacles come before the run)
+    lookup_obstacles_ = obstacle_count;
+  }
+  std::vector<uint32_t> near(by_lookup ? 0 : obstacle_count);
+  std::iota(near.begin(), near.end(), 0u);
   if (!rows.empty()) {
     const double cell = std::max(2 * rmax, 1e-6);
     std::unordered_map<uint64_t, std::vector<std::size_t>> grid;
@@ -254,16 +267,22 @@ void SteerBench::collisions(const World& world) {
           }
         }
       const double x = t.x[i], y = t.y[i], r = t.radius[i];
+      // A penetration over 1 mm puts the centre that far inside the obstacle's box grown by r:
+      // the lookup's candidates hold every such obstacle (tested as before, one by one, they cost
+      // agents x obstacles a tick while any overlap lasts).
       const auto circles = world.circles();
-      for (std::size_t k = 0; k < circles.size(); ++k)
-        if (r + circles[k].radius - std::hypot(circles[k].x - x, circles[k].y - y) > kCollision)
-          obstacles.insert({t.id[i], static_cast<int64_t>(k)});
       const auto polys = world.polygons();
-      for (std::size_t k = 0; k < polys.size(); ++k) {
-        const auto& v = polys[k].vertices;
+      if (by_lookup) lookup_->candidates(x, y, r, near);
+      for (const uint32_t k : near) {
+        if (k < circles.size()) {
+          if (r + circles[k].radius - std::hypot(circles[k].x - x, circles[k].y - y) > kCollision)
+            obstacles.insert({t.id[i], static_cast<int64_t>(k)});
+          continue;
+        }
+        const auto& v = polys[k - circles.size()].vertices;
         const double pen =
             point_in_polygon(v, x, y) ? r : r - std::sqrt(dist2_to_boundary(v, x, y));
-        if (pen > kCollision) obstacles.insert({t.id[i], static_cast<int64_t>(circles.size() + k)});
+        if (pen > kCollision) obstacles.insert({t.id[i], static_cast<int64_t>(k)});
       }
       if (walls_) {
         const Bounds& b = world.bounds();

@@ -17,6 +17,7 @@
 #include "util/byte_codec.hpp"
 #include "util/executor.hpp"
 #include "util/rng.hpp"
+#include "world/geometry.hpp"
 
 namespace crowddb::metrics {
 namespace {
@@ -147,6 +148,75 @@ TEST(SteerBench, CollisionEpisodesCountOncePerAgentAndEpisode) {
   EXPECT_EQ(sb.scores()[1].collisions, 2u);
   EXPECT_EQ(sb.scores()[2].collisions, 1u);  // the wall
   EXPECT_EQ(sb.totals().collisions, 5u);
+}
+
+// Among many obstacles (hundreds of circles, triangles and boxes, some inside others, agents
+// walking into and out of them), the collision episodes with obstacles are those of the naive
+// test of every agent against every obstacle, tick by tick.
+TEST(SteerBench, ObstacleCollisionsAmongManyObstaclesAreTheNaiveCount) {
+  World w(Bounds{0, 0, 100, 100});
+  w.add_goal({"g", 99, 50, 0.5, 1, {}});
+  for (int i = 0; i < 40; ++i)  // a lattice 2.4 m apart: no two agents ever touch
+    for (int j = 0; j < 40; ++j) {
+      AgentSpec a;
+      a.x = 2 + 2.4 * i;
+      a.y = 2 + 2.4 * j;
+      a.radius = 0.3;
+      a.goal = 0;
+      w.insert(a);
+    }
+  w.apply_pending();
+  Rng rng(7);
+  for (int o = 0; o < 300; ++o) {
+    const double x = rng.uniform(0, 100), y = rng.uniform(0, 100), s = rng.uniform(0.1, 2);
+    if (o % 3 == 0)
+      w.add_obstacle(CircleObstacle{x, y, s, 1});
+    else if (o % 3 == 1)
+      w.add_obstacle(PolygonObstacle{{{x, y}, {x + s, y}, {x, y + s}}, 1});
+    else
+      w.add_obstacle(PolygonObstacle{{{x, y}, {x + s, y}, {x + s, y + 0.3}, {x, y + 0.3}}, 1});
+  }
+  SteerBench sb(0.1, true);
+  sb.start(w);
+  AgentTable& t = w.agents_for_tick();
+  const std::vector<double> x0 = t.x, y0 = t.y;
+  TickMetrics m;
+  m.obstacle_overlaps = 1;                    // tells the collector to look
+  const auto touching = [&](std::size_t i) {  // SteerSuite's penetration over 1 mm, naively
+    std::vector<std::size_t> out;
+    const double x = t.x[i], y = t.y[i], r = t.radius[i];
+    const auto circles = w.circles();
+    for (std::size_t k = 0; k < circles.size(); ++k)
+      if (r + circles[k].radius - std::hypot(circles[k].x - x, circles[k].y - y) > 0.001)
+        out.push_back(k);
+    for (std::size_t k = 0; k < w.polygons().size(); ++k) {
+      const auto& v = w.polygons()[k].vertices;
+      const double pen = point_in_polygon(v, x, y) ? r : r - std::sqrt(dist2_to_boundary(v, x, y));
+      if (pen > 0.001) out.push_back(circles.size() + k);
+    }
+    return out;
+  };
+  std::vector<std::vector<std::size_t>> before(t.size());
+  std::vector<std::size_t> episodes(t.size(), 0);
+  std::size_t all = 0;
+  for (int tick = 0; tick < 12; ++tick) {
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      t.x[i] = x0[i] + rng.uniform(-0.5, 0.5);
+      t.y[i] = y0[i] + rng.uniform(-0.5, 0.5);
+      std::vector<std::size_t> now = touching(i);
+      for (std::size_t k : now)
+        episodes[i] += std::find(before[i].begin(), before[i].end(), k) == before[i].end();
+      before[i] = std::move(now);
+    }
+    sb.tick(w, m);
+  }
+  const std::vector<AgentScore>& got = sb.scores();
+  ASSERT_EQ(got.size(), t.size());
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    EXPECT_EQ(got[i].collisions, episodes[i]) << "agent " << i;
+    all += episodes[i];
+  }
+  EXPECT_GT(all, 200u);  // many episodes to compare
 }
 
 // The tracks follow agents, not rows: the same walks give the same scores, bit for bit, whether
