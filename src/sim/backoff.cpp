@@ -218,6 +218,10 @@ constexpr std::size_t kProbeGrain = 64;
 // Rows whose lists fall short, at most (their pairs among each other are tested one by one).
 constexpr std::size_t kShortMost = 256;
 
+// Obstacles (walls included) beyond which the final count of the moved rows' obstacle hits goes
+// through an index rather than the naive test per row.
+constexpr std::size_t kObstaclesForAnIndex = 32;
+
 bool lists_rule_out_overlaps(const AgentTable& t, const NextState& next, const NearLists& near,
                              Executor& ex) {
   const std::size_t n = t.size();
@@ -399,9 +403,21 @@ OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& s
   for (const Found& f : found) report.agent_pairs += stamp[f.b] == 0 || stamp[f.b] <= f.k;
   for (const auto& hit : first.obstacles) report.obstacle_hits += stamp[hit.first] == 0;
   if (!scene.empty()) {
+    // Where the scene has more than a few obstacles, through an obstacle index over where
+    // everyone stands now (the naive test per moved row cost moved rows x obstacles: 10^3 among
+    // SteerSuite's 5,000 boxes, 5·10^6 tests a tick); the same hits either way.
     std::vector<std::pair<uint32_t, Collider>> hits;
-    for (std::size_t i = 0; i < t.size(); ++i)
-      if (stamp[i]) disc_obstacle_overlaps(view, scene, i, i + 1, hits);
+    const bool any = std::any_of(stamp.begin(), stamp.end(), [](auto s) { return s != 0; });
+    if (any && scene.circles().size() + scene.polygons().size() > kObstaclesForAnIndex) {
+      index::ObstacleIndex obstacles;
+      obstacles.build(scene, index::Frame::of(view));
+      uint64_t tests = 0;
+      for (std::size_t i = 0; i < t.size(); ++i)
+        if (stamp[i]) obstacles.overlaps(view, i, i + 1, hits, tests);
+    } else if (any) {
+      for (std::size_t i = 0; i < t.size(); ++i)
+        if (stamp[i]) disc_obstacle_overlaps(view, scene, i, i + 1, hits);
+    }
     report.obstacle_hits += hits.size();
   }
   return report;

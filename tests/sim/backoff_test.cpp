@@ -58,6 +58,14 @@ Tentative make_tick(std::size_t n, uint64_t seed, bool equal_radii, bool spawn_o
   std::vector<CircleObstacle> circles = {{w * 0.3, w * 0.3, 4, 1}, {w * 0.7, w * 0.6, 6, 1}};
   std::vector<PolygonObstacle> polys = {
       {{{w * 0.5, w * 0.1}, {w * 0.6, w * 0.1}, {w * 0.55, w * 0.25}}, 1}};
+  if (n >= 600)  // enough obstacles for the final count's obstacle index, many on agents
+    for (int o = 0; o < 40; ++o) {
+      const double ox = rng.uniform(0, w), oy = rng.uniform(0, w), s = rng.uniform(0.5, 3);
+      if (o % 2)
+        circles.push_back({ox, oy, s, 1});
+      else
+        polys.push_back({{{ox, oy}, {ox + s, oy}, {ox, oy + s}}, 1});
+    }
   const Bounds walls{-1, -1, w, w};
   k.scene = StaticScene(circles, polys, 1, ObstacleCharges::centres, &walls);
   return k;
@@ -73,7 +81,7 @@ std::unique_ptr<CollisionPath> make_path(const std::string& name) {
 // frozen for the moved rows to get a grid of their own.
 TEST(Backoff, IncrementalLoopEqualsThePlainLoop) {
   Executor ex(1), ex2(2);
-  std::size_t cascades = 0, grid_probes = 0, moved_grid_rounds = 0;
+  std::size_t cascades = 0, grid_probes = 0, moved_grid_rounds = 0, obstacle_hits = 0;
   const std::pair<std::size_t, uint64_t> sizes[] = {{40, 1},  {40, 2},  {40, 3},  {600, 1},
                                                     {600, 2}, {600, 3}, {4000, 1}};
   for (const auto& [n, seed] : sizes)
@@ -104,6 +112,7 @@ TEST(Backoff, IncrementalLoopEqualsThePlainLoop) {
               EXPECT_EQ(iter, plain_iter);
               EXPECT_EQ(r.agent_pairs, want.agent_pairs);
               EXPECT_EQ(r.obstacle_hits, want.obstacle_hits);
+              obstacle_hits += r.obstacle_hits * (n >= 600);
               EXPECT_TRUE(r.violators.empty());
               EXPECT_EQ(got.frozen, plain.frozen);
               EXPECT_EQ(got.x, plain.x);
@@ -115,6 +124,7 @@ TEST(Backoff, IncrementalLoopEqualsThePlainLoop) {
   EXPECT_GT(cascades, 20u);          // freezes that cause further freezes
   EXPECT_GE(grid_probes, 6u);        // large enough for the probes to use the grid
   EXPECT_GT(moved_grid_rounds, 0u);  // and for the moved rows to get a grid of their own
+  EXPECT_GT(obstacle_hits, 0u);      // hits left among many obstacles (counted through an index)
 }
 
 TEST(Backoff, ChainOfFreezesTakesOneIterationPerLink) {
