@@ -403,18 +403,21 @@ OverlapReport backoff(const AgentTable& t, NextState& next, const StaticScene& s
   for (const Found& f : found) report.agent_pairs += stamp[f.b] == 0 || stamp[f.b] <= f.k;
   for (const auto& hit : first.obstacles) report.obstacle_hits += stamp[hit.first] == 0;
   if (!scene.empty()) {
-    // Where the scene has more than a few obstacles, through an obstacle index over where
-    // everyone stands now (the naive test per moved row cost moved rows x obstacles: 10^3 among
-    // SteerSuite's 5,000 boxes, 5·10^6 tests a tick); the same hits either way.
+    // Where the moved rows times the obstacles outweigh the rows and obstacles, through an
+    // obstacle index over where everyone stands now (its frame is a pass over every row; the
+    // naive test per moved row cost moved rows x obstacles: 10^3 among SteerSuite's 5,000
+    // boxes, 5·10^6 tests a tick); the same hits either way.
     std::vector<std::pair<uint32_t, Collider>> hits;
-    const bool any = std::any_of(stamp.begin(), stamp.end(), [](auto s) { return s != 0; });
-    if (any && scene.circles().size() + scene.polygons().size() > kObstaclesForAnIndex) {
+    const auto moved = static_cast<std::size_t>(
+        std::count_if(stamp.begin(), stamp.end(), [](auto s) { return s != 0; }));
+    const std::size_t m = scene.circles().size() + scene.polygons().size();
+    if (m > kObstaclesForAnIndex && moved * m > 2 * (t.size() + m)) {
       index::ObstacleIndex obstacles;
       obstacles.build(scene, index::Frame::of(view));
       uint64_t tests = 0;
       for (std::size_t i = 0; i < t.size(); ++i)
         if (stamp[i]) obstacles.overlaps(view, i, i + 1, hits, tests);
-    } else if (any) {
+    } else if (moved > 0) {
       for (std::size_t i = 0; i < t.size(); ++i)
         if (stamp[i]) disc_obstacle_overlaps(view, scene, i, i + 1, hits);
     }
