@@ -371,7 +371,7 @@ class SqliteWriter final : public TrajectoryWriter {
     exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA synchronous=NORMAL");
     exec("BEGIN");
-    create_piece_table();  // a .partial of a crowddb before 2026-12-06 has none
+    create_piece_table();  // a .partial of an older crowddb has none
     {
       Statement g(db_, "SELECT hash, wkt FROM geometry LIMIT 1", path_.string());
       if (sqlite3_step(g.get()) != SQLITE_ROW)
@@ -640,7 +640,7 @@ class SqliteWriter final : public TrajectoryWriter {
 // The latest checkpoint's records into p.engine and p.progress, each read straight into its
 // place (SQLite's blob I/O: no copy of a piece in between): the first piece from
 // crowddb_checkpoint, the rest in order from crowddb_checkpoint_piece (absent in the files of a
-// crowddb before 2026-12-06). In one read transaction, so that a run still writing the file
+// crowddb before it). In one read transaction, so that a run still writing the file
 // cannot mix two checkpoints; the lengths claimed are checked against the file's size before
 // anything is allocated for them (a header may claim more than the file holds).
 void read_checkpoint(sqlite3* db, const std::string& where, PartialRun& p) {
