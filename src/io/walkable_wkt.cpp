@@ -45,20 +45,32 @@ std::string walkable_area_wkt(const World& world) {
   Multi area;
   area.push_back(
       ring_polygon({{b.xmin, b.ymin}, {b.xmax, b.ymin}, {b.xmax, b.ymax}, {b.xmin, b.ymax}}));
-  auto subtract = [&](const Polygon& hole) {
-    Multi out;
-    bg::difference(area, hole, out);
-    area = std::move(out);
-  };
+  // The obstacles united pairwise, level by level, then taken from the bounds at once.
+  // (Subtracting them one at a time from an area that gains a hole each time was quadratic in
+  // the obstacles: 12 s before the first tick among 5,000 boxes, minutes among 10^4 circles.)
+  std::vector<Multi> blocked;
   for (const CircleObstacle& c : world.circles()) {
     std::vector<Vec2> pts;
     for (int i = 0; i < 64; ++i) {
       const double a = 2 * std::numbers::pi * i / 64;
       pts.push_back({c.x + c.radius * std::cos(a), c.y + c.radius * std::sin(a)});
     }
-    subtract(ring_polygon(pts));
+    blocked.push_back(Multi{ring_polygon(pts)});
   }
-  for (const PolygonObstacle& p : world.polygons()) subtract(ring_polygon(p.vertices));
+  for (const PolygonObstacle& p : world.polygons())
+    blocked.push_back(Multi{ring_polygon(p.vertices)});
+  while (blocked.size() > 1) {
+    std::vector<Multi> next((blocked.size() + 1) / 2);
+    for (std::size_t i = 0; i + 1 < blocked.size(); i += 2)
+      bg::union_(blocked[i], blocked[i + 1], next[i / 2]);
+    if (blocked.size() % 2) next.back() = std::move(blocked.back());
+    blocked = std::move(next);
+  }
+  if (!blocked.empty()) {
+    Multi out;
+    bg::difference(area, blocked.front(), out);
+    area = std::move(out);
+  }
   std::ostringstream os;
   os.precision(17);
   if (area.size() == 1)

@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <filesystem>
 #include <functional>
+#include <numbers>
 
 #include "crowddb/scenario.hpp"
 #include "io/walkable_wkt.hpp"
 #include "support/cli.hpp"
+#include "util/rng.hpp"
 #include "world/geometry.hpp"
 
 namespace crowddb {
@@ -86,6 +88,50 @@ TEST(WalkableArea, BlockedPiecesAreTheExactComplement) {
           EXPECT_EQ(in, 1) << wkt << " at " << x << "," << y;
         }
     }
+  }
+}
+
+// The output's walkable area (the `geometry` table) is the bounds less every obstacle: point
+// by point, among 150 obstacles that overlap, nest, touch and cross the bounds (circles as the
+// 64-gons the WKT draws), and it parses as valid geometry.
+TEST(WalkableArea, TheOutputsAreaIsTheBoundsLessEveryObstacle) {
+  for (const uint64_t seed : {1u, 2u, 3u}) {
+    SCOPED_TRACE(seed);
+    Rng rng(seed);
+    World w(Bounds{0, 0, 50, 50});
+    std::vector<std::vector<Vec2>> shapes;  // each obstacle's outline as the WKT draws it
+    for (int o = 0; o < 150; ++o) {
+      const double x = rng.uniform(-2, 52), y = rng.uniform(-2, 52), s = rng.uniform(0.3, 4);
+      std::vector<Vec2> ring;
+      if (o % 3 == 0) {
+        w.add_obstacle(CircleObstacle{x, y, s / 2, 1});
+        for (int k = 0; k < 64; ++k) {
+          const double a = 2 * std::numbers::pi * k / 64;
+          ring.push_back({x + s / 2 * std::cos(a), y + s / 2 * std::sin(a)});
+        }
+      } else {
+        ring = o % 3 == 1
+                   ? std::vector<Vec2>{{x, y}, {x + s, y}, {x, y + s}}
+                   : std::vector<Vec2>{{x, y}, {x + s, y}, {x + s, y + s / 3}, {x, y + s / 3}};
+        w.add_obstacle(PolygonObstacle{ring, 1});
+      }
+      shapes.push_back(ring);
+    }
+    const io::WalkableArea a = io::WalkableArea::parse(io::walkable_area_wkt(w));
+    std::size_t in = 0, out = 0;
+    for (int k = 0; k < 4000; ++k) {
+      const double x = rng.uniform(0, 50), y = rng.uniform(0, 50);
+      bool blocked = false, near_an_edge = false;
+      for (const auto& ring : shapes) {
+        near_an_edge |= dist2_to_boundary(ring, x, y) < 1e-12;
+        blocked |= point_in_polygon(ring, x, y);
+      }
+      if (near_an_edge) continue;  // on an edge: either answer is the area's
+      EXPECT_EQ(a.covers(x, y), !blocked) << "(" << x << ", " << y << ")";
+      (blocked ? out : in) += 1;
+    }
+    EXPECT_GT(in, 1000u);
+    EXPECT_GT(out, 200u);
   }
 }
 
