@@ -127,6 +127,30 @@ TEST(ScenarioJson, SourcesAreRead) {
   EXPECT_TRUE(std::isinf(sc.world.sources()[1].end));
 }
 
+// The table is reserved for the sources' agents too (up to as many again as were loaded): the
+// first agent a source lets in must not move every column (0.65 s at 10^6 agents).
+TEST(ScenarioJson, RoomForTheSourcesAgentsIsReserved) {
+  Scenario sc =
+      parse_scenario(R"({"bounds": [0, 0, 100, 100], "goals": [{"name": "g", "x": 90, "y": 50}],
+    "groups": [{"count": 64, "placement": {"type": "grid", "region": [10, 10, 50, 50], "spacing": 1}, "radius": 0.3,
+                "goals": {"assign": "round_robin"}}],
+    "sources": [{"area": [60, 0, 100, 100], "rate": 1, "count": 10, "radius": 0.3, "goals": ["g"]}]})",
+                     "s.json");
+  ASSERT_EQ(sc.world.agents().size(), 64u);
+  const double* x = sc.world.agents().x.data();
+  const uint32_t* goal = sc.world.agents().goal.data();
+  AgentSpec spec = sc.world.sources()[0].agent;
+  for (int k = 0; k < 10; ++k) {
+    spec.x = 70 + k;
+    spec.y = 50;
+    sc.world.insert(spec);
+  }
+  sc.world.apply_pending();
+  ASSERT_EQ(sc.world.agents().size(), 74u);
+  EXPECT_EQ(sc.world.agents().x.data(), x);
+  EXPECT_EQ(sc.world.agents().goal.data(), goal);
+}
+
 TEST(ScenarioJson, SyntaxErrorNamesLineAndColumn) {
   const std::string e = error_of("{\n  \"bounds\": [0, 0, 1, 1],\n  \"ticks\": 5,,\n}");
   EXPECT_NE(e.find("s.json:3:"), std::string::npos) << e;
