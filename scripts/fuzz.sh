@@ -26,9 +26,10 @@ declare -A seeds=(
   [sdf_json_fuzz]="tests/sdf/data/*.json,fuzz/corpus/sdf_json"
   [checkpoint_fuzz]="fuzz/corpus/checkpoint"
   [runfile_fuzz]="fuzz/corpus/runfile"
+  [partial_fuzz]="fuzz/corpus/partial"
 )
 targets=(scenario_fuzz csv_fuzz steersuite_fuzz menge_fuzz vadere_fuzz overrides_fuzz sdf_sdf3_fuzz sdf_json_fuzz
-  checkpoint_fuzz runfile_fuzz)
+  checkpoint_fuzz runfile_fuzz partial_fuzz)
 
 # FUZZ_TREE: a build tree already configured with CROWDDB_FUZZ=ON (scripts/test.sh's sanitizer
 # tree, which holds the tests too); by default build-fuzz, configured here with the fuzz targets only.
