@@ -219,7 +219,18 @@ std::size_t Navigation::apply_results(World& world, uint64_t tick) {
     t.progress_best[i] = INFINITY;
     ++applied;
   }
+  forget_departed(world);
   return applied;
+}
+
+void Navigation::forget_departed(const World& world) {
+  // Swept when the two sets hold more than twice the agents there are (plus a margin): each sweep
+  // removes at least half of what it looks at, and the condition depends on the state alone, so a
+  // resumed run sweeps where the uninterrupted one did.
+  const std::size_t live = world.agents().size();
+  if (short_routes_.size() + narrow_routes_.size() <= 2 * live + 64) return;
+  for (std::set<uint64_t>* s : {&short_routes_, &narrow_routes_})
+    std::erase_if(*s, [&](uint64_t id) { return !world.contains(AgentId::from_value(id)); });
 }
 
 std::size_t Navigation::request_paths(World& world, uint64_t tick,

@@ -130,6 +130,9 @@ class Navigation {
   // steers straight at the goal). A passage on the narrow mesh but narrower than the agent's
   // disc is not caught (its route reaches the goal).
   std::size_t without_path(const World& world) const;
+  // Entries of the two route sets behind blocked_ahead and without_path, departed agents
+  // included until the next sweep (forget_departed): what they cost in memory and checkpoints.
+  std::size_t flagged_routes() const { return short_routes_.size() + narrow_routes_.size(); }
 
   double class_radius(double radius) const;
   const NavigationParams& params() const { return params_; }
@@ -159,6 +162,7 @@ class Navigation {
   int narrow_key(double radius) const;
   bool is_narrow(const NavMesh* m) const;
   bool off_mesh(const PathResult& r, const NavMesh& m) const;
+  void forget_departed(const World& world);  // drops agents no longer in the world from the sets
   // A stalled agent's polygon on a mesh and its heading (unit vector to its waypoint).
   struct StalledAt {
     uint32_t ref;
@@ -200,6 +204,9 @@ class Navigation {
   Executor& ex_;
   std::map<int, std::unique_ptr<NavMesh>> meshes_;  // by class (radius = class * radius_step);
                                                     // negative: narrow meshes (narrow_key)
+  // Agents that left are swept out now and then (forget_departed): a source letting people in
+  // for hours would otherwise keep everyone who ever took such a route, in memory and in every
+  // checkpoint.
   std::set<uint64_t> short_routes_;   // agents whose last route does not reach their goal
   std::set<uint64_t> narrow_routes_;  // agents whose route came from a narrow mesh
   std::deque<Queued> queue_;

@@ -380,6 +380,36 @@ TEST(Navigation, QueuesAtDoorsAreCostedAlikeOnAnyThreadCount) {
               static_cast<unsigned long long>(door_costed));
 }
 
+// Agents that left keep no entry in the sets of routes that fall short: with a source letting
+// people in for hours, they grew with everyone who ever walked (and so did every checkpoint).
+TEST(Navigation, AgentsThatLeftAreForgotten) {
+  World w = walled_world();
+  // Goal 0 walled in on every side: every route to it ends short.
+  w.add_obstacle(PolygonObstacle{{{44, 4}, {56, 4}, {56, 5}, {44, 5}}, 0.1});
+  w.add_obstacle(PolygonObstacle{{{44, 15}, {56, 15}, {56, 16}, {44, 16}}, 0.1});
+  w.add_obstacle(PolygonObstacle{{{44, 5}, {45, 5}, {45, 15}, {44, 15}}, 0.1});
+  w.add_obstacle(PolygonObstacle{{{55, 5}, {56, 5}, {56, 15}, {55, 15}}, 0.1});
+  std::vector<AgentId> ids;
+  for (int k = 0; k < 100; ++k) ids.push_back(w.insert(walker(5 + (k % 10) * 2, 5 + (k / 10) * 2)));
+  w.apply_pending();
+  const SimConfig c = nav_config(1, 100);
+  Executor ex(1);
+  path::Navigation nav(w, c, ex);
+  EXPECT_EQ(nav.request_paths(w, 0), 100u);
+  EXPECT_EQ(nav.apply_results(w, 1), 100u);
+  EXPECT_EQ(nav.without_path(w), 100u);
+  EXPECT_EQ(nav.flagged_routes(), 100u);
+  for (int k = 0; k < 60; ++k) w.erase(ids[k]);
+  w.apply_pending();
+  nav.apply_results(w, 2);  // 100 entries for 40 agents: within twice as many and 64
+  EXPECT_EQ(nav.flagged_routes(), 100u);
+  for (int k = 60; k < 99; ++k) w.erase(ids[k]);
+  w.apply_pending();
+  nav.apply_results(w, 3);  // 100 entries for one agent: swept
+  EXPECT_EQ(nav.flagged_routes(), 1u);
+  EXPECT_EQ(nav.without_path(w), 1u);
+}
+
 TEST(Navigation, RadiusClassesRoundUp) {
   World w = walled_world();
   w.insert(walker(10, 10));
