@@ -61,7 +61,7 @@ void DocBuilder::polygon(const std::vector<Vec2>& vertices, const std::string& o
   }
   origins_["/obstacles/" + std::to_string(doc_["obstacles"].size())] = origin;
   doc_["obstacles"].push_back({{"type", "polygon"}, {"vertices", vs}});
-  polygons_.push_back(vertices);
+  polygons_.push_back({vertices, 1});
 }
 
 void DocBuilder::circle(Vec2 c, double r, const std::string& origin) {
@@ -69,7 +69,7 @@ void DocBuilder::circle(Vec2 c, double r, const std::string& origin) {
   doc_["obstacles"].push_back({{"type", "circle"}, {"x", c.x}, {"y", c.y}, {"radius", r}});
   extent_.add(c.x - r, c.y - r);
   extent_.add(c.x + r, c.y + r);
-  circles_.push_back({c.x, c.y, r});
+  circles_.push_back({c.x, c.y, r, 1});
 }
 
 std::size_t DocBuilder::agent(nlohmann::json row, const std::string& origin) {
@@ -98,11 +98,49 @@ void DocBuilder::warn(const std::string& kind, const std::string& text) {
   warning_repeats_.push_back(0);
 }
 
+namespace {
+constexpr std::size_t kScanned = 16;  // obstacles tested one by one before a lookup pays
+}  // namespace
+
+bool DocBuilder::touches_obstacle_by_scan(double x, double y, double r, std::size_t circles_from,
+                                          std::size_t polygons_from) const {
+  for (std::size_t k = circles_from; k < circles_.size(); ++k) {
+    const CircleObstacle& c = circles_[k];
+    if (discs_overlap(c.x - x, c.y - y, c.radius + r)) return true;
+  }
+  for (std::size_t k = polygons_from; k < polygons_.size(); ++k)
+    if (disc_overlaps_polygon(polygons_[k].vertices, x, y, r)) return true;
+  return false;
+}
+
+bool DocBuilder::free_by_scan(double x, double y, double r, bool agents) const {
+  return !touches_obstacle_by_scan(x, y, r, 0, 0) && (!agents || !agents_.any_overlap(x, y, r, 0));
+}
+
 bool DocBuilder::free(double x, double y, double r, bool agents) const {
-  for (const Disc& c : circles_)
-    if (discs_overlap(c.x - x, c.y - y, c.r + r)) return false;
-  for (const auto& p : polygons_)
-    if (disc_overlaps_polygon(p, x, y, r)) return false;
+  Indexed& ix = indexed_;
+  const std::size_t scanned = circles_.size() - ix.circles + polygons_.size() - ix.polygons;
+  // Rebuilt when the scanned ones outnumber four times the root of the indexed ones: m obstacles
+  // added one at a time between placements then cost O(m^1.5) tests and builds in all, not m^2
+  // (rebuilding only when they doubled left half of them scanned at each placement).
+  if (scanned > kScanned && scanned * scanned > 16 * (ix.circles + ix.polygons)) {
+    ix.lookup = std::make_unique<ObstacleLookup>(circles_, polygons_);
+    ix.circles = circles_.size();
+    ix.polygons = polygons_.size();
+  }
+  if (ix.lookup) {
+    // Obstacle k of the lookup: circle k below ix.circles, else polygon k - ix.circles.
+    ix.lookup->candidates(x, y, std::max(r, 0.0), near_);
+    for (const uint32_t k : near_) {
+      if (k < ix.circles) {
+        const CircleObstacle& c = circles_[k];
+        if (discs_overlap(c.x - x, c.y - y, c.radius + r)) return false;
+      } else if (disc_overlaps_polygon(polygons_[k - ix.circles].vertices, x, y, r)) {
+        return false;
+      }
+    }
+  }
+  if (touches_obstacle_by_scan(x, y, r, ix.circles, ix.polygons)) return false;
   return !agents || !agents_.any_overlap(x, y, r, 0);
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -12,6 +13,7 @@
 #include "crowddb/world.hpp"
 #include "io/import/importer.hpp"
 #include "util/rng.hpp"
+#include "world/obstacle_lookup.hpp"
 #include "world/placement_grid.hpp"
 
 namespace crowddb::io {
@@ -66,7 +68,11 @@ class DocBuilder {
   const Box& extent() const { return extent_; }
 
   // Is a disc free of the obstacles added so far and (with `agents`) of the discs occupied?
+  // The obstacles through a lookup once there are many (SteerSuite's obstacle regions hold
+  // thousands of boxes, each placed with this test, and then thousands of agents).
   bool free(double x, double y, double r, bool agents = true) const;
+  // The same answer by testing every obstacle: free's oracle (tests).
+  bool free_by_scan(double x, double y, double r, bool agents = true) const;
   // Remembers an agent disc for `free` (explicit agents too, so random ones avoid them).
   void occupy(double x, double y, double r);
 
@@ -75,9 +81,6 @@ class DocBuilder {
  private:
   // The goal `g` under a new name, or the name of an identical goal added before.
   std::string named_goal(nlohmann::json g, const std::string& origin);
-  struct Disc {
-    double x, y, r;
-  };
   nlohmann::json doc_;
   Origins origins_;
   std::vector<std::pair<std::string, std::string>> warnings_;  // kind, text
@@ -85,9 +88,19 @@ class DocBuilder {
   std::vector<std::size_t> warning_repeats_;
   std::map<std::string, std::string> goal_names_;  // goal JSON text -> name
   Box extent_;
-  std::vector<std::vector<Vec2>> polygons_;
-  std::vector<Disc> circles_;
-  PlacementGrid agents_{2.0};  // agent discs (cells of 2 m: agents are 0.2-0.5 m)
+  bool touches_obstacle_by_scan(double x, double y, double r, std::size_t circles_from,
+                                std::size_t polygons_from) const;
+  std::vector<PolygonObstacle> polygons_;
+  std::vector<CircleObstacle> circles_;
+  // Circles [0, circles) and polygons [0, polygons) in a lookup, the ones added since scanned
+  // (rebuilt as they grow: DocBuilder::free).
+  struct Indexed {
+    std::unique_ptr<ObstacleLookup> lookup;
+    std::size_t circles = 0, polygons = 0;
+  };
+  mutable Indexed indexed_;
+  mutable std::vector<uint32_t> near_;  // the lookup's candidates, kept between calls
+  PlacementGrid agents_{2.0};           // agent discs (cells of 2 m: agents are 0.2-0.5 m)
 };
 
 // Distance formatting for messages: shortest form.
