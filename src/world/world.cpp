@@ -390,7 +390,7 @@ void World::permute_rows(std::span<const uint32_t> order, Executor* ex) {
     gather.push_back([&column, order, n] {
       if (same_in_every_row(column)) return;
       std::remove_reference_t<decltype(column)> out;
-      out.reserve(n);
+      out.reserve(std::max(n, column.capacity()));  // room kept for the agents yet to come
       for (uint32_t r : order) out.push_back(std::move(column[r]));
       column.swap(out);
     });
@@ -417,7 +417,8 @@ void World::reserve(std::size_t agents) {
                                         std::to_string(AgentId::kNoIndex));
   each_column(agents_, [&](auto& column) { column.reserve(agents); });
   slots_.reserve(agents);
-  pending_.reserve(agents - std::min(agents, agents_.size()));
+  // (Not beyond one batch's kept room: apply_pending gives a larger one back at once.)
+  pending_.reserve(std::min(agents - std::min(agents, agents_.size()), kKeptPending));
 }
 
 void World::remove_rows(std::vector<std::size_t> rows) {

@@ -77,6 +77,28 @@ TEST(World, ReserveGivesRoomAndChangesNothingElse) {
   EXPECT_EQ(w.apply_pending(), 1u);
 }
 
+// A reorder keeps the room reserved: a loader reserves for the agents sources will let in, and
+// the reorder of the first tick (Simulation, every few seconds from 4,096 rows) rebuilt each
+// column with room for exactly its rows, so the next agent moved them all again.
+TEST(World, PermutingRowsKeepsTheRoomReserved) {
+  World w = world_with_goals();
+  w.reserve(500);
+  for (int i = 0; i < 300; ++i) w.insert(spec_at(1 + i % 90, 1 + i / 90, i % 2));
+  w.apply_pending();
+  std::vector<uint32_t> order(300);
+  for (uint32_t r = 0; r < 300; ++r) order[r] = 299 - r;
+  w.permute_rows(order);
+  EXPECT_GE(w.agents().x.capacity(), 500u);  // a column that differs from row to row
+  EXPECT_GE(w.agents().id.capacity(), 500u);
+  EXPECT_GE(w.agents().goal.capacity(), 500u);
+  EXPECT_EQ(w.agents().x[0], 1 + 299 % 90);
+  const double* x = w.agents().x.data();
+  for (int i = 0; i < 200; ++i) w.insert(spec_at(50, 1 + i % 90));
+  w.apply_pending();
+  EXPECT_EQ(w.agents().x.data(), x);
+  w.validate();
+}
+
 TEST(World, EraseSwapsLastRowInAndKeepsHandlesValid) {
   World w = world_with_goals();
   const AgentId a = w.insert(spec_at(1, 0)), b = w.insert(spec_at(2, 0)),
