@@ -19,7 +19,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const std::string path = "/tmp/partial_fuzz_" + std::to_string(getpid()) + ".sqlite";
   static const std::string partial = path + ".partial";
   std::error_code ec;
-  for (const char* extra : {"-wal", "-shm"}) std::filesystem::remove(partial + extra, ec);
+  for (const char* extra : {"-wal", "-shm", "-journal"})
+    std::filesystem::remove(partial + extra, ec);
   if (std::FILE* f = std::fopen(partial.c_str(), "wb")) {
     std::fwrite(data, 1, size, f);
     std::fclose(f);

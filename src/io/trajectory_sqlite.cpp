@@ -39,6 +39,7 @@
 #include "io/trajectory.hpp"
 #include "io/walkable_wkt.hpp"
 #include "io/write_behind.hpp"
+#include "util/utf8.hpp"
 
 namespace crowddb::io {
 namespace {
@@ -812,12 +813,13 @@ PartialRun read_partial_run(const std::filesystem::path& file) {
     read_checkpoint(db, where, p);
   } catch (const Error& e) {
     close();
-    const std::string msg = e.what();
-    if (msg.rfind(where, 0) == 0) throw;
+    const std::string msg = one_line(e.what());  // (names and SQL quoted from the file)
+    if (msg.rfind(where, 0) == 0) throw Error(e.kind(), msg);
     throw Error(Error::Kind::input, where + ": not an interrupted crowddb run (" + msg + ")");
   } catch (const std::exception& e) {  // out of memory for the checkpoint, say
     close();
-    throw Error(Error::Kind::io, where + ": cannot read the checkpoint (" + e.what() + ")");
+    throw Error(Error::Kind::io,
+                where + ": cannot read the checkpoint (" + one_line(e.what()) + ")");
   }
   close();
   return p;
@@ -835,7 +837,11 @@ std::unique_ptr<TrajectoryWriter> resume_sqlite_writer(const PartialRun& partial
   if (every < 1 || every > 1u << 30)
     throw Error(Error::Kind::input, partial.path.string() + ".partial: bad frame_every");
   auto w = std::make_unique<SqliteWriter>(partial.path, static_cast<uint32_t>(every), 0);
-  w->reopen(partial.tick, dt, stall_after, format);
+  try {
+    w->reopen(partial.tick, dt, stall_after, format);
+  } catch (const Error& e) {  // SQLite's messages quote names and SQL from the file
+    throw Error(e.kind(), one_line(e.what()));
+  }
   return w;
 }
 

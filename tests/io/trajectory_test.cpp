@@ -463,6 +463,29 @@ TEST(TrajectorySqlite, ACheckpointWithAPieceMissingIsRefusedByName) {
   }
 }
 
+// Text the file holds, quoted in an error (a piece's record name, SQLite's message about a
+// damaged schema), keeps the error on one line (partial_fuzz would trap on a line break).
+TEST(TrajectorySqlite, ErrorsQuotingThePartialFileAreOneLine) {
+  test::TempDir dir;
+  interrupted_after_12(dir / "run.sqlite", 100'003);
+  const std::string partial = (dir / "run.sqlite.partial").string();
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(partial.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db,
+                         "UPDATE crowddb_checkpoint_piece SET record = 'eng' || char(10) || 'ine' "
+                         "WHERE record = 'engine' AND part = 1",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  try {
+    io::read_partial_run(partial);
+    ADD_FAILURE() << "read a checkpoint piece of an unknown record";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              partial + ": a checkpoint piece of an unknown record 'eng ine'");
+  }
+}
+
 // A checkpoint whose record fails half way while it is streamed into the file leaves the
 // previous checkpoint as it was (a stop then commits everything else written).
 TEST(TrajectorySqlite, ACheckpointThatFailsHalfWayLeavesThePreviousOne) {
