@@ -9,6 +9,7 @@
 
 #include "crowddb/error.hpp"
 #include "io/walkable_wkt.hpp"
+#include "util/utf8.hpp"
 
 namespace crowddb::view {
 namespace {
@@ -17,9 +18,7 @@ std::string valid_utf8(std::string s);
 
 // Errors are one line: SQLite's messages quote names from the file, which may hold anything.
 [[noreturn]] void fail(const std::string& path, std::string what) {
-  for (char& c : what)
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
-  throw Error(Error::Kind::input, path + ": " + valid_utf8(std::move(what)));
+  throw Error(Error::Kind::input, path + ": " + valid_utf8(one_line(std::move(what))));
 }
 
 std::string text_of(sqlite3_stmt* st, int col) {
