@@ -431,11 +431,7 @@ TEST(TrajectorySqlite, AnInterruptedRunWithoutTheTableOfPiecesIsResumed) {
   test::TempDir dir;
   const std::string state = interrupted_after_12(dir / "run.sqlite", 0);
   const auto partial = dir / "run.sqlite.partial";
-  sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open(partial.string().c_str(), &db), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(db, "DROP TABLE crowddb_checkpoint_piece", nullptr, nullptr, nullptr),
-            SQLITE_OK);
-  sqlite3_close(db);
+  ASSERT_NO_FATAL_FAILURE(test::execute(partial, "DROP TABLE crowddb_checkpoint_piece"));
   EXPECT_TRUE(io::read_partial_run(partial).engine == state);
   const test::CliResult r = test::run_cli("resume --quiet " + partial.string(), dir);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -448,13 +444,8 @@ TEST(TrajectorySqlite, ACheckpointWithAPieceMissingIsRefusedByName) {
   test::TempDir dir;
   interrupted_after_12(dir / "run.sqlite", 100'003);
   const std::string partial = (dir / "run.sqlite.partial").string();
-  sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open(partial.c_str(), &db), SQLITE_OK);
-  ASSERT_EQ(
-      sqlite3_exec(db, "DELETE FROM crowddb_checkpoint_piece WHERE record = 'engine' AND part = 2",
-                   nullptr, nullptr, nullptr),
-      SQLITE_OK);
-  sqlite3_close(db);
+  ASSERT_NO_FATAL_FAILURE(test::execute(
+      partial, "DELETE FROM crowddb_checkpoint_piece WHERE record = 'engine' AND part = 2"));
   try {
     io::read_partial_run(partial);
     ADD_FAILURE() << "read a checkpoint without its part 2";
@@ -469,14 +460,10 @@ TEST(TrajectorySqlite, ErrorsQuotingThePartialFileAreOneLine) {
   test::TempDir dir;
   interrupted_after_12(dir / "run.sqlite", 100'003);
   const std::string partial = (dir / "run.sqlite.partial").string();
-  sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open(partial.c_str(), &db), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(db,
-                         "UPDATE crowddb_checkpoint_piece SET record = 'eng' || char(10) || 'ine' "
-                         "WHERE record = 'engine' AND part = 1",
-                         nullptr, nullptr, nullptr),
-            SQLITE_OK);
-  sqlite3_close(db);
+  ASSERT_NO_FATAL_FAILURE(
+      test::execute(partial,
+                    "UPDATE crowddb_checkpoint_piece SET record = 'eng' || char(10) || 'ine' "
+                    "WHERE record = 'engine' AND part = 1"));
   try {
     io::read_partial_run(partial);
     ADD_FAILURE() << "read a checkpoint piece of an unknown record";

@@ -1,4 +1,5 @@
-// Reads an SQLite file from tests: the first column of every row of a query, as text.
+// Reads (and, for damaged files, changes) an SQLite file from tests: the first column of every
+// row of a query, as text.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -23,6 +24,17 @@ inline std::vector<std::string> query(const std::filesystem::path& db, const std
       &out, nullptr);
   sqlite3_close(h);
   return out;
+}
+
+// Changes an SQLite file from tests (a damaged or older file made from a good one): `sql` must
+// succeed.
+inline void execute(const std::filesystem::path& db, const std::string& sql) {
+  sqlite3* h = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &h), SQLITE_OK);
+  char* err = nullptr;
+  EXPECT_EQ(sqlite3_exec(h, sql.c_str(), nullptr, nullptr, &err), SQLITE_OK) << (err ? err : "");
+  sqlite3_free(err);
+  sqlite3_close(h);
 }
 
 // The rows of a query, read with SQLite's own types (doubles bit for bit):
