@@ -284,7 +284,7 @@ struct Loader {
                  ", outside the walkable area";
       } else if (const std::size_t p = k - circles; p >= walkable_pieces) {
         const auto& ring = sc.world.polygons()[p].vertices;
-        if (point_in_polygon(ring, x, y) && dist2_to_boundary(ring, x, y) > 0)
+        if (lookup->polygon_holds(p, ring, x, y) && lookup->polygon_dist2(p, ring, x, y, 0) > 0)
           return "lies inside obstacle /obstacles/" +
                  std::to_string(polygon_src[p - walkable_pieces]) + ", outside the walkable area";
       }
@@ -298,7 +298,8 @@ struct Loader {
       if (k < circles) {
         const CircleObstacle& c = sc.world.circles()[k];
         if (discs_overlap(c.x - x, c.y - y, c.radius + r + gap)) return true;
-      } else if (disc_overlaps_polygon(sc.world.polygons()[k - circles].vertices, x, y, r + gap)) {
+      } else if (lookup->disc_overlaps_polygon(
+                     k - circles, sc.world.polygons()[k - circles].vertices, x, y, r + gap)) {
         return true;
       }
     }

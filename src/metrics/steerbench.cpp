@@ -279,9 +279,15 @@ void SteerBench::collisions(const World& world) {
             obstacles.insert({t.id[i], static_cast<int64_t>(k)});
           continue;
         }
-        const auto& v = polys[k - circles.size()].vertices;
+        // Through the lookup's edge grid where there is one: the distance is exact up to r, and
+        // beyond it the penetration is negative either way.
+        const std::size_t p = k - circles.size();
+        const auto& v = polys[p].vertices;
         const double pen =
-            point_in_polygon(v, x, y) ? r : r - std::sqrt(dist2_to_boundary(v, x, y));
+            by_lookup ? (lookup_->polygon_holds(p, v, x, y)
+                             ? r
+                             : r - std::sqrt(lookup_->polygon_dist2(p, v, x, y, std::abs(r))))
+                      : (point_in_polygon(v, x, y) ? r : r - std::sqrt(dist2_to_boundary(v, x, y)));
         if (pen > kCollision) obstacles.insert({t.id[i], static_cast<int64_t>(k)});
       }
       if (walls_) {

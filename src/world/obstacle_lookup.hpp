@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "crowddb/world.hpp"
+#include "world/ring_grid.hpp"
 
 namespace crowddb {
 
@@ -32,6 +33,12 @@ class ObstacleLookup {
     boxes.reserve(count_);
     for (const CircleObstacle& c : circles)
       boxes.push_back({c.x - c.radius, c.y - c.radius, c.x + c.radius, c.y + c.radius});
+    ring_of_.assign(polygons.size(), -1);
+    for (std::size_t k = 0; k < polygons.size(); ++k)
+      if (polygons[k].vertices.size() >= RingGrid::kMinEdges) {
+        ring_of_[k] = static_cast<int32_t>(rings_.size());
+        rings_.emplace_back(polygons[k].vertices);
+      }
     for (const PolygonObstacle& p : polygons) {
       Box b{INFINITY, INFINITY, -INFINITY, -INFINITY};
       for (const Vec2& v : p.vertices)
@@ -86,6 +93,26 @@ class ObstacleLookup {
     }
   }
 
+  // The exact tests of world/geometry.hpp on polygon p (of those the lookup was built over;
+  // `ring` its vertices), through an edge grid (world/ring_grid.hpp) where it has many edges:
+  // point_in_polygon; dist2_to_boundary where that is <= reach^2 (else a value above reach^2);
+  // disc_overlaps_polygon.
+  bool polygon_holds(std::size_t p, std::span<const Vec2> ring, double x, double y) const {
+    return ring_of_[p] < 0 ? point_in_polygon(ring, x, y)
+                           : rings_[static_cast<std::size_t>(ring_of_[p])].inside(ring, x, y);
+  }
+  double polygon_dist2(std::size_t p, std::span<const Vec2> ring, double x, double y,
+                       double reach) const {
+    return ring_of_[p] < 0 ? dist2_to_boundary(ring, x, y)
+                           : rings_[static_cast<std::size_t>(ring_of_[p])].dist2(ring, x, y, reach);
+  }
+  bool disc_overlaps_polygon(std::size_t p, std::span<const Vec2> ring, double x, double y,
+                             double r) const {
+    return ring_of_[p] < 0
+               ? crowddb::disc_overlaps_polygon(ring, x, y, r)
+               : rings_[static_cast<std::size_t>(ring_of_[p])].disc_overlaps(ring, x, y, r);
+  }
+
   // The obstacles whose bounding box, grown by `reach` (>= 0), holds (x, y), in obstacle order,
   // each once (a superset of those a disc of radius `reach` there touches). `out` is overwritten.
   void candidates(double x, double y, double reach, std::vector<uint32_t>& out) const {
@@ -133,9 +160,11 @@ class ObstacleLookup {
   std::size_t count_ = 0;
   double origin_x_ = 0, origin_y_ = 0, cell_ = 1;
   int64_t nx_ = 0, ny_ = 0;
-  std::vector<uint32_t> start_;  // CSR offsets per cell (row-major), nx_ * ny_ + 1; empty: no grid
-  std::vector<uint32_t> ids_;    // the obstacles registered in each cell, in obstacle order
-  std::vector<uint32_t> big_;    // obstacles spanning more than kMaxCells cells, in order
+  std::vector<uint32_t> start_;   // CSR offsets per cell (row-major), nx_ * ny_ + 1; empty: no grid
+  std::vector<uint32_t> ids_;     // the obstacles registered in each cell, in obstacle order
+  std::vector<uint32_t> big_;     // obstacles spanning more than kMaxCells cells, in order
+  std::vector<RingGrid> rings_;   // the edge grids of polygons with many edges
+  std::vector<int32_t> ring_of_;  // per polygon: its grid in rings_, or -1
 };
 
 }  // namespace crowddb

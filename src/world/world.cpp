@@ -218,7 +218,7 @@ void World::check_walkable(double x, double y) const {
     }
     const std::size_t p = k - circles_.size();
     const auto& ring = polygons_[p].vertices;
-    if (point_in_polygon(ring, x, y) && dist2_to_boundary(ring, x, y) > 0)
+    if (lookup_->polygon_holds(p, ring, x, y) && lookup_->polygon_dist2(p, ring, x, y, 0) > 0)
       throw InvalidRow("x", at() + "inside polygon obstacle " + std::to_string(p));
   }
 }

@@ -135,7 +135,8 @@ bool DocBuilder::free(double x, double y, double r, bool agents) const {
       if (k < ix.circles) {
         const CircleObstacle& c = circles_[k];
         if (discs_overlap(c.x - x, c.y - y, c.radius + r)) return false;
-      } else if (disc_overlaps_polygon(polygons_[k - ix.circles].vertices, x, y, r)) {
+      } else if (const std::size_t p = k - ix.circles;
+                 ix.lookup->disc_overlaps_polygon(p, polygons_[p].vertices, x, y, r)) {
         return false;
       }
     }

@@ -1,0 +1,156 @@
+// RingGrid (world/ring_grid.hpp) against geometry.hpp's loops over every edge, answer for answer:
+// point in polygon, the boundary distance up to a reach, disc overlap; also through
+// ObstacleLookup's polygon tests.
+#include "world/ring_grid.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "util/rng.hpp"
+#include "world/obstacle_lookup.hpp"
+
+namespace crowddb {
+namespace {
+
+// A star-shaped ring of n vertices around (cx, cy): radii drawn in [r0, r1], some vertices
+// snapped to a coarse lattice (horizontal and vertical edges, vertices sharing a y), some
+// repeated (zero-length edges).
+std::vector<Vec2> star(Rng& rng, std::size_t n, double cx, double cy, double r0, double r1) {
+  std::vector<Vec2> ring;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double a = 2 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n);
+    const double r = rng.uniform(r0, r1);
+    Vec2 v{cx + r * std::cos(a), cy + r * std::sin(a)};
+    if (rng.below(4) == 0) v = {std::round(v.x * 2) / 2, std::round(v.y * 2) / 2};
+    ring.push_back(v);
+    if (rng.below(20) == 0) ring.push_back(v);
+  }
+  return ring;
+}
+
+// Points that stress the edge cases: on vertices, on edges' midpoints, on a vertex's horizontal
+// line just left and right of it, a hair off an edge, far outside, and anywhere.
+std::vector<Vec2> probes(Rng& rng, const std::vector<Vec2>& ring, double cx, double cy,
+                         double span) {
+  std::vector<Vec2> out;
+  for (int q = 0; q < 400; ++q) {
+    const Vec2& a = ring[rng.below(ring.size())];
+    const Vec2& b = ring[rng.below(ring.size())];
+    switch (q % 8) {
+      case 0:
+        out.push_back(a);
+        break;
+      case 1:
+        out.push_back({(a.x + b.x) / 2, (a.y + b.y) / 2});
+        break;
+      case 2:
+        out.push_back({a.x - rng.uniform(0, span), a.y});
+        break;
+      case 3:
+        out.push_back({std::nextafter(a.x, -INFINITY), a.y});
+        break;
+      case 4: {
+        const std::size_t k = rng.below(ring.size());
+        const Vec2 &p = ring[k], &s = ring[(k + 1) % ring.size()];
+        const double t = rng.uniform();
+        out.push_back({std::nextafter(p.x + t * (s.x - p.x), INFINITY), p.y + t * (s.y - p.y)});
+        break;
+      }
+      case 5:
+        out.push_back({cx + rng.uniform(-20, 20) * span, cy + rng.uniform(-20, 20) * span});
+        break;
+      default:
+        out.push_back({cx + rng.uniform(-1.2, 1.2) * span, cy + rng.uniform(-1.2, 1.2) * span});
+    }
+  }
+  return out;
+}
+
+TEST(RingGrid, AnswersAreTheLoopsOverEveryEdge) {
+  std::size_t inside = 0, near = 0, total = 0;
+  for (const uint64_t seed : {1u, 2u, 3u, 4u}) {
+    Rng rng(seed);
+    for (const std::size_t n : {64u, 300u, 3000u}) {
+      const double cx = rng.uniform(-1e3, 1e3), cy = rng.uniform(-1e3, 1e3);
+      const double span = rng.uniform(1, 200);
+      const std::vector<Vec2> ring = star(rng, n, cx, cy, span * 0.3, span);
+      const RingGrid grid(ring);
+      for (const Vec2& p : probes(rng, ring, cx, cy, span)) {
+        const bool in = point_in_polygon(ring, p.x, p.y);
+        ASSERT_EQ(grid.inside(ring, p.x, p.y), in)
+            << "seed " << seed << " n " << n << " at (" << p.x << ", " << p.y << ")";
+        const double d2 = dist2_to_boundary(ring, p.x, p.y);
+        for (const double reach : {0.0, 1e-9, span / 100, span / 3, 2 * span, 1e9}) {
+          const double got = grid.dist2(ring, p.x, p.y, reach);
+          if (d2 <= reach * reach)
+            ASSERT_EQ(got, d2) << "seed " << seed << " n " << n << " reach " << reach;
+          else
+            ASSERT_GT(got, reach * reach) << "seed " << seed << " n " << n << " reach " << reach;
+          ASSERT_EQ(grid.disc_overlaps(ring, p.x, p.y, reach),
+                    disc_overlaps_polygon(ring, p.x, p.y, reach));
+        }
+        ++total;
+        inside += in;
+        near += d2 <= (span / 100) * (span / 100);
+      }
+    }
+  }
+  // The probes hit both sides and the boundary's neighbourhood.
+  EXPECT_GT(inside, total / 5);
+  EXPECT_LT(inside, total - total / 5);
+  EXPECT_GT(near, total / 5);
+}
+
+// Long edges (a thin ring around a hall, a wall across it) go to the list every question scans;
+// coordinates beyond any grid are scanned too.
+TEST(RingGrid, LongEdgesAndHugeCoordinatesAreTheLoops) {
+  Rng rng(7);
+  std::vector<Vec2> ring;
+  for (int k = 0; k < 200; ++k) ring.push_back({static_cast<double>(k) * 0.5, std::sin(k) * 0.2});
+  ring.push_back({100, 50});  // then two edges spanning the whole box
+  ring.push_back({0, 50});
+  const RingGrid grid(ring);
+  for (int q = 0; q < 3000; ++q) {
+    const double x = rng.uniform(-5, 105), y = q % 3 == 0 ? 50 : rng.uniform(-5, 55);
+    ASSERT_EQ(grid.inside(ring, x, y), point_in_polygon(ring, x, y)) << x << ", " << y;
+    const double d2 = dist2_to_boundary(ring, x, y);
+    const double got = grid.dist2(ring, x, y, 1);
+    if (d2 <= 1)
+      ASSERT_EQ(got, d2);
+    else
+      ASSERT_GT(got, 1);
+  }
+  std::vector<Vec2> huge;
+  for (int k = 0; k < 100; ++k)
+    huge.push_back({k % 2 ? 1e308 : -1e308, static_cast<double>(k) * (k % 3 ? 1 : -1)});
+  const RingGrid wide(huge);
+  for (const double x : {-1e308, 0.0, 1e300})
+    for (const double y : {-50.0, 0.5, 99.0})
+      EXPECT_EQ(wide.inside(huge, x, y), point_in_polygon(huge, x, y));
+}
+
+// ObstacleLookup's polygon tests: the grid for rings with many edges, the loops for the rest.
+TEST(RingGrid, ObstacleLookupsPolygonTestsAreTheLoops) {
+  Rng rng(11);
+  std::vector<PolygonObstacle> polys;
+  polys.push_back({star(rng, 2000, 0, 0, 40, 60), 1});
+  polys.push_back({{{70, 0}, {80, 0}, {80, 10}, {70, 10}}, 1});
+  polys.push_back({star(rng, 500, 100, 100, 10, 30), 1});
+  const std::vector<CircleObstacle> circles{{0, 100, 5, 1}};
+  const ObstacleLookup lookup(circles, polys);
+  for (int q = 0; q < 20000; ++q) {
+    const double x = rng.uniform(-70, 140), y = rng.uniform(-70, 140), r = rng.uniform(0, 3);
+    for (std::size_t p = 0; p < polys.size(); ++p) {
+      const auto& v = polys[p].vertices;
+      ASSERT_EQ(lookup.polygon_holds(p, v, x, y), point_in_polygon(v, x, y));
+      ASSERT_EQ(lookup.disc_overlaps_polygon(p, v, x, y, r), disc_overlaps_polygon(v, x, y, r));
+      ASSERT_EQ(lookup.polygon_dist2(p, v, x, y, 0) > 0, dist2_to_boundary(v, x, y) > 0);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace crowddb
