@@ -2,6 +2,7 @@
 #include "io/walkable_wkt.hpp"
 
 #include "world/geometry.hpp"
+#include "world/obstacle_lookup.hpp"
 
 // Boost 1.74's rescale policy trips GCC 12's -Wmaybe-uninitialized where it is inlined here.
 #if defined(__GNUC__) && !defined(__clang__)
@@ -174,6 +175,11 @@ std::vector<Vec2> simple_ring(const Polygon& p) {
 
 struct WalkableArea::Impl {
   Multi area;
+  // covers() away from the boundary: every ring (outer and holes, without the closing point) in
+  // an obstacle lookup, whose edge grids answer the point's parity and its distance to the rings.
+  std::vector<PolygonObstacle> rings;
+  std::unique_ptr<ObstacleLookup> lookup;
+  double near = 0;  // [m] points closer than this to a ring are left to Boost.Geometry
 };
 
 WalkableArea::WalkableArea(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -260,6 +266,21 @@ WalkableArea WalkableArea::parse(std::string_view wkt) {
   } catch (const std::exception& e) {  // Boost.Geometry on extreme coordinates
     invalid(std::string("invalid walkable area: ") + e.what());
   }
+  double largest = 1;  // the largest coordinate's magnitude, for the rounding margin
+  const auto add_ring = [&](const Ring& r) {
+    PolygonObstacle o;
+    for (std::size_t k = 0; k + 1 < r.size(); ++k) {  // (the last point closes the ring)
+      o.vertices.push_back({r[k].x(), r[k].y()});
+      largest = std::max({largest, std::abs(r[k].x()), std::abs(r[k].y())});
+    }
+    impl->rings.push_back(std::move(o));
+  };
+  for (const Polygon& p : m) {
+    add_ring(p.outer());
+    for (const Ring& h : p.inners()) add_ring(h);
+  }
+  impl->lookup = std::make_unique<ObstacleLookup>(std::span<const CircleObstacle>{}, impl->rings);
+  impl->near = 1e-9 * largest;
   return WalkableArea(std::move(impl));
 }
 
@@ -273,6 +294,27 @@ double WalkableArea::area() const {
 }
 
 bool WalkableArea::covers(double x, double y) const {
+  // A point farther than `near` from every ring is inside exactly when an odd number of rings
+  // hold it (the rings of a valid area do not cross; holes lie inside their outer ring), and the
+  // even-odd test cannot round the wrong way there: its crossings are accurate to ~1e-15 of the
+  // coordinates, a millionth of `near`. Closer points, and only those, take Boost.Geometry's
+  // exact predicates. So each point costs the rings and edges near it, not every vertex (the
+  // loader asks for every agent and goal).
+  const Impl& a = *impl_;
+  if (!(std::isfinite(x) && std::isfinite(y))) return covers_by_boost(x, y);
+  thread_local std::vector<uint32_t> rings;
+  a.lookup->candidates(x, y, a.near, rings);
+  bool in = false;
+  for (const uint32_t k : rings) {
+    const std::vector<Vec2>& ring = a.rings[k].vertices;
+    if (a.lookup->polygon_dist2(k, ring, x, y, a.near) <= a.near * a.near)
+      return covers_by_boost(x, y);
+    in ^= a.lookup->polygon_holds(k, ring, x, y);
+  }
+  return in;
+}
+
+bool WalkableArea::covers_by_boost(double x, double y) const {
   return bg::covered_by(Point(x, y), impl_->area);
 }
 

@@ -30,6 +30,9 @@ class WalkableArea {
   double area() const;
   // Inside or on the boundary.
   bool covers(double x, double y) const;
+  // The same by Boost.Geometry's covered_by alone: covers' oracle (tests), and what it asks
+  // for points near the boundary.
+  bool covers_by_boost(double x, double y) const;
   // Whether the area lies within `b` (boundary contact allowed).
   bool within(const Bounds& b) const;
   // Everything in `b` that is not walkable, as simple polygons (no holes; polygons with holes

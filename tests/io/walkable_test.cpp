@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <numbers>
+#include <sstream>
 
 #include "crowddb/scenario.hpp"
 #include "io/walkable_wkt.hpp"
@@ -45,6 +46,79 @@ TEST(WalkableArea, PolygonWithHoles) {
   EXPECT_TRUE(a.covers(0, 20));  // the boundary counts
   EXPECT_FALSE(a.covers(12, 12));
   EXPECT_FALSE(a.covers(41, 5));
+}
+
+// covers() decides points away from the boundary by the rings' edge grids and leaves the rest
+// to Boost.Geometry: the same answers as covered_by alone, on areas of many vertices with holes
+// (one of them holding an island) and a square beside it, at coordinates near 0
+// and near 10^6, for vertices, edges' midpoints, points a hair off them and anywhere.
+TEST(WalkableArea, CoversIsBoostsCoveredBy) {
+  Rng rng(5);
+  std::size_t inside = 0, total = 0;
+  const auto num = [](double v) {
+    std::ostringstream os;
+    os.precision(17);
+    os << v;
+    return os.str();
+  };
+  for (const double offset : {0.0, 1e6}) {
+    std::vector<Vec2> vertices;  // of every ring, for the probes
+    const auto ring = [&](double cx, double cy, double r0, double r1, int n, bool cw) {
+      std::vector<Vec2> v;
+      for (int k = 0; k < n; ++k) {
+        const double a = 2 * std::numbers::pi * k / n * (cw ? -1 : 1);
+        const double r = rng.uniform(r0, r1);
+        v.push_back({offset + cx + r * std::cos(a), offset + cy + r * std::sin(a)});
+      }
+      vertices.insert(vertices.end(), v.begin(), v.end());
+      v.push_back(v.front());
+      std::string w = "(";
+      for (std::size_t k = 0; k < v.size(); ++k)
+        w += (k ? ", " : "") + num(v[k].x) + " " + num(v[k].y);
+      return w + ")";
+    };
+    const auto box = [&](double x0, double y0, double x1, double y1) {
+      x0 += offset, y0 += offset, x1 += offset, y1 += offset;
+      vertices.insert(vertices.end(), {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}});
+      return "((" + num(x0) + " " + num(y0) + ", " + num(x1) + " " + num(y0) + ", " + num(x1) +
+             " " + num(y1) + ", " + num(x0) + " " + num(y1) + ", " + num(x0) + " " + num(y0) + "))";
+    };
+    // A hall of 3,000 vertices with a hole of 400 holding an island of 200, a pillar of 6, and a
+    // square outside the hall.
+    const std::string hall = "(" + ring(0, 0, 90, 100, 3000, false) + ", " +
+                             ring(0, 0, 30, 40, 400, true) + ", " + ring(60, 0, 3, 4, 6, true) +
+                             ")";
+    const std::string island = "(" + ring(0, 0, 10, 20, 200, false) + ")";
+    const io::WalkableArea a = io::WalkableArea::parse("MULTIPOLYGON(" + hall + ", " + island +
+                                                       ", " + box(105, 105, 115, 115) + ")");
+    for (int k = 0; k < 40000; ++k) {
+      double x = offset + rng.uniform(-120, 120), y = offset + rng.uniform(-120, 120);
+      const Vec2& v = vertices[rng.below(vertices.size())];
+      const Vec2& w = vertices[rng.below(vertices.size())];
+      switch (k % 5) {
+        case 1:  // a vertex, or a hair beside it
+          x = k % 10 == 1 ? v.x : std::nextafter(v.x, INFINITY);
+          y = v.y;
+          break;
+        case 2:  // on a vertex's horizontal line
+          x = v.x + rng.uniform(-5, 5);
+          y = v.y;
+          break;
+        case 3:  // between two vertices (often a ring's edge, when they are neighbours)
+          x = (v.x + w.x) / 2;
+          y = (v.y + w.y) / 2;
+          break;
+        default:
+          break;
+      }
+      const bool got = a.covers(x, y);
+      ASSERT_EQ(got, a.covers_by_boost(x, y)) << "(" << num(x) << ", " << num(y) << ")";
+      inside += got;
+      ++total;
+    }
+  }
+  EXPECT_GT(inside, total / 5);
+  EXPECT_LT(inside, total - total / 5);
 }
 
 TEST(WalkableArea, EitherRingOrientationIsAccepted) {
