@@ -298,8 +298,8 @@ bool WalkableArea::covers(double x, double y) const {
   // hold it (the rings of a valid area do not cross; holes lie inside their outer ring), and the
   // even-odd test cannot round the wrong way there: its crossings are accurate to ~1e-15 of the
   // coordinates, a millionth of `near`. Closer points, and only those, take Boost.Geometry's
-  // exact predicates. So each point costs the rings and edges near it, not every vertex (the
-  // loader asks for every agent and goal).
+  // covered_by, as every point did before. So each point costs the rings and edges near it, not
+  // every vertex (the loader asks for every agent and goal).
   const Impl& a = *impl_;
   if (!(std::isfinite(x) && std::isfinite(y))) return covers_by_boost(x, y);
   thread_local std::vector<uint32_t> rings;

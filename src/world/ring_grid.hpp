@@ -42,13 +42,18 @@ class RingGrid {
     x0_ = b.x0;
     y0_ = b.y0;
     const double w = std::max(b.x1 - b.x0, 1e-9), h = std::max(b.y1 - b.y0, 1e-9);
+    // Cells no finer than 10^-12 of the coordinates: the one-cell margins then exceed any
+    // rounding of a crossing or of a query window's edges (callers' points lie within 10^9 m).
+    const double magnitude =
+        std::max({std::abs(b.x0), std::abs(b.x1), std::abs(b.y0), std::abs(b.y1)});
     double extent = 0;  // the edges' mean box side: cells no smaller than an edge
     for (std::size_t s = 0; s < n_; ++s) {
       const Vec2 &p = ring[s], &q = ring[(s + 1) % n_];
       extent += std::max(std::abs(q.x - p.x), std::abs(q.y - p.y));
     }
     const auto edges = static_cast<double>(n_);
-    cell_ = std::max({std::sqrt(w * h / edges), extent / edges, w / kMaxSide, h / kMaxSide});
+    cell_ = std::max(
+        {std::sqrt(w * h / edges), extent / edges, w / kMaxSide, h / kMaxSide, 1e-12 * magnitude});
     nx_ = std::clamp<int64_t>(static_cast<int64_t>(w / cell_) + 1, 1, kMaxSide + 1);
     ny_ = std::clamp<int64_t>(static_cast<int64_t>(h / cell_) + 1, 1, kMaxSide + 1);
     start_.assign(static_cast<std::size_t>(nx_ * ny_) + 1, 0);
@@ -79,8 +84,10 @@ class RingGrid {
     }
   }
 
-  // point_in_polygon(ring, px, py), `ring` the one the grid was built over.
+  // point_in_polygon(ring, px, py), `ring` the one the grid was built over (another ring, one
+  // of another size, say, gets the loop itself).
   bool inside(std::span<const Vec2> ring, double px, double py) const {
+    if (ring.size() != n_) return point_in_polygon(ring, px, py);
     thread_local std::vector<uint32_t> near;
     if (start_.empty() || !(std::isfinite(px) && std::isfinite(py))) {
       all(near);
@@ -103,6 +110,7 @@ class RingGrid {
   // dist2_to_boundary(ring, px, py) where that is <= reach^2 (reach >= 0); otherwise a value
   // above reach^2.
   double dist2(std::span<const Vec2> ring, double px, double py, double reach) const {
+    if (ring.size() != n_) return dist2_to_boundary(ring, px, py);
     thread_local std::vector<uint32_t> near;
     if (start_.empty() || !(std::isfinite(px) && std::isfinite(py) && reach < INFINITY)) {
       all(near);
@@ -124,6 +132,9 @@ class RingGrid {
     }
     return best;
   }
+
+  // Edges every question scans (more than kMaxCells cells long, or no grid): for tests.
+  std::size_t scanned_edges() const { return big_.size(); }
 
   // disc_overlaps_polygon(ring, px, py, r).
   bool disc_overlaps(std::span<const Vec2> ring, double px, double py, double r) const {

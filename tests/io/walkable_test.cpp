@@ -50,8 +50,10 @@ TEST(WalkableArea, PolygonWithHoles) {
 
 // covers() decides points away from the boundary by the rings' edge grids and leaves the rest
 // to Boost.Geometry: the same answers as covered_by alone, on areas of many vertices with holes
-// (one of them holding an island) and a square beside it, at coordinates near 0
-// and near 10^6, for vertices, edges' midpoints, points a hair off them and anywhere.
+// (one of them holding an island, one touching its outer ring at a vertex), squares sharing a
+// vertex, at coordinates near 0, 10^6 and 5 * 10^8, for vertices, points on the lines through
+// them, and points off an edge's middle by 0.5 to 10 times the distance under which covers()
+// asks Boost (10^-9 of the coordinates), on either side.
 TEST(WalkableArea, CoversIsBoostsCoveredBy) {
   Rng rng(5);
   std::size_t inside = 0, total = 0;
@@ -61,58 +63,70 @@ TEST(WalkableArea, CoversIsBoostsCoveredBy) {
     os << v;
     return os.str();
   };
-  for (const double offset : {0.0, 1e6}) {
-    std::vector<Vec2> vertices;  // of every ring, for the probes
-    const auto ring = [&](double cx, double cy, double r0, double r1, int n, bool cw) {
-      std::vector<Vec2> v;
-      for (int k = 0; k < n; ++k) {
-        const double a = 2 * std::numbers::pi * k / n * (cw ? -1 : 1);
-        const double r = rng.uniform(r0, r1);
-        v.push_back({offset + cx + r * std::cos(a), offset + cy + r * std::sin(a)});
-      }
-      vertices.insert(vertices.end(), v.begin(), v.end());
+  for (const double offset : {0.0, 1e6, 5e8}) {
+    std::vector<std::vector<Vec2>> rings;  // every ring's vertices, for the probes
+    const auto text = [&](std::vector<Vec2> v) {
+      for (Vec2& p : v) p = {p.x + offset, p.y + offset};
+      rings.push_back(v);
       v.push_back(v.front());
       std::string w = "(";
       for (std::size_t k = 0; k < v.size(); ++k)
         w += (k ? ", " : "") + num(v[k].x) + " " + num(v[k].y);
       return w + ")";
     };
-    const auto box = [&](double x0, double y0, double x1, double y1) {
-      x0 += offset, y0 += offset, x1 += offset, y1 += offset;
-      vertices.insert(vertices.end(), {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}});
-      return "((" + num(x0) + " " + num(y0) + ", " + num(x1) + " " + num(y0) + ", " + num(x1) +
-             " " + num(y1) + ", " + num(x0) + " " + num(y1) + ", " + num(x0) + " " + num(y0) + "))";
+    const auto star = [&](double cx, double cy, double r0, double r1, int n, bool cw) {
+      std::vector<Vec2> v;
+      for (int k = 0; k < n; ++k) {
+        const double a = 2 * std::numbers::pi * k / n * (cw ? -1 : 1);
+        const double r = rng.uniform(r0, r1);
+        v.push_back({cx + r * std::cos(a), cy + r * std::sin(a)});
+      }
+      return text(v);
     };
-    // A hall of 3,000 vertices with a hole of 400 holding an island of 200, a pillar of 6, and a
-    // square outside the hall.
-    const std::string hall = "(" + ring(0, 0, 90, 100, 3000, false) + ", " +
-                             ring(0, 0, 30, 40, 400, true) + ", " + ring(60, 0, 3, 4, 6, true) +
+    const auto box = [&](double x0, double y0, double x1, double y1, bool cw) {
+      return cw ? text({{x0, y0}, {x0, y1}, {x1, y1}, {x1, y0}})
+                : text({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}});
+    };
+    // A hall of 3,000 vertices with a hole of 400 holding an island of 200, and a pillar; a
+    // square with a triangular hole touching its corner; two squares sharing a vertex.
+    const std::string hall = "(" + star(0, 0, 90, 100, 3000, false) + ", " +
+                             star(0, 0, 30, 40, 400, true) + ", " + star(60, 0, 3, 4, 6, true) +
                              ")";
-    const std::string island = "(" + ring(0, 0, 10, 20, 200, false) + ")";
+    const std::string island = "(" + star(0, 0, 10, 20, 200, false) + ")";
+    const std::string notch =
+        "(" + box(130, -10, 150, 10, false) + ", " + text({{130, -10}, {135, 5}, {140, 0}}) + ")";
+    const std::string pair =
+        "(" + box(105, 105, 115, 115, false) + "), (" + box(115, 115, 125, 125, false) + ")";
     const io::WalkableArea a = io::WalkableArea::parse("MULTIPOLYGON(" + hall + ", " + island +
-                                                       ", " + box(105, 105, 115, 115) + ")");
-    for (int k = 0; k < 40000; ++k) {
-      double x = offset + rng.uniform(-120, 120), y = offset + rng.uniform(-120, 120);
-      const Vec2& v = vertices[rng.below(vertices.size())];
-      const Vec2& w = vertices[rng.below(vertices.size())];
-      switch (k % 5) {
-        case 1:  // a vertex, or a hair beside it
-          x = k % 10 == 1 ? v.x : std::nextafter(v.x, INFINITY);
+                                                       ", " + notch + ", " + pair + ")");
+    const double near = 1e-9 * (offset + 150);  // covers()'s margin, about
+    for (int k = 0; k < 20000; ++k) {
+      double x = offset + rng.uniform(-120, 160), y = offset + rng.uniform(-120, 130);
+      const std::vector<Vec2>& ring = rings[rng.below(rings.size())];
+      const std::size_t e = rng.below(ring.size());
+      const Vec2& v = ring[e];
+      const Vec2& w = ring[(e + 1) % ring.size()];
+      switch (k % 4) {
+        case 1:  // a vertex, or a point on the horizontal line through one
+          x = k % 8 == 1 ? v.x : v.x + rng.uniform(-5, 5);
           y = v.y;
           break;
-        case 2:  // on a vertex's horizontal line
-          x = v.x + rng.uniform(-5, 5);
-          y = v.y;
+        case 2:
+        case 3: {  // off an edge's middle along its normal, either side
+          const double l = std::hypot(w.x - v.x, w.y - v.y);
+          if (l == 0) break;
+          static constexpr double kOff[] = {0.5, 1, 1.01, 2, 10};
+          const double d = kOff[rng.below(5)] * near * (rng.below(2) ? 1 : -1);
+          x = (v.x + w.x) / 2 - d * (w.y - v.y) / l;
+          y = (v.y + w.y) / 2 + d * (w.x - v.x) / l;
           break;
-        case 3:  // between two vertices (often a ring's edge, when they are neighbours)
-          x = (v.x + w.x) / 2;
-          y = (v.y + w.y) / 2;
-          break;
+        }
         default:
           break;
       }
       const bool got = a.covers(x, y);
-      ASSERT_EQ(got, a.covers_by_boost(x, y)) << "(" << num(x) << ", " << num(y) << ")";
+      ASSERT_EQ(got, a.covers_by_boost(x, y))
+          << "offset " << offset << " (" << num(x) << ", " << num(y) << ")";
       inside += got;
       ++total;
     }

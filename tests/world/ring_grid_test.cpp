@@ -104,25 +104,37 @@ TEST(RingGrid, AnswersAreTheLoopsOverEveryEdge) {
   EXPECT_GT(near, total / 5);
 }
 
-// Long edges (a thin ring around a hall, a wall across it) go to the list every question scans;
-// coordinates beyond any grid are scanned too.
+// A thin zigzag closed by one edge along its whole length: that edge spans more cells than an
+// edge may be registered in and goes to the list every question scans, beside the grid.
 TEST(RingGrid, LongEdgesAndHugeCoordinatesAreTheLoops) {
   Rng rng(7);
   std::vector<Vec2> ring;
-  for (int k = 0; k < 200; ++k) ring.push_back({static_cast<double>(k) * 0.5, std::sin(k) * 0.2});
-  ring.push_back({100, 50});  // then two edges spanning the whole box
-  ring.push_back({0, 50});
+  for (int k = 0; k <= 1000; ++k) ring.push_back({k * 0.1, k % 2 ? 1.0 : 0.5});
+  ring.push_back({100, 0});
+  ring.push_back({0, 0});
   const RingGrid grid(ring);
-  for (int q = 0; q < 3000; ++q) {
-    const double x = rng.uniform(-5, 105), y = q % 3 == 0 ? 50 : rng.uniform(-5, 55);
-    ASSERT_EQ(grid.inside(ring, x, y), point_in_polygon(ring, x, y)) << x << ", " << y;
+  EXPECT_EQ(grid.scanned_edges(), 1u);  // the long one; the others in cells
+  std::size_t inside = 0;
+  for (int q = 0; q < 20000; ++q) {
+    const double x = rng.uniform(-5, 105);
+    const double y = q % 4 == 0 ? 0 : (q % 4 == 1 ? 0.5 : rng.uniform(-1, 2));
+    const bool in = point_in_polygon(ring, x, y);
+    ASSERT_EQ(grid.inside(ring, x, y), in) << x << ", " << y;
+    inside += in;
     const double d2 = dist2_to_boundary(ring, x, y);
-    const double got = grid.dist2(ring, x, y, 1);
-    if (d2 <= 1)
-      ASSERT_EQ(got, d2);
-    else
-      ASSERT_GT(got, 1);
+    for (const double reach : {0.0, 0.05, 1.0}) {
+      const double got = grid.dist2(ring, x, y, reach);
+      if (d2 <= reach * reach)
+        ASSERT_EQ(got, d2) << x << ", " << y;
+      else
+        ASSERT_GT(got, reach * reach) << x << ", " << y;
+    }
   }
+  EXPECT_GT(inside, 2000u);
+  // A ring of another size than the grid's gets the loops.
+  const std::vector<Vec2> other(ring.begin(), ring.begin() + 500);
+  EXPECT_EQ(grid.inside(other, 20, 0.6), point_in_polygon(other, 20, 0.6));
+  EXPECT_EQ(grid.dist2(other, 20, 0.6, 0), dist2_to_boundary(other, 20, 0.6));
   std::vector<Vec2> huge;
   for (int k = 0; k < 100; ++k)
     huge.push_back({k % 2 ? 1e308 : -1e308, static_cast<double>(k) * (k % 3 ? 1 : -1)});
