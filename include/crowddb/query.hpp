@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -72,6 +73,8 @@ enum class ObstacleCharges {
              // model's default, ThesisParams::obstacle_repulsion)
 };
 
+class RingGrid;  // src/world/ring_grid.hpp
+
 // Static obstacles in the form the queries use, with derived data (bounding boxes, charged
 // points) computed once. Polygons are stored counter-clockwise.
 class StaticScene {
@@ -119,6 +122,11 @@ class StaticScene {
     Vec2 a, b;
   };
   const Edge& edge(std::size_t f) const { return edges_[f - circles_.size()]; }
+  // Polygon p's edge grid (src/world/ring_grid.hpp) where it has many edges, else null: the
+  // exact polygon tests through it (src/query/scene_polygons.hpp) read the edges near the
+  // question. A walkable hall drawn with 20,000 vertices made its blocked pieces' tests loop over
+  // every edge for every agent each tick.
+  const RingGrid* ring_grid(std::size_t p) const { return grids_[p].get(); }
   // A distinct number for every scene built in this process: caches keyed by it (an index over
   // the features) never outlive the scene they were built for.
   uint64_t generation() const { return generation_; }
@@ -132,6 +140,7 @@ class StaticScene {
   std::vector<uint32_t> edge_start_ = {0};  // polygons().size() + 1 prefix sums of edge counts
   std::vector<uint32_t> edge_polygon_;      // per edge feature: its polygon row
   std::vector<Edge> edges_;                 // per edge feature: its endpoints
+  std::vector<std::shared_ptr<const RingGrid>> grids_;  // per polygon (immutable: copies share)
   uint64_t generation_ = 0;
 };
 

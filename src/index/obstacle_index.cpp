@@ -5,6 +5,7 @@
 
 #include "index/row_buckets.hpp"  // cell_by_product
 #include "query/naive_paths.hpp"
+#include "query/scene_polygons.hpp"
 
 namespace crowddb::index {
 namespace {
@@ -115,7 +116,7 @@ void ObstacleIndex::overlaps(const DiscView& d, std::size_t begin, std::size_t e
       if (id < nc) {
         if (disc_hits_circle(circles[id], x, y, r))
           out.push_back({static_cast<uint32_t>(i), {Collider::Kind::circle, id}});
-      } else if (disc_hits_polygon(polygons[id - nc], boxes[id - nc], x, y, r)) {
+      } else if (scene_disc_hits_polygon(*scene_, id - nc, x, y, r)) {
         out.push_back({static_cast<uint32_t>(i), {Collider::Kind::polygon, id - nc}});
       }
     }

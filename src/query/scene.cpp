@@ -5,6 +5,7 @@
 
 #include "crowddb/query.hpp"
 #include "world/geometry.hpp"
+#include "world/ring_grid.hpp"
 
 namespace crowddb {
 
@@ -82,6 +83,9 @@ StaticScene::StaticScene(std::vector<CircleObstacle> circles, std::vector<Polygo
       b = {std::min(b.xmin, a.x), std::min(b.ymin, a.y), std::max(b.xmax, a.x),
            std::max(b.ymax, a.y)};
     boxes_.push_back(b);
+    grids_.push_back(p.vertices.size() >= RingGrid::kMinEdges
+                         ? std::make_shared<const RingGrid>(p.vertices)
+                         : nullptr);
   }
 }
 

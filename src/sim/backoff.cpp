@@ -7,6 +7,7 @@
 #include "index/collisions_grid.hpp"
 #include "index/obstacle_index.hpp"
 #include "query/naive_paths.hpp"
+#include "query/scene_polygons.hpp"
 #include "sim/stages.hpp"
 #include "util/stopwatch.hpp"
 #include "world/geometry.hpp"
@@ -14,10 +15,10 @@
 namespace crowddb::sim {
 namespace {
 
-// Penetration depth of a disc into a polygon (> 0: overlapping).
-double polygon_depth(std::span<const Vec2> ring, double x, double y, double r) {
-  const double d = std::sqrt(dist2_to_boundary(ring, x, y));
-  return point_in_polygon(ring, x, y) ? r + d : r - d;
+// Penetration depth of a disc into polygon p (> 0: overlapping).
+double polygon_depth(const StaticScene& scene, std::size_t p, double x, double y, double r) {
+  const double d = std::sqrt(scene_polygon_dist2(scene, p, x, y, std::abs(r)));
+  return scene_polygon_holds(scene, p, x, y) ? r + d : r - d;
 }
 
 DiscView next_view(const AgentTable& t, const NextState& next) {
@@ -162,9 +163,8 @@ bool obstacle_violates(const AgentTable& t, const NextState& next, const StaticS
     const double sx = c.x - t.x[i], sy = c.y - t.y[i], nx = c.x - next.x[i], ny = c.y - next.y[i];
     return !(discs_overlap(sx, sy, r_i + c.radius) && nx * nx + ny * ny >= sx * sx + sy * sy);
   }
-  const auto& ring = scene.polygons()[with.row].vertices;
-  const double before = polygon_depth(ring, t.x[i], t.y[i], r_i);
-  return !(before > 0 && polygon_depth(ring, next.x[i], next.y[i], r_i) <= before);
+  const double before = polygon_depth(scene, with.row, t.x[i], t.y[i], r_i);
+  return !(before > 0 && polygon_depth(scene, with.row, next.x[i], next.y[i], r_i) <= before);
 }
 
 namespace {

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "query/naive_paths.hpp"
+#include "query/scene_polygons.hpp"
 #include "util/byte_codec.hpp"
 #include "world/geometry.hpp"
 #include "world/placement_grid.hpp"
@@ -49,9 +50,10 @@ void SourceEmitter::restore(ByteReader& in, const World& world) {
 bool SourceEmitter::touches_an_obstacle(const StaticScene& scene, const AgentSpec& a) {
   const std::size_t circles = scene.circles().size(), count = circles + scene.polygons().size();
   const auto hits = [&](std::size_t k) {
-    return k < circles ? disc_hits_circle(scene.circles()[k], a.x, a.y, a.radius)
-                       : disc_hits_polygon(scene.polygons()[k - circles],
-                                           scene.polygon_boxes()[k - circles], a.x, a.y, a.radius);
+    if (k < circles) return disc_hits_circle(scene.circles()[k], a.x, a.y, a.radius);
+    return naive_ ? disc_hits_polygon(scene.polygons()[k - circles],
+                                      scene.polygon_boxes()[k - circles], a.x, a.y, a.radius)
+                  : scene_disc_hits_polygon(scene, k - circles, a.x, a.y, a.radius);
   };
   if (naive_ || count <= kObstaclesForALookup) {
     for (std::size_t k = 0; k < count; ++k)

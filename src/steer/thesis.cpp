@@ -16,6 +16,7 @@
 #include <map>
 
 #include "plan/access_path.hpp"
+#include "query/scene_polygons.hpp"
 #include "steer/model.hpp"
 #include "util/stopwatch.hpp"
 #include "world/geometry.hpp"
@@ -251,7 +252,8 @@ class ThesisModel final : public Model {
           case Collider::Kind::polygon:
           default: {
             Vec2 c{};
-            dist2_to_boundary(scene.polygons()[h.with.row].vertices, ax, ay, &c);
+            // Touching at t*: within about a radius of the boundary (exact at any distance).
+            scene_polygon_dist2(scene, h.with.row, ax, ay, 2 * t.radius[i], &c);
             bx = c.x;
             by = c.y;
             break;

@@ -66,10 +66,12 @@ class RingGrid {
     return in;
   }
 
-  // dist2_to_boundary(ring, px, py) where that is <= reach^2 (reach >= 0); otherwise a value
+  // dist2_to_boundary(ring, px, py, closest) where that is <= reach^2 (reach >= 0), the same
+  // closest point too (the first nearest edge in ring order: `near` is sorted); otherwise a value
   // above reach^2.
-  double dist2(std::span<const Vec2> ring, double px, double py, double reach) const {
-    if (ring.size() != n_) return dist2_to_boundary(ring, px, py);
+  double dist2(std::span<const Vec2> ring, double px, double py, double reach,
+               Vec2* closest = nullptr) const {
+    if (ring.size() != n_) return dist2_to_boundary(ring, px, py, closest);
     thread_local std::vector<uint32_t> near;
     if (!(std::isfinite(px) && std::isfinite(py) && reach < INFINITY))
       grid_.all(near);
@@ -80,7 +82,11 @@ class RingGrid {
     for (const uint32_t s : near) {
       const Vec2 c = closest_on_segment(ring[s], ring[(s + 1) % n_], px, py);
       const double dx = px - c.x, dy = py - c.y;
-      best = std::min(best, dx * dx + dy * dy);
+      const double d2 = dx * dx + dy * dy;
+      if (d2 < best) {
+        best = d2;
+        if (closest) *closest = c;
+      }
     }
     return best;
   }
