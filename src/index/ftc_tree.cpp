@@ -1249,7 +1249,7 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, ProbeScratch& sc, Count
     const double b = node_bound(&polygon_boxes[p], 1, static_frames[opt.lanes], q, ar, cap);
     if (b == INFINITY || best.beats(b, Kind::polygon, p)) continue;
     ++c.pair_tests;
-    best.offer(ray_polygon_time(polys[p].vertices, ax, ay, avx, avy, ar, horizon), Kind::polygon, p,
+    best.offer(ray_polygon_time(*scene, p, ax, ay, avx, avy, ar, horizon, cap), Kind::polygon, p,
                static_cast<uint32_t>(p));
   }
   return best.kind == Kind::none ? FtcHit{} : FtcHit{{best.kind, best.row}, best.t};

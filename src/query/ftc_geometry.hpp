@@ -36,6 +36,12 @@ inline double ray_disc_time(double dx, double dy, double wx, double wy, double R
 double ray_polygon_time(std::span<const Vec2> ring, double px, double py, double vx, double vy,
                         double r, double horizon);
 
+// The same for the scene's polygon p through its edge grid (StaticScene::ring_grid) where it has
+// one: bit for bit the loop's time where that is <= cap, else a value above cap (the caller holds
+// a hit at cap already). The loop stays the naive path's and the tests' oracle.
+double ray_polygon_time(const StaticScene& scene, std::size_t p, double px, double py, double vx,
+                        double vy, double r, double horizon, double cap);
+
 // Tie rule: earlier time first; at equal times agents before circles before polygons; then the
 // smaller agent id or obstacle row. `key` is the agent's id or the obstacle's row.
 inline bool precedes(double t1, Collider::Kind k1, uint64_t key1, double t2, Collider::Kind k2,

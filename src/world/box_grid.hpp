@@ -79,6 +79,7 @@ class BoxGrid {
   int64_t nx() const { return nx_; }
   int64_t ny() const { return ny_; }
   std::size_t count() const { return count_; }
+  double cell() const { return cell_; }
   // Boxes every question scans: for tests.
   std::size_t scanned() const { return big_.size(); }
 

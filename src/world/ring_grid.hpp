@@ -91,6 +91,20 @@ class RingGrid {
     return best;
   }
 
+  // The edges whose box may meet [x0, x1] x [y0, y1] (grown by a cell against rounding), sorted,
+  // each once; every edge where there is no grid or a bound is not finite. For questions the
+  // grid does not answer itself (first-to-collide's ray against the edges' capsules).
+  void edges_meeting(double x0, double y0, double x1, double y1, std::vector<uint32_t>& out) const {
+    if (!(std::isfinite(x0) && std::isfinite(y0) && std::isfinite(x1) && std::isfinite(y1)))
+      grid_.all(out);
+    else
+      grid_.collect(grid_.cell_x(x0) - 1, grid_.cell_x(x1) + 1, grid_.cell_y(y0) - 1,
+                    grid_.cell_y(y1) + 1, out);
+  }
+  double cell() const { return grid_.cell(); }
+  int64_t cells_across() const { return grid_.nx() + grid_.ny(); }
+  std::size_t edges() const { return n_; }
+
   // Edges every question scans (long ones, or all where there is no grid): for tests.
   std::size_t scanned_edges() const { return grid_.scanned(); }
 

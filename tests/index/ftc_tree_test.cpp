@@ -14,6 +14,7 @@
 #include "query/ftc_geometry.hpp"
 #include "query/naive_paths.hpp"
 #include "scenario/builders.hpp"
+#include "support/polygons.hpp"
 #include "support/random_tables.hpp"
 #include "util/rng.hpp"
 
@@ -339,6 +340,24 @@ TEST(FtcIndex, StaticObstacles) {
   EXPECT_EQ(index.query(0), (FtcHit{{Collider::Kind::circle, 0}, 8.0}));
   index.build(t.view(), square, 30);
   EXPECT_EQ(index.query(0), (FtcHit{{Collider::Kind::polygon, 0}, 8.0}));
+}
+
+// Polygons of many edges (a hall's blocked piece, stars), answered through their edge grids:
+// the naive loop's answers under every option set.
+TEST(FtcIndex, PolygonsOfManyEdges) {
+  Rng rng(5);
+  std::vector<PolygonObstacle> polys = {{test::hall_piece(3000, 0, 0, 120), 1}};
+  for (int k = 0; k < 4; ++k)
+    polys.push_back({test::star(rng, 64 + rng.below(1500), rng.uniform(-60, 60),
+                                rng.uniform(-60, 60), 2, rng.uniform(5, 20)),
+                     1});
+  const StaticScene scene({}, polys, 1.0);
+  for (uint64_t seed : {1, 2}) {
+    const DiscTable t = build::uniform(400, build::Box{-130, -130, 130, 130}, 3, 0.5, 2, seed);
+    for (const Opt& o : some_options()) EXPECT_EQ(compare(t, scene, 30, o), 0) << seed;
+    EXPECT_EQ(compare(t, scene, INFINITY), 0) << seed;
+    EXPECT_EQ(compare(t, scene, 1), 0) << seed;
+  }
 }
 
 // Exactly grazing and nearly grazing pairs, where the pair time is most sensitive to rounding.

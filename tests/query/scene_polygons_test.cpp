@@ -7,39 +7,21 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <vector>
 
 #include "index/obstacle_index.hpp"
+#include "query/ftc_geometry.hpp"
 #include "query/naive_paths.hpp"
+#include "support/polygons.hpp"
 #include "util/rng.hpp"
 
 namespace crowddb {
 namespace {
 
-std::vector<Vec2> star(Rng& rng, std::size_t n, double cx, double cy, double r0, double r1) {
-  std::vector<Vec2> ring;
-  for (std::size_t k = 0; k < n; ++k) {
-    const double a = 2 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n);
-    const double r = rng.uniform(r0, r1);
-    ring.push_back({cx + r * std::cos(a), cy + r * std::sin(a)});
-  }
-  return ring;
-}
-
-// A square of side 2 h around (cx, cy) less a wavy disc of n vertices inside it: the blocked
-// piece of a hall drawn as a walkable area (one ring around, along the hole's border; a slit
-// joins them, as the walkable areas' complement is cut).
-std::vector<Vec2> hall_piece(std::size_t n, double cx, double cy, double h) {
-  std::vector<Vec2> ring = {
-      {cx + h, cy}, {cx + h, cy + h}, {cx - h, cy + h}, {cx - h, cy - h}, {cx + h, cy - h}};
-  for (std::size_t k = 0; k <= n; ++k) {  // clockwise around the hole, back to its start
-    const double a = -2 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n);
-    const double r = 0.8 * h * (1 + 0.05 * std::sin(7 * a));
-    ring.push_back({cx + r * std::cos(a), cy + r * std::sin(a)});
-  }
-  return ring;
-}
+using test::hall_piece;
+using test::star;
 
 // Discs anywhere near the polygons, and on, a hair inside and a hair outside their edges.
 DiscTable discs_about(Rng& rng, const std::vector<PolygonObstacle>& polys, double lo, double hi) {
@@ -111,6 +93,50 @@ TEST(ScenePolygons, TheCollisionQuerysObstacleHalfIsTheOracleLoop) {
   index::obstacle_overlaps(d, scene, index::Frame::of(d), got, st);
   EXPECT_GT(want.size(), 1000u);
   EXPECT_TRUE(got == want) << got.size() << " vs " << want.size();
+}
+
+// First-to-collide's ray against a polygon (query/ftc_geometry.hpp): the grid's time is the
+// loop's bit for bit where that is at most the cap, and above the cap otherwise.
+TEST(ScenePolygons, RayTimesThroughTheEdgeGridsAreTheLoops) {
+  Rng rng(2612);
+  std::vector<PolygonObstacle> polys;
+  for (const std::size_t n : {64, 700, 3000})
+    polys.push_back({star(rng, n, static_cast<double>(n) * 0.05, 0, 5, 40), 1});
+  polys.push_back({hall_piece(4000, 0, 300, 120), 1});
+  // Spikes: long edges whose boxes meet a slice of the path long before the edge is hit, while a
+  // short edge just past the slice is hit first.
+  std::vector<Vec2> spiky = star(rng, 600, 200, 100, 20, 22);
+  for (std::size_t k = 0; k < spiky.size(); k += 23)
+    spiky[k] = {200 + 4 * (spiky[k].x - 200), 100 + 4 * (spiky[k].y - 100)};
+  polys.push_back({spiky, 1});
+  const StaticScene scene({}, polys, 1, ObstacleCharges::none, nullptr);
+  const DiscTable t = discs_about(rng, polys, -150, 450);
+  std::size_t hits = 0, capped = 0;
+  for (std::size_t i = 0; i < t.x.size(); ++i) {
+    const double x = t.x[i], y = t.y[i], r = t.radius[i];
+    const double speed = rng.below(10) == 0 ? 0 : rng.below(10) == 0 ? 1e3 : rng.uniform(0.1, 5);
+    const double a = rng.uniform(0, 2 * std::numbers::pi);
+    double vx = speed * std::cos(a), vy = speed * std::sin(a);
+    if (rng.below(4) == 0) vy = 0;  // along the lattice's horizontal edges
+    for (std::size_t p = 0; p < polys.size(); ++p)
+      for (const double horizon : {0.0, 2.0, 30.0, double(INFINITY)}) {
+        const double want = ray_polygon_time(polys[p].vertices, x, y, vx, vy, r, horizon);
+        for (const double cap : {double(INFINITY), horizon, rng.uniform(0, 30), 0.0}) {
+          const double got = ray_polygon_time(scene, p, x, y, vx, vy, r, horizon, cap);
+          if (want <= cap) {
+            ASSERT_EQ(std::memcmp(&got, &want, sizeof got), 0)
+                << i << " " << p << " horizon " << horizon << " cap " << cap << ": " << got
+                << " vs " << want;
+            hits += want < INFINITY && want > 0;
+          } else {
+            ASSERT_GT(got, cap) << i << " " << p << " horizon " << horizon << " want " << want;
+            ++capped;
+          }
+        }
+      }
+  }
+  EXPECT_GT(hits, 1000u);
+  EXPECT_GT(capped, 1000u);
 }
 
 }  // namespace

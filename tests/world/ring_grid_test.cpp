@@ -9,27 +9,14 @@
 #include <numbers>
 #include <vector>
 
+#include "support/polygons.hpp"
 #include "util/rng.hpp"
 #include "world/obstacle_lookup.hpp"
 
 namespace crowddb {
 namespace {
 
-// A star-shaped ring of n vertices around (cx, cy): radii drawn in [r0, r1], some vertices
-// snapped to a coarse lattice (horizontal and vertical edges, vertices sharing a y), some
-// repeated (zero-length edges).
-std::vector<Vec2> star(Rng& rng, std::size_t n, double cx, double cy, double r0, double r1) {
-  std::vector<Vec2> ring;
-  for (std::size_t k = 0; k < n; ++k) {
-    const double a = 2 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n);
-    const double r = rng.uniform(r0, r1);
-    Vec2 v{cx + r * std::cos(a), cy + r * std::sin(a)};
-    if (rng.below(4) == 0) v = {std::round(v.x * 2) / 2, std::round(v.y * 2) / 2};
-    ring.push_back(v);
-    if (rng.below(20) == 0) ring.push_back(v);
-  }
-  return ring;
-}
+using test::star;
 
 // Points that stress the edge cases: on vertices, on edges' midpoints, on a vertex's horizontal
 // line just left and right of it, a hair off an edge, far outside, and anywhere.
