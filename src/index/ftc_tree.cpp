@@ -18,6 +18,7 @@
 #include "util/cpu.hpp"
 #include "util/executor.hpp"
 #include "util/stopwatch.hpp"
+#include "world/box_grid.hpp"
 
 namespace crowddb {
 
@@ -248,9 +249,10 @@ struct ProbeScratch {
   std::vector<double> cx, cy, cr, cc;
   std::vector<uint32_t> cpos, pick, hit;  // candidates' positions in tree order
   uint32_t leaf = kNoRow;
-  std::size_t ncand = 0;      // candidates of that leaf (the member itself included)
-  bool crowded = false;       // more than the join's cap: that leaf uses the tree search
-  uint64_t join_visited = 0;  // nodes its walk visited
+  std::size_t ncand = 0;           // candidates of that leaf (the member itself included)
+  bool crowded = false;            // more than the join's cap: that leaf uses the tree search
+  uint64_t join_visited = 0;       // nodes its walk visited
+  std::vector<uint32_t> polygons;  // the polygons whose box may meet the query's sweep
 };
 
 struct AgentSource {
@@ -1138,10 +1140,15 @@ struct FtcIndex::Impl {
   KineticTree<AgentSource> agent_tree;
   KineticTree<CircleSource> circle_tree;
   std::vector<Slice> polygon_boxes;  // one static slice per polygon (frustum form)
-  mutable ProbeScratch scratch;      // for query()
-  bool no_overlaps = false;          // FtcPath::assume_no_overlaps
-  uint64_t refits = 0;               // agent tree refits since its last build
-  bool refitted = false;             // the last build refitted it
+  // Among many polygons, their boxes in a grid (kept while the scene is the same): a query reads
+  // those whose box meets its sweep, not every polygon (SteerSuite's 5,000 boxes).
+  static constexpr std::size_t kPolygonsForAGrid = 16;
+  BoxGrid polygon_grid;
+  uint64_t polygon_grid_scene = 0;  // the scene's generation() it was built for
+  mutable ProbeScratch scratch;     // for query()
+  bool no_overlaps = false;         // FtcPath::assume_no_overlaps
+  uint64_t refits = 0;              // agent tree refits since its last build
+  bool refitted = false;            // the last build refitted it
 
   void make_frame();
   // The answer for one row; pos: its position in the agent tree's order.
@@ -1234,23 +1241,34 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, ProbeScratch& sc, Count
   circle_tree.search<false>(q, horizon, best, sc, c, opt.order, kNoRow, false);
   const auto polys = scene->polygons();
   const auto boxes = scene->polygon_boxes();
-  for (std::size_t p = 0; p < polys.size(); ++p) {
-    // The naive path's filter first (same inputs, so the same polygons reach ray_polygon_time).
+  // The naive path's filter first (same inputs, so the same polygons reach ray_polygon_time):
+  // the sweep's box against the polygon's.
+  const double ax = q.ax, ay = q.ay, avx = q.avx, avy = q.avy, ar = q.ar;
+  const double ex0 = ax + std::fmin(0.0, avx * horizon) - ar,
+               ex1 = ax + std::fmax(0.0, avx * horizon) + ar;
+  const double ey0 = ay + std::fmin(0.0, avy * horizon) - ar,
+               ey1 = ay + std::fmax(0.0, avy * horizon) + ar;
+  auto offer_polygon = [&](std::size_t p) {
     const auto& bx = boxes[p];
-    const double ax = q.ax, ay = q.ay, avx = q.avx, avy = q.avy, ar = q.ar;
-    const double ex0 = ax + std::fmin(0.0, avx * horizon) - ar,
-                 ex1 = ax + std::fmax(0.0, avx * horizon) + ar;
-    const double ey0 = ay + std::fmin(0.0, avy * horizon) - ar,
-                 ey1 = ay + std::fmax(0.0, avy * horizon) + ar;
-    if (ex1 < bx.xmin || ex0 > bx.xmax || ey1 < bx.ymin || ey0 > bx.ymax) continue;
+    if (ex1 < bx.xmin || ex0 > bx.xmax || ey1 < bx.ymin || ey0 > bx.ymax) return;
     const double cap = best.kind == Kind::none ? horizon : std::min(horizon, best.t);
     static const Frame static_frames[2] = {{0, 0, {0.0, INFINITY}, false, 0, 0, false},
                                            {0, 0, {0.0, INFINITY}, false, 0, 0, true}};
     const double b = node_bound(&polygon_boxes[p], 1, static_frames[opt.lanes], q, ar, cap);
-    if (b == INFINITY || best.beats(b, Kind::polygon, p)) continue;
+    if (b == INFINITY || best.beats(b, Kind::polygon, p)) return;
     ++c.pair_tests;
     best.offer(ray_polygon_time(*scene, p, ax, ay, avx, avy, ar, horizon, cap), Kind::polygon, p,
                static_cast<uint32_t>(p));
+  };
+  if (polys.size() >= kPolygonsForAGrid &&
+      !(std::isnan(ex0) || std::isnan(ex1) || std::isnan(ey0) || std::isnan(ey1))) {
+    // Every box meeting [ex0, ex1] x [ey0, ey1] has a cell in that window's cells (cell_x is
+    // monotone), listed in ascending order: the loop's polygons that pass the filter, in its order.
+    polygon_grid.collect(polygon_grid.cell_x(ex0), polygon_grid.cell_x(ex1),
+                         polygon_grid.cell_y(ey0), polygon_grid.cell_y(ey1), sc.polygons);
+    for (const uint32_t p : sc.polygons) offer_polygon(p);
+  } else {
+    for (std::size_t p = 0; p < polys.size(); ++p) offer_polygon(p);
   }
   return best.kind == Kind::none ? FtcHit{} : FtcHit{{best.kind, best.row}, best.t};
 }
@@ -1318,6 +1336,13 @@ void FtcIndex::build(const DiscView& discs, const StaticScene& scene, double hor
     m.polygon_boxes.push_back({b.xmin - m.frame.ox - d0, b.ymin - m.frame.oy - d0,
                                b.xmax - m.frame.ox + d0, b.ymax - m.frame.oy + d0, -d1, -d1, d1,
                                d1});
+  if (scene.polygons().size() >= Impl::kPolygonsForAGrid &&
+      m.polygon_grid_scene != scene.generation()) {
+    std::vector<BoxBounds> boxes;
+    for (const auto& b : scene.polygon_boxes()) boxes.push_back({b.xmin, b.ymin, b.xmax, b.ymax});
+    m.polygon_grid = BoxGrid(boxes, 1024);
+    m.polygon_grid_scene = scene.generation();
+  }
 }
 
 void FtcIndex::query_all(std::span<FtcHit> out, Executor& ex, QueryStats& stats) const {

@@ -351,13 +351,25 @@ TEST(FtcIndex, PolygonsOfManyEdges) {
     polys.push_back({test::star(rng, 64 + rng.below(1500), rng.uniform(-60, 60),
                                 rng.uniform(-60, 60), 2, rng.uniform(5, 20)),
                      1});
-  const StaticScene scene({}, polys, 1.0);
-  for (uint64_t seed : {1, 2}) {
-    const DiscTable t = build::uniform(400, build::Box{-130, -130, 130, 130}, 3, 0.5, 2, seed);
-    for (const Opt& o : some_options()) EXPECT_EQ(compare(t, scene, 30, o), 0) << seed;
-    EXPECT_EQ(compare(t, scene, INFINITY), 0) << seed;
-    EXPECT_EQ(compare(t, scene, 1), 0) << seed;
+  const StaticScene few({}, polys, 1.0);
+  // Many polygons: their boxes in a grid, each query reading those its sweep meets. Boxes of
+  // every size, some long enough to be read by every query, inside and beyond the crowd.
+  for (int k = 0; k < 400; ++k) {
+    const double x = rng.uniform(-200, 200), y = rng.uniform(-200, 200);
+    const double w = rng.below(40) == 0 ? rng.uniform(50, 300) : rng.uniform(0.5, 4);
+    const double h = rng.below(40) == 0 ? rng.uniform(50, 300) : rng.uniform(0.5, 4);
+    polys.push_back({{{x, y}, {x + w, y}, {x + w, y + h}, {x, y + h}}, 1});
   }
+  const Bounds bounds{-210, -210, 210, 210};
+  const StaticScene many({}, polys, 1.0, ObstacleCharges::boundary, &bounds);
+  for (const StaticScene* scene : {&few, &many})
+    for (uint64_t seed : {1, 2}) {
+      const DiscTable t = build::uniform(400, build::Box{-130, -130, 130, 130}, 3, 0.5, 2, seed);
+      for (const Opt& o : some_options()) EXPECT_EQ(compare(t, *scene, 30, o), 0) << seed;
+      EXPECT_EQ(compare(t, *scene, INFINITY), 0) << seed;
+      EXPECT_EQ(compare(t, *scene, 1), 0) << seed;
+      EXPECT_EQ(compare(t, *scene, 0), 0) << seed;
+    }
 }
 
 // Exactly grazing and nearly grazing pairs, where the pair time is most sensitive to rounding.
