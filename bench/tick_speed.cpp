@@ -32,7 +32,10 @@
 // (uniform at 0.5 people/m^2 in a walled square, radius 0.25 m, 1.3 m/s, four goals on the
 // walls, round robin, dt 0.1 s), so their figures compare with RVO2's; ring-1k is 1,000 people
 // on a circle of radius 100 m swapping with the point opposite (RVO2's Circle in metres);
-// bottleneck-2k empties a 40 x 40 m room of 2,000 people through a 2.4 m door (navigation on).
+// bottleneck-2k empties a 40 x 40 m room of 2,000 people through a 2.4 m door (navigation on);
+// hall-100k walks 10^5 people to the middle of a round hall of radius 480 m drawn as a walkable
+// area of 20,000 vertices (its blocked pieces are polygons of that many edges: the polygon tests
+// through edge grids).
 //
 // Models: any registered steering model, or a benchmark variant (bench/model_variant.hpp):
 // `--models orca,orca-core` puts the default orca beside itself without keeping to a side, the
@@ -136,6 +139,28 @@ std::string bottleneck(const std::string& model, int threads) {
   return doc;
 }
 
+std::string hall(const std::string& model, int threads) {
+  constexpr int kVertices = 20000;
+  std::string ring;
+  for (int k = 0; k <= kVertices; ++k) {  // closed: the last vertex is the first
+    const double a = 2 * 3.14159265358979323846 * (k % kVertices) / kVertices;
+    char v[64];
+    std::snprintf(v, sizeof v, "%s%.6f %.6f", k ? "," : "", 500 + 480 * std::cos(a),
+                  500 + 480 * std::sin(a));
+    ring += v;
+  }
+  char doc[1024];
+  std::snprintf(doc, sizeof doc, R"json({"bounds": [0, 0, 1000, 1000], "dt": 0.1, "seed": 5,
+    "threads": %d, "steering": {"model": "%s"}, "goals": [{"name": "g", "x": 500, "y": 500}],
+    "groups": [{"count": 100000, "placement": {"type": "uniform", "region": [200, 200, 800, 800]},
+                "radius": 0.25, "goals": {"assign": "round_robin"}}],
+    "walkable": "POLYGON((RING))"})json",
+                threads, model.c_str());
+  std::string out = doc;
+  out.replace(out.find("RING"), 4, ring);
+  return out;
+}
+
 const Case kCases[] = {
     {"airport-1k", 200, [](const std::string& m, int t) { return airport(1000, m, t); }},
     {"airport-20k", 100, [](const std::string& m, int t) { return airport(20000, m, t); }},
@@ -146,6 +171,7 @@ const Case kCases[] = {
      10000000},
     {"ring-1k", 1200, ring},
     {"bottleneck-2k", 600, bottleneck},
+    {"hall-100k", 10, hall},
 };
 
 // The case of that name, or nullptr.
