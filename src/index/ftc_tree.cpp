@@ -1260,13 +1260,15 @@ FtcHit FtcIndex::Impl::probe(uint32_t row, uint32_t pos, ProbeScratch& sc, Count
     best.offer(ray_polygon_time(*scene, p, ax, ay, avx, avy, ar, horizon, cap), Kind::polygon, p,
                static_cast<uint32_t>(p));
   };
-  if (polys.size() >= kPolygonsForAGrid &&
-      !(std::isnan(ex0) || std::isnan(ex1) || std::isnan(ey0) || std::isnan(ey1))) {
+  const std::size_t walls = scene->wall_begin();
+  if (walls >= kPolygonsForAGrid && ex0 <= ex1 && ey0 <= ey1) {  // (not NaN, nor a negative radius)
     // Every box meeting [ex0, ex1] x [ey0, ey1] has a cell in that window's cells (cell_x is
-    // monotone), listed in ascending order: the loop's polygons that pass the filter, in its order.
+    // monotone), listed in ascending order: the loop's polygons that pass the filter, in its order;
+    // then the walls (the last rows, kept out of the grid: they reach a world's width beyond it).
     polygon_grid.collect(polygon_grid.cell_x(ex0), polygon_grid.cell_x(ex1),
                          polygon_grid.cell_y(ey0), polygon_grid.cell_y(ey1), sc.polygons);
     for (const uint32_t p : sc.polygons) offer_polygon(p);
+    for (std::size_t p = walls; p < polys.size(); ++p) offer_polygon(p);
   } else {
     for (std::size_t p = 0; p < polys.size(); ++p) offer_polygon(p);
   }
@@ -1336,10 +1338,10 @@ void FtcIndex::build(const DiscView& discs, const StaticScene& scene, double hor
     m.polygon_boxes.push_back({b.xmin - m.frame.ox - d0, b.ymin - m.frame.oy - d0,
                                b.xmax - m.frame.ox + d0, b.ymax - m.frame.oy + d0, -d1, -d1, d1,
                                d1});
-  if (scene.polygons().size() >= Impl::kPolygonsForAGrid &&
-      m.polygon_grid_scene != scene.generation()) {
+  if (scene.wall_begin() >= Impl::kPolygonsForAGrid && m.polygon_grid_scene != scene.generation()) {
     std::vector<BoxBounds> boxes;
-    for (const auto& b : scene.polygon_boxes()) boxes.push_back({b.xmin, b.ymin, b.xmax, b.ymax});
+    for (const auto& b : scene.polygon_boxes().first(scene.wall_begin()))
+      boxes.push_back({b.xmin, b.ymin, b.xmax, b.ymax});
     m.polygon_grid = BoxGrid(boxes, 1024);
     m.polygon_grid_scene = scene.generation();
   }

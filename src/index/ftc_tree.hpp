@@ -17,8 +17,10 @@
 // kinetic bounds (below), the largest radius, the smallest key, the node's cell (its ancestors'
 // split half-planes) and its parent. Built anew every rebuild_every-th tick, and refitted on the
 // ticks between (REFIT below).
-// Static circles get a tree of their own (zero velocities); polygons (few) are tested one by one
-// through their boxes (the naive path's box filter, then the box bound, then ray_polygon_time).
+// Static circles get a tree of their own (zero velocities); polygons are tested one by one
+// through their boxes (the naive path's box filter, then the box bound, then ray_polygon_time,
+// through the polygon's edge grid where it has many edges); among many polygons, only those in
+// the cells of a grid over their boxes that the query's sweep box meets (then the walls).
 //
 // INVARIANT (kinetic bounds). For every node, every member b and every t in [0, horizon]:
 // p_b + v_b t lies in the node's box B(t), inflated by delta(t) = delta0 + delta1 t.

@@ -54,25 +54,35 @@ double ray_polygon_time(const StaticScene& scene, std::size_t p, double px, doub
   const auto& ring = scene.polygons()[p].vertices;
   const RingGrid* g = scene.ring_grid(p);
   const double end = std::min(horizon, cap);
-  if (!g || g->cells_across() == 0 ||
+  if (!g || g->cells_across() == 0 || g->edges() != ring.size() ||
       !(std::isfinite(px) && std::isfinite(py) && std::isfinite(vx) && std::isfinite(vy) &&
         std::isfinite(r) && end >= 0 && end < INFINITY))
     return ray_polygon_time(ring, px, py, vx, vy, r, horizon);
   if (g->disc_overlaps(ring, px, py, r)) return 0;
   const std::size_t n = ring.size();
   // Slices about two cells of path long, at most as many as the grid's cells across (a line
-  // crosses no more of them), so the work is bounded by the grid whatever the speed.
+  // crosses no more of them), whatever the speed; the edges they list, at most the loop's count
+  // (below).
   const double speed = std::sqrt(vx * vx + vy * vy);
   const double step = std::max(speed > 0 ? 2 * g->cell() / speed : end,
                                end / static_cast<double>(g->cells_across() + 1));
-  const double grow = std::abs(r) * (1 + 1e-9);
+  // The radius, and room for the rounding of positions far from a small ring (the grid's cells
+  // are sized by the ring's coordinates, not the query's).
+  const double grow =
+      std::abs(r) * (1 + 1e-9) + 1e-15 * (std::abs(px) + std::abs(py) + speed * end);
   thread_local std::vector<uint32_t> near;
   double best = INFINITY;
+  std::size_t listed = 0;  // cells read and edges listed by the slices so far
   for (double t0 = 0;;) {
     const double t1 = step > 0 ? std::min(t0 + step, end) : end;
     const double xa = px + vx * t0, xb = px + vx * t1, ya = py + vy * t0, yb = py + vy * t1;
-    g->edges_meeting(std::min(xa, xb) - grow, std::min(ya, yb) - grow, std::max(xa, xb) + grow,
-                     std::max(ya, yb) + grow, near);
+    const std::size_t cells =
+        g->edges_meeting(std::min(xa, xb) - grow, std::min(ya, yb) - grow, std::max(xa, xb) + grow,
+                         std::max(ya, yb) + grow, near);
+    // Long edges are listed by every slice, and a disc wider than many cells reads many cells or
+    // lists every edge: past the loop's own work, the loop.
+    listed += cells + near.size();
+    if (listed > n) return ray_polygon_time(ring, px, py, vx, vy, r, horizon);
     for (const uint32_t s : near)
       edge_capsule_time(ring[s], ring[(s + 1) % n], px, py, vx, vy, r, horizon, best);
     if (best <= t1 || !(t1 < end)) return best;

@@ -37,8 +37,9 @@ double ray_polygon_time(std::span<const Vec2> ring, double px, double py, double
                         double r, double horizon);
 
 // The same for the scene's polygon p through its edge grid (StaticScene::ring_grid) where it has
-// one: bit for bit the loop's time where that is <= cap, else a value above cap (the caller holds
-// a hit at cap already). The loop stays the naive path's and the tests' oracle.
+// one: bit for bit the loop's time where that is <= cap, else a value above cap (a caller whose
+// best hit so far is at cap cannot tell them apart). The loop stays the naive path's and the
+// tests' oracle.
 double ray_polygon_time(const StaticScene& scene, std::size_t p, double px, double py, double vx,
                         double vy, double r, double horizon, double cap);
 

@@ -237,10 +237,12 @@ inline bool disc_hits_circle(const CircleObstacle& c, double x, double y, double
 }
 // The bounding-box rejection is part of the definition (as the naive loop applies it), so an
 // index that pre-filters more loosely must still call this, not disc_overlaps_polygon directly.
+inline bool disc_misses_box(const StaticScene::Box& b, double x, double y, double r) {
+  return x + r <= b.xmin || x - r >= b.xmax || y + r <= b.ymin || y - r >= b.ymax;
+}
 inline bool disc_hits_polygon(const PolygonObstacle& p, const StaticScene::Box& b, double x,
                               double y, double r) {
-  if (x + r <= b.xmin || x - r >= b.xmax || y + r <= b.ymin || y - r >= b.ymax) return false;
-  return disc_overlaps_polygon(p.vertices, x, y, r);
+  return !disc_misses_box(b, x, y, r) && disc_overlaps_polygon(p.vertices, x, y, r);
 }
 
 // The obstacle half of a collision query (disc against circles and polygons), shared by every

@@ -8,6 +8,7 @@
 #include <cstddef>
 
 #include "crowddb/query.hpp"
+#include "query/naive_paths.hpp"  // disc_misses_box
 #include "world/geometry.hpp"
 #include "world/ring_grid.hpp"
 
@@ -36,8 +37,7 @@ inline double scene_polygon_dist2(const StaticScene& scene, std::size_t p, doubl
 // disc_hits_polygon (query/naive_paths.hpp): the box rejection, then disc_overlaps_polygon.
 inline bool scene_disc_hits_polygon(const StaticScene& scene, std::size_t p, double x, double y,
                                     double r) {
-  const StaticScene::Box& b = scene.polygon_boxes()[p];
-  if (x + r <= b.xmin || x - r >= b.xmax || y + r <= b.ymin || y - r >= b.ymax) return false;
+  if (disc_misses_box(scene.polygon_boxes()[p], x, y, r)) return false;
   const auto& ring = scene.polygons()[p].vertices;
   const RingGrid* g = scene.ring_grid(p);
   return g ? g->disc_overlaps(ring, x, y, r) : disc_overlaps_polygon(ring, x, y, r);

@@ -95,13 +95,13 @@ class BoxGrid {
   }
   // The boxes registered in cells [cx0, cx1] x [cy0, cy1] (clamped into the grid) and the big
   // ones, sorted, each once; every box where there is no grid or the window, as given, has more
-  // cells than there are boxes. `out` is overwritten.
-  void collect(int64_t cx0, int64_t cx1, int64_t cy0, int64_t cy1,
-               std::vector<uint32_t>& out) const {
+  // cells than there are boxes. `out` is overwritten. Returns the cells read.
+  std::size_t collect(int64_t cx0, int64_t cx1, int64_t cy0, int64_t cy1,
+                      std::vector<uint32_t>& out) const {
     if (!gridded() || static_cast<double>(cx1 - cx0 + 1) * static_cast<double>(cy1 - cy0 + 1) >
                           static_cast<double>(count_)) {
       all(out);
-      return;
+      return 0;
     }
     cx0 = std::max<int64_t>(cx0, 0), cx1 = std::min(cx1, nx_ - 1);
     cy0 = std::max<int64_t>(cy0, 0), cy1 = std::min(cy1, ny_ - 1);
@@ -113,6 +113,8 @@ class BoxGrid {
       }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
+    return static_cast<std::size_t>(std::max<int64_t>(cx1 - cx0 + 1, 0) *
+                                    std::max<int64_t>(cy1 - cy0 + 1, 0));
   }
 
  private:

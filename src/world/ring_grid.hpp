@@ -73,11 +73,7 @@ class RingGrid {
                Vec2* closest = nullptr) const {
     if (ring.size() != n_) return dist2_to_boundary(ring, px, py, closest);
     thread_local std::vector<uint32_t> near;
-    if (!(std::isfinite(px) && std::isfinite(py) && reach < INFINITY))
-      grid_.all(near);
-    else
-      grid_.collect(grid_.cell_x(px - reach) - 1, grid_.cell_x(px + reach) + 1,
-                    grid_.cell_y(py - reach) - 1, grid_.cell_y(py + reach) + 1, near);
+    edges_meeting(px - reach, py - reach, px + reach, py + reach, near);
     double best = INFINITY;
     for (const uint32_t s : near) {
       const Vec2 c = closest_on_segment(ring[s], ring[(s + 1) % n_], px, py);
@@ -92,14 +88,17 @@ class RingGrid {
   }
 
   // The edges whose box may meet [x0, x1] x [y0, y1] (grown by a cell against rounding), sorted,
-  // each once; every edge where there is no grid or a bound is not finite. For questions the
-  // grid does not answer itself (first-to-collide's ray against the edges' capsules).
-  void edges_meeting(double x0, double y0, double x1, double y1, std::vector<uint32_t>& out) const {
-    if (!(std::isfinite(x0) && std::isfinite(y0) && std::isfinite(x1) && std::isfinite(y1)))
+  // each once; every edge where there is no grid, a bound is not finite or the window has more
+  // cells than there are edges. Returns the cells read. For questions the grid does not answer
+  // itself (first-to-collide's ray against the edges' capsules).
+  std::size_t edges_meeting(double x0, double y0, double x1, double y1,
+                            std::vector<uint32_t>& out) const {
+    if (!(std::isfinite(x0) && std::isfinite(y0) && std::isfinite(x1) && std::isfinite(y1))) {
       grid_.all(out);
-    else
-      grid_.collect(grid_.cell_x(x0) - 1, grid_.cell_x(x1) + 1, grid_.cell_y(y0) - 1,
-                    grid_.cell_y(y1) + 1, out);
+      return 0;
+    }
+    return grid_.collect(grid_.cell_x(x0) - 1, grid_.cell_x(x1) + 1, grid_.cell_y(y0) - 1,
+                         grid_.cell_y(y1) + 1, out);
   }
   double cell() const { return grid_.cell(); }
   int64_t cells_across() const { return grid_.nx() + grid_.ny(); }

@@ -372,6 +372,31 @@ TEST(FtcIndex, PolygonsOfManyEdges) {
     }
 }
 
+// One index over scenes of many polygons in turn: the grid over their boxes is the scene's, not
+// the last one's.
+TEST(FtcIndex, PolygonGridFollowsTheScene) {
+  Rng rng(8);
+  auto boxes = [&](int n, double size) {
+    std::vector<PolygonObstacle> polys;
+    for (int k = 0; k < n; ++k) {
+      const double x = rng.uniform(-100, 100), y = rng.uniform(-100, 100);
+      polys.push_back({{{x, y}, {x + size, y}, {x + size, y + size}, {x, y + size}}, 1});
+    }
+    return polys;
+  };
+  const StaticScene a({}, boxes(300, 2), 1.0), b({}, boxes(40, 8), 1.0);
+  const DiscTable t = build::uniform(500, build::Box{-100, -100, 100, 100}, 3, 0.3, 1, 4);
+  const DiscView d = t.view();
+  FtcIndex index;
+  Executor ex(1);
+  for (const StaticScene* s : {&a, &b, &a, &b}) {
+    QueryStats st;
+    std::vector<FtcHit> got(d.n);
+    index.run(d, *s, 30, got, ex, st);
+    EXPECT_EQ(got, naive(d, *s, 30));
+  }
+}
+
 // Exactly grazing and nearly grazing pairs, where the pair time is most sensitive to rounding.
 TEST(FtcIndex, GrazingPairs) {
   Rng rng(77);

@@ -38,7 +38,8 @@ TEST(BoxGrid, AWindowListsEveryBoxMeetingItOnRandomBoxes) {
     scanned_somewhere += grid.scanned();
     std::vector<uint32_t> got;
     for (int q = 0; q < 300; ++q) {
-      const double x = rng.uniform(-1.2 * span, 1.2 * span), y = rng.uniform(-1.2 * span, span);
+      const double x = rng.uniform(-1.2 * span, 1.2 * span),
+                   y = rng.uniform(-1.2 * span, 1.2 * span);
       const double r = rng.below(4) == 0 ? 0 : rng.uniform(0, span / 10);
       const BoxBounds window{x - r, y - r, x + r, y + r};
       grid.collect(grid.cell_x(window.x0), grid.cell_x(window.x1), grid.cell_y(window.y0),
