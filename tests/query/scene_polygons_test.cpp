@@ -45,12 +45,20 @@ DiscTable discs_about(Rng& rng, const std::vector<PolygonObstacle>& polys, doubl
   return t;
 }
 
+// Stars of the given sizes along the x axis (centres `spread` times their vertex count apart)
+// and a hall's blocked piece above them.
+std::vector<PolygonObstacle> stars_and_hall(Rng& rng, std::initializer_list<std::size_t> sizes,
+                                            double spread) {
+  std::vector<PolygonObstacle> polys;
+  for (const std::size_t n : sizes)
+    polys.push_back({star(rng, n, static_cast<double>(n) * spread, 0, 5, 40), 1});
+  polys.push_back({hall_piece(4000, 0, 300, 120), 1});
+  return polys;
+}
+
 TEST(ScenePolygons, TestsThroughTheEdgeGridsAreTheLoops) {
   Rng rng(61206);
-  std::vector<PolygonObstacle> polys;
-  for (const std::size_t n : {64, 200, 3000})
-    polys.push_back({star(rng, n, static_cast<double>(n) * 0.1, 0, 5, 40), 1});
-  polys.push_back({hall_piece(4000, 0, 300, 120), 1});
+  std::vector<PolygonObstacle> polys = stars_and_hall(rng, {64, 200, 3000}, 0.1);
   polys.push_back({{{0, -100}, {10, -100}, {10, -90}}, 1});  // few edges: the loops
   const StaticScene scene({}, polys, 1, ObstacleCharges::none, nullptr);
   for (std::size_t p = 0; p < 4; ++p) ASSERT_NE(scene.ring_grid(p), nullptr) << p;
@@ -119,10 +127,7 @@ TEST(ScenePolygons, TheCollisionQuerysObstacleHalfIsTheOracleLoop) {
 // loop's bit for bit where that is at most the cap, and above the cap otherwise.
 TEST(ScenePolygons, RayTimesThroughTheEdgeGridsAreTheLoops) {
   Rng rng(2612);
-  std::vector<PolygonObstacle> polys;
-  for (const std::size_t n : {64, 700, 3000})
-    polys.push_back({star(rng, n, static_cast<double>(n) * 0.05, 0, 5, 40), 1});
-  polys.push_back({hall_piece(4000, 0, 300, 120), 1});
+  std::vector<PolygonObstacle> polys = stars_and_hall(rng, {64, 700, 3000}, 0.05);
   // Spikes: long edges whose boxes meet a slice of the path long before the edge is hit, while a
   // short edge just past the slice is hit first.
   std::vector<Vec2> spiky = star(rng, 600, 200, 100, 20, 22);
