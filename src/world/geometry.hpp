@@ -57,34 +57,42 @@ inline double dist2_to_segment(const Vec2& a, const Vec2& b, double px, double p
 
 // Even-odd rule; points exactly on the boundary may go either way (callers also test the
 // boundary distance, so the disc tests below are exact where it matters).
+// Whether the edge from b to a (a the later vertex) crosses the horizontal line through p to
+// p's right: one step of the even-odd count below, shared with world/ring_grid.hpp so that the
+// two cannot drift apart.
+inline bool crosses_right_of(const Vec2& a, const Vec2& b, double px, double py) {
+  if ((a.y > py) == (b.y > py)) return false;
+  const double xcross = a.x + (py - a.y) * (b.x - a.x) / (b.y - a.y);
+  return px < xcross;
+}
+
 inline bool point_in_polygon(std::span<const Vec2> ring, double px, double py) {
   bool inside = false;
-  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
-    const Vec2& a = ring[i];
-    const Vec2& b = ring[j];
-    if ((a.y > py) != (b.y > py)) {
-      const double xcross = a.x + (py - a.y) * (b.x - a.x) / (b.y - a.y);
-      if (px < xcross) inside = !inside;
-    }
-  }
+  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
+    if (crosses_right_of(ring[i], ring[j], px, py)) inside = !inside;
   return inside;
 }
 
 // Squared distance from p to the polygon's boundary, and the closest boundary point.
+// One step of the boundary distance below, shared with world/ring_grid.hpp: the segment a-b's
+// nearest point to p replaces `best` (and `closest`) where strictly nearer, so that the first
+// nearest edge in order wins.
+inline void offer_segment(const Vec2& a, const Vec2& b, double px, double py, double& best,
+                          Vec2* closest) {
+  const Vec2 c = closest_on_segment(a, b, px, py);
+  const double dx = px - c.x, dy = py - c.y;
+  const double d2 = dx * dx + dy * dy;
+  if (d2 < best) {
+    best = d2;
+    if (closest) *closest = c;
+  }
+}
+
 inline double dist2_to_boundary(std::span<const Vec2> ring, double px, double py,
                                 Vec2* closest = nullptr) {
   double best = INFINITY;
-  for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
-    const Vec2& a = ring[i];
-    const Vec2& b = ring[(i + 1) % n];
-    const Vec2 c = closest_on_segment(a, b, px, py);
-    const double dx = px - c.x, dy = py - c.y;
-    const double d2 = dx * dx + dy * dy;
-    if (d2 < best) {
-      best = d2;
-      if (closest) *closest = c;
-    }
-  }
+  for (std::size_t i = 0, n = ring.size(); i < n; ++i)
+    offer_segment(ring[i], ring[(i + 1) % n], px, py, best, closest);
   return best;
 }
 

@@ -55,14 +55,8 @@ class RingGrid {
       grid_.collect(grid_.cell_x(px) - 1, grid_.nx() - 1, cy, cy, near);
     }
     bool in = false;
-    for (const uint32_t s : near) {        // segment s joins ring[s] and ring[s + 1]
-      const Vec2& a = ring[(s + 1) % n_];  // (the loop's pairing: a = ring[i], b = ring[i - 1])
-      const Vec2& b = ring[s];
-      if ((a.y > py) != (b.y > py)) {
-        const double xcross = a.x + (py - a.y) * (b.x - a.x) / (b.y - a.y);
-        if (px < xcross) in = !in;
-      }
-    }
+    for (const uint32_t s : near)  // segment s joins ring[s] and ring[s + 1]; the loop's pairing
+      if (crosses_right_of(ring[(s + 1) % n_], ring[s], px, py)) in = !in;
     return in;
   }
 
@@ -75,15 +69,7 @@ class RingGrid {
     thread_local std::vector<uint32_t> near;
     edges_meeting(px - reach, py - reach, px + reach, py + reach, near);
     double best = INFINITY;
-    for (const uint32_t s : near) {
-      const Vec2 c = closest_on_segment(ring[s], ring[(s + 1) % n_], px, py);
-      const double dx = px - c.x, dy = py - c.y;
-      const double d2 = dx * dx + dy * dy;
-      if (d2 < best) {
-        best = d2;
-        if (closest) *closest = c;
-      }
-    }
+    for (const uint32_t s : near) offer_segment(ring[s], ring[(s + 1) % n_], px, py, best, closest);
     return best;
   }
 
