@@ -48,6 +48,7 @@ class BoxGrid {
     nx_ = std::clamp<int64_t>(static_cast<int64_t>(w / cell_) + 1, 1, max_side + 1);
     ny_ = std::clamp<int64_t>(static_cast<int64_t>(h / cell_) + 1, 1, max_side + 1);
     start_.assign(static_cast<std::size_t>(nx_ * ny_) + 1, 0);
+    first_.resize(count_);
     for (int pass = 0; pass < 2; ++pass) {  // count, then place
       std::vector<uint32_t> fill;
       if (pass == 1) {
@@ -63,6 +64,7 @@ class BoxGrid {
           if (pass == 0) big_.push_back(static_cast<uint32_t>(k));
           continue;
         }
+        if (pass == 0) first_[k] = {static_cast<int32_t>(cx0), static_cast<int32_t>(cy0)};
         for (int64_t cy = cy0; cy <= cy1; ++cy)
           for (int64_t cx = cx0; cx <= cx1; ++cx) {
             const auto c = static_cast<std::size_t>(cy * nx_ + cx);
@@ -73,6 +75,33 @@ class BoxGrid {
           }
       }
     }
+  }
+
+  // The boxes collect() would list, each once, in no set order: f(id) for each. Where a box is
+  // registered in several cells of the window, only the window's cell nearest its own first
+  // cell (the larger of the two firsts on each axis) calls f; no list, no sort. Returns the
+  // cells read.
+  template <class F>
+  std::size_t visit(int64_t cx0, int64_t cx1, int64_t cy0, int64_t cy1, F&& f) const {
+    if (!gridded() || static_cast<double>(cx1 - cx0 + 1) * static_cast<double>(cy1 - cy0 + 1) >
+                          static_cast<double>(count_)) {
+      for (std::size_t k = 0; k < count_; ++k) f(static_cast<uint32_t>(k));
+      return 0;
+    }
+    cx0 = std::max<int64_t>(cx0, 0), cx1 = std::min(cx1, nx_ - 1);
+    cy0 = std::max<int64_t>(cy0, 0), cy1 = std::min(cy1, ny_ - 1);
+    for (const uint32_t k : big_) f(k);
+    for (int64_t cy = cy0; cy <= cy1; ++cy)
+      for (int64_t cx = cx0; cx <= cx1; ++cx) {
+        const auto c = static_cast<std::size_t>(cy * nx_ + cx);
+        for (uint32_t a = start_[c]; a < start_[c + 1]; ++a) {
+          const uint32_t k = ids_[a];
+          const FirstCell first = first_[k];
+          if ((cx == cx0 || first.x == cx) && (cy == cy0 || first.y == cy)) f(k);
+        }
+      }
+    return static_cast<std::size_t>(std::max<int64_t>(cx1 - cx0 + 1, 0) *
+                                    std::max<int64_t>(cy1 - cy0 + 1, 0));
   }
 
   bool gridded() const { return !start_.empty(); }
@@ -131,6 +160,10 @@ class BoxGrid {
   std::vector<uint32_t> start_;  // CSR offsets per cell (row-major), nx_ * ny_ + 1; empty: no grid
   std::vector<uint32_t> ids_;    // the boxes registered in each cell, in box order
   std::vector<uint32_t> big_;    // boxes spanning more than kMaxCells cells, in order
+  struct FirstCell {
+    int32_t x, y;  // (nx_, ny_ <= max_side + 1: callers pass at most a few thousand)
+  };
+  std::vector<FirstCell> first_;  // each registered box's lowest cell on each axis: visit()
 };
 
 }  // namespace crowddb

@@ -75,13 +75,17 @@ inline bool point_in_polygon(std::span<const Vec2> ring, double px, double py) {
 
 // Squared distance from p to the polygon's boundary, and the closest boundary point.
 // One step of the boundary distance below, shared with world/ring_grid.hpp: the segment a-b's
-// nearest point to p replaces `best` (and `closest`) where strictly nearer, so that the first
-// nearest edge in order wins.
+// nearest point c to p and its squared distance; offered, it replaces `best` (and `closest`)
+// where strictly nearer, so that the first nearest edge in order wins.
+inline double segment_dist2(const Vec2& a, const Vec2& b, double px, double py, Vec2& c) {
+  c = closest_on_segment(a, b, px, py);
+  const double dx = px - c.x, dy = py - c.y;
+  return dx * dx + dy * dy;
+}
 inline void offer_segment(const Vec2& a, const Vec2& b, double px, double py, double& best,
                           Vec2* closest) {
-  const Vec2 c = closest_on_segment(a, b, px, py);
-  const double dx = px - c.x, dy = py - c.y;
-  const double d2 = dx * dx + dy * dy;
+  Vec2 c;
+  const double d2 = segment_dist2(a, b, px, py, c);
   if (d2 < best) {
     best = d2;
     if (closest) *closest = c;

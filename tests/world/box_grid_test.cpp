@@ -1,5 +1,6 @@
 // BoxGrid (world/box_grid.hpp) against a scan of every box: a window of cells lists every box
-// that meets the part of the plane those cells cover, sorted and each once, on random boxes of
+// that meets the part of the plane those cells cover, sorted and each once (and visit() calls
+// for the same boxes, each once), on random boxes of
 // mixed sizes (some long enough to be scanned by every question), points outside the grid, and
 // degenerate inputs.
 #include "world/box_grid.hpp"
@@ -46,6 +47,20 @@ TEST(BoxGrid, AWindowListsEveryBoxMeetingItOnRandomBoxes) {
                    grid.cell_y(window.y1), got);
       ASSERT_TRUE(std::is_sorted(got.begin(), got.end()));
       ASSERT_EQ(std::adjacent_find(got.begin(), got.end()), got.end());
+      // visit() calls for exactly the boxes collect() lists, each once; also on windows of
+      // cells reaching past the grid's edges, wholly right of it, or turned inside out.
+      const int64_t cx0 = q % 11 == 0 ? grid.nx() + static_cast<int64_t>(rng.below(2))
+                                      : grid.cell_x(window.x0) - static_cast<int64_t>(rng.below(3)),
+                    cy0 = grid.cell_y(window.y0) - static_cast<int64_t>(rng.below(3));
+      const int64_t cx1 = q % 7 == 0 ? cx0 - 1 : grid.cell_x(window.x1) + int64_t(rng.below(3)),
+                    cy1 = grid.cell_y(window.y1) + static_cast<int64_t>(rng.below(3));
+      std::vector<uint32_t> listed, visited;
+      grid.collect(cx0, cx1, cy0, cy1, listed);
+      const std::size_t read =
+          grid.visit(cx0, cx1, cy0, cy1, [&](uint32_t k) { visited.push_back(k); });
+      std::sort(visited.begin(), visited.end());
+      ASSERT_EQ(visited, listed) << "scene " << scene << " query " << q;
+      EXPECT_EQ(read, grid.collect(cx0, cx1, cy0, cy1, listed));
       for (std::size_t k = 0; k < n; ++k)
         if (meets(boxes[k], window)) {
           ASSERT_TRUE(std::binary_search(got.begin(), got.end(), static_cast<uint32_t>(k)))

@@ -57,7 +57,7 @@ std::vector<Vec2> probes(Rng& rng, const std::vector<Vec2>& ring, double cx, dou
 }
 
 TEST(RingGrid, AnswersAreTheLoopsOverEveryEdge) {
-  std::size_t inside = 0, near = 0, total = 0;
+  std::size_t inside = 0, near = 0, total = 0, by_strip = 0;
   for (const uint64_t seed : {1u, 2u, 3u, 4u}) {
     Rng rng(seed);
     for (const std::size_t n : {64u, 300u, 3000u}) {
@@ -81,6 +81,7 @@ TEST(RingGrid, AnswersAreTheLoopsOverEveryEdge) {
         }
         ++total;
         inside += in;
+        by_strip += grid.strip_answers(p.y);
         near += d2 <= (span / 100) * (span / 100);
       }
     }
@@ -89,6 +90,7 @@ TEST(RingGrid, AnswersAreTheLoopsOverEveryEdge) {
   EXPECT_GT(inside, total / 5);
   EXPECT_LT(inside, total - total / 5);
   EXPECT_GT(near, total / 5);
+  EXPECT_GT(by_strip, total / 2);  // stars: short strips answer most points
 }
 
 // A thin zigzag closed by one edge along its whole length: that edge spans more cells than an
@@ -118,6 +120,9 @@ TEST(RingGrid, LongEdgesAndHugeCoordinatesAreTheLoops) {
     }
   }
   EXPECT_GT(inside, 2000u);
+  // The zigzag's strips between its teeth's heights list hundreds of edges: the row of cells
+  // answers there.
+  EXPECT_FALSE(grid.strip_answers(0.75));
   // A ring of another size than the grid's gets the loops.
   const std::vector<Vec2> other(ring.begin(), ring.begin() + 500);
   EXPECT_EQ(grid.inside(other, 20, 0.6), point_in_polygon(other, 20, 0.6));
