@@ -70,21 +70,21 @@ double ray_polygon_time(const StaticScene& scene, std::size_t p, double px, doub
   // are sized by the ring's coordinates, not the query's).
   const double grow =
       std::abs(r) * (1 + 1e-9) + 1e-15 * (std::abs(px) + std::abs(py) + speed * end);
-  thread_local std::vector<uint32_t> near;
   double best = INFINITY;
-  std::size_t listed = 0;  // cells read and edges listed by the slices so far
+  std::size_t listed = 0;  // cells read and edges tested by the slices so far
   for (double t0 = 0;;) {
     const double t1 = step > 0 ? std::min(t0 + step, end) : end;
     const double xa = px + vx * t0, xb = px + vx * t1, ya = py + vy * t0, yb = py + vy * t1;
-    const std::size_t cells =
-        g->edges_meeting(std::min(xa, xb) - grow, std::min(ya, yb) - grow, std::max(xa, xb) + grow,
-                         std::max(ya, yb) + grow, near);
-    // Long edges are listed by every slice, and a disc wider than many cells reads many cells or
-    // lists every edge: past the loop's own work, the loop.
-    listed += cells + near.size();
+    // The minimum over a slice's edges does not depend on the order they come in.
+    listed += g->visit_edges_meeting(
+        std::min(xa, xb) - grow, std::min(ya, yb) - grow, std::max(xa, xb) + grow,
+        std::max(ya, yb) + grow, [&](uint32_t s) {
+          ++listed;
+          edge_capsule_time(ring[s], ring[(s + 1) % n], px, py, vx, vy, r, horizon, best);
+        });
+    // Long edges are tested by every slice, and a disc wider than many cells reads many cells or
+    // tests every edge: past the loop's own work, the loop.
     if (listed > n) return ray_polygon_time(ring, px, py, vx, vy, r, horizon);
-    for (const uint32_t s : near)
-      edge_capsule_time(ring[s], ring[(s + 1) % n], px, py, vx, vy, r, horizon, best);
     if (best <= t1 || !(t1 < end)) return best;
     t0 = t1;
   }

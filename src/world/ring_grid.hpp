@@ -96,18 +96,19 @@ class RingGrid {
     return best;
   }
 
-  // The edges whose box may meet [x0, x1] x [y0, y1] (grown by a cell against rounding), sorted,
-  // each once; every edge where there is no grid, a bound is not finite or the window has more
-  // cells than there are edges. Returns the cells read. For questions the grid does not answer
-  // itself (first-to-collide's ray against the edges' capsules).
-  std::size_t edges_meeting(double x0, double y0, double x1, double y1,
-                            std::vector<uint32_t>& out) const {
+  // f(s) for each edge s whose box may meet [x0, x1] x [y0, y1] (grown by a cell against
+  // rounding), each once, in no set order; every edge where there is no grid, a bound is not
+  // finite or the window has more cells than there are edges. Returns the cells read. For
+  // questions the grid does not answer itself (first-to-collide's ray against the edges'
+  // capsules).
+  template <class F>
+  std::size_t visit_edges_meeting(double x0, double y0, double x1, double y1, F&& f) const {
     if (!(std::isfinite(x0) && std::isfinite(y0) && std::isfinite(x1) && std::isfinite(y1))) {
-      grid_.all(out);
+      for (std::size_t s = 0; s < n_; ++s) f(static_cast<uint32_t>(s));
       return 0;
     }
-    return grid_.collect(grid_.cell_x(x0) - 1, grid_.cell_x(x1) + 1, grid_.cell_y(y0) - 1,
-                         grid_.cell_y(y1) + 1, out);
+    return grid_.visit(grid_.cell_x(x0) - 1, grid_.cell_x(x1) + 1, grid_.cell_y(y0) - 1,
+                       grid_.cell_y(y1) + 1, f);
   }
   double cell() const { return grid_.cell(); }
   int64_t cells_across() const { return grid_.nx() + grid_.ny(); }
