@@ -63,7 +63,8 @@ bool SourceEmitter::touches_an_obstacle(const StaticScene& scene, const AgentSpe
   // Among many obstacles, those whose box holds the disc (grown by a micrometre against the
   // rounding of the box's and the disc's bounds): the same answer as the loop over all.
   if (!lookup_ || lookup_obstacles_ != count) {
-    lookup_.emplace(scene.circles(), scene.polygons());
+    // Candidates only: the scene's own edge grids answer the tests (query/scene_polygons.hpp).
+    lookup_.emplace(scene.circles(), scene.polygons(), ObstacleLookup::EdgeGrids::skip);
     lookup_obstacles_ = count;
   }
   lookup_->candidates(a.x, a.y, a.radius + 1e-6, near_obstacles_);

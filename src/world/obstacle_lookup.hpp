@@ -26,16 +26,20 @@ namespace crowddb {
 
 class ObstacleLookup {
  public:
+  // Whether polygons with many edges get edge grids for the polygon tests below (without them,
+  // those tests loop over the edges): a caller asking only for candidates skips building them.
+  enum class EdgeGrids { build, skip };
+
   // Obstacle k: circle k for k < circles.size(), else polygon k - circles.size().
-  ObstacleLookup(std::span<const CircleObstacle> circles,
-                 std::span<const PolygonObstacle> polygons) {
+  ObstacleLookup(std::span<const CircleObstacle> circles, std::span<const PolygonObstacle> polygons,
+                 EdgeGrids edge_grids = EdgeGrids::build) {
     std::vector<BoxBounds> boxes;
     boxes.reserve(circles.size() + polygons.size());
     for (const CircleObstacle& c : circles)
       boxes.push_back({c.x - c.radius, c.y - c.radius, c.x + c.radius, c.y + c.radius});
     ring_of_.assign(polygons.size(), -1);
     for (std::size_t k = 0; k < polygons.size(); ++k)
-      if (polygons[k].vertices.size() >= RingGrid::kMinEdges) {
+      if (edge_grids == EdgeGrids::build && polygons[k].vertices.size() >= RingGrid::kMinEdges) {
         ring_of_[k] = static_cast<int32_t>(rings_.size());
         rings_.emplace_back(polygons[k].vertices);
       }

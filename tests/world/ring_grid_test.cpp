@@ -145,10 +145,18 @@ TEST(RingGrid, ObstacleLookupsPolygonTestsAreTheLoops) {
   polys.push_back({star(rng, 500, 100, 100, 10, 30), 1});
   const std::vector<CircleObstacle> circles{{0, 100, 5, 1}};
   const ObstacleLookup lookup(circles, polys);
+  // Without edge grids (a caller asking only for candidates): the same candidates, and the
+  // polygon tests by the loops.
+  const ObstacleLookup bare(circles, polys, ObstacleLookup::EdgeGrids::skip);
+  std::vector<uint32_t> got, bare_got;
   for (int q = 0; q < 20000; ++q) {
     const double x = rng.uniform(-70, 140), y = rng.uniform(-70, 140), r = rng.uniform(0, 3);
+    lookup.candidates(x, y, r, got);
+    bare.candidates(x, y, r, bare_got);
+    ASSERT_EQ(got, bare_got);
     for (std::size_t p = 0; p < polys.size(); ++p) {
       const auto& v = polys[p].vertices;
+      ASSERT_EQ(bare.polygon_holds(p, v, x, y), point_in_polygon(v, x, y));
       ASSERT_EQ(lookup.polygon_holds(p, v, x, y), point_in_polygon(v, x, y));
       ASSERT_EQ(lookup.disc_overlaps_polygon(p, v, x, y, r), disc_overlaps_polygon(v, x, y, r));
       ASSERT_EQ(lookup.polygon_dist2(p, v, x, y, 0) > 0, dist2_to_boundary(v, x, y) > 0);
