@@ -16,17 +16,15 @@
 #include <span>
 #include <vector>
 
-namespace crowddb {
+#include "world/geometry.hpp"  // BoxBounds
 
-struct BoxBounds {
-  double x0, y0, x1, y1;
-};
+namespace crowddb {
 
 class BoxGrid {
  public:
   BoxGrid() = default;
   BoxGrid(std::span<const BoxBounds> boxes, int64_t max_side) : count_(boxes.size()) {
-    BoxBounds all{INFINITY, INFINITY, -INFINITY, -INFINITY};
+    BoxBounds all;      // (empty)
     double extent = 0;  // the boxes' mean larger side: cells no smaller than a box
     for (const BoxBounds& b : boxes) {
       all = {std::min(all.x0, b.x0), std::min(all.y0, b.y0), std::max(all.x1, b.x1),

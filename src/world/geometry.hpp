@@ -100,12 +100,14 @@ inline double dist2_to_boundary(std::span<const Vec2> ring, double px, double py
   return best;
 }
 
-// The axis-aligned box of a ring's vertices.
-struct RingBox {
+// An axis-aligned box; empty (inside out) until something is added.
+struct BoxBounds {
   double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
 };
-inline RingBox ring_box(std::span<const Vec2> ring) {
-  RingBox b;
+
+// The axis-aligned box of a ring's vertices.
+inline BoxBounds ring_box(std::span<const Vec2> ring) {
+  BoxBounds b;
   for (const Vec2& v : ring) {
     b.x0 = std::min(b.x0, v.x);
     b.y0 = std::min(b.y0, v.y);
@@ -139,7 +141,7 @@ inline bool inside_goal(const Goal& g, double px, double py) {
   // A point a millimetre outside the area's box is outside (and far beyond the micrometre): this
   // runs for every walking agent and tick, and the boundary distance divides once per edge.
   constexpr double kFar = 1e-3;
-  const RingBox b = ring_box(g.area);
+  const BoxBounds b = ring_box(g.area);
   if (px < b.x0 - kFar || px > b.x1 + kFar || py < b.y0 - kFar || py > b.y1 + kFar) return false;
   return point_in_polygon(g.area, px, py) || dist2_to_boundary(g.area, px, py) <= 1e-12;
 }

@@ -43,12 +43,7 @@ class ObstacleLookup {
         ring_of_[k] = static_cast<int32_t>(rings_.size());
         rings_.emplace_back(polygons[k].vertices);
       }
-    for (const PolygonObstacle& p : polygons) {
-      BoxBounds b{INFINITY, INFINITY, -INFINITY, -INFINITY};
-      for (const Vec2& v : p.vertices)
-        b = {std::min(b.x0, v.x), std::min(b.y0, v.y), std::max(b.x1, v.x), std::max(b.y1, v.y)};
-      boxes.push_back(b);
-    }
+    for (const PolygonObstacle& p : polygons) boxes.push_back(ring_box(p.vertices));
     grid_ = BoxGrid(boxes, kMaxSide);
   }
 
