@@ -61,8 +61,8 @@ double ray_polygon_time(const StaticScene& scene, std::size_t p, double px, doub
   if (g->disc_overlaps(ring, px, py, r)) return 0;
   const std::size_t n = ring.size();
   // Slices about two cells of path long, at most as many as the grid's cells across (a line
-  // crosses no more of them), whatever the speed; the edges they list, at most the loop's count
-  // (below).
+  // crosses no more of them), whatever the speed; the cells they read and the edges they test,
+  // at most the loop's count (below).
   const double speed = std::sqrt(vx * vx + vy * vy);
   const double step = std::max(speed > 0 ? 2 * g->cell() / speed : end,
                                end / static_cast<double>(g->cells_across() + 1));
@@ -75,15 +75,17 @@ double ray_polygon_time(const StaticScene& scene, std::size_t p, double px, doub
   for (double t0 = 0;;) {
     const double t1 = step > 0 ? std::min(t0 + step, end) : end;
     const double xa = px + vx * t0, xb = px + vx * t1, ya = py + vy * t0, yb = py + vy * t1;
-    // The minimum over a slice's edges does not depend on the order they come in.
-    listed += g->visit_edges_meeting(
+    // The minimum over a slice's edges does not depend on the order they come in. Long edges
+    // come up in every slice, and a disc wider than many cells reads many cells or every edge:
+    // past the loop's own work (cells read and edges tested), the rest of the slice is skipped
+    // and the loop answers.
+    const std::size_t cells = g->visit_edges_meeting(
         std::min(xa, xb) - grow, std::min(ya, yb) - grow, std::max(xa, xb) + grow,
         std::max(ya, yb) + grow, [&](uint32_t s) {
-          ++listed;
+          if (++listed > n) return;
           edge_capsule_time(ring[s], ring[(s + 1) % n], px, py, vx, vy, r, horizon, best);
         });
-    // Long edges are tested by every slice, and a disc wider than many cells reads many cells or
-    // tests every edge: past the loop's own work, the loop.
+    listed += cells;
     if (listed > n) return ray_polygon_time(ring, px, py, vx, vy, r, horizon);
     if (best <= t1 || !(t1 < end)) return best;
     t0 = t1;

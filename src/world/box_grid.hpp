@@ -24,7 +24,8 @@ class BoxGrid {
  public:
   BoxGrid() = default;
   BoxGrid(std::span<const BoxBounds> boxes, int64_t max_side) : count_(boxes.size()) {
-    BoxBounds all;      // (empty)
+    max_side = std::clamp<int64_t>(max_side, 1, 1 << 20);  // (cells per axis fit first_'s int32)
+    BoxBounds all;                                         // (empty)
     double extent = 0;  // the boxes' mean larger side: cells no smaller than a box
     for (const BoxBounds& b : boxes) {
       all = {std::min(all.x0, b.x0), std::min(all.y0, b.y0), std::max(all.x1, b.x1),
@@ -107,6 +108,9 @@ class BoxGrid {
   int64_t ny() const { return ny_; }
   std::size_t count() const { return count_; }
   double cell() const { return cell_; }
+  // The grid's corner: cell (i, j) covers [x0 + i cell, x0 + (i + 1) cell) x (likewise in y).
+  double x0() const { return x0_; }
+  double y0() const { return y0_; }
   // Boxes every question scans: for tests.
   std::size_t scanned() const { return big_.size(); }
 

@@ -49,14 +49,17 @@ inline Vec2 closest_on_segment(const Vec2& a, const Vec2& b, double px, double p
   return {a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
 }
 
-inline double dist2_to_segment(const Vec2& a, const Vec2& b, double px, double py) {
-  const Vec2 c = closest_on_segment(a, b, px, py);
+// The squared distance from p to the segment a-b, and its point c nearest to p.
+inline double segment_dist2(const Vec2& a, const Vec2& b, double px, double py, Vec2& c) {
+  c = closest_on_segment(a, b, px, py);
   const double dx = px - c.x, dy = py - c.y;
   return dx * dx + dy * dy;
 }
+inline double dist2_to_segment(const Vec2& a, const Vec2& b, double px, double py) {
+  Vec2 c;
+  return segment_dist2(a, b, px, py, c);
+}
 
-// Even-odd rule; points exactly on the boundary may go either way (callers also test the
-// boundary distance, so the disc tests below are exact where it matters).
 // Whether the edge from b to a (a the later vertex) crosses the horizontal line through p to
 // p's right: one step of the even-odd count below, shared with world/ring_grid.hpp so that the
 // two cannot drift apart.
@@ -66,6 +69,8 @@ inline bool crosses_right_of(const Vec2& a, const Vec2& b, double px, double py)
   return px < xcross;
 }
 
+// Even-odd rule; points exactly on the boundary may go either way (callers also test the
+// boundary distance, so the disc tests below are exact where it matters).
 inline bool point_in_polygon(std::span<const Vec2> ring, double px, double py) {
   bool inside = false;
   for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
@@ -73,15 +78,10 @@ inline bool point_in_polygon(std::span<const Vec2> ring, double px, double py) {
   return inside;
 }
 
-// Squared distance from p to the polygon's boundary, and the closest boundary point.
-// One step of the boundary distance below, shared with world/ring_grid.hpp: the segment a-b's
-// nearest point c to p and its squared distance; offered, it replaces `best` (and `closest`)
-// where strictly nearer, so that the first nearest edge in order wins.
-inline double segment_dist2(const Vec2& a, const Vec2& b, double px, double py, Vec2& c) {
-  c = closest_on_segment(a, b, px, py);
-  const double dx = px - c.x, dy = py - c.y;
-  return dx * dx + dy * dy;
-}
+// One step of the boundary distance below: the segment a-b's nearest point to p replaces `best`
+// (and `closest`) where strictly nearer, so that the first nearest edge in order wins.
+// (world/ring_grid.hpp visits edges in no set order and keeps the same winner as the least
+// (distance, edge) pair.)
 inline void offer_segment(const Vec2& a, const Vec2& b, double px, double py, double& best,
                           Vec2* closest) {
   Vec2 c;
@@ -92,6 +92,7 @@ inline void offer_segment(const Vec2& a, const Vec2& b, double px, double py, do
   }
 }
 
+// Squared distance from p to the polygon's boundary, and the closest boundary point.
 inline double dist2_to_boundary(std::span<const Vec2> ring, double px, double py,
                                 Vec2* closest = nullptr) {
   double best = INFINITY;

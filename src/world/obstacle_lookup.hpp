@@ -48,7 +48,8 @@ class ObstacleLookup {
   }
 
   // The exact tests of world/geometry.hpp on polygon p (of those the lookup was built over;
-  // `ring` its vertices), through an edge grid (world/ring_grid.hpp) where it has many edges:
+  // `ring` its vertices), through an edge grid (world/ring_grid.hpp) where it has many edges
+  // and the lookup built edge grids (else the loops):
   // point_in_polygon; dist2_to_boundary where that is <= reach^2 (else a value above reach^2);
   // disc_overlaps_polygon.
   bool polygon_holds(std::size_t p, std::span<const Vec2> ring, double x, double y) const {

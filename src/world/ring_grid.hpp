@@ -54,8 +54,7 @@ class RingGrid {
       return point_in_polygon(ring, px, py);
     // Each crossing edge once, in no set order: a parity does not depend on the order.
     bool in = false;
-    if (strip_answers(py)) {
-      const auto st = static_cast<std::size_t>(strip_of(py));
+    if (const std::size_t st = answering_strip(py); st != kNoStrip) {
       for (uint32_t a = strip_start_[st]; a < strip_start_[st + 1]; ++a) {
         const uint32_t s = strip_ids_[a];
         in ^= crosses_right_of(ring[(s + 1) % n_], ring[s], px, py);
@@ -115,12 +114,9 @@ class RingGrid {
   std::size_t edges() const { return n_; }
 
   // Whether inside() answers a point at height py from its strip (else from the grid's row of
-  // cells): for tests.
-  bool strip_answers(double py) const {
-    if (strip_start_.empty()) return false;
-    const auto st = static_cast<std::size_t>(strip_of(py));
-    return strip_start_[st + 1] - strip_start_[st] <= strip_scan_;
-  }
+  // cells), and the strips' entries in all (at most about 8 n): for tests.
+  bool strip_answers(double py) const { return answering_strip(py) != kNoStrip; }
+  std::size_t strip_entries() const { return strip_ids_.size(); }
 
   // Edges every question scans (long ones, or all where there is no grid): for tests.
   std::size_t scanned_edges() const { return grid_.scanned(); }
@@ -177,6 +173,13 @@ class RingGrid {
     }
     // A strip's list beyond this costs more than the row of cells would (roughly).
     strip_scan_ = 2 * static_cast<uint32_t>(std::sqrt(n)) + 16;
+  }
+  // py's strip where it lists few enough edges to answer inside(), else kNoStrip.
+  static constexpr std::size_t kNoStrip = SIZE_MAX;
+  std::size_t answering_strip(double py) const {
+    if (strip_start_.empty()) return kNoStrip;
+    const auto st = static_cast<std::size_t>(strip_of(py));
+    return strip_start_[st + 1] - strip_start_[st] <= strip_scan_ ? st : kNoStrip;
   }
   int64_t strip_of(double y) const {
     const double t = (y - strip_y0_) * strip_inv_;

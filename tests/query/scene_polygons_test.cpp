@@ -86,20 +86,25 @@ TEST(ScenePolygons, TestsThroughTheEdgeGridsAreTheLoops) {
 // Points as far from two parallel edges: the closest point is the first edge's in ring order,
 // as the loop's (a grid keeping the last would pass the random probes, whose ties are at shared
 // vertices, where both edges give the same point).
+// Both ways round: the grid reads its rows bottom up, so with the bottom side first in the
+// ring a grid keeping whichever tie it meets first would pass too.
 TEST(ScenePolygons, TheClosestPointOfTiesIsTheFirstEdgesInRingOrder) {
-  std::vector<Vec2> ring;  // a 100 x 2 strip, each long side in 50 pieces
-  for (int k = 0; k <= 50; ++k) ring.push_back({2.0 * k, 0});
-  for (int k = 50; k >= 0; --k) ring.push_back({2.0 * k, 2});
-  const StaticScene scene({}, {{ring, 1}}, 1, ObstacleCharges::none, nullptr);
-  ASSERT_NE(scene.ring_grid(0), nullptr);
-  for (int k = 0; k < 97; ++k) {  // farther than 1 from the strip's ends
-    const double x = 1.5 + k;
-    Vec2 want_c{NAN, NAN}, got_c{NAN, NAN};
-    const double want = dist2_to_boundary(ring, x, 1, &want_c);
-    ASSERT_EQ(scene_polygon_dist2(scene, 0, x, 1, 1.5, &got_c), want) << x;
-    ASSERT_EQ(want_c.y, 0) << x;  // the bottom edges come first
-    ASSERT_EQ(got_c.x, want_c.x) << x;
-    ASSERT_EQ(got_c.y, want_c.y) << x;
+  for (const bool bottom_first : {true, false}) {
+    std::vector<Vec2> ring;  // a 100 x 2 strip, each long side in 50 pieces
+    const double first_y = bottom_first ? 0 : 2, second_y = 2 - first_y;
+    for (int k = 0; k <= 50; ++k) ring.push_back({2.0 * k, first_y});
+    for (int k = 50; k >= 0; --k) ring.push_back({2.0 * k, second_y});
+    const StaticScene scene({}, {{ring, 1}}, 1, ObstacleCharges::none, nullptr);
+    ASSERT_NE(scene.ring_grid(0), nullptr);
+    for (int k = 0; k < 97; ++k) {  // farther than 1 from the strip's ends
+      const double x = 1.5 + k;
+      Vec2 want_c{NAN, NAN}, got_c{NAN, NAN};
+      const double want = dist2_to_boundary(ring, x, 1, &want_c);
+      ASSERT_EQ(scene_polygon_dist2(scene, 0, x, 1, 1.5, &got_c), want) << x;
+      ASSERT_EQ(want_c.y, first_y) << x;  // the first side's edges come first
+      ASSERT_EQ(got_c.x, want_c.x) << x;
+      ASSERT_EQ(got_c.y, want_c.y) << x << (bottom_first ? " bottom first" : " top first");
+    }
   }
 }
 

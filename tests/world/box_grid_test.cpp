@@ -52,8 +52,10 @@ TEST(BoxGrid, AWindowListsEveryBoxMeetingItOnRandomBoxes) {
       const int64_t cx0 = q % 11 == 0 ? grid.nx() + static_cast<int64_t>(rng.below(2))
                                       : grid.cell_x(window.x0) - static_cast<int64_t>(rng.below(3)),
                     cy0 = grid.cell_y(window.y0) - static_cast<int64_t>(rng.below(3));
-      const int64_t cx1 = q % 7 == 0 ? cx0 - 1 : grid.cell_x(window.x1) + int64_t(rng.below(3)),
-                    cy1 = grid.cell_y(window.y1) + static_cast<int64_t>(rng.below(3));
+      const int64_t cx1 = q % 7 == 0 ? cx0 - 1 - int64_t(rng.below(3))
+                                     : grid.cell_x(window.x1) + int64_t(rng.below(3)),
+                    cy1 = q % 13 == 0 ? cy0 - 1 - int64_t(rng.below(3))
+                                      : grid.cell_y(window.y1) + int64_t(rng.below(3));
       std::vector<uint32_t> listed, visited;
       grid.collect(cx0, cx1, cy0, cy1, listed);
       const std::size_t read =
@@ -84,6 +86,14 @@ TEST(BoxGrid, NoBoxesOrUnboundedBoxesListEverything) {
   EXPECT_FALSE(unbounded.gridded());
   unbounded.collect(unbounded.cell_x(0.5), unbounded.cell_x(0.5), 0, 0, got);
   EXPECT_EQ(got, (std::vector<uint32_t>{0, 1, 2}));
+
+  // visit() on grids that list everything: every box once.
+  for (const BoxGrid* g : {&none, &unbounded}) {
+    std::vector<uint32_t> visited;
+    g->visit(0, 0, 0, 0, [&](uint32_t k) { visited.push_back(k); });
+    g->collect(0, 0, 0, 0, got);
+    EXPECT_EQ(visited, got);
+  }
 
   const std::vector<BoxBounds> point{{5, 5, 5, 5}};  // zero extent: one cell
   const BoxGrid one(point, 16);

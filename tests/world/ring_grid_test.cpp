@@ -65,6 +65,7 @@ TEST(RingGrid, AnswersAreTheLoopsOverEveryEdge) {
       const double span = rng.uniform(1, 200);
       const std::vector<Vec2> ring = star(rng, n, cx, cy, span * 0.3, span);
       const RingGrid grid(ring);
+      EXPECT_LE(grid.strip_entries(), 8 * n);
       for (const Vec2& p : probes(rng, ring, cx, cy, span)) {
         const bool in = point_in_polygon(ring, p.x, p.y);
         ASSERT_EQ(grid.inside(ring, p.x, p.y), in)
@@ -123,6 +124,7 @@ TEST(RingGrid, LongEdgesAndHugeCoordinatesAreTheLoops) {
   // The zigzag's strips between its teeth's heights list hundreds of edges: the row of cells
   // answers there.
   EXPECT_FALSE(grid.strip_answers(0.75));
+  EXPECT_LE(grid.strip_entries(), 8 * ring.size());  // fewer strips where the edges climb far
   // A ring of another size than the grid's gets the loops.
   const std::vector<Vec2> other(ring.begin(), ring.begin() + 500);
   EXPECT_EQ(grid.inside(other, 20, 0.6), point_in_polygon(other, 20, 0.6));
