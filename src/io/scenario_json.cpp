@@ -9,6 +9,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <span>
 #include <sstream>
@@ -21,6 +22,7 @@
 #include "steer/model.hpp"
 #include "util/rng.hpp"
 #include "world/geometry.hpp"
+#include "world/nearest_point.hpp"
 #include "world/obstacle_lookup.hpp"
 #include "world/placement_grid.hpp"
 
@@ -597,7 +599,8 @@ struct Loader {
       // Goal assignment: one named goal (or sequence), or a rule over several.
       std::string assign = "single";
       std::vector<uint32_t> pool, then;
-      double own_radius = 0.5, own_charge = 1;  // antipodal and targets: each agent's own goal
+      std::optional<NearestPoint> nearest_goal;  // over the pool's goals, at the first "nearest"
+      double own_radius = 0.5, own_charge = 1;   // antipodal and targets: each agent's own goal
       std::vector<Vec2> targets;
       if (g.has("goal") == g.has("goals")) g.fail("goal", "give exactly one of 'goal' and 'goals'");
       if (g.has("goal")) {
@@ -737,16 +740,16 @@ struct Loader {
           s.goal = pool[i % pool.size()];
         } else if (assign == "random") {
           s.goal = pool[rng.below(pool.size())];
-        } else {  // nearest
-          double best = INFINITY;
-          for (uint32_t k : pool) {
-            const Goal& gl = sc.world.goals()[k];
-            const double d = std::hypot(gl.x - s.x, gl.y - s.y);
-            if (d < best) {
-              best = d;
-              s.goal = k;
-            }
+        } else {  // nearest: the first in the pool at the least distance (world/nearest_point.hpp)
+          if (!nearest_goal) {
+            std::vector<Vec2> at;
+            at.reserve(pool.size());
+            for (const uint32_t k : pool)
+              at.push_back({sc.world.goals()[k].x, sc.world.goals()[k].y});
+            nearest_goal.emplace(at);
           }
+          if (const std::size_t k = nearest_goal->nearest(s.x, s.y); k != NearestPoint::kNone)
+            s.goal = pool[k];
         }
         // Initial velocity.
         const double v =

@@ -1,0 +1,91 @@
+// NearestPoint (world/nearest_point.hpp) against its loop over every point, answer for answer:
+// random points, clusters, lattices (many points at equal distances: ties by list position),
+// duplicates, queries on points, between them and far outside, and degenerate lists.
+#include "world/nearest_point.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "util/rng.hpp"
+
+namespace crowddb {
+namespace {
+
+std::vector<Vec2> scene(Rng& rng, int kind, std::size_t n) {
+  std::vector<Vec2> out;
+  for (std::size_t k = 0; k < n; ++k) {
+    switch (kind) {
+      case 0:  // uniform over a square
+        out.push_back({rng.uniform(-500, 500), rng.uniform(-500, 500)});
+        break;
+      case 1:  // a lattice, shuffled by position in the list: ties everywhere
+        out.push_back({static_cast<double>(rng.below(40)), static_cast<double>(rng.below(40))});
+        break;
+      case 2:  // two far clusters
+        out.push_back(k % 2 ? Vec2{rng.uniform(0, 1), rng.uniform(0, 1)}
+                            : Vec2{1e5 + rng.uniform(0, 10), rng.uniform(-3e4, 3e4)});
+        break;
+      default:  // a thin line, far from the origin
+        out.push_back({1e7 + rng.uniform(0, 1e3), 2e6 + 1e-3 * static_cast<double>(rng.below(7))});
+    }
+  }
+  return out;
+}
+
+TEST(NearestPoint, AnswersAreTheLoopsOnRandomScenes) {
+  Rng rng(20261206);
+  std::size_t gridded = 0, queries = 0;
+  for (int s = 0; s < 48; ++s) {
+    const int kind = s % 4;
+    const std::size_t n =
+        s % 6 == 0 ? 1 + rng.below(NearestPoint::kMinPoints) : 64 + rng.below(5000);
+    const std::vector<Vec2> points = scene(rng, kind, n);
+    const NearestPoint near(points);
+    gridded += near.gridded();
+    for (int q = 0; q < 500; ++q) {
+      Vec2 at;
+      const Vec2& p = points[rng.below(n)];
+      switch (q % 5) {
+        case 0:
+          at = p;  // on a point (duplicates: the first in the list)
+          break;
+        case 1:
+          at = {p.x + 0.5, p.y + 0.5};  // a lattice cell's centre: four at the same distance
+          break;
+        case 2:
+          at = {p.x * (1 + rng.uniform(-1, 1) * 10), p.y * (1 + rng.uniform(-1, 1) * 10)};
+          break;
+        case 3:
+          at = {std::nextafter(p.x, INFINITY), p.y};
+          break;
+        default:
+          at = {rng.uniform(-2e5, 2e5), rng.uniform(-2e5, 2e5)};
+      }
+      ASSERT_EQ(near.nearest(at.x, at.y), near.loop(at.x, at.y))
+          << "scene " << s << " query " << q << " at " << at.x << ", " << at.y;
+      ++queries;
+    }
+  }
+  EXPECT_GT(gridded, 30u);
+  EXPECT_EQ(queries, 48u * 500u);
+}
+
+TEST(NearestPoint, DegenerateListsAndQueries) {
+  EXPECT_EQ(NearestPoint(std::vector<Vec2>{}).nearest(0, 0), NearestPoint::kNone);
+  std::vector<Vec2> same(200, Vec2{3, 4});  // all at one spot: the first
+  const NearestPoint one(same);
+  EXPECT_EQ(one.nearest(0, 0), 0u);
+  EXPECT_EQ(one.nearest(NAN, 0), NearestPoint::kNone);
+  EXPECT_EQ(one.nearest(INFINITY, 0), NearestPoint::kNone);
+  std::vector<Vec2> wild(100);
+  for (std::size_t k = 0; k < wild.size(); ++k) wild[k] = {double(k), double(k % 7)};
+  wild[50] = {INFINITY, 0};  // not finite: the loop answers every query
+  const NearestPoint loop_only(wild);
+  EXPECT_FALSE(loop_only.gridded());
+  EXPECT_EQ(loop_only.nearest(49.9, 0), loop_only.loop(49.9, 0));
+}
+
+}  // namespace
+}  // namespace crowddb
