@@ -78,7 +78,8 @@ class NearestPoint {
       if (wx1 < nx - 1) gap = std::min(gap, grid_.x0() + static_cast<double>(wx1 + 1) * cell - x);
       if (wy0 > 0) gap = std::min(gap, y - (grid_.y0() + static_cast<double>(wy0) * cell));
       if (wy1 < ny - 1) gap = std::min(gap, grid_.y0() + static_cast<double>(wy1 + 1) * cell - y);
-      if (best < (gap - slack) * (1 - 1e-12)) return best_k;
+      // (A gap that overflowed bounds nothing.)
+      if (gap < INFINITY && best < (gap - slack) * (1 - 1e-12)) return best_k;
     }
   }
 

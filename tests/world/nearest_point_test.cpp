@@ -72,6 +72,27 @@ TEST(NearestPoint, AnswersAreTheLoopsOnRandomScenes) {
   EXPECT_EQ(queries, 48u * 500u);
 }
 
+// A lattice whose grid cells are exactly one unit: points on cell borders, and ties across the
+// window's edges (a stop at "best <= gap", or without the rounding margin, would miss them).
+TEST(NearestPoint, TiesAcrossCellBordersOnAUnitLattice) {
+  std::vector<Vec2> points;
+  for (int k = 0; k <= 31; ++k) {  // the four outer lines: a 31 x 31 extent
+    points.push_back({double(k), 0});
+    points.push_back({double(k), 31});
+    points.push_back({0, double(k)});
+    points.push_back({31, double(k)});
+  }
+  Rng rng(31);
+  while (points.size() < 961) points.push_back({double(rng.below(32)), double(rng.below(32))});
+  const NearestPoint near(points);
+  ASSERT_TRUE(near.gridded());
+  for (int qx = -4; qx <= 70; ++qx)
+    for (int qy = -4; qy <= 70; ++qy) {
+      const double x = qx * 0.5, y = qy * 0.5;
+      ASSERT_EQ(near.nearest(x, y), near.loop(x, y)) << x << ", " << y;
+    }
+}
+
 TEST(NearestPoint, DegenerateListsAndQueries) {
   EXPECT_EQ(NearestPoint(std::vector<Vec2>{}).nearest(0, 0), NearestPoint::kNone);
   std::vector<Vec2> same(200, Vec2{3, 4});  // all at one spot: the first
