@@ -16,6 +16,7 @@
 #include <span>
 #include <vector>
 
+#include "util/bucket_lists.hpp"
 #include "world/geometry.hpp"  // BoxBounds
 
 namespace crowddb {
@@ -46,34 +47,28 @@ class BoxGrid {
     cell_ = std::max({std::sqrt(w * h / n), extent / n, w / side, h / side, 1e-12 * magnitude});
     nx_ = std::clamp<int64_t>(static_cast<int64_t>(w / cell_) + 1, 1, max_side + 1);
     ny_ = std::clamp<int64_t>(static_cast<int64_t>(h / cell_) + 1, 1, max_side + 1);
-    start_.assign(static_cast<std::size_t>(nx_ * ny_) + 1, 0);
+    // Each box's first cell, or its place in the list every question scans (big_).
     first_.resize(count_);
-    for (int pass = 0; pass < 2; ++pass) {  // count, then place
-      std::vector<uint32_t> fill;
-      if (pass == 1) {
-        for (std::size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
-        ids_.resize(start_.back());
-        fill.assign(start_.begin(), start_.end() - 1);
-      }
-      for (std::size_t k = 0; k < count_; ++k) {
-        const BoxBounds& b = boxes[k];
-        const int64_t cx0 = cell_x(b.x0), cx1 = cell_x(b.x1), cy0 = cell_y(b.y0),
-                      cy1 = cell_y(b.y1);
-        if ((cx1 - cx0 + 1) * (cy1 - cy0 + 1) > kMaxCells) {
-          if (pass == 0) big_.push_back(static_cast<uint32_t>(k));
-          continue;
-        }
-        if (pass == 0) first_[k] = {static_cast<int32_t>(cx0), static_cast<int32_t>(cy0)};
-        for (int64_t cy = cy0; cy <= cy1; ++cy)
-          for (int64_t cx = cx0; cx <= cx1; ++cx) {
-            const auto c = static_cast<std::size_t>(cy * nx_ + cx);
-            if (pass == 0)
-              ++start_[c + 1];
-            else
-              ids_[fill[c]++] = static_cast<uint32_t>(k);
-          }
+    for (std::size_t k = 0; k < count_; ++k) {
+      const BoxBounds& b = boxes[k];
+      const int64_t cx0 = cell_x(b.x0), cy0 = cell_y(b.y0);
+      if ((cell_x(b.x1) - cx0 + 1) * (cell_y(b.y1) - cy0 + 1) > kMaxCells) {
+        first_[k] = {kBig, kBig};
+        big_.push_back(static_cast<uint32_t>(k));
+      } else {
+        first_[k] = {static_cast<int32_t>(cx0), static_cast<int32_t>(cy0)};
       }
     }
+    fill_bucket_lists(
+        static_cast<std::size_t>(nx_ * ny_), count_,
+        [&](std::size_t k, auto&& to) {
+          if (first_[k].x == kBig) return;
+          const int64_t cx1 = cell_x(boxes[k].x1), cy1 = cell_y(boxes[k].y1);
+          for (int64_t cy = first_[k].y; cy <= cy1; ++cy)
+            for (int64_t cx = first_[k].x; cx <= cx1; ++cx)
+              to(static_cast<std::size_t>(cy * nx_ + cx));
+        },
+        start_, ids_);
   }
 
   // The boxes collect() would list, each once, in no set order: f(id) for each. Where a box is
@@ -165,7 +160,8 @@ class BoxGrid {
   struct FirstCell {
     int32_t x, y;  // (nx_, ny_ <= max_side + 1: callers pass at most a few thousand)
   };
-  std::vector<FirstCell> first_;  // each registered box's lowest cell on each axis: visit()
+  static constexpr int32_t kBig = -1;  // first_ of a box in big_ (registered in no cell)
+  std::vector<FirstCell> first_;       // each registered box's lowest cell on each axis: visit()
 };
 
 }  // namespace crowddb

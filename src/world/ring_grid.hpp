@@ -27,6 +27,7 @@
 #include <span>
 #include <vector>
 
+#include "util/bucket_lists.hpp"
 #include "world/box_grid.hpp"
 #include "world/geometry.hpp"
 
@@ -151,26 +152,15 @@ class RingGrid {
     strip_y0_ = lo;
     strip_inv_ = static_cast<double>(strips_) / height;
     if (!(strip_inv_ < INFINITY)) return;
-    strip_start_.assign(static_cast<std::size_t>(strips_) + 1, 0);
-    for (int pass = 0; pass < 2; ++pass) {  // count, then place (CSR, as BoxGrid)
-      std::vector<uint32_t> fill;
-      if (pass == 1) {
-        for (std::size_t t = 1; t < strip_start_.size(); ++t)
-          strip_start_[t] += strip_start_[t - 1];
-        strip_ids_.resize(strip_start_.back());
-        fill.assign(strip_start_.begin(), strip_start_.end() - 1);
-      }
-      for (std::size_t s = 0; s < n_; ++s) {
-        const double ya = ring[s].y, yb = ring[(s + 1) % n_].y;
-        for (int64_t t = strip_of(std::min(ya, yb)), end = strip_of(std::max(ya, yb)); t <= end;
-             ++t) {
-          if (pass == 0)
-            ++strip_start_[static_cast<std::size_t>(t) + 1];
-          else
-            strip_ids_[fill[static_cast<std::size_t>(t)]++] = static_cast<uint32_t>(s);
-        }
-      }
-    }
+    fill_bucket_lists(
+        static_cast<std::size_t>(strips_), n_,
+        [&](std::size_t s, auto&& to) {
+          const double ya = ring[s].y, yb = ring[(s + 1) % n_].y;
+          for (int64_t t = strip_of(std::min(ya, yb)), end = strip_of(std::max(ya, yb)); t <= end;
+               ++t)
+            to(static_cast<std::size_t>(t));
+        },
+        strip_start_, strip_ids_);
     // A strip's list beyond this costs more than the row of cells would (roughly).
     strip_scan_ = 2 * static_cast<uint32_t>(std::sqrt(n)) + 16;
   }
