@@ -746,7 +746,7 @@ struct Loader {
             at.reserve(pool.size());
             for (const uint32_t k : pool)
               at.push_back({sc.world.goals()[k].x, sc.world.goals()[k].y});
-            nearest_goal.emplace(at);
+            nearest_goal.emplace(std::move(at));
           }
           if (const std::size_t k = nearest_goal->nearest(s.x, s.y); k != NearestPoint::kNone)
             s.goal = pool[k];

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -27,8 +28,13 @@ std::vector<Vec2> scene(Rng& rng, int kind, std::size_t n) {
         out.push_back(k % 2 ? Vec2{rng.uniform(0, 1), rng.uniform(0, 1)}
                             : Vec2{1e5 + rng.uniform(0, 10), rng.uniform(-3e4, 3e4)});
         break;
-      default:  // a thin line, far from the origin
+      case 3:  // a thin line, far from the origin
         out.push_back({1e7 + rng.uniform(0, 1e3), 2e6 + 1e-3 * static_cast<double>(rng.below(7))});
+        break;
+      default:  // rooms: dense clusters far apart, and a few points at subnormal spacing
+        out.push_back(k % 50 == 0 ? Vec2{1e-310 * static_cast<double>(rng.below(5)), 0}
+                                  : Vec2{1e3 * static_cast<double>(k % 7) + rng.uniform(0, 2),
+                                         -4e2 * static_cast<double>(k % 3) + rng.uniform(0, 2)});
     }
   }
   return out;
@@ -36,14 +42,14 @@ std::vector<Vec2> scene(Rng& rng, int kind, std::size_t n) {
 
 TEST(NearestPoint, AnswersAreTheLoopsOnRandomScenes) {
   Rng rng(20261206);
-  std::size_t gridded = 0, queries = 0;
-  for (int s = 0; s < 48; ++s) {
-    const int kind = s % 4;
+  std::size_t indexed = 0, queries = 0;
+  for (int s = 0; s < 60; ++s) {
+    const int kind = s % 5;
     const std::size_t n =
         s % 6 == 0 ? 1 + rng.below(NearestPoint::kMinPoints) : 64 + rng.below(5000);
     const std::vector<Vec2> points = scene(rng, kind, n);
     const NearestPoint near(points);
-    gridded += near.gridded();
+    indexed += near.indexed();
     for (int q = 0; q < 500; ++q) {
       Vec2 at;
       const Vec2& p = points[rng.below(n)];
@@ -68,12 +74,12 @@ TEST(NearestPoint, AnswersAreTheLoopsOnRandomScenes) {
       ++queries;
     }
   }
-  EXPECT_GT(gridded, 30u);
-  EXPECT_EQ(queries, 48u * 500u);
+  EXPECT_GT(indexed, 40u);
+  EXPECT_EQ(queries, 60u * 500u);
 }
 
-// A lattice whose grid cells are exactly one unit: points on cell borders, and ties across the
-// window's edges (a stop at "best <= gap", or without the rounding margin, would miss them).
+// A lattice with half-unit queries: ties between points in different leaves, whose boxes lie at
+// exactly the best distance (a skip at "box distance >= best" would miss them).
 TEST(NearestPoint, TiesAcrossCellBordersOnAUnitLattice) {
   std::vector<Vec2> points;
   for (int k = 0; k <= 31; ++k) {  // the four outer lines: a 31 x 31 extent
@@ -85,7 +91,7 @@ TEST(NearestPoint, TiesAcrossCellBordersOnAUnitLattice) {
   Rng rng(31);
   while (points.size() < 961) points.push_back({double(rng.below(32)), double(rng.below(32))});
   const NearestPoint near(points);
-  ASSERT_TRUE(near.gridded());
+  ASSERT_TRUE(near.indexed());
   for (int qx = -4; qx <= 70; ++qx)
     for (int qy = -4; qy <= 70; ++qy) {
       const double x = qx * 0.5, y = qy * 0.5;
@@ -104,8 +110,30 @@ TEST(NearestPoint, DegenerateListsAndQueries) {
   for (std::size_t k = 0; k < wild.size(); ++k) wild[k] = {double(k), double(k % 7)};
   wild[50] = {INFINITY, 0};  // not finite: the loop answers every query
   const NearestPoint loop_only(wild);
-  EXPECT_FALSE(loop_only.gridded());
+  EXPECT_FALSE(loop_only.indexed());
   EXPECT_EQ(loop_only.nearest(49.9, 0), loop_only.loop(49.9, 0));
+}
+
+// The work of a query is a walk down the tree, also where a grid sized for the mean spacing read
+// every point: clusters of many points in a small part of the extent, and queries far outside it.
+TEST(NearestPoint, ClustersAndFarQueriesReadFewPoints) {
+  Rng rng(7);
+  std::vector<Vec2> points;
+  for (int room = 0; room < 4; ++room)  // 4 rooms of 5,000 in 1 m^2, 10 km apart
+    for (int k = 0; k < 5000; ++k)
+      points.push_back({1e4 * room + rng.uniform(0, 1), rng.uniform(0, 1)});
+  const NearestPoint near(points);
+  ASSERT_TRUE(near.indexed());
+  std::size_t most = 0;
+  for (int q = 0; q < 2000; ++q) {
+    const double x = q % 2 ? rng.uniform(-1e6, 1e6)
+                           : 1e4 * static_cast<double>(rng.below(4)) + rng.uniform(-1, 2);
+    const double y = q % 2 ? rng.uniform(-1e6, 1e6) : rng.uniform(-1, 2);
+    std::size_t read = 0;
+    ASSERT_EQ(near.nearest(x, y, &read), near.loop(x, y)) << x << ", " << y;
+    most = std::max(most, read);
+  }
+  EXPECT_LT(most, 400u);  // of 20,000
 }
 
 }  // namespace
