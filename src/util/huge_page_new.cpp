@@ -4,14 +4,22 @@
 // (madvise MADV_HUGEPAGE), so that the kernel maps them 2 MiB at a time where it can; the rest is
 // plain malloc. At 10^6 agents the columns, lists and buffers are tens of such blocks, and their
 // first touch took 257,000 page faults of 4 KiB, about 1.8 s of system time on the 2-core VM the
-// benchmarks run on (a run of one tick, loading included: 4.4-4.6 s); now 56,000 (2.8 s). Where
-// the system has no transparent huge pages, or has them only on request (the `madvise` setting,
-// Debian's default) and this request is turned off, the blocks are 4 KiB pages as before, a
-// little address space left unused before each one.
+// benchmarks run on (a run of one tick, loading included: 4.5-5.3 s); now 56,000 (2.5-3.6 s).
 //
-// CROWDDB_HUGE_PAGES=0 in the environment turns the request off (read once, at the first large
-// block): with the kernel's `defrag` setting at `madvise` (also Debian's default), a fault in a
-// marked block may wait for the kernel to compact memory when no huge page is free.
+// malloc's threshold for giving a block a mapping of its own is fixed at the same 4 MiB (glibc
+// otherwise raises it to the size of each such block freed, up to 32 MiB, and serves later ones
+// from its heap). Marked blocks thus always have their own mapping, returned on free: carved out
+// of the heap instead, the marks stayed on the heap's pages after the blocks were freed, the
+// kernel kept whole 2 MiB pages there for the small blocks that followed, and a run of 300 ticks
+// at 10^6 agents peaked at 1,338 MB instead of 977.
+//
+// Where the system has no transparent huge pages, or has them only on request (the `madvise`
+// setting, Debian's default) and this request is turned off, the blocks are 4 KiB pages as
+// before, a little address space left unused before each one. CROWDDB_HUGE_PAGES=0 in the
+// environment turns all of this off (read once, at start-up): with the
+// kernel's `defrag` setting at `madvise` (also Debian's default), a fault in a marked block may
+// wait for the kernel to compact memory when no huge page is free.
+#include <malloc.h>
 #include <sys/mman.h>
 
 #include <cstdlib>
@@ -26,10 +34,17 @@ constexpr std::size_t kLargeBlock = std::size_t{4} << 20;
 bool huge_pages_wanted() {
   static const bool wanted = [] {
     const char* v = std::getenv("CROWDDB_HUGE_PAGES");
-    return !(v && std::strcmp(v, "0") == 0);
+    const bool on = !(v && std::strcmp(v, "0") == 0);
+#ifdef MADV_HUGEPAGE
+    if (on) mallopt(M_MMAP_THRESHOLD, static_cast<int>(kLargeBlock));
+#endif
+    return on;
   }();
   return wanted;
 }
+
+// At start-up (or at the first large block, should another file's start-up make one first).
+[[maybe_unused]] const bool kDecided = huge_pages_wanted();
 
 void* allocate(std::size_t n) {
 #ifdef MADV_HUGEPAGE
