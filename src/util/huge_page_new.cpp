@@ -1,15 +1,18 @@
-// The program's operator new, for the crowddb executable and the speed benchmarks (never the
-// library: a library must not replace its users' allocator). Blocks of 4 MiB and more start at a
-// 2 MiB boundary, are rounded up to a multiple of it and are marked for transparent huge pages
-// (madvise MADV_HUGEPAGE), so that the kernel maps them 2 MiB at a time where it can; the rest is
-// plain malloc. At 10^6 agents the columns, lists and buffers are tens of such blocks, and their
-// first touch took 257,000 page faults of 4 KiB, about 1.8 s of system time on the 2-core VM the
-// benchmarks run on (a run of one tick, loading included: 4.5-5.3 s); now 56,000 (2.5-3.6 s).
+// The program's operator new, for the crowddb executable, tick_speed, rvo2_side_by_side and
+// crowddb_tests (never the library: a library must not replace its users' allocator; nor under
+// the sanitizers, whose runtime keeps its own to check that news and deletes pair up). Blocks of 4
+// MiB and more start at a 2 MiB boundary, are rounded up to a multiple of it and are marked for
+// transparent huge pages (madvise MADV_HUGEPAGE), so that the kernel maps them 2 MiB at a time
+// where it can; the rest is plain malloc. At 10^6 agents the columns, lists and buffers are tens of
+// such blocks, and their first touch took 257,000 page faults of 4 KiB, about 1.8 s of system time
+// on the 2-core VM the benchmarks run on (a run of one tick, loading included: 4.5-5.5 s); now
+// 56,000 (2.8-3.8 s).
 //
 // malloc's threshold for giving a block a mapping of its own is fixed at the same 4 MiB (glibc
 // otherwise raises it to the size of each such block freed, up to 32 MiB, and serves later ones
-// from its heap). Marked blocks thus always have their own mapping, returned on free: carved out
-// of the heap instead, the marks stayed on the heap's pages after the blocks were freed, the
+// from its heap). Marked blocks thus nearly always have their own mapping, returned on free (a
+// free stretch of the heap large enough, left by many small blocks, could still serve one): carved
+// out of the heap instead, the marks stayed on the heap's pages after the blocks were freed, the
 // kernel kept whole 2 MiB pages there for the small blocks that followed, and a run of 300 ticks
 // at 10^6 agents peaked at 1,338 MB instead of 977.
 //
@@ -46,21 +49,28 @@ bool huge_pages_wanted() {
 // At start-up (or at the first large block, should another file's start-up make one first).
 [[maybe_unused]] const bool kDecided = huge_pages_wanted();
 
-void* allocate(std::size_t n) {
+// A block of n bytes, or null.
+void* try_allocate(std::size_t n) {
 #ifdef MADV_HUGEPAGE
   if (n >= kLargeBlock && huge_pages_wanted()) {
     const std::size_t rounded = (n + kHugePage - 1) & ~(kHugePage - 1);
-    if (rounded >= n) {  // (else the size wrapped round: malloc below refuses it)
-      if (void* p = std::aligned_alloc(kHugePage, rounded)) {
-        madvise(p, rounded, MADV_HUGEPAGE);  // (a refusal leaves 4 KiB pages: nothing to undo)
-        return p;
-      }
-      throw std::bad_alloc();
-    }
+    if (rounded < n) return nullptr;  // the size wrapped round
+    void* p = std::aligned_alloc(kHugePage, rounded);
+    if (p) madvise(p, rounded, MADV_HUGEPAGE);  // (a refusal leaves 4 KiB pages: nothing to undo)
+    return p;
   }
 #endif
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
+  return std::malloc(n ? n : 1);
+}
+
+// As the standard asks: on failure the new-handler, if any, then another try.
+void* allocate(std::size_t n) {
+  for (;;) {
+    if (void* p = try_allocate(n)) return p;
+    const std::new_handler handler = std::get_new_handler();
+    if (!handler) throw std::bad_alloc();
+    handler();
+  }
 }
 
 }  // namespace
