@@ -80,7 +80,7 @@ TEST(NearestPoint, AnswersAreTheLoopsOnRandomScenes) {
 
 // A lattice with half-unit queries: ties between points in different leaves, whose boxes lie at
 // exactly the best distance (a skip at "box distance >= best" would miss them).
-TEST(NearestPoint, TiesAcrossCellBordersOnAUnitLattice) {
+TEST(NearestPoint, TiesBetweenLeavesOnAUnitLattice) {
   std::vector<Vec2> points;
   for (int k = 0; k <= 31; ++k) {  // the four outer lines: a 31 x 31 extent
     points.push_back({double(k), 0});
@@ -112,6 +112,42 @@ TEST(NearestPoint, DegenerateListsAndQueries) {
   const NearestPoint loop_only(wild);
   EXPECT_FALSE(loop_only.indexed());
   EXPECT_EQ(loop_only.nearest(49.9, 0), loop_only.loop(49.9, 0));
+}
+
+// Distances that overflow (some, or every one: then no answer), distances equal only after
+// rounding (coordinates near 10^16, a unit apart), signed zeros, and the smallest indexed list.
+TEST(NearestPoint, OverflowRoundingTiesSignedZerosAndTheSmallestTree) {
+  Rng rng(41);
+  std::vector<std::vector<Vec2>> scenes(4);
+  for (int k = 0; k < 300; ++k) {
+    const double big = 1.7e308 * (k % 2 ? 1 : -1);
+    scenes[0].push_back({big * rng.uniform(0.5, 1), 1.7e308 * rng.uniform(-1, 1)});
+    scenes[1].push_back({1e16 + 2 * static_cast<double>(rng.below(8)),
+                         -1e16 + 2 * static_cast<double>(rng.below(8))});
+    scenes[2].push_back({k % 3 == 0 ? -0.0 : 0.0, k % 5 == 0 ? -0.0 : static_cast<double>(k % 4)});
+  }
+  for (int k = 0; k < static_cast<int>(NearestPoint::kMinPoints); ++k)
+    scenes[3].push_back({rng.uniform(0, 10), rng.uniform(0, 10)});
+  const std::vector<Vec2> queries = {{0, 0},        {-0.0, -0.0},          {1.7e308, 1.7e308},
+                                     {-1.7e308, 0}, {1e16 + 1, -1e16 + 3}, {1e16 - 5, -1e16},
+                                     {5, 5},        {-1e300, 1e300}};
+  for (std::size_t s = 0; s < scenes.size(); ++s) {
+    const NearestPoint near(scenes[s]);
+    ASSERT_TRUE(near.indexed()) << "scene " << s;
+    for (const Vec2& q : queries)
+      ASSERT_EQ(near.nearest(q.x, q.y), near.loop(q.x, q.y))
+          << "scene " << s << " at " << q.x << ", " << q.y;
+    for (int q = 0; q < 300; ++q) {  // on and beside the points
+      const Vec2& p = scenes[s][rng.below(scenes[s].size())];
+      const double x = q % 2 ? p.x : std::nextafter(p.x, -INFINITY), y = p.y;
+      ASSERT_EQ(near.nearest(x, y), near.loop(x, y)) << "scene " << s << " at " << x << ", " << y;
+    }
+  }
+  // Every distance infinite: no answer, as the loop.
+  std::vector<Vec2> far(100, Vec2{1.7e308, 1.7e308});
+  const NearestPoint all_far(far);
+  EXPECT_EQ(all_far.nearest(-1.7e308, -1.7e308), NearestPoint::kNone);
+  EXPECT_EQ(all_far.loop(-1.7e308, -1.7e308), NearestPoint::kNone);
 }
 
 // The work of a query is a walk down the tree, also where a grid sized for the mean spacing read
