@@ -277,6 +277,11 @@ class World {
   // Throws InvalidRow("x") when (x, y) lies outside the walkable area: outside the bounds with
   // walls, or strictly inside an obstacle (on its boundary is walkable).
   void check_walkable(double x, double y) const;
+  // The obstacles' lookup (src/world/obstacle_lookup.hpp: candidates near a point, edge grids for
+  // polygons of many edges), built at the first call after an obstacle was added and shared by
+  // everyone who asks (the walkable checks, the scenario reader, SteerBench's collision count);
+  // never changed, so a holder keeps a consistent one however the obstacles change after.
+  std::shared_ptr<const ObstacleLookup> obstacle_lookup() const;
 
   // ---- checkpoints (Simulation::save_state) ----
   // The agents table, slot map and free list. The static tables (bounds, goals, sources,
@@ -307,8 +312,7 @@ class World {
   Bounds bounds_{};
   bool has_bounds_ = false;
   bool walls_ = true;
-  // The obstacles near a point, for check_walkable (src/world/obstacle_lookup.hpp): built at the
-  // first check after an obstacle was added; shared by copies (it is never changed).
+  // obstacle_lookup()'s: built at the first call after an obstacle was added; shared by copies.
   mutable std::shared_ptr<const ObstacleLookup> lookup_;
   AgentTable agents_;
   std::vector<Goal> goals_;

@@ -263,9 +263,9 @@ struct Loader {
   const io::WalkableArea* walkable = nullptr;  // the "walkable" WKT, if given
   std::size_t walkable_pieces = 0;             // polygons [0, walkable_pieces) are its blocked area
   std::vector<std::size_t> circle_src,
-      polygon_src;                                 // /obstacles index of each circle / polygon row
-  mutable std::unique_ptr<ObstacleLookup> lookup;  // built at the first obstacle question
-  mutable std::vector<uint32_t> near;              // its last answer
+      polygon_src;  // /obstacles index of each circle / polygon row
+  mutable std::shared_ptr<const ObstacleLookup> lookup;  // the world's, at the first question
+  mutable std::vector<uint32_t> near;                    // its last answer
   // Agents from this row on were each placed clear of every agent before them, so no
   // overlapping pair reaches past it (warn_overlaps looks at the rows before it only).
   std::size_t may_overlap_end = 0;
@@ -309,10 +309,11 @@ struct Loader {
   }
 
   // The obstacles (circles, then polygons, by row) that a disc of radius `reach` at (x, y) may
-  // touch, in row order (world/obstacle_lookup.hpp). The lookup is built at the first question: the
-  // obstacles are all read by then (read_walkable, read_obstacles), and none come after.
+  // touch, in row order (world/obstacle_lookup.hpp). The world's lookup, taken at the first
+  // question: the obstacles are all read by then (read_walkable, read_obstacles), and none come
+  // after. (The walkable checks of the agents inserted use the same one.)
   const std::vector<uint32_t>& obstacles_near(double x, double y, double reach) const {
-    if (!lookup) lookup = std::make_unique<ObstacleLookup>(sc.world.circles(), sc.world.polygons());
+    if (!lookup) lookup = sc.world.obstacle_lookup();
     lookup->candidates(x, y, reach, near);
     return near;
   }

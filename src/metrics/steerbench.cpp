@@ -240,10 +240,9 @@ void SteerBench::collisions(const World& world) {
   // Among more than a few obstacles, each agent is tested against those near it only.
   const std::size_t obstacle_count = world.circles().size() + world.polygons().size();
   const bool by_lookup = obstacle_count > kObstaclesForALookup;
-  if (by_lookup && (!lookup_ || lookup_obstacles_ != obstacle_count)) {
-    lookup_.emplace(world.circles(), world.polygons());  // (obstacles come before the run)
-    lookup_obstacles_ = obstacle_count;
-  }
+  // The world's (built once, shared with its walkable checks and the scenario reader).
+  const std::shared_ptr<const ObstacleLookup> lookup =
+      by_lookup ? world.obstacle_lookup() : nullptr;
   std::vector<uint32_t> near(by_lookup ? 0 : obstacle_count);
   std::iota(near.begin(), near.end(), 0u);
   if (!rows.empty()) {
@@ -272,7 +271,7 @@ void SteerBench::collisions(const World& world) {
       // agents x obstacles a tick while any overlap lasts).
       const auto circles = world.circles();
       const auto polys = world.polygons();
-      if (by_lookup) lookup_->candidates(x, y, r, near);
+      if (by_lookup) lookup->candidates(x, y, r, near);
       for (const uint32_t k : near) {
         if (k < circles.size()) {
           if (r + circles[k].radius - std::hypot(circles[k].x - x, circles[k].y - y) > kCollision)
@@ -284,9 +283,9 @@ void SteerBench::collisions(const World& world) {
         const std::size_t p = k - circles.size();
         const auto& v = polys[p].vertices;
         const double pen =
-            by_lookup ? (lookup_->polygon_holds(p, v, x, y)
+            by_lookup ? (lookup->polygon_holds(p, v, x, y)
                              ? r
-                             : r - std::sqrt(lookup_->polygon_dist2(p, v, x, y, std::abs(r))))
+                             : r - std::sqrt(lookup->polygon_dist2(p, v, x, y, std::abs(r))))
                       : (point_in_polygon(v, x, y) ? r : r - std::sqrt(dist2_to_boundary(v, x, y)));
         if (pen > kCollision) obstacles.insert({t.id[i], static_cast<int64_t>(k)});
       }

@@ -18,7 +18,6 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <set>
 #include <utility>
 #include <vector>
@@ -26,7 +25,6 @@
 #include "crowddb/simulation.hpp"
 #include "crowddb/world.hpp"
 #include "util/flat_map.hpp"
-#include "world/obstacle_lookup.hpp"
 
 namespace crowddb::metrics {
 
@@ -110,10 +108,6 @@ class SteerBench {
   double dt_;
   bool walls_;
   uint64_t tick_ = 0;
-  // The obstacles near a point, for the collision count (built at its first call, over the
-  // world's obstacles then; again should their number change).
-  std::optional<ObstacleLookup> lookup_;
-  std::size_t lookup_obstacles_ = 0;
   // Per agent measured, in order of first appearance: its live track's slot, or where its
   // closed score is.
   std::vector<uint32_t> where_;
