@@ -22,7 +22,7 @@
 
 namespace crowddb {
 
-class ObstacleLookup;
+class ObstacleLookup;  // src/world/obstacle_lookup.hpp
 
 class ByteWriter;  // src/util/byte_codec.hpp
 class Executor;    // src/util/executor.hpp
@@ -279,8 +279,9 @@ class World {
   void check_walkable(double x, double y) const;
   // The obstacles' lookup (src/world/obstacle_lookup.hpp: candidates near a point, edge grids for
   // polygons of many edges), built at the first call after an obstacle was added and shared by
-  // everyone who asks (the walkable checks, the scenario reader, SteerBench's collision count);
-  // never changed, so a holder keeps a consistent one however the obstacles change after.
+  // everyone who asks (the walkable checks, the scenario reader, SteerBench's collision count).
+  // It answers for the obstacles as they were when it was taken: after add_obstacle (which drops
+  // the world's), take it again.
   std::shared_ptr<const ObstacleLookup> obstacle_lookup() const;
 
   // ---- checkpoints (Simulation::save_state) ----

@@ -19,9 +19,9 @@
 // Where the system has no transparent huge pages, or has them only on request (the `madvise`
 // setting, Debian's default) and this request is turned off, the blocks are 4 KiB pages as
 // before, a little address space left unused before each one. CROWDDB_HUGE_PAGES=0 in the
-// environment turns all of this off (read once, at start-up): with the
-// kernel's `defrag` setting at `madvise` (also Debian's default), a fault in a marked block may
-// wait for the kernel to compact memory when no huge page is free.
+// environment turns all of this off (read once, at start-up): with the kernel's `defrag` setting
+// at `madvise` (also Debian's default), a fault in a marked block may wait for the kernel to
+// compact memory when no huge page is free.
 #include <malloc.h>
 #include <sys/mman.h>
 
