@@ -19,6 +19,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
@@ -60,11 +61,13 @@ class NearestPoint {
       uint32_t node;
       double lower;  // the distance from the query to the node's box
     };
-    std::vector<Pending> stack;  // at most about one entry per level
-    stack.push_back({0, box_distance(nodes_[0], x, y)});
-    while (!stack.empty()) {
-      const Pending at = stack.back();
-      stack.pop_back();
+    // Each level pushes two and pops one: at most the tree's depth + 1 entries, and median
+    // splits of fewer than 2^32 points into leaves of 8 are at most 30 levels deep.
+    std::array<Pending, 64> stack;
+    std::size_t top = 0;
+    stack[top++] = {0, box_distance(nodes_[0], x, y)};
+    while (top > 0) {
+      const Pending at = stack[--top];
       if (cannot_reach(at.lower, best)) continue;
       const Node& node = nodes_[at.node];
       if (node.left == kLeafNode) {
@@ -83,11 +86,11 @@ class NearestPoint {
       const double dl = box_distance(nodes_[l], x, y), dr = box_distance(nodes_[r], x, y);
       // The nearer child on top: it is read first and tightens the bound for the other.
       if (dl <= dr) {
-        stack.push_back({r, dr});
-        stack.push_back({l, dl});
+        stack[top++] = {r, dr};
+        stack[top++] = {l, dl};
       } else {
-        stack.push_back({l, dl});
-        stack.push_back({r, dr});
+        stack[top++] = {l, dl};
+        stack[top++] = {r, dr};
       }
     }
     if (read) *read = distances;

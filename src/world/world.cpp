@@ -207,9 +207,9 @@ void World::check_walkable(double x, double y) const {
     throw InvalidRow("x", at() + "outside the bounds [" + fmt(b.xmin) + ", " + fmt(b.xmax) +
                               "] x [" + fmt(b.ymin) + ", " + fmt(b.ymax) + "] (the walls)");
   if (circles_.empty() && polygons_.empty()) return;
-  const std::shared_ptr<const ObstacleLookup> lookup = obstacle_lookup();
+  const ObstacleLookup& lookup = *obstacle_lookup();  // (held by lookup_: no copy per insert)
   thread_local std::vector<uint32_t> near;
-  lookup->candidates(x, y, 0, near);
+  lookup.candidates(x, y, 0, near);
   for (const uint32_t k : near) {  // circles, then polygons, by row: the first hit as a scan's
     if (k < circles_.size()) {
       if (std::hypot(circles_[k].x - x, circles_[k].y - y) < circles_[k].radius)
@@ -218,7 +218,7 @@ void World::check_walkable(double x, double y) const {
     }
     const std::size_t p = k - circles_.size();
     const auto& ring = polygons_[p].vertices;
-    if (lookup->polygon_holds(p, ring, x, y) && lookup->polygon_dist2(p, ring, x, y, 0) > 0)
+    if (lookup.polygon_holds(p, ring, x, y) && lookup.polygon_dist2(p, ring, x, y, 0) > 0)
       throw InvalidRow("x", at() + "inside polygon obstacle " + std::to_string(p));
   }
 }
