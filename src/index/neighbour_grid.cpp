@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <numbers>
 
 #include "index/neighbour_lanes.hpp"
 #include "index/row_buckets.hpp"
@@ -25,7 +26,10 @@ constexpr uint32_t kBatch = 32;  // candidates filtered at once before any is of
 // first tick, rows new to a query, a k above NearestK::kInline), unmeasured.
 constexpr double kBlockFill = 6;
 constexpr double kChordReach = 1.5;  // hinted bounds up to this many cells: gathered and ranked
-constexpr uint32_t kNoRow = ~0u;     // pads the hints (no table has 2^32 rows)
+// A row without hints: the bound's disc is expected to hold this many times k others at the
+// density around the row (a Poisson count of mean 2 k falls below k about once in 100 at k = 10).
+constexpr double kDensityFill = 2;
+constexpr uint32_t kNoRow = ~0u;  // pads the hints (no table has 2^32 rows)
 // Four rows and their comparison masks (GCC's and clang's vector extensions; SSE2 on x86-64).
 typedef uint32_t V4u __attribute__((vector_size(16)));
 constexpr std::size_t kCopyGrain = 4096;   // rows per chunk of the lists' compaction
@@ -391,6 +395,30 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         }
         for (uint32_t u = 0; u < nh; ++u) best.offer(hint[u], d.id[hint[u]], hint_d2[u]);
         for (uint32_t u = nh; u < ((nh + 3) & ~3u); ++u) hint[u] = kNoRow;
+      } else if (hintable) {
+        // No list of the last call (the first tick, rows new to the query): a bound from the
+        // density of the 3 x 3 block around the row instead, a disc expected to hold kDensityFill
+        // times k others, gathered and ranked the same way. Exact whatever the bound: when fewer
+        // than k lie within it, nothing is written and the search below goes the usual way.
+        const int64_t cx = col(px), cy = row(py);
+        const int64_t bx0 = std::max<int64_t>(0, cx - 1), bx1 = std::min(W_ - 1, cx + 1);
+        const int64_t by0 = std::max<int64_t>(0, cy - 1), by1 = std::min(H_ - 1, cy + 1);
+        uint32_t around = 0;  // the row itself among them
+        for (int64_t y = by0; y <= by1; ++y) {
+          const auto base = static_cast<std::size_t>(y * W_);
+          around +=
+              S[base + static_cast<std::size_t>(bx1) + 1] - S[base + static_cast<std::size_t>(bx0)];
+        }
+        if (around > k) {
+          const auto cells = static_cast<double>((bx1 - bx0 + 1) * (by1 - by0 + 1));
+          const double bound = kDensityFill * k * cells * cell_ * cell_ /
+                               (std::numbers::pi * static_cast<double>(around - 1));
+          if (bound < r2 && bound < kChordReach * kChordReach * cell_ * cell_ &&
+              ranked(i, spatial ? At[i] : kNoRow, px, py, bound, slack, tests_c)) {
+            ++rings_c;
+            continue;
+          }
+        }
       }
       auto scan = [&](int64_t cy, int64_t cx0, int64_t cx1) {
         const auto base = static_cast<std::size_t>(cy * W_);

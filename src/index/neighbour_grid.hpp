@@ -15,7 +15,10 @@
 // usual case), every disc within that distance is gathered from the cells meeting its bounding
 // square, row by row, each row's cells as one run, and nothing beyond; the gathered ones (the
 // hints among them) are ranked by (distance, id), each rank counted without branches, and the
-// first k are the answer. Otherwise (too few hints, more than 256 gathered, ids not distinct)
+// first k are the answer. A row with no list of the last call (the first call, rows new to a
+// subset) is gathered and ranked the same way within a bound from the density of its 3 x 3 block
+// of cells (a disc expected to hold 2 k others), when at least k lie within it. Otherwise (too
+// few hints or found within the bound, more than 256 gathered, ids not distinct)
 // the hints are offered to the selection first, and with a full list whose k-th distance is
 // within 1.5 cells its disc's chords of cells are scanned for anything better. Otherwise the 3 x 3
 // block around the query's cell is scanned first, as three runs; when the k-th best so far (or the

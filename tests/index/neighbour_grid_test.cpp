@@ -182,6 +182,41 @@ TEST(NeighbourGrid, ShortRangesInADenseKnotOfASparseWorld) {
   }
 }
 
+// A row with no list of the last call (the first call, a subset's new rows) takes its bound from
+// the density of the cells around it, gathers and ranks at once: one visit (no rings) for most
+// rows of an even crowd, the naive twin's answer for all of them, and where the crowd is uneven
+// (a knot beside empty space: fewer than k within the bound) the usual search.
+TEST(NeighbourGrid, RowsWithoutHintsTakeABoundFromTheDensity) {
+  NeighbourNaive naive;
+  const DiscTable even = build::uniform(4000, {0, 0, 100, 100}, 1.3, 0.25, 0.25, 7);
+  std::vector<uint32_t> every_seventh;
+  for (uint32_t i = 0; i < even.size(); i += 7) every_seventh.push_back(i);
+  for (const std::vector<uint32_t>& q : {std::vector<uint32_t>{}, every_seventh}) {
+    NeighbourGrid grid;
+    Executor ex(1);
+    QueryStats st;
+    NeighbourLists got;
+    grid.run(even.view(), q, 5, 10, got, ex, st);
+    const std::size_t rows = q.empty() ? even.size() : q.size();
+    EXPECT_LT(st.nodes_visited, rows * 11 / 10);  // the ring search visits two or more a row
+    expect_same(got, run(naive, even.view(), 5, 10, q));
+  }
+  Rng rng(31);
+  for (int c = 0; c < 20; ++c) {
+    DiscTable t;
+    const std::size_t knot = 30 + rng.below(300);
+    for (std::size_t i = 0; i < knot; ++i)  // a tight knot ...
+      t.push_back(i, rng.uniform(0, 2), rng.uniform(0, 2), 0, 0, 0.25);
+    for (std::size_t i = 0; i < 400; ++i)  // ... beside a sparse field
+      t.push_back(knot + i, rng.uniform(0, 60), rng.uniform(0, 60), 0, 0, 0.25);
+    const uint32_t k = static_cast<uint32_t>(1 + rng.below(NearestK::kInline));
+    const double range = rng.uniform(0.5, 20);
+    SCOPED_TRACE("case " + std::to_string(c) + " k " + std::to_string(k));
+    NeighbourGrid grid;
+    expect_same(run(grid, t.view(), range, k), run(naive, t.view(), range, k));
+  }
+}
+
 TEST(NeighbourGrid, HugeAndSparseWorlds) {
   NeighbourNaive naive;
   NeighbourGrid grid;
