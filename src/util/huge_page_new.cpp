@@ -25,6 +25,7 @@
 #include <malloc.h>
 #include <sys/mman.h>
 
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -49,24 +50,28 @@ bool huge_pages_wanted() {
 // At start-up (or at the first large block, should another file's start-up make one first).
 [[maybe_unused]] const bool kDecided = huge_pages_wanted();
 
-// A block of n bytes, or null.
-void* try_allocate(std::size_t n) {
+// A block of n bytes aligned to `align` (a power of two), or null.
+void* try_allocate(std::size_t n, std::size_t align) {
 #ifdef MADV_HUGEPAGE
   if (n >= kLargeBlock && huge_pages_wanted()) {
-    const std::size_t rounded = (n + kHugePage - 1) & ~(kHugePage - 1);
+    const std::size_t at = align > kHugePage ? align : kHugePage;
+    const std::size_t rounded = (n + at - 1) & ~(at - 1);
     if (rounded < n) return nullptr;  // the size wrapped round
-    void* p = std::aligned_alloc(kHugePage, rounded);
+    void* p = std::aligned_alloc(at, rounded);
     if (p) madvise(p, rounded, MADV_HUGEPAGE);  // (a refusal leaves 4 KiB pages: nothing to undo)
     return p;
   }
 #endif
-  return std::malloc(n ? n : 1);
+  if (align <= alignof(std::max_align_t)) return std::malloc(n ? n : 1);
+  const std::size_t rounded = (n + align - 1) & ~(align - 1);  // (C11 asks for a multiple)
+  if (rounded < n) return nullptr;
+  return std::aligned_alloc(align, rounded ? rounded : align);
 }
 
 // As the standard asks: on failure the new-handler, if any, then another try.
-void* allocate(std::size_t n) {
+void* allocate(std::size_t n, std::size_t align = alignof(std::max_align_t)) {
   for (;;) {
-    if (void* p = try_allocate(n)) return p;
+    if (void* p = try_allocate(n, align)) return p;
     const std::new_handler handler = std::get_new_handler();
     if (!handler) throw std::bad_alloc();
     handler();
@@ -75,13 +80,20 @@ void* allocate(std::size_t n) {
 
 }  // namespace
 
-// Every form the library allocates with; the nothrow forms and the aligned ones keep the
-// standard library's own definitions (which call these, or aligned_alloc and free).
+// Every form the library allocates with, the aligned ones included (an alignas(64) column of
+// 10^6 rows, 64 MB, went to libstdc++'s aligned new and 16,000 faults of 4 KiB on the first
+// tick). The nothrow forms keep the standard library's definitions, which call these.
 void* operator new(std::size_t n) {
   return allocate(n);
 }
 void* operator new[](std::size_t n) {
   return allocate(n);
+}
+void* operator new(std::size_t n, std::align_val_t al) {
+  return allocate(n, static_cast<std::size_t>(al));
+}
+void* operator new[](std::size_t n, std::align_val_t al) {
+  return allocate(n, static_cast<std::size_t>(al));
 }
 void operator delete(void* p) noexcept {
   std::free(p);
@@ -93,5 +105,17 @@ void operator delete(void* p, std::size_t) noexcept {
   std::free(p);
 }
 void operator delete[](void* p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
   std::free(p);
 }

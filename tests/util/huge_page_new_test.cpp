@@ -97,19 +97,49 @@ TEST(HugePageNew, LargeBlocksAreEligibleWhereTheKernelOffersHugePages) {
   EXPECT_EQ(eligible, 1) << header;
 }
 
-// The nothrow and aligned forms keep the standard library's definitions, which pair with the
-// replaced ones (libstdc++'s nothrow new calls the replaced new; aligned new uses aligned_alloc).
+// The nothrow forms keep the standard library's definitions, which pair with the replaced ones
+// (libstdc++'s nothrow new calls the replaced new); the aligned forms are replaced too.
 TEST(HugePageNew, NothrowAndAlignedFormsPairWithTheReplacedOnes) {
+  struct alignas(64) Wide {
+    double v[8];
+  };
+  struct alignas(4096) Page {
+    char bytes[4096];
+  };
   for (std::size_t n : {std::size_t{64}, std::size_t{8} << 20}) {
     char* p = new (std::nothrow) char[n];
     ASSERT_NE(p, nullptr);
     p[n - 1] = 1;
     delete[] p;
-    struct alignas(64) Wide {
-      double v[8];
-    };
     auto wide = std::make_unique<Wide[]>(n / sizeof(Wide) + 1);
     EXPECT_EQ(reinterpret_cast<std::uintptr_t>(wide.get()) % 64, 0u);
+    Wide* one = new (std::nothrow) Wide;
+    ASSERT_NE(one, nullptr);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(one) % 64, 0u);
+    delete one;
+    std::vector<Page> pages(n / sizeof(Page) + 1);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(pages.data()) % 4096, 0u);
+    pages.back().bytes[4095] = 1;
+  }
+}
+
+// An over-aligned column (a record a cache line wide, as orca's per-row records) goes through the
+// aligned new: large, it starts at a huge page in a mapping of its own and is eligible for them.
+TEST(HugePageNew, LargeAlignedBlocksToo) {
+  if (const std::string why = not_in_use(); !why.empty()) GTEST_SKIP() << why;
+  struct alignas(64) Record {
+    double v[8];
+  };
+  std::vector<Record> records(std::size_t{1} << 17);  // 8 MiB
+  records[0].v[0] = 1;
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(records.data()) % kHugePage, 0u);
+  std::string header;
+  int eligible = 0;
+  ASSERT_TRUE(mapping_of(records.data(), header, eligible));
+  EXPECT_EQ(header.find("[heap]"), std::string::npos) << header;
+  const std::string setting = thp_setting();
+  if (eligible >= 0 && (setting == "madvise" || setting == "always")) {
+    EXPECT_EQ(eligible, 1) << header;
   }
 }
 
