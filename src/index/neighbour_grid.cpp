@@ -27,7 +27,7 @@ constexpr uint32_t kBatch = 32;  // candidates filtered at once before any is of
 constexpr double kBlockFill = 6;
 constexpr double kChordReach = 1.5;  // hinted bounds up to this many cells: gathered and ranked
 // A row without hints: the bound's disc is expected to hold this many times k others at the
-// density around the row (a Poisson count of mean 2 k falls below k about once in 100 at k = 10).
+// density around the row (a Poisson count of mean 2 k falls below k about once in 200 at k = 10).
 constexpr double kDensityFill = 2;
 constexpr uint32_t kNoRow = ~0u;  // pads the hints (no table has 2^32 rows)
 // Four rows and their comparison masks (GCC's and clang's vector extensions; SSE2 on x86-64).
@@ -396,7 +396,8 @@ void NeighbourGrid::run(const DiscView& d, std::span<const uint32_t> queries, do
         for (uint32_t u = 0; u < nh; ++u) best.offer(hint[u], d.id[hint[u]], hint_d2[u]);
         for (uint32_t u = nh; u < ((nh + 3) & ~3u); ++u) hint[u] = kNoRow;
       } else if (hintable) {
-        // No list of the last call (the first tick, rows new to the query): a bound from the
+        // No full list of the last call (the first tick, rows new to the query, a short list): a
+        // bound from the
         // density of the 3 x 3 block around the row instead, a disc expected to hold kDensityFill
         // times k others, gathered and ranked the same way. Exact whatever the bound: when fewer
         // than k lie within it, nothing is written and the search below goes the usual way.

@@ -15,23 +15,23 @@
 // usual case), every disc within that distance is gathered from the cells meeting its bounding
 // square, row by row, each row's cells as one run, and nothing beyond; the gathered ones (the
 // hints among them) are ranked by (distance, id), each rank counted without branches, and the
-// first k are the answer. A row with no list of the last call (the first call, rows new to a
-// subset) is gathered and ranked the same way within a bound from the density of its 3 x 3 block
-// of cells (a disc expected to hold 2 k others), when at least k lie within it. Otherwise (too
-// few hints or found within the bound, more than 256 gathered, ids not distinct)
-// the hints are offered to the selection first, and with a full list whose k-th distance is
-// within 1.5 cells its disc's chords of cells are scanned for anything better. Otherwise the 3 x 3
-// block around the query's cell is scanned first, as three runs; when the k-th best so far (or the
-// range) is strictly nearer than the block's nearest outside edge, nothing beyond can contribute.
-// Else the rings beyond are visited outwards: every disc in ring rho (Chebyshev cell distance rho)
-// is at least (rho - 1) * cell away from the query, so once the list holds k entries whose worst
-// distance is below that bound, or the bound reaches the range, no further ring can contribute;
-// within a ring, a cell whose nearest point is farther than the k-th best so far is skipped.
-// Each run's candidates within the bound are picked without a branch, then offered to the same
-// NearestK selection as the naive scan, computing the same squared distance from the same
-// doubles, so both give identical lists. Cell tests are widened by a relative 1e-9 to stay
-// conservative under rounding of the cell coordinates (bucketing decides only which candidates
-// are looked at, never the answer).
+// first k are the answer. A row without a full list of the last call (the first call, rows new
+// to a subset, a short list) is gathered and ranked the same way within a bound from the density of
+// its 3 x 3 block of cells (a disc expected to hold 2 k others), when at least k lie within it.
+// Otherwise (too few hints or found within the bound, more than 256 gathered, ids not distinct) the
+// hints are offered to the selection first, and with a full list whose k-th distance is within 1.5
+// cells its disc's chords of cells are scanned for anything better. Otherwise the 3 x 3 block
+// around the query's cell is scanned first, as three runs; when the k-th best so far (or the range)
+// is strictly nearer than the block's nearest outside edge, nothing beyond can contribute. Else the
+// rings beyond are visited outwards: every disc in ring rho (Chebyshev cell distance rho) is at
+// least (rho - 1) * cell away from the query, so once the list holds k entries whose worst distance
+// is below that bound, or the bound reaches the range, no further ring can contribute; within a
+// ring, a cell whose nearest point is farther than the k-th best so far is skipped. Each run's
+// candidates within the bound are picked without a branch, then offered to the same NearestK
+// selection as the naive scan, computing the same squared distance from the same doubles, so both
+// give identical lists. Cell tests are widened by a relative 1e-9 to stay conservative under
+// rounding of the cell coordinates (bucketing decides only which candidates are looked at, never
+// the answer).
 //
 // Cell side: about 6k discs per 3 x 3 block at the table's mean density (k = 0: half the range;
 // measured in neighbour_grid.cpp), never larger than the range, and never more than ~4 cells per

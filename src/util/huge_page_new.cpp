@@ -25,6 +25,7 @@
 #include <malloc.h>
 #include <sys/mman.h>
 
+#include <bit>
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
@@ -78,6 +79,13 @@ void* allocate(std::size_t n, std::size_t align = alignof(std::max_align_t)) {
   }
 }
 
+// An alignment other than a power of two is undefined behaviour; libstdc++ throws bad_alloc.
+void* allocate_aligned(std::size_t n, std::align_val_t al) {
+  const auto align = static_cast<std::size_t>(al);
+  if (!std::has_single_bit(align)) throw std::bad_alloc();
+  return allocate(n, align);
+}
+
 }  // namespace
 
 // Every form the library allocates with, the aligned ones included (an alignas(64) column of
@@ -90,10 +98,10 @@ void* operator new[](std::size_t n) {
   return allocate(n);
 }
 void* operator new(std::size_t n, std::align_val_t al) {
-  return allocate(n, static_cast<std::size_t>(al));
+  return allocate_aligned(n, al);
 }
 void* operator new[](std::size_t n, std::align_val_t al) {
-  return allocate(n, static_cast<std::size_t>(al));
+  return allocate_aligned(n, al);
 }
 void operator delete(void* p) noexcept {
   std::free(p);

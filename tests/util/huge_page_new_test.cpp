@@ -143,4 +143,38 @@ TEST(HugePageNew, LargeAlignedBlocksToo) {
   }
 }
 
+// The aligned forms' edges, as libstdc++'s own: a zero-size request is a distinct block, a size
+// that wraps round when rounded up throws bad_alloc (not a small block), an alignment above a
+// huge page is kept, and one that is not a power of two throws.
+TEST(HugePageNew, AlignedFormsAtTheirEdges) {
+#ifdef CROWDDB_NO_HUGE_PAGE_NEW
+  GTEST_SKIP() << "not linked under the sanitizers (their runtime aborts on the huge request)";
+#else
+  void* a = ::operator new (0, std::align_val_t{64});
+  void* b = ::operator new (0, std::align_val_t{64});
+  EXPECT_NE(a, nullptr);
+  EXPECT_NE(a, b);
+  ::operator delete (a, std::align_val_t{64});
+  ::operator delete (b, std::align_val_t{64});
+  // (Sizes and alignments through a volatile: the compiler would warn of a size it can see.)
+  volatile std::size_t wraps = SIZE_MAX - 8, odd = 48;
+  const auto take = [](std::size_t n, std::size_t align, bool array) {
+    if (array) {
+      ::operator delete[](::operator new[](n, std::align_val_t{align}), std::align_val_t{align});
+    } else {
+      ::operator delete (::operator new (n, std::align_val_t{align}), std::align_val_t{align});
+    }
+  };
+  EXPECT_THROW(take(wraps, 64, false), std::bad_alloc);
+  EXPECT_THROW(take(wraps, 4096, true), std::bad_alloc);
+  EXPECT_EQ(::operator new (wraps, std::align_val_t{64}, std::nothrow), nullptr);
+  EXPECT_THROW(take(64, odd, false), std::bad_alloc);
+  const std::size_t big = std::size_t{4} << 20;
+  void* c = ::operator new (std::size_t{8} << 20, std::align_val_t{big});
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(c) % big, 0u);
+  static_cast<char*>(c)[(std::size_t{8} << 20) - 1] = 1;
+  ::operator delete (c, std::size_t{8} << 20, std::align_val_t{big});
+#endif
+}
+
 }  // namespace
