@@ -51,22 +51,23 @@ bool huge_pages_wanted() {
 // At start-up (or at the first large block, should another file's start-up make one first).
 [[maybe_unused]] const bool kDecided = huge_pages_wanted();
 
-// A block of n bytes aligned to `align` (a power of two), or null.
+// A block of n bytes aligned to `align` (a power of two), or null: a large one aligned to a huge
+// page at least and marked, a small one of the usual alignment from malloc, the others from
+// aligned_alloc (one rounding and one wrap check for both kinds).
 void* try_allocate(std::size_t n, std::size_t align) {
+  bool huge = false;
 #ifdef MADV_HUGEPAGE
-  if (n >= kLargeBlock && huge_pages_wanted()) {
-    const std::size_t at = align > kHugePage ? align : kHugePage;
-    const std::size_t rounded = (n + at - 1) & ~(at - 1);
-    if (rounded < n) return nullptr;  // the size wrapped round
-    void* p = std::aligned_alloc(at, rounded);
-    if (p) madvise(p, rounded, MADV_HUGEPAGE);  // (a refusal leaves 4 KiB pages: nothing to undo)
-    return p;
-  }
+  huge = n >= kLargeBlock && huge_pages_wanted();
 #endif
-  if (align <= alignof(std::max_align_t)) return std::malloc(n ? n : 1);
+  if (huge && align < kHugePage) align = kHugePage;
+  if (!huge && align <= alignof(std::max_align_t)) return std::malloc(n ? n : 1);
   const std::size_t rounded = (n + align - 1) & ~(align - 1);  // (C11 asks for a multiple)
-  if (rounded < n) return nullptr;
-  return std::aligned_alloc(align, rounded ? rounded : align);
+  if (rounded < n) return nullptr;                             // the size wrapped round
+  void* p = std::aligned_alloc(align, rounded ? rounded : align);
+#ifdef MADV_HUGEPAGE
+  if (p && huge) madvise(p, rounded, MADV_HUGEPAGE);  // (a refusal leaves 4 KiB pages)
+#endif
+  return p;
 }
 
 // As the standard asks: on failure the new-handler, if any, then another try.
