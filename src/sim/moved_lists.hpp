@@ -13,8 +13,11 @@
 // is at least the range asked (with a relative 1e-9 for the rounding of the distances, as the
 // backoff's use of the lists), the answer is the listed rows strictly within range now, ranked as
 // every neighbour method ranks them (NearestK: nearest first, ties by id), so it is the neighbour
-// query's answer bit for bit. The other rows (a dense jam, where the k'-th is close) are left to
-// a scan of every row when a few, else to the neighbour query (neighbours_after_move).
+// query's answer bit for bit. In a jam the k'-th is close and the bound falls short of the range;
+// the answer is still the listed rows' k nearest when the k-th of them is now strictly nearer than
+// b - m_i - m (with the same relative 1e-9), since nobody unlisted can be that near. The other rows
+// (where even that fails) are left to a scan of every row when a few, else to the neighbour query
+// (neighbours_after_move).
 //
 // The commit removes rows (World::remove_rows: swap-removes from the highest row down), so the
 // lists' rows are mapped to the rows as they are now (RowRenumbering).
