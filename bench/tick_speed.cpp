@@ -7,7 +7,12 @@
 // one core's two hardware threads, which the host may switch between from one minute to the
 // next (seen here on 2026-12-04: two processes copying 16 KB took 0.055 s each at once against
 // 0.026 alone at 00:58, 0.026 each at 01:10), and a tick cannot then gain near 2 from a second
-// thread.
+// thread. Column "cpus": each CPU's speed at the tick itself, against the fastest (cpu_speeds:
+// one CPU can run the tick a quarter slower than the other for minutes while "2cpu" reads 2).
+// One-thread runs are pinned to the fastest CPU (column "pin"; `--pin no` leaves them to the
+// scheduler, which put them on either and so made the one-thread figure, and every speed-up,
+// swing by that quarter), and `--rounds` also gives each speed-up against what the CPUs could
+// do: the sum of the speeds of as many CPUs as threads.
 //
 // Each case runs in a child process of its own, so that its peak memory is its own
 // (getrusage of the child) and one case's allocations do not slow the next. `--fork no` runs
@@ -40,6 +45,7 @@
 // Models: any registered steering model, or a benchmark variant (bench/model_variant.hpp):
 // `--models orca,orca-core` puts the default orca beside itself without keeping to a side, the
 // stream gap and the perturbation, which is what those three cost.
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -254,6 +260,94 @@ double two_cpu_throughput() {
   return median(ratios);
 }
 
+// Each CPU this process may run on, and how fast it runs the tick now against the fastest: the
+// host can give one of a VM's CPUs less than the other for minutes at a time. Seen here on
+// 2026-12-06: `crowddb run` of airport-20k, one thread, pinned by taskset, took 1,597-1,647 ms on
+// CPU 0 and 1,261-1,272 ms on CPU 1 for 100 ticks (three rounds), and two such runs at once, one
+// on each, 1,751 and 1,266; ten minutes later 1,255 and 1,303. A 16 KB copy in the level-1 cache
+// and a random walk over 1-64 MB ran alike on both meanwhile, so "2cpu" above does not see it: this
+// probe runs the tick itself. A two-thread tick then gets at most the sum of its CPUs' speeds over
+// one thread on the fastest (1.79 with 0.79), however well its work is shared; the summary gives
+// the speed-ups against that sum as well. The probe: airport-20k under orca on one thread, two
+// ticks to warm up, then four turns of two ticks pinned to each CPU in turn (the same crowd for
+// all), each CPU's median; about 0.4 s.
+struct CpuSpeeds {
+  std::vector<int> cpu;       // the CPUs this process may run on
+  std::vector<double> speed;  // of each: the fastest's median ms over its own, so 1 for the fastest
+  int fastest = -1;           // -1: the affinity could not be read or set (nothing pinned)
+  // "1.00/0.79": the speeds in CPU order.
+  std::string text() const {
+    std::string t;
+    for (double v : speed) {
+      char b[16];
+      std::snprintf(b, sizeof b, "%s%.2f", t.empty() ? "" : "/", v);
+      t += b;
+    }
+    return t.empty() ? "-" : t;
+  }
+  // The sum of the `threads` largest speeds: what `threads` threads can get done against one on
+  // the fastest CPU.
+  double capacity(int threads) const {
+    std::vector<double> v = speed;
+    std::sort(v.rbegin(), v.rend());
+    double c = 0;
+    for (std::size_t k = 0; k < v.size() && k < static_cast<std::size_t>(threads); ++k) c += v[k];
+    return c;
+  }
+};
+
+bool pin_to(const cpu_set_t& set) {
+  return sched_setaffinity(0, sizeof set, &set) == 0;
+}
+
+bool pin_to(int cpu) {
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  CPU_SET(cpu, &one);
+  return pin_to(one);
+}
+
+CpuSpeeds cpu_speeds() {
+  CpuSpeeds s;
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) != 0) return s;
+  for (int c = 0; c < CPU_SETSIZE; ++c)
+    if (CPU_ISSET(c, &allowed)) s.cpu.push_back(c);
+  if (s.cpu.size() < 2) {
+    s.speed.assign(s.cpu.size(), 1.0);
+    s.fastest = s.cpu.empty() ? -1 : s.cpu.front();
+    return s;
+  }
+  std::vector<std::vector<double>> ms(s.cpu.size());
+  bool pinned = true;
+  try {
+    Scenario sc = parse_scenario(airport(20000, "orca", 1), "cpu probe");
+    Simulation sim(std::move(sc.world), sc.config);
+    sim.step();
+    sim.step();
+    for (int turn = 0; turn < 4 && pinned; ++turn)
+      for (std::size_t k = 0; k < s.cpu.size() && pinned; ++k) {
+        pinned = pin_to(s.cpu[k]);
+        for (int t = 0; t < 2 && pinned; ++t) {
+          const auto a = Clock::now();
+          sim.step();
+          ms[k].push_back(std::chrono::duration<double, std::milli>(Clock::now() - a).count());
+        }
+      }
+  } catch (const std::exception&) {
+    pinned = false;
+  }
+  pin_to(allowed);
+  if (!pinned) return CpuSpeeds{s.cpu, {}, -1};
+  std::vector<double> med;
+  for (const auto& m : ms) med.push_back(median(m));
+  const auto best = std::min_element(med.begin(), med.end());
+  s.fastest = s.cpu[static_cast<std::size_t>(best - med.begin())];
+  for (double m : med) s.speed.push_back(*best / m);
+  return s;
+}
+
 Result run_case(const Case& c, const std::string& model, int threads, uint64_t ticks) {
   Result r;
   try {
@@ -307,6 +401,7 @@ Spread spread(std::vector<double> v) {
 // After several rounds: per case/model and thread count the spread of the rounds' medians, and
 // the speed-up over the first thread count within each round that ran both.
 void print_summary(const std::map<std::string, std::vector<std::map<int, double>>>& medians,
+                   const std::map<std::string, std::vector<std::map<int, double>>>& capacities,
                    const std::vector<int>& thread_counts, int rounds) {
   std::printf(
       "\nover %d rounds (ms per tick: median of the rounds' medians, least - greatest; "
@@ -314,13 +409,22 @@ void print_summary(const std::map<std::string, std::vector<std::map<int, double>
       rounds, thread_counts.front(), thread_counts.front() == 1 ? "" : "s");
   for (const auto& [key, per_round] : medians) {
     for (int threads : thread_counts) {
-      std::vector<double> ms, ratio;
-      for (const auto& round : per_round) {
+      std::vector<double> ms, ratio, of_capacity;
+      const auto caps = capacities.find(key);
+      for (std::size_t r = 0; r < per_round.size(); ++r) {
+        const auto& round = per_round[r];
         const auto it = round.find(threads);
         if (it == round.end()) continue;
         ms.push_back(it->second);
         const auto base = round.find(thread_counts.front());
-        if (base != round.end() && it->second > 0) ratio.push_back(base->second / it->second);
+        if (base == round.end() || !(it->second > 0)) continue;
+        ratio.push_back(base->second / it->second);
+        // Against what the CPUs could do in that round: the speed-up over the first thread
+        // count divided by the capacities' ratio (1 thread: pinned to the fastest, capacity 1).
+        if (caps == capacities.end() || r >= caps->second.size()) continue;
+        const auto cap = caps->second[r].find(threads), cap0 = caps->second[r].find(base->first);
+        if (cap != caps->second[r].end() && cap0 != caps->second[r].end() && cap->second > 0)
+          of_capacity.push_back(ratio.back() / (cap->second / cap0->second));
       }
       if (ms.empty()) continue;
       const Spread t = spread(ms);
@@ -329,6 +433,10 @@ void print_summary(const std::map<std::string, std::vector<std::map<int, double>
       if (threads != thread_counts.front() && !ratio.empty()) {
         const Spread r = spread(ratio);
         std::printf("  speed-up %.2f (%.2f - %.2f)", r.median, r.least, r.greatest);
+        if (!of_capacity.empty()) {
+          const Spread e = spread(of_capacity);
+          std::printf(", of the CPUs' capacity %.2f (%.2f - %.2f)", e.median, e.least, e.greatest);
+        }
       }
       std::printf("\n");
     }
@@ -340,7 +448,7 @@ int usage(const char* why) {
   static const std::string text = [] {
     std::string s =
         "usage: tick_speed [--cases all|NAME,...] [--models orca,cfsm,thesis,orca-core] "
-        "[--threads 1,2] [--ticks N] [--rounds N] [--csv FILE] [--fork yes|no]\n"
+        "[--threads 1,2] [--ticks N] [--rounds N] [--csv FILE] [--fork yes|no] [--pin yes|no]\n"
         "       tick_speed --print CASE [--models M] [--threads T]   (its scenario, for crowddb "
         "run)\ncases:";
     for (const Case& c : kCases) s += std::string(" ") + c.name;
@@ -358,7 +466,7 @@ int main(int argc, char** argv) {
   uint64_t ticks = 0;
   int rounds = 1;
   std::string csv, print;
-  bool fork_cases = true;
+  bool fork_cases = true, pin = true;
   for (int a = 1; a < argc; a += 2) {
     const std::string k = argv[a];
     if (bench::Usage::asked(k)) return usage(nullptr);
@@ -386,6 +494,9 @@ int main(int argc, char** argv) {
     } else if (k == "--fork") {
       if (v != "yes" && v != "no") return usage("--fork takes yes or no");
       fork_cases = v == "yes";
+    } else if (k == "--pin") {
+      if (v != "yes" && v != "no") return usage("--pin takes yes or no");
+      pin = v == "yes";
     } else if (k == "--csv") {
       csv = v;
     } else if (k == "--print") {
@@ -423,16 +534,20 @@ int main(int argc, char** argv) {
   std::FILE* out = csv.empty() ? nullptr : std::fopen(csv.c_str(), "w");
   if (!csv.empty() && !out) return usage(("cannot write " + csv).c_str());
   if (out)
-    std::fprintf(out,
-                 "case,model,threads,agents,ticks,median_ms,min_ms,first_tenth_ms,last_tenth_ms,"
-                 "agent_ticks_per_s,peak_mb,load_before,load_after,two_cpu,state_hash,round\n");
-  std::printf("%-14s %-9s %3s %9s %6s %10s %10s %10s %10s %12s %8s %11s %5s  %s\n", "case", "model",
-              "thr", "agents", "ticks", "median ms", "min ms", "first 1/10", "last 1/10",
-              "agent-t/s", "peak MB", "load", "2cpu", "state hash");
+    std::fprintf(
+        out,
+        "case,model,threads,agents,ticks,median_ms,min_ms,first_tenth_ms,last_tenth_ms,"
+        "agent_ticks_per_s,peak_mb,load_before,load_after,two_cpu,state_hash,round,cpu_speeds,"
+        "pinned_cpu\n");
+  std::printf("%-14s %-9s %3s %9s %6s %10s %10s %10s %10s %12s %8s %11s %5s %-9s %3s  %s\n", "case",
+              "model", "thr", "agents", "ticks", "median ms", "min ms", "first 1/10", "last 1/10",
+              "agent-t/s", "peak MB", "load", "2cpu", "cpus", "pin", "state hash");
   int status = 0;
   std::map<std::string, uint64_t> hash_of;  // case/model -> hash of the first thread count
   // Per case/model, per round: the median ms of each thread count (for the summary).
   std::map<std::string, std::vector<std::map<int, double>>> medians;
+  // Per case/model, per round: what each thread count's CPUs could do (CpuSpeeds::capacity).
+  std::map<std::string, std::vector<std::map<int, double>>> capacities;
   for (int round = 0; round < rounds; ++round) {
     for (const Case* c : chosen) {
       for (const std::string& model : models) {
@@ -442,6 +557,10 @@ int main(int argc, char** argv) {
           const uint64_t n = ticks ? ticks : c->ticks;
           const double load_before = load_average();
           const double two_cpu = two_cpu_throughput();
+          const CpuSpeeds speeds = cpu_speeds();
+          // One thread on the fastest CPU: its figure does not depend on where the scheduler put
+          // it, and the speed-ups are over the best one CPU does.
+          const int pinned = pin && threads == 1 ? speeds.fastest : -1;
           Result r;
           bool got = true;
           rusage ru{};
@@ -451,6 +570,7 @@ int main(int argc, char** argv) {
             const pid_t pid = fork();
             if (pid == 0) {
               close(fd[0]);
+              if (pinned >= 0) pin_to(pinned);
               const Result child = run_case(*c, model, threads, n);
               const ssize_t w = write(fd[1], &child, sizeof child);
               _exit(w == static_cast<ssize_t>(sizeof child) ? 0 : 1);
@@ -461,7 +581,11 @@ int main(int argc, char** argv) {
             int wstatus = 0;
             wait4(pid, &wstatus, 0, &ru);
           } else {
+            cpu_set_t allowed;
+            const bool restore = pinned >= 0 && sched_getaffinity(0, sizeof allowed, &allowed) == 0;
+            if (restore) pin_to(pinned);
             r = run_case(*c, model, threads, n);
+            if (restore) pin_to(allowed);
             getrusage(RUSAGE_SELF, &ru);  // the process's peak so far, every earlier case included
           }
           const double load_after = load_average();
@@ -478,29 +602,38 @@ int main(int argc, char** argv) {
           const std::string key = std::string(c->name) + "/" + model;
           const auto [it, first] = hash_of.emplace(key, r.hash);
           const bool same = first || it->second == r.hash;
+          const std::string cpus = speeds.text();
+          char pin_text[16] = "-";
+          if (pinned >= 0) std::snprintf(pin_text, sizeof pin_text, "%d", pinned);
           std::printf(
               "%-14s %-9s %3d %9.0f %6llu %10.2f %10.2f %10.2f %10.2f %12.3g %8.0f %5.2f-%5.2f "
-              "%5.2f  "
+              "%5.2f %-9s %3s  "
               "%s%s\n",
               c->name, model.c_str(), threads, r.agents, static_cast<unsigned long long>(r.ticks),
               r.median_ms, r.min_ms, r.first_ms, r.last_ms, rate, peak_mb, load_before, load_after,
-              two_cpu, hash, same ? "" : "  DIFFERS FROM THE FIRST THREAD COUNT");
+              two_cpu, cpus.c_str(), pin_text, hash,
+              same ? "" : "  DIFFERS FROM THE FIRST THREAD COUNT");
           std::fflush(stdout);
           if (!same) status = 1;
           auto& per_round = medians[key];
           per_round.resize(static_cast<std::size_t>(rounds));
           per_round[static_cast<std::size_t>(round)][threads] = r.median_ms;
+          auto& cap_round = capacities[key];
+          cap_round.resize(static_cast<std::size_t>(rounds));
+          if (!speeds.speed.empty())
+            cap_round[static_cast<std::size_t>(round)][threads] = speeds.capacity(threads);
           if (out)
             std::fprintf(
-                out, "%s,%s,%d,%.0f,%llu,%.3f,%.3f,%.3f,%.3f,%.4g,%.0f,%.2f,%.2f,%.2f,%s,%d\n",
+                out,
+                "%s,%s,%d,%.0f,%llu,%.3f,%.3f,%.3f,%.3f,%.4g,%.0f,%.2f,%.2f,%.2f,%s,%d,%s,%s\n",
                 c->name, model.c_str(), threads, r.agents, static_cast<unsigned long long>(r.ticks),
                 r.median_ms, r.min_ms, r.first_ms, r.last_ms, rate, peak_mb, load_before,
-                load_after, two_cpu, hash, round + 1);
+                load_after, two_cpu, hash, round + 1, cpus.c_str(), pin_text);
         }
       }
     }
   }
   if (out) std::fclose(out);
-  if (rounds > 1) print_summary(medians, thread_counts, rounds);
+  if (rounds > 1) print_summary(medians, capacities, thread_counts, rounds);
   return status;
 }
