@@ -269,8 +269,8 @@ double two_cpu_throughput() {
 // probe runs the tick itself. A two-thread tick then gets at most the sum of its CPUs' speeds over
 // one thread on the fastest (1.79 with 0.79), however well its work is shared; the summary gives
 // the speed-ups against that sum as well. The probe: airport-20k under orca on one thread, two
-// ticks to warm up, then four turns of two ticks pinned to each CPU in turn (the same crowd for
-// all), each CPU's median; about 0.4 s.
+// ticks to warm up, then eight turns of two ticks pinned to each CPU in turn (the same crowd for
+// all), each CPU's median; about 0.6 s (with four turns equal CPUs read 0.91-1.00).
 struct CpuSpeeds {
   std::vector<int> cpu;       // the CPUs this process may run on
   std::vector<double> speed;  // of each: the fastest's median ms over its own, so 1 for the fastest
@@ -326,7 +326,7 @@ CpuSpeeds cpu_speeds() {
     Simulation sim(std::move(sc.world), sc.config);
     sim.step();
     sim.step();
-    for (int turn = 0; turn < 4 && pinned; ++turn)
+    for (int turn = 0; turn < 8 && pinned; ++turn)
       for (std::size_t k = 0; k < s.cpu.size() && pinned; ++k) {
         pinned = pin_to(s.cpu[k]);
         for (int t = 0; t < 2 && pinned; ++t) {
