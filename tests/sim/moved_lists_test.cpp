@@ -179,8 +179,9 @@ TEST(ListsAfterMove, SureAnswersAreTheNaiveQuerysAndTheRestFillsIn) {
 
 // In a jam the model's lists (10 within 5 m) reach less far than the range asked plus the moves,
 // and the k nearest listed are the answer only where the k-th of them is nearer than anyone
-// unlisted can have come. Dense crowds, most rows moving little and some a full step, a lattice
-// (ties everywhere): the answers the lists give for such rows are the naive query's.
+// unlisted can have come. Dense crowds (every fourth a lattice: ties everywhere) whose rows stand,
+// take the full step or less, steps of at most 5 cm on even trials and up to 30 cm on odd ones:
+// the answers the lists give for such rows are the naive query's.
 TEST(ListsAfterMove, InAJamTheKthListedBoundsTheRest) {
   Rng rng(23);
   std::size_t by_kth = 0, unsure_total = 0;
