@@ -193,6 +193,7 @@ struct Result {
   double agents = 0;  // mean rows per tick
   double median_ms = 0, min_ms = 0, first_ms = 0, last_ms = 0, seconds = 0;
   uint64_t hash = 0;
+  int cpu = -1;  // the CPU the run was pinned to, -1: none (not asked, or refused)
   char error[256] = {};
 };
 
@@ -263,14 +264,16 @@ double two_cpu_throughput() {
 // Each CPU this process may run on, and how fast it runs the tick now against the fastest: the
 // host can give one of a VM's CPUs less than the other for minutes at a time. Seen here on
 // 2026-12-06: `crowddb run` of airport-20k, one thread, pinned by taskset, took 1,597-1,647 ms on
-// CPU 0 and 1,261-1,272 ms on CPU 1 for 100 ticks (three rounds), and two such runs at once, one
+// CPU 0 and 1,261-1,272 ms on CPU 1 for 100 ticks (four runs each), and two such runs at once, one
 // on each, 1,751 and 1,266; ten minutes later 1,255 and 1,303. A 16 KB copy in the level-1 cache
 // and a random walk over 1-64 MB ran alike on both meanwhile, so "2cpu" above does not see it: this
 // probe runs the tick itself. A two-thread tick then gets at most the sum of its CPUs' speeds over
 // one thread on the fastest (1.79 with 0.79), however well its work is shared; the summary gives
 // the speed-ups against that sum as well. The probe: airport-20k under orca on one thread, two
 // ticks to warm up, then eight turns of two ticks pinned to each CPU in turn (the same crowd for
-// all), each CPU's median; about 0.6 s (with four turns equal CPUs read 0.91-1.00).
+// all), each CPU's median; about 0.6 s (with four turns equal CPUs read 0.91-1.00). It runs in a
+// child process of its own: the crowd's memory, kept by the heap after it is freed, would
+// otherwise be counted in the peak of every case forked after it.
 struct CpuSpeeds {
   std::vector<int> cpu;       // the CPUs this process may run on
   std::vector<double> speed;  // of each: the fastest's median ms over its own, so 1 for the fastest
@@ -307,7 +310,8 @@ bool pin_to(int cpu) {
   return pin_to(one);
 }
 
-CpuSpeeds cpu_speeds() {
+// The probe itself, in the calling process (it pins the calling thread and leaves it pinned).
+CpuSpeeds cpu_speeds_here() {
   CpuSpeeds s;
   cpu_set_t allowed;
   CPU_ZERO(&allowed);
@@ -338,13 +342,56 @@ CpuSpeeds cpu_speeds() {
   } catch (const std::exception&) {
     pinned = false;
   }
-  pin_to(allowed);
   if (!pinned) return CpuSpeeds{s.cpu, {}, -1};
   std::vector<double> med;
   for (const auto& m : ms) med.push_back(median(m));
   const auto best = std::min_element(med.begin(), med.end());
   s.fastest = s.cpu[static_cast<std::size_t>(best - med.begin())];
   for (double m : med) s.speed.push_back(*best / m);
+  return s;
+}
+
+// cpu_speeds_here in a child process; its answer through a pipe (empty speeds: none).
+CpuSpeeds cpu_speeds() {
+  struct Sent {
+    int n = 0, fastest = -1;
+    int cpu[64] = {};
+    double speed[64] = {};
+  };
+  int fd[2];
+  if (pipe(fd) != 0) return {};
+  const pid_t pid = fork();
+  if (pid < 0) {
+    close(fd[0]);
+    close(fd[1]);
+    return {};
+  }
+  if (pid == 0) {
+    close(fd[0]);
+    const CpuSpeeds here = cpu_speeds_here();
+    Sent out;
+    out.fastest = here.fastest;
+    for (std::size_t k = 0; k < here.speed.size() && k < 64; ++k) {
+      out.cpu[k] = here.cpu[k];
+      out.speed[k] = here.speed[k];
+      out.n = static_cast<int>(k + 1);
+    }
+    const ssize_t w = write(fd[1], &out, sizeof out);
+    _exit(w == static_cast<ssize_t>(sizeof out) ? 0 : 1);
+  }
+  close(fd[1]);
+  Sent in;
+  const bool got = read(fd[0], &in, sizeof in) == static_cast<ssize_t>(sizeof in);
+  close(fd[0]);
+  int wstatus = 0;
+  waitpid(pid, &wstatus, 0);
+  CpuSpeeds s;
+  if (!got) return s;
+  for (int k = 0; k < in.n; ++k) {
+    s.cpu.push_back(in.cpu[k]);
+    s.speed.push_back(in.speed[k]);
+  }
+  s.fastest = in.n > 0 ? in.fastest : -1;
   return s;
 }
 
@@ -570,8 +617,9 @@ int main(int argc, char** argv) {
             const pid_t pid = fork();
             if (pid == 0) {
               close(fd[0]);
-              if (pinned >= 0) pin_to(pinned);
-              const Result child = run_case(*c, model, threads, n);
+              const bool on = pinned >= 0 && pin_to(pinned);
+              Result child = run_case(*c, model, threads, n);
+              child.cpu = on ? pinned : -1;
               const ssize_t w = write(fd[1], &child, sizeof child);
               _exit(w == static_cast<ssize_t>(sizeof child) ? 0 : 1);
             }
@@ -582,10 +630,15 @@ int main(int argc, char** argv) {
             wait4(pid, &wstatus, 0, &ru);
           } else {
             cpu_set_t allowed;
-            const bool restore = pinned >= 0 && sched_getaffinity(0, sizeof allowed, &allowed) == 0;
-            if (restore) pin_to(pinned);
+            const bool on = pinned >= 0 && sched_getaffinity(0, sizeof allowed, &allowed) == 0 &&
+                            pin_to(pinned);
             r = run_case(*c, model, threads, n);
-            if (restore) pin_to(allowed);
+            r.cpu = on ? pinned : -1;
+            if (on && !pin_to(allowed)) {
+              // Every later run would inherit the one CPU: stop rather than print their figures.
+              std::fprintf(stderr, "tick_speed: could not give the process its CPUs back\n");
+              return 1;
+            }
             getrusage(RUSAGE_SELF, &ru);  // the process's peak so far, every earlier case included
           }
           const double load_after = load_average();
@@ -604,7 +657,7 @@ int main(int argc, char** argv) {
           const bool same = first || it->second == r.hash;
           const std::string cpus = speeds.text();
           char pin_text[16] = "-";
-          if (pinned >= 0) std::snprintf(pin_text, sizeof pin_text, "%d", pinned);
+          if (r.cpu >= 0) std::snprintf(pin_text, sizeof pin_text, "%d", r.cpu);
           std::printf(
               "%-14s %-9s %3d %9.0f %6llu %10.2f %10.2f %10.2f %10.2f %12.3g %8.0f %5.2f-%5.2f "
               "%5.2f %-9s %3s  "
@@ -620,7 +673,8 @@ int main(int argc, char** argv) {
           per_round[static_cast<std::size_t>(round)][threads] = r.median_ms;
           auto& cap_round = capacities[key];
           cap_round.resize(static_cast<std::size_t>(rounds));
-          if (!speeds.speed.empty())
+          // (A one-thread run not pinned to the fastest CPU has no capacity of 1: none booked.)
+          if (!speeds.speed.empty() && (threads > 1 || r.cpu >= 0))
             cap_round[static_cast<std::size_t>(round)][threads] = speeds.capacity(threads);
           if (out)
             std::fprintf(

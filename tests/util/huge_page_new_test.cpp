@@ -104,8 +104,9 @@ TEST(HugePageNew, LargeBlocksAreEligibleWhereTheKernelOffersHugePages) {
 // been fixed): the next tick's blocks find those pages mapped instead of faulting them in again.
 TEST(HugePageNew, FreedHeapTopIsKeptForTheNextBlocks) {
   if (const std::string why = not_in_use(); !why.empty()) GTEST_SKIP() << why;
-  malloc_trim(0);  // the heap's top as small as it gets
   std::vector<std::unique_ptr<char[]>> blocks;
+  blocks.reserve(3);  // (allocated now: nothing but the blocks comes after the trim)
+  malloc_trim(0);     // the heap's top as small as it gets
   for (int b = 0; b < 3; ++b) {
     blocks.emplace_back(new char[std::size_t{1} << 20]);
     std::memset(blocks.back().get(), 1, std::size_t{1} << 20);
