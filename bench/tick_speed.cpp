@@ -61,6 +61,7 @@
 #include <map>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "airport_scenario.hpp"
@@ -351,40 +352,56 @@ CpuSpeeds cpu_speeds_here() {
   return s;
 }
 
-// cpu_speeds_here in a child process; its answer through a pipe (empty speeds: none).
+// Runs f() in a child process of its own and puts its answer (trivially copyable) in `out`,
+// through a pipe; `ru` gets the child's resource use. False when the pipe or the fork failed or
+// the child died before answering.
+template <class T, class F>
+bool in_child(F&& f, T& out, rusage* ru = nullptr) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  int fd[2];
+  if (pipe(fd) != 0) return false;
+  const pid_t pid = fork();
+  if (pid < 0) {
+    close(fd[0]);
+    close(fd[1]);
+    return false;
+  }
+  if (pid == 0) {
+    close(fd[0]);
+    const T answer = f();
+    const ssize_t w = write(fd[1], &answer, sizeof answer);
+    _exit(w == static_cast<ssize_t>(sizeof answer) ? 0 : 1);
+  }
+  close(fd[1]);
+  const bool got = read(fd[0], &out, sizeof out) == static_cast<ssize_t>(sizeof out);
+  close(fd[0]);
+  int wstatus = 0;
+  rusage ignored{};
+  wait4(pid, &wstatus, 0, ru ? ru : &ignored);
+  return got;
+}
+
+// cpu_speeds_here in a child process (empty speeds: none).
 CpuSpeeds cpu_speeds() {
   struct Sent {
     int n = 0, fastest = -1;
     int cpu[64] = {};
     double speed[64] = {};
   };
-  int fd[2];
-  if (pipe(fd) != 0) return {};
-  const pid_t pid = fork();
-  if (pid < 0) {
-    close(fd[0]);
-    close(fd[1]);
-    return {};
-  }
-  if (pid == 0) {
-    close(fd[0]);
-    const CpuSpeeds here = cpu_speeds_here();
-    Sent out;
-    out.fastest = here.fastest;
-    for (std::size_t k = 0; k < here.speed.size() && k < 64; ++k) {
-      out.cpu[k] = here.cpu[k];
-      out.speed[k] = here.speed[k];
-      out.n = static_cast<int>(k + 1);
-    }
-    const ssize_t w = write(fd[1], &out, sizeof out);
-    _exit(w == static_cast<ssize_t>(sizeof out) ? 0 : 1);
-  }
-  close(fd[1]);
   Sent in;
-  const bool got = read(fd[0], &in, sizeof in) == static_cast<ssize_t>(sizeof in);
-  close(fd[0]);
-  int wstatus = 0;
-  waitpid(pid, &wstatus, 0);
+  const bool got = in_child(
+      [] {
+        const CpuSpeeds here = cpu_speeds_here();
+        Sent out;
+        out.fastest = here.fastest;
+        for (std::size_t k = 0; k < here.speed.size() && k < 64; ++k) {
+          out.cpu[k] = here.cpu[k];
+          out.speed[k] = here.speed[k];
+          out.n = static_cast<int>(k + 1);
+        }
+        return out;
+      },
+      in);
   CpuSpeeds s;
   if (!got) return s;
   for (int k = 0; k < in.n; ++k) {
@@ -612,22 +629,14 @@ int main(int argc, char** argv) {
           bool got = true;
           rusage ru{};
           if (fork_cases) {
-            int fd[2];
-            if (pipe(fd) != 0) return usage("pipe failed");
-            const pid_t pid = fork();
-            if (pid == 0) {
-              close(fd[0]);
-              const bool on = pinned >= 0 && pin_to(pinned);
-              Result child = run_case(*c, model, threads, n);
-              child.cpu = on ? pinned : -1;
-              const ssize_t w = write(fd[1], &child, sizeof child);
-              _exit(w == static_cast<ssize_t>(sizeof child) ? 0 : 1);
-            }
-            close(fd[1]);
-            got = read(fd[0], &r, sizeof r) == static_cast<ssize_t>(sizeof r);
-            close(fd[0]);
-            int wstatus = 0;
-            wait4(pid, &wstatus, 0, &ru);
+            got = in_child(
+                [&] {
+                  const bool on = pinned >= 0 && pin_to(pinned);
+                  Result child = run_case(*c, model, threads, n);
+                  child.cpu = on ? pinned : -1;
+                  return child;
+                },
+                r, &ru);
           } else {
             cpu_set_t allowed;
             const bool on = pinned >= 0 && sched_getaffinity(0, sizeof allowed, &allowed) == 0 &&
@@ -643,8 +652,9 @@ int main(int argc, char** argv) {
           }
           const double load_after = load_average();
           if (!got || r.error[0]) {
-            std::printf("%-14s %-9s %3d  failed: %s\n", c->name, model.c_str(), threads,
-                        got ? r.error : "the child process died");
+            std::printf(
+                "%-14s %-9s %3d  failed: %s\n", c->name, model.c_str(), threads,
+                got ? r.error : "no answer from its child process (pipe, fork, or it died)");
             status = 1;
             continue;
           }

@@ -114,7 +114,7 @@ void lists_after_move(const AgentTable& t, const TickMove& move, std::span<const
       // now nearer than anyone unlisted can be, strictly (a tie would go by id), they are. In
       // the ring's knot the model's 10 nearest reach ~0.9 m and the stalemate stage asks for 6
       // within 1.1 m: every such row went to the neighbour query.
-      if (!reaches && !(bound2 > 0 && listed.size() >= k)) {
+      if (!reaches && listed.size() < k) {
         mine.counts.push_back(0);
         continue;
       }
