@@ -233,11 +233,11 @@ bool lists_rule_out_overlaps(const AgentTable& t, const NextState& next, const N
   // The largest move and radius, per chunk, then folded (a maximum: the same in any order).
   // Every row is given the largest move as its own (D_i <= D_max): no square root per row, and
   // a bound hardly looser where everyone walks.
-  constexpr std::size_t kCheckGrain = 4096;
-  const std::size_t chunks = (n + kCheckGrain - 1) / kCheckGrain;
+  const std::size_t grain = chunk_rows(n, 4096);
+  const std::size_t chunks = (n + grain - 1) / grain;
   std::vector<double> part_move2(chunks, 0), part_radius(chunks, 0);
   std::vector<uint8_t> shown(chunks, 1);
-  ex.for_each_chunk(n, kCheckGrain, [&](std::size_t b, std::size_t e) {
+  ex.for_each_chunk(n, grain, [&](std::size_t b, std::size_t e) {
     double m2 = 0, rm = 0;
     bool finite = true;
     for (std::size_t i = b; i < e; ++i) {
@@ -246,9 +246,9 @@ bool lists_rule_out_overlaps(const AgentTable& t, const NextState& next, const N
       m2 = std::max(m2, d2);
       rm = std::max(rm, r[i]);
     }
-    part_move2[b / kCheckGrain] = m2;
-    part_radius[b / kCheckGrain] = rm;
-    shown[b / kCheckGrain] = finite;
+    part_move2[b / grain] = m2;
+    part_radius[b / grain] = rm;
+    shown[b / grain] = finite;
   });
   double move2_max = 0, radius_max = 0;
   for (std::size_t c = 0; c < chunks; ++c) {
@@ -264,9 +264,9 @@ bool lists_rule_out_overlaps(const AgentTable& t, const NextState& next, const N
   // Once a chunk fails the answer is no, whichever: the chunks not yet begun are skipped.
   std::atomic<bool> failed{false};
   std::vector<std::vector<uint32_t>> part_short(chunks);
-  ex.for_each_chunk(n, kCheckGrain, [&](std::size_t b, std::size_t e) {
+  ex.for_each_chunk(n, grain, [&](std::size_t b, std::size_t e) {
     bool ok = !failed.load(std::memory_order_relaxed);
-    std::vector<uint32_t>& short_rows = part_short[b / kCheckGrain];
+    std::vector<uint32_t>& short_rows = part_short[b / grain];
     for (std::size_t i = b; i < e && ok; ++i) {
       const double need = (r[i] + skin) * (1 + 1e-9);
       const double need2 = need * need;
