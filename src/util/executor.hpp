@@ -17,9 +17,10 @@
 namespace crowddb {
 
 // Rows per chunk for a cheap pass over n rows: `most`, but no more than gives 16 chunks, and no
-// fewer than 512 rows. A coarse grain that suits 10^6 rows leaves a few thousand in two or three
-// chunks, and two threads sharing three chunks take two thirds of the one thread's time. It
-// depends on n alone, never on the number of threads, so per-chunk results stay the same on any.
+// fewer than 512 rows (or `most`, when that is less): at most 16 chunks of n, or chunks of `most`
+// rows. A coarse grain that suits 10^6 rows leaves a few thousand in two or three chunks, and two
+// threads sharing three chunks take two thirds of the one thread's time. It depends on n alone,
+// never on the number of threads, so per-chunk results stay the same on any.
 inline std::size_t chunk_rows(std::size_t n, std::size_t most) {
   constexpr std::size_t kChunks = 16, kLeast = 512;
   return std::max(std::min(most, (n + kChunks - 1) / kChunks), std::min(most, kLeast));

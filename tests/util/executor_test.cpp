@@ -38,21 +38,22 @@ TEST(Executor, ChunksStartAtMultiplesOfTheGrainAndCoverEachRowOnce) {
   }
 }
 
-// A cheap pass's grain: at most the coarse one, at least 16 chunks where that leaves 512 rows or
-// more a chunk, never below 512 (nor below the coarse one, when that is smaller).
-TEST(Executor, ChunkRowsSplitsAFewThousandRowsIntoSixteen) {
+// A cheap pass's grain: at most the coarse one, and no finer than 512 rows (nor than the coarse
+// one, when that is smaller); in between, ceil(n / 16): exactly 16 chunks.
+TEST(Executor, ChunkRowsGivesSixteenChunksBetweenTheCoarseGrainAnd512Rows) {
   EXPECT_EQ(chunk_rows(20000, 4096), 1250u);    // 5 chunks of the coarse grain: 16 now
+  EXPECT_EQ(chunk_rows(20001, 4096), 1251u);    // rounded up, so that 16 chunks cover the rows
   EXPECT_EQ(chunk_rows(1000000, 4096), 4096u);  // plenty of chunks already
-  EXPECT_EQ(chunk_rows(3000, 4096), 512u);      // small tables: 512 rows a chunk
+  EXPECT_EQ(chunk_rows(3000, 4096), 512u);      // small tables: 512 rows a chunk (6 chunks)
   EXPECT_EQ(chunk_rows(0, 4096), 512u);
   EXPECT_EQ(chunk_rows(100000, 256), 256u);  // never coarser than asked
-  for (std::size_t n : {1u, 511u, 8191u, 8192u, 8193u, 65536u, 1000003u})
+  for (std::size_t n : {1u, 511u, 8191u, 8192u, 8193u, 20001u, 65536u, 1000003u})
     for (std::size_t most : {1u, 300u, 4096u, 16384u}) {
       const std::size_t g = chunk_rows(n, most);
       EXPECT_LE(g, most);
       EXPECT_GE(g, std::min<std::size_t>(most, 512));
       if (g < most && g > 512) {
-        EXPECT_GE((n + g - 1) / g, 16u) << n << " " << most;
+        EXPECT_EQ((n + g - 1) / g, 16u) << n << " " << most;
       }
     }
 }
