@@ -233,7 +233,8 @@ bool lists_rule_out_overlaps(const AgentTable& t, const NextState& next, const N
   // The largest move and radius, per chunk, then folded (a maximum: the same in any order).
   // Every row is given the largest move as its own (D_i <= D_max): no square root per row, and
   // a bound hardly looser where everyone walks.
-  const std::size_t grain = chunk_rows(n, 4096);
+  constexpr std::size_t kCheckGrain = 4096;  // rows per chunk where there are many
+  const std::size_t grain = chunk_rows(n, kCheckGrain);
   const std::size_t chunks = (n + grain - 1) / grain;
   std::vector<double> part_move2(chunks, 0), part_radius(chunks, 0);
   std::vector<uint8_t> shown(chunks, 1);

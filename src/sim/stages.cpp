@@ -17,6 +17,9 @@ namespace crowddb::sim {
 namespace {
 
 constexpr std::size_t kGrain = 256;
+// Rows per chunk of the integration where there are many (chunk_rows: fewer where there are not):
+// two multiply-adds a row, so chunks of kGrain rows cost more to hand out than to run.
+constexpr std::size_t kIntegrateGrain = 8192;
 
 // Arrived or waiting at its goal: no steering for the goal, only making room at it.
 bool idle(const AgentTable& t, std::size_t i) {
@@ -288,8 +291,8 @@ void goal_stage(const AgentTable& t, std::span<const Goal> goals, const SimConfi
 }
 
 void integrate(const AgentTable& t, NextState& next, double dt, Executor& ex) {
-  // (Two multiply-adds a row: chunks of kGrain rows cost more to hand out than to run.)
-  ex.for_each_chunk(t.size(), chunk_rows(t.size(), 8192), [&](std::size_t b, std::size_t e) {
+  const std::size_t grain = chunk_rows(t.size(), kIntegrateGrain);
+  ex.for_each_chunk(t.size(), grain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       next.x[i] = t.x[i] + next.vx[i] * dt;
       next.y[i] = t.y[i] + next.vy[i] * dt;
