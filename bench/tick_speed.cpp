@@ -25,6 +25,12 @@
 //   build/bench/tick_speed --cases airport-10m --models orca --threads 2   # ~9 GB, minutes
 //   build/bench/tick_speed --cases airport-20k --models orca --threads 1,2 --rounds 6
 //   build/bench/tick_speed --print airport-20k --threads 1 > a20k.json  # the case, for crowddb run
+//   build/bench/tick_speed --cases airport-20k --models orca --rounds 3 --busy-cpu 0
+//
+// `--busy-cpu K` keeps CPU K busy for the whole run with a loop of another process pinned there
+// (column "busy"), the way other work on the machine would: is two threads' tick still no
+// slower than one thread's (issue "Five times RVO2")? The CPU probe then reads K slow and the
+// one-thread runs go to another CPU.
 //
 // `--rounds N` runs every case N times, the thread counts in turn forwards and backwards (1 2,
 // 2 1, 1 2, ...), and ends with a summary per case, model and thread count: the median, least
@@ -46,6 +52,8 @@
 // `--models orca,orca-core` puts the default orca beside itself without keeping to a side, the
 // stream gap and the perturbation, which is what those three cost.
 #include <sched.h>
+#include <signal.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -59,6 +67,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <string>
 #include <thread>
 #include <type_traits>
@@ -311,6 +320,35 @@ bool pin_to(int cpu) {
   return pin_to(one);
 }
 
+// A process spinning on one CPU while it lives (--busy-cpu); it dies with this one.
+class BusyLoop {
+ public:
+  explicit BusyLoop(int cpu) {
+    const pid_t parent = getpid();
+    pid_ = fork();
+    if (pid_ == 0) {
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (getppid() != parent) _exit(0);  // the parent is gone already
+      if (!pin_to(cpu)) _exit(1);
+      volatile uint64_t spins = 0;
+      for (;;) spins = spins + 1;
+    }
+  }
+  ~BusyLoop() {
+    if (pid_ <= 0) return;
+    kill(pid_, SIGKILL);
+    waitpid(pid_, nullptr, 0);
+  }
+  BusyLoop(const BusyLoop&) = delete;
+  BusyLoop& operator=(const BusyLoop&) = delete;
+  bool running() const {  // started, and not dead already (it could not pin itself)
+    return pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) == 0;
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
 // The probe itself, in the calling process (it pins the calling thread and leaves it pinned).
 CpuSpeeds cpu_speeds_here() {
   CpuSpeeds s;
@@ -512,7 +550,8 @@ int usage(const char* why) {
   static const std::string text = [] {
     std::string s =
         "usage: tick_speed [--cases all|NAME,...] [--models orca,cfsm,thesis,orca-core] "
-        "[--threads 1,2] [--ticks N] [--rounds N] [--csv FILE] [--fork yes|no] [--pin yes|no]\n"
+        "[--threads 1,2] [--ticks N] [--rounds N] [--csv FILE] [--fork yes|no] [--pin yes|no] "
+        "[--busy-cpu K]\n"
         "       tick_speed --print CASE [--models M] [--threads T]   (its scenario, for crowddb "
         "run)\ncases:";
     for (const Case& c : kCases) s += std::string(" ") + c.name;
@@ -531,6 +570,7 @@ int main(int argc, char** argv) {
   int rounds = 1;
   std::string csv, print;
   bool fork_cases = true, pin = true;
+  int busy_cpu = -1;
   for (int a = 1; a < argc; a += 2) {
     const std::string k = argv[a];
     if (bench::Usage::asked(k)) return usage(nullptr);
@@ -561,6 +601,15 @@ int main(int argc, char** argv) {
     } else if (k == "--pin") {
       if (v != "yes" && v != "no") return usage("--pin takes yes or no");
       pin = v == "yes";
+    } else if (k == "--busy-cpu") {
+      cpu_set_t allowed;
+      const auto n = bench::whole_number(v, 0, CPU_SETSIZE - 1);
+      if (!n || sched_getaffinity(0, sizeof allowed, &allowed) != 0 ||
+          !CPU_ISSET(static_cast<int>(*n), &allowed) || CPU_COUNT(&allowed) < 2)
+        return usage(
+            ("--busy-cpu takes one of this process's CPUs (and it needs two), not '" + v + "'")
+                .c_str());
+      busy_cpu = static_cast<int>(*n);
     } else if (k == "--csv") {
       csv = v;
     } else if (k == "--print") {
@@ -602,7 +651,20 @@ int main(int argc, char** argv) {
         out,
         "case,model,threads,agents,ticks,median_ms,min_ms,first_tenth_ms,last_tenth_ms,"
         "agent_ticks_per_s,peak_mb,load_before,load_after,two_cpu,state_hash,round,cpu_speeds,"
-        "pinned_cpu\n");
+        "pinned_cpu,busy_cpu\n");
+  std::unique_ptr<BusyLoop> busy;
+  char busy_text[16] = "-";
+  if (busy_cpu >= 0) {
+    busy = std::make_unique<BusyLoop>(busy_cpu);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // (it has pinned itself)
+    if (!busy->running()) {
+      std::fprintf(stderr, "tick_speed: could not keep CPU %d busy\n", busy_cpu);
+      if (out) std::fclose(out);
+      return 1;
+    }
+    std::snprintf(busy_text, sizeof busy_text, "%d", busy_cpu);
+    std::printf("a loop of another process keeps CPU %d busy throughout\n", busy_cpu);
+  }
   std::printf("%-14s %-9s %3s %9s %6s %10s %10s %10s %10s %12s %8s %11s %5s %-9s %3s  %s\n", "case",
               "model", "thr", "agents", "ticks", "median ms", "min ms", "first 1/10", "last 1/10",
               "agent-t/s", "peak MB", "load", "2cpu", "cpus", "pin", "state hash");
@@ -689,10 +751,10 @@ int main(int argc, char** argv) {
           if (out)
             std::fprintf(
                 out,
-                "%s,%s,%d,%.0f,%llu,%.3f,%.3f,%.3f,%.3f,%.4g,%.0f,%.2f,%.2f,%.2f,%s,%d,%s,%s\n",
+                "%s,%s,%d,%.0f,%llu,%.3f,%.3f,%.3f,%.3f,%.4g,%.0f,%.2f,%.2f,%.2f,%s,%d,%s,%s,%s\n",
                 c->name, model.c_str(), threads, r.agents, static_cast<unsigned long long>(r.ticks),
                 r.median_ms, r.min_ms, r.first_ms, r.last_ms, rate, peak_mb, load_before,
-                load_after, two_cpu, hash, round + 1, cpus.c_str(), pin_text);
+                load_after, two_cpu, hash, round + 1, cpus.c_str(), pin_text, busy_text);
         }
       }
     }
