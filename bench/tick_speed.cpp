@@ -28,9 +28,10 @@
 //   build/bench/tick_speed --cases airport-20k --models orca --rounds 3 --busy-cpu 0
 //
 // `--busy-cpu K` keeps CPU K busy for the whole run with a loop of another process pinned there
-// (column "busy"), the way other work on the machine would: is two threads' tick still no
-// slower than one thread's (issue "Five times RVO2")? The CPU probe then reads K slow and the
-// one-thread runs go to another CPU.
+// (CSV column busy_cpu), the way other work on the machine would: is two threads' tick still no
+// slower than one thread's (issue "Five times RVO2")? The CPU probe then reads K slow, so with
+// `--pin yes` the one-thread runs go to another CPU; "2cpu" reads about 1 throughout (one of
+// the two CPUs is taken), which then says nothing about whether they share a core.
 //
 // `--rounds N` runs every case N times, the thread counts in turn forwards and backwards (1 2,
 // 2 1, 1 2, ...), and ends with a summary per case, model and thread count: the median, least
@@ -60,6 +61,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -320,18 +322,36 @@ bool pin_to(int cpu) {
   return pin_to(one);
 }
 
-// A process spinning on one CPU while it lives (--busy-cpu); it dies with this one.
+// A process spinning on one CPU while it lives (--busy-cpu); it dies with this one. started():
+// it has pinned itself to that CPU (it says so through a pipe; end of file: it could not).
 class BusyLoop {
  public:
   explicit BusyLoop(int cpu) {
+    int ready[2];
+    if (pipe(ready) != 0) return;
+    std::fflush(nullptr);  // (nothing buffered can be written twice)
     const pid_t parent = getpid();
     pid_ = fork();
     if (pid_ == 0) {
+      close(ready[0]);
       prctl(PR_SET_PDEATHSIG, SIGKILL);
-      if (getppid() != parent) _exit(0);  // the parent is gone already
-      if (!pin_to(cpu)) _exit(1);
+      if (getppid() != parent || !pin_to(cpu)) _exit(1);  // (the parent gone already, or no pin)
+      const char yes = 1;
+      if (write(ready[1], &yes, 1) != 1) _exit(1);
+      close(ready[1]);
       volatile uint64_t spins = 0;
       for (;;) spins = spins + 1;
+    }
+    close(ready[1]);
+    char got = 0;
+    ssize_t r;
+    while ((r = read(ready[0], &got, 1)) < 0 && errno == EINTR) {
+    }
+    close(ready[0]);
+    started_ = pid_ > 0 && r == 1;
+    if (pid_ > 0 && !started_) {  // it has exited, or is about to: reap it, never kill a reused pid
+      waitpid(pid_, nullptr, 0);
+      pid_ = -1;
     }
   }
   ~BusyLoop() {
@@ -341,12 +361,11 @@ class BusyLoop {
   }
   BusyLoop(const BusyLoop&) = delete;
   BusyLoop& operator=(const BusyLoop&) = delete;
-  bool running() const {  // started, and not dead already (it could not pin itself)
-    return pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) == 0;
-  }
+  bool started() const { return started_; }
 
  private:
   pid_t pid_ = -1;
+  bool started_ = false;
 };
 
 // The probe itself, in the calling process (it pins the calling thread and leaves it pinned).
@@ -656,8 +675,7 @@ int main(int argc, char** argv) {
   char busy_text[16] = "-";
   if (busy_cpu >= 0) {
     busy = std::make_unique<BusyLoop>(busy_cpu);
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // (it has pinned itself)
-    if (!busy->running()) {
+    if (!busy->started()) {
       std::fprintf(stderr, "tick_speed: could not keep CPU %d busy\n", busy_cpu);
       if (out) std::fclose(out);
       return 1;
