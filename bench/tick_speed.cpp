@@ -331,6 +331,7 @@ class BusyLoop {
     if (pipe(ready) != 0) return;
     std::fflush(nullptr);  // (nothing buffered can be written twice)
     const pid_t parent = getpid();
+    owner_ = parent;
     pid_ = fork();
     if (pid_ == 0) {
       close(ready[0]);
@@ -355,7 +356,8 @@ class BusyLoop {
     }
   }
   ~BusyLoop() {
-    if (pid_ <= 0) return;
+    // (Only its owner ends it: not a case's child process that leaves main by an exception.)
+    if (pid_ <= 0 || getpid() != owner_) return;
     kill(pid_, SIGKILL);
     waitpid(pid_, nullptr, 0);
   }
@@ -364,7 +366,7 @@ class BusyLoop {
   bool started() const { return started_; }
 
  private:
-  pid_t pid_ = -1;
+  pid_t pid_ = -1, owner_ = -1;
   bool started_ = false;
 };
 
