@@ -330,13 +330,12 @@ class BusyLoop {
     int ready[2];
     if (pipe(ready) != 0) return;
     std::fflush(nullptr);  // (nothing buffered can be written twice)
-    const pid_t parent = getpid();
-    owner_ = parent;
+    owner_ = getpid();
     pid_ = fork();
     if (pid_ == 0) {
       close(ready[0]);
       prctl(PR_SET_PDEATHSIG, SIGKILL);
-      if (getppid() != parent || !pin_to(cpu)) _exit(1);  // (the parent gone already, or no pin)
+      if (getppid() != owner_ || !pin_to(cpu)) _exit(1);  // (the parent gone already, or no pin)
       const char yes = 1;
       if (write(ready[1], &yes, 1) != 1) _exit(1);
       close(ready[1]);
